@@ -1,0 +1,219 @@
+// The sample forward engine: owns a Vulkan 1.3 instance/device/queue, renders a Scene with
+//   shadow map -> depth+normal pre-pass -> [pre-pass hook] -> forward PBR lighting -> tonemap
+// into an offscreen image (read back to the CPU) and optionally presents it to a swapchain.
+//
+// Add-ons (e.g. a ray-tracing adapter) plug in through three small things:
+//   * EngineConfig: extra device extensions / feature chain, so they can share the engine's device;
+//   * setPrepassHook(): called with the frame's command buffer between the pre-pass and the lighting pass;
+//   * LightingInputs: external sun-visibility / AO / reflection images the lighting pass samples.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include <glm/glm.hpp>
+
+#include "sample_engine/image_io.h"
+#include "sample_engine/result.h"
+#include "sample_engine/scene.h"
+
+namespace sample_engine {
+
+inline constexpr uint32_t kFramesInFlight = 2;
+
+struct EngineConfig {
+  // Enables VK_LAYER_KHRONOS_validation plus a debug messenger that counts (and prints) errors.
+  bool enableValidation = false;
+  // Requests bufferDeviceAddress and gives vertex/index buffers SHADER_DEVICE_ADDRESS + STORAGE usage
+  // (plus ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY when VK_KHR_acceleration_structure is among the
+  // enabled device extensions). Silently off when the device lacks bufferDeviceAddress.
+  bool enableRayTracingInputs = true;
+  // Adds VK_KHR_swapchain to the device; needed by attachSurface().
+  bool enableSwapchain = false;
+  // Extra instance extensions (e.g. from Window::requiredInstanceExtensions()).
+  std::vector<std::string> instanceExtensions;
+  // Extra device extensions an add-on needs; devices lacking one are not chosen.
+  std::vector<std::string> deviceExtensions;
+  // Extra feature structs appended to the engine's VkPhysicalDeviceFeatures2 chain at device creation
+  // (e.g. acceleration-structure / ray-query features). It must not contain VkPhysicalDeviceFeatures2 or
+  // VkPhysicalDeviceVulkan11/12/13Features: set the core features you need in the fields below, which are
+  // OR-ed into the engine's own. The chain must stay alive during Engine::create().
+  const void* deviceFeaturesPNext = nullptr;
+  VkPhysicalDeviceFeatures extraFeatures10{};
+  VkPhysicalDeviceVulkan11Features extraFeatures11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
+  VkPhysicalDeviceVulkan12Features extraFeatures12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  VkPhysicalDeviceVulkan13Features extraFeatures13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  // Substring of the device name to pick. Empty: environment variable SAMPLE_ENGINE_DEVICE, else the
+  // first discrete GPU, else the first device that works.
+  std::string deviceNameFilter;
+  std::string applicationName = "raybridge-sample-engine";
+};
+
+// Shadow-map settings; changing the size between frames recreates the map.
+struct ShadowSettings {
+  uint32_t mapSize = 2048;      // clamped to [1024, 8192]
+  uint32_t pcfKernelSize = 3;   // odd, 1..9: taps per axis (each tap is a 2x2 hardware-filtered compare)
+  float depthBiasConstant = 1.5f;
+  float depthBiasSlope = 2.0f;
+  float normalOffset = 1.5f;    // world offset along the normal, in shadow-map texels
+};
+
+// External images the lighting pass samples instead of its own terms. Each must be a 2D view that stays
+// valid until the frame completes, in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL when the lighting pass
+// runs, and covering the whole viewport (any resolution: sampled bilinearly at the pixel's UV).
+struct LightingInputs {
+  // R channel, 1 = lit, 0 = shadowed (R8_UNORM / R16_SFLOAT / R32_SFLOAT...). Replaces the shadow map.
+  VkImageView sunVisibility = VK_NULL_HANDLE;
+  // R channel, 1 = unoccluded. Multiplies the ambient (sky) terms.
+  VkImageView ambientOcclusion = VK_NULL_HANDLE;
+  // RGB = linear radiance arriving along the mirror direction (RGBA16F). Replaces the constant-sky specular
+  // ambient term; the engine weights it by its Fresnel/roughness environment BRDF and AO.
+  VkImageView reflection = VK_NULL_HANDLE;
+};
+
+// Everything a frame needs besides the scene.
+struct FrameParams {
+  Camera camera;
+  Sun sun;
+  glm::vec3 skyColor{0.45f, 0.62f, 0.9f};  // linear; background and constant ambient light
+  float ambientIntensity = 0.5f;
+  float exposure = 1.0f;
+  ShadowSettings shadow;
+  LightingInputs lightingInputs;  // the pre-pass hook may change these for the frame
+};
+
+// One image of the pre-pass, as the hook receives it.
+struct PassImage {
+  VkImage image = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;  // layout it is in when the hook runs; keep it so
+};
+
+struct PrepassHookInfo {
+  VkCommandBuffer commandBuffer = VK_NULL_HANDLE;  // recording, outside any rendering scope
+  uint32_t frameIndex = 0;                         // frame in flight, 0..kFramesInFlight-1
+  uint64_t frameNumber = 0;                        // increments every rendered frame
+  VkExtent2D extent{};                             // viewport = size of every pre-pass image
+  // D32_SFLOAT, standard depth (1.0 = far plane / background), DEPTH_READ_ONLY_OPTIMAL.
+  PassImage depth;
+  // RGBA16F: xyz = shading normal (world space, normal-mapped, facing the camera), w = perceptual
+  // roughness; (0,0,0,0) for background. SHADER_READ_ONLY_OPTIMAL.
+  PassImage normalRoughness;
+  // RGBA16F: xyz = geometric (triangle) normal in world space, facing the camera, w = metallic;
+  // (0,0,0,0) for background. SHADER_READ_ONLY_OPTIMAL.
+  PassImage geometricNormal;
+  bool reversedZ = false;
+  glm::mat4 view{1.0f}, proj{1.0f}, viewProj{1.0f};  // proj: Vulkan clip space, Y flipped, depth [0,1]
+  glm::mat4 invView{1.0f}, invProj{1.0f}, invViewProj{1.0f};
+  glm::vec3 cameraPosition{0.0f};
+  glm::vec3 sunDirection{0.0f, 1.0f, 0.0f};  // towards the sun, normalized
+};
+
+// Called once per frame after the pre-pass, before the lighting pass. May record commands into
+// info.commandBuffer (it must leave the pre-pass images in the layouts given) and may set `inputs`.
+// Images it writes and passes in `inputs` must be in SHADER_READ_ONLY_OPTIMAL at the end of the hook;
+// the engine then adds a full memory barrier (all commands -> fragment shader reads).
+using PrepassHook = std::function<void(const PrepassHookInfo& info, LightingInputs& inputs)>;
+
+struct PassTimings {
+  double shadowMs = 0.0;
+  double prepassMs = 0.0;
+  double hookMs = 0.0;  // whatever the hook recorded
+  double lightingMs = 0.0;
+  double tonemapMs = 0.0;
+  bool valid = false;   // false until a frame with timestamps has completed
+};
+
+// A mesh as uploaded. Positions are R32G32B32_SFLOAT, tightly packed (stride 12) in their own buffer.
+// Attributes are interleaved {vec3 normal; vec2 uv; vec4 tangent} with stride 36 (offsets 0, 12, 20).
+// Indices are always uint32 (VK_INDEX_TYPE_UINT32), or absent (VK_INDEX_TYPE_NONE_KHR, indexCount 0).
+// Device addresses are 0 unless ray-tracing inputs are enabled.
+struct GpuMesh {
+  VkBuffer positionBuffer = VK_NULL_HANDLE;
+  VkDeviceAddress positionAddress = 0;
+  VkFormat positionFormat = VK_FORMAT_R32G32B32_SFLOAT;
+  uint32_t positionStride = 12;
+  VkBuffer attributeBuffer = VK_NULL_HANDLE;
+  VkDeviceAddress attributeAddress = 0;
+  uint32_t attributeStride = 36;
+  VkBuffer indexBuffer = VK_NULL_HANDLE;
+  VkDeviceAddress indexAddress = 0;
+  VkIndexType indexType = VK_INDEX_TYPE_NONE_KHR;
+  uint32_t vertexCount = 0;
+  uint32_t indexCount = 0;
+  uint32_t material = 0;
+  const MeshData* cpu = nullptr;  // CPU copy (finalized), owned by the engine
+};
+
+struct DeviceInfo {
+  std::string name;
+  uint32_t apiVersion = 0;
+  VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+  bool bufferDeviceAddress = false;  // enabled on the device and used for scene buffers
+};
+
+class Engine {
+ public:
+  static Result<std::unique_ptr<Engine>> create(const EngineConfig& config);
+  ~Engine();
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
+
+  // --- Vulkan objects, for add-ons sharing the device ---
+  VkInstance instance() const;
+  VkPhysicalDevice physicalDevice() const;
+  VkDevice device() const;
+  VkQueue queue() const;  // the single graphics+compute queue the engine submits to
+  uint32_t queueFamily() const;
+  PFN_vkGetInstanceProcAddr getInstanceProcAddr() const;
+  uint32_t apiVersion() const;  // the instance/device API version the engine targets (1.3)
+  const DeviceInfo& deviceInfo() const;
+  const std::vector<std::string>& enabledDeviceExtensions() const;
+  uint32_t validationErrorCount() const;    // errors seen by the debug messenger (0 without validation)
+  uint32_t validationWarningCount() const;
+
+  // --- Scene ---
+  // Copies, finalizes and uploads the scene, replacing the previous one (waits for the GPU first).
+  Status loadScene(const Scene& scene);
+  const Scene& scene() const;              // finalized CPU copy
+  std::span<const GpuMesh> meshes() const;  // parallel to scene().meshes
+  Bounds sceneBounds() const;
+
+  // --- Targets ---
+  // Size of the offscreen render targets (headless). With a swapchain the size follows the swapchain.
+  Status setRenderSize(uint32_t width, uint32_t height);
+  VkExtent2D renderSize() const;
+  // Takes ownership of the surface (created on this engine's instance) and creates a swapchain; from then
+  // on renderFrame() also presents. Requires EngineConfig::enableSwapchain.
+  Status attachSurface(VkSurfaceKHR surface, uint32_t width, uint32_t height);
+  Status resizeSwapchain(uint32_t width, uint32_t height);
+
+  // --- Frame ---
+  void setPrepassHook(PrepassHook hook);
+  // Records and submits one frame (and presents when a swapchain is attached). Does not wait for it.
+  Status renderFrame(const FrameParams& params);
+  // Waits until the GPU is idle; afterwards lastTimings() covers the last submitted frame.
+  Status waitIdle();
+  PassTimings lastTimings() const;
+  uint64_t frameNumber() const;
+
+  // Read the last rendered frame back (waits for it): tonemapped sRGB RGBA8, and linear HDR.
+  Result<ImageRGBA8> readbackLdr();
+  Result<ImageRGBA32F> readbackHdr();
+
+  struct Impl;
+
+ private:
+  explicit Engine(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sample_engine

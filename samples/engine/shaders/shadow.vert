@@ -1,0 +1,8 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Depth-only shadow-map pass (no fragment shader), positions only.
+#include "common.glsl"
+
+layout(location = 0) in vec3 inPosition;
+
+void main() { gl_Position = frame.lightViewProj * draw.model * vec4(inPosition, 1.0); }

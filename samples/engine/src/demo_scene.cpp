@@ -1,0 +1,97 @@
+// The default demo scene: a small colonnade on a checkered ground with a few test objects chosen to show
+// what a ray-tracing add-on changes (sharp metal, mirrors, contact shadows under arches).
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "sample_engine/procedural.h"
+
+namespace sample_engine {
+namespace {
+
+TextureData makeChecker(uint32_t size, uint32_t checks, uint8_t light, uint8_t dark) {
+  TextureData t{.name = "checker", .width = size, .height = size, .rgba8 = {}};
+  t.rgba8.resize(size_t(size) * size * 4);
+  for (uint32_t y = 0; y < size; ++y)
+    for (uint32_t x = 0; x < size; ++x) {
+      bool on = ((x * checks / size) + (y * checks / size)) % 2 == 0;
+      uint8_t* p = &t.rgba8[(size_t(y) * size + x) * 4];
+      p[0] = p[1] = p[2] = on ? light : dark;
+      p[3] = 255;
+    }
+  return t;
+}
+
+uint32_t addMaterial(Scene& s, const char* name, glm::vec3 color, float metallic, float roughness,
+                     int texture = -1) {
+  s.materials.push_back(Material{.name = name,
+                                 .baseColorFactor = glm::vec4(color, 1.0f),
+                                 .metallicFactor = metallic,
+                                 .roughnessFactor = roughness,
+                                 .baseColorTexture = texture});
+  return static_cast<uint32_t>(s.materials.size() - 1);
+}
+
+uint32_t addMesh(Scene& s, MeshData mesh, uint32_t material) {
+  mesh.material = material;
+  s.meshes.push_back(std::move(mesh));
+  return static_cast<uint32_t>(s.meshes.size() - 1);
+}
+
+void place(Scene& s, uint32_t mesh, glm::vec3 position, float yawDegrees = 0.0f) {
+  glm::mat4 m = glm::translate(glm::mat4(1.0f), position);
+  m = glm::rotate(m, glm::radians(yawDegrees), glm::vec3(0, 1, 0));
+  s.instances.push_back(Instance{mesh, m});
+}
+
+}  // namespace
+
+Scene makeDefaultDemoScene() {
+  Scene s;
+  s.textures.push_back(makeChecker(256, 8, 200, 110));
+
+  const uint32_t ground = addMaterial(s, "ground", {0.85f, 0.82f, 0.78f}, 0.0f, 0.75f, 0);
+  const uint32_t stone = addMaterial(s, "stone", {0.78f, 0.74f, 0.66f}, 0.0f, 0.6f);
+  const uint32_t gold = addMaterial(s, "polished gold", {1.0f, 0.78f, 0.34f}, 1.0f, 0.15f);
+  const uint32_t redPlastic = addMaterial(s, "red plastic", {0.75f, 0.08f, 0.06f}, 0.0f, 0.35f);
+  const uint32_t blue = addMaterial(s, "blue matte", {0.1f, 0.25f, 0.7f}, 0.0f, 0.8f);
+  const uint32_t mirror = addMaterial(s, "mirror", {0.95f, 0.95f, 0.95f}, 1.0f, 0.02f);
+  const uint32_t copper = addMaterial(s, "brushed copper", {0.95f, 0.64f, 0.54f}, 1.0f, 0.45f);
+  const uint32_t white = addMaterial(s, "white ceramic", {0.9f, 0.9f, 0.88f}, 0.0f, 0.2f);
+
+  // Ground: 40 m square; the 8x8 checker repeats 5 times, giving 1 m squares.
+  MeshData plane = makePlane(40.0f, 40.0f, 8, 8);
+  for (glm::vec2& uv : plane.uvs) uv *= 5.0f;
+  place(s, addMesh(s, std::move(plane), ground), {0, 0, 0});
+
+  // Colonnade: four columns in the back carrying two arches, two free-standing columns in front.
+  const float columnHeight = 3.2f;
+  const uint32_t column = addMesh(s, makeCylinder(0.32f, columnHeight, 48, 4, true), stone);
+  const uint32_t plinth = addMesh(s, makeBox({0.9f, 0.3f, 0.9f}, 2), stone);
+  for (float x : {-6.5f, -2.5f, 2.5f, 6.5f}) {
+    place(s, column, {x, 0.0f, -3.5f});
+    place(s, plinth, {x, 0.15f, -3.5f});
+  }
+  for (float x : {-6.5f, 6.5f}) {
+    place(s, column, {x, 0.0f, 2.5f});
+    place(s, plinth, {x, 0.15f, 2.5f});
+  }
+  const uint32_t arch = addMesh(s, makeArch(2.0f, 0.3f, glm::pi<float>(), 64, 24), stone);
+  place(s, arch, {-4.5f, columnHeight, -3.5f});
+  place(s, arch, {4.5f, columnHeight, -3.5f});
+
+  // Test objects.
+  place(s, addMesh(s, makeSphere(1.0f, 96, 48), gold), {-1.6f, 1.0f, 0.0f});
+  place(s, addMesh(s, makeSphere(0.7f, 80, 40), redPlastic), {1.4f, 0.7f, 1.3f});
+  place(s, addMesh(s, makeSphere(0.45f, 64, 32), white), {0.2f, 0.45f, 2.6f});
+  place(s, addMesh(s, makeBox({1.2f, 1.2f, 1.2f}, 4), blue), {3.6f, 0.6f, 0.2f}, 30.0f);
+  place(s, addMesh(s, makeBox({1.4f, 1.6f, 0.3f}, 4), mirror), {-4.3f, 0.8f, 0.8f}, 35.0f);
+  place(s, addMesh(s, makeCylinder(0.5f, 1.4f, 64, 2, true), copper), {4.6f, 0.0f, 2.4f});
+  // Mirror patch lying on the ground in front of the objects (a thin box so it has real thickness).
+  place(s, addMesh(s, makeBox({3.0f, 0.02f, 1.8f}, 1), mirror), {0.0f, 0.01f, 4.2f});
+
+  s.camera = Camera{.eye = {0.0f, 4.2f, 12.5f}, .target = {0.0f, 1.2f, 0.0f}, .fovYDegrees = 50.0f,
+                    .zNear = 0.1f, .zFar = 200.0f};
+  s.sun = Sun{};
+  return s;
+}
+
+}  // namespace sample_engine

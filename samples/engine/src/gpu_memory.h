@@ -1,0 +1,77 @@
+// Buffers, images and one-shot command submission. One VkDeviceMemory per resource: the sample scenes
+// hold a few hundred resources at most, far below maxMemoryAllocationCount.
+#pragma once
+
+#include <string>
+
+#include <vulkan/vulkan.h>
+
+namespace sample_engine::detail {
+
+struct Buffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceSize size = 0;
+  void* mapped = nullptr;       // persistently mapped when host visible
+  VkDeviceAddress address = 0;  // when created with SHADER_DEVICE_ADDRESS usage
+};
+
+struct Image {
+  VkImage image = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  VkImageView altView = VK_NULL_HANDLE;  // e.g. the sRGB view of a mutable-format texture
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkExtent2D extent{};
+  uint32_t mipLevels = 1;
+};
+
+struct ImageDesc {
+  VkFormat format;
+  VkExtent2D extent;
+  VkImageUsageFlags usage;
+  VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT;
+  uint32_t mipLevels = 1;
+  VkFormat altViewFormat = VK_FORMAT_UNDEFINED;  // creates a MUTABLE_FORMAT image with a second view
+};
+
+class Gpu {
+ public:
+  void init(VkPhysicalDevice pd, VkDevice device, VkQueue queue, uint32_t family);
+  void shutdown();
+  VkDevice device() const { return device_; }
+
+  std::string createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags props, Buffer& out);
+  std::string createImage(const ImageDesc& desc, Image& out);
+  void destroy(Buffer& b);
+  void destroy(Image& i);
+
+  // Records with `record` into a fresh command buffer, submits it on the queue and waits.
+  template <typename F>
+  std::string submitNow(F&& record) {
+    VkCommandBuffer cmd;
+    if (std::string e = beginOneShot(cmd); !e.empty()) return e;
+    record(cmd);
+    return endOneShot(cmd);
+  }
+
+ private:
+  std::string beginOneShot(VkCommandBuffer& cmd);
+  std::string endOneShot(VkCommandBuffer cmd);
+  uint32_t memoryType(uint32_t bits, VkMemoryPropertyFlags props) const;
+
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceMemoryProperties memProps_{};
+};
+
+// Synchronization2 image barrier over all mips/layers of `image`.
+void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout oldLayout,
+                  VkImageLayout newLayout, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
+                  VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess);
+void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
+                   VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess);
+
+}  // namespace sample_engine::detail

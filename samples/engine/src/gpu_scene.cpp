@@ -1,0 +1,287 @@
+// Scene upload: everything goes through one staging buffer and one command buffer.
+#include "gpu_scene.h"
+
+#include <cstring>
+
+#include "vk_check.h"
+
+namespace sample_engine::detail {
+namespace {
+
+struct VertexAttributes {  // 36 bytes, matches the pipelines' binding 1
+  glm::vec3 normal;
+  glm::vec2 uv;
+  glm::vec4 tangent;
+};
+static_assert(sizeof(VertexAttributes) == 36);
+
+struct Upload {
+  VkBuffer dst;
+  VkDeviceSize srcOffset, size;
+};
+struct TextureUpload {
+  Image* image;
+  VkDeviceSize srcOffset;
+};
+
+uint32_t mipCount(uint32_t w, uint32_t h) {
+  uint32_t n = 1;
+  while ((w | h) >> n) ++n;
+  return n;
+}
+
+// Copies level 0 from the staging buffer, builds the mip chain by blits, leaves SHADER_READ_ONLY_OPTIMAL.
+void recordTextureUpload(VkCommandBuffer cmd, VkBuffer staging, const TextureUpload& t) {
+  Image& img = *t.image;
+  imageBarrier(cmd, img.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+               VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  VkBufferImageCopy copy{};
+  copy.bufferOffset = t.srcOffset;
+  copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  copy.imageExtent = {img.extent.width, img.extent.height, 1};
+  vkCmdCopyBufferToImage(cmd, staging, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+  int32_t w = int32_t(img.extent.width), h = int32_t(img.extent.height);
+  for (uint32_t level = 1; level < img.mipLevels; ++level) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
+    b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = img.image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, level - 1, 1, 0, 1};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dep);
+    int32_t nw = std::max(w / 2, 1), nh = std::max(h / 2, 1);
+    VkImageBlit blit{};
+    blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level - 1, 0, 1};
+    blit.srcOffsets[1] = {w, h, 1};
+    blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, 1};
+    blit.dstOffsets[1] = {nw, nh, 1};
+    vkCmdBlitImage(cmd, img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, img.image,
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_LINEAR);
+    w = nw;
+    h = nh;
+  }
+  // Levels 0..n-2 are TRANSFER_SRC, the last is TRANSFER_DST: move both groups to shader reads.
+  VkImageMemoryBarrier2 b[2] = {{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2}, {VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2}};
+  uint32_t count = 0;
+  if (img.mipLevels > 1) {
+    b[count].oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    b[count].srcAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
+    b[count].subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, img.mipLevels - 1, 0, 1};
+    ++count;
+  }
+  b[count].oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+  b[count].srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+  b[count].subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, img.mipLevels - 1, 1, 0, 1};
+  ++count;
+  for (uint32_t i = 0; i < count; ++i) {
+    b[i].srcStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
+    b[i].dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
+    b[i].dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+    b[i].newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    b[i].srcQueueFamilyIndex = b[i].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b[i].image = img.image;
+  }
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.imageMemoryBarrierCount = count;
+  dep.pImageMemoryBarriers = b;
+  vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+// Creates RGBA8 textures (UNORM + sRGB views) and uploads `pixels` (each width*height*4 bytes).
+std::string uploadTextures(Gpu& gpu, bool mips, std::vector<std::pair<Image*, const TextureData*>> textures) {
+  VkDeviceSize total = 0;
+  for (auto& [img, data] : textures) total += data->rgba8.size();
+  Buffer staging;
+  if (std::string e = gpu.createBuffer(total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                       VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                                       staging);
+      !e.empty())
+    return e;
+  std::vector<TextureUpload> uploads;
+  VkDeviceSize offset = 0;
+  std::string e;
+  for (auto& [img, data] : textures) {
+    ImageDesc desc{VK_FORMAT_R8G8B8A8_UNORM, {data->width, data->height},
+                   VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                   VK_IMAGE_ASPECT_COLOR_BIT, mips ? mipCount(data->width, data->height) : 1u,
+                   VK_FORMAT_R8G8B8A8_SRGB};
+    if (e = gpu.createImage(desc, *img); !e.empty()) break;
+    std::memcpy(static_cast<char*>(staging.mapped) + offset, data->rgba8.data(), data->rgba8.size());
+    uploads.push_back({img, offset});
+    offset += data->rgba8.size();
+  }
+  if (e.empty())
+    e = gpu.submitNow([&](VkCommandBuffer cmd) {
+      for (const auto& u : uploads) recordTextureUpload(cmd, staging.buffer, u);
+    });
+  gpu.destroy(staging);
+  return e;
+}
+
+bool canBlitMips(VkPhysicalDevice pd) {
+  VkFormatProperties p;
+  vkGetPhysicalDeviceFormatProperties(pd, VK_FORMAT_R8G8B8A8_UNORM, &p);
+  const VkFormatFeatureFlags need =
+      VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
+  return (p.optimalTilingFeatures & need) == need;
+}
+
+}  // namespace
+
+std::string DefaultImages::create(Gpu& gpu) {
+  TextureData w{"white", 1, 1, {255, 255, 255, 255}};
+  TextureData b{"black", 1, 1, {0, 0, 0, 0}};
+  TextureData n{"flat normal", 1, 1, {128, 128, 255, 255}};
+  return uploadTextures(gpu, false, {{&white, &w}, {&black, &b}, {&flatNormal, &n}});
+}
+
+void DefaultImages::destroy(Gpu& gpu) {
+  gpu.destroy(white);
+  gpu.destroy(black);
+  gpu.destroy(flatNormal);
+}
+
+std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pipelines,
+                        const DefaultImages& defaults, const Scene& scene, GpuScene& out) {
+  out.cpu = scene;
+  finalizeScene(out.cpu);
+  const Scene& s = out.cpu;
+  out.bounds = s.bounds();
+
+  // --- Buffers ---
+  VkBufferUsageFlags rtUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  if (ctx.info.bufferDeviceAddress) {
+    rtUsage |= VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+    if (ctx.accelerationStructureEnabled) rtUsage |= VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
+  }
+  std::vector<std::vector<VertexAttributes>> attributes(s.meshes.size());
+  VkDeviceSize stagingSize = 0;
+  for (size_t m = 0; m < s.meshes.size(); ++m) {
+    const MeshData& mesh = s.meshes[m];
+    attributes[m].resize(mesh.positions.size());
+    for (size_t v = 0; v < mesh.positions.size(); ++v)
+      attributes[m][v] = {mesh.normals[v], mesh.uvs[v], mesh.tangents[v]};
+    stagingSize += mesh.positions.size() * 12 + attributes[m].size() * 36 + mesh.indices.size() * 4;
+  }
+  Buffer staging;
+  if (std::string e = gpu.createBuffer(stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                       VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                                       staging);
+      !e.empty())
+    return e;
+  std::vector<Upload> uploads;
+  VkDeviceSize offset = 0;
+  std::string e;
+  auto stage = [&](const void* data, VkDeviceSize size, VkBufferUsageFlags usage, Buffer& dst) {
+    if (!e.empty() || size == 0) return;
+    e = gpu.createBuffer(size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, dst);
+    if (!e.empty()) return;
+    std::memcpy(static_cast<char*>(staging.mapped) + offset, data, size);
+    uploads.push_back({dst.buffer, offset, size});
+    offset += size;
+  };
+  out.buffers.resize(s.meshes.size());
+  out.meshes.resize(s.meshes.size());
+  for (size_t m = 0; m < s.meshes.size(); ++m) {
+    const MeshData& mesh = s.meshes[m];
+    MeshBuffers& b = out.buffers[m];
+    stage(mesh.positions.data(), mesh.positions.size() * 12, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | rtUsage, b.positions);
+    stage(attributes[m].data(), attributes[m].size() * 36, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | rtUsage, b.attributes);
+    stage(mesh.indices.data(), mesh.indices.size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT | rtUsage, b.indices);
+    GpuMesh& g = out.meshes[m];
+    g.positionBuffer = b.positions.buffer;
+    g.positionAddress = b.positions.address;
+    g.attributeBuffer = b.attributes.buffer;
+    g.attributeAddress = b.attributes.address;
+    g.indexBuffer = b.indices.buffer;
+    g.indexAddress = b.indices.address;
+    g.indexType = mesh.indices.empty() ? VK_INDEX_TYPE_NONE_KHR : VK_INDEX_TYPE_UINT32;
+    g.vertexCount = uint32_t(mesh.positions.size());
+    g.indexCount = uint32_t(mesh.indices.size());
+    g.material = mesh.material;
+    g.cpu = &mesh;
+  }
+  if (e.empty() && !uploads.empty())
+    e = gpu.submitNow([&](VkCommandBuffer cmd) {
+      for (const Upload& u : uploads) {
+        VkBufferCopy c{u.srcOffset, 0, u.size};
+        vkCmdCopyBuffer(cmd, staging.buffer, u.dst, 1, &c);
+      }
+      // Later readers: vertex input, index input and any add-on (AS builds, shaders).
+      memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                    VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
+    });
+  gpu.destroy(staging);
+  if (!e.empty()) return e;
+
+  // --- Textures ---
+  out.textures.resize(s.textures.size());
+  std::vector<std::pair<Image*, const TextureData*>> textures;
+  for (size_t t = 0; t < s.textures.size(); ++t)
+    if (!s.textures[t].rgba8.empty()) textures.push_back({&out.textures[t], &s.textures[t]});
+  if (!textures.empty())
+    if (e = uploadTextures(gpu, canBlitMips(ctx.physicalDevice), textures); !e.empty()) return e;
+
+  // --- Materials ---
+  const uint32_t materialCount = uint32_t(s.materials.size());
+  VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3 * materialCount};
+  VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pci.maxSets = materialCount;
+  pci.poolSizeCount = 1;
+  pci.pPoolSizes = &poolSize;
+  SE_VK_TRY(vkCreateDescriptorPool(gpu.device(), &pci, nullptr, &out.materialPool));
+  std::vector<VkDescriptorSetLayout> layouts(materialCount, pipelines.materialSetLayout);
+  out.materialSets.resize(materialCount);
+  VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  ai.descriptorPool = out.materialPool;
+  ai.descriptorSetCount = materialCount;
+  ai.pSetLayouts = layouts.data();
+  SE_VK_TRY(vkAllocateDescriptorSets(gpu.device(), &ai, out.materialSets.data()));
+  out.materialConstants.resize(materialCount);
+  for (uint32_t m = 0; m < materialCount; ++m) {
+    const Material& mat = s.materials[m];
+    auto view = [&](int texture, const Image& fallback, bool srgb) {
+      if (texture < 0 || !out.textures[texture].image) return fallback.view;
+      return srgb ? out.textures[texture].altView : out.textures[texture].view;
+    };
+    VkDescriptorImageInfo infos[3] = {
+        {pipelines.materialSampler, view(mat.baseColorTexture, defaults.white, true),
+         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+        {pipelines.materialSampler, view(mat.metallicRoughnessTexture, defaults.white, false),
+         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+        {pipelines.materialSampler, view(mat.normalTexture, defaults.flatNormal, false),
+         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = out.materialSets[m];
+    w.descriptorCount = 3;
+    w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    w.pImageInfo = infos;
+    vkUpdateDescriptorSets(gpu.device(), 1, &w, 0, nullptr);
+    DrawConstants& c = out.materialConstants[m];
+    c.model = glm::mat4(1.0f);
+    c.baseColorFactor = mat.baseColorFactor;
+    c.material = glm::vec4(mat.metallicFactor, mat.roughnessFactor, mat.normalScale, 0.0f);
+    c.emissive = glm::vec4(mat.emissiveFactor, 0.0f);
+  }
+  return {};
+}
+
+void destroyScene(Gpu& gpu, GpuScene& scene) {
+  for (MeshBuffers& b : scene.buffers) {
+    gpu.destroy(b.positions);
+    gpu.destroy(b.attributes);
+    gpu.destroy(b.indices);
+  }
+  for (Image& i : scene.textures) gpu.destroy(i);
+  if (scene.materialPool) vkDestroyDescriptorPool(gpu.device(), scene.materialPool, nullptr);
+  scene = GpuScene{};
+}
+
+}  // namespace sample_engine::detail

@@ -1,0 +1,42 @@
+// GPU copy of a Scene: vertex/index buffers per mesh, textures, one descriptor set per material.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "gpu_memory.h"
+#include "pipelines.h"
+#include "sample_engine/engine.h"
+#include "vk_context.h"
+
+namespace sample_engine::detail {
+
+// 1x1 fallback textures bound where a material or lighting input has nothing.
+struct DefaultImages {
+  Image white;      // RGBA8 UNORM (1,1,1,1): base color, metallic-roughness, visibility, AO
+  Image black;      // RGBA8 UNORM (0,0,0,0): reflection
+  Image flatNormal; // RGBA8 UNORM (0.5,0.5,1): tangent-space +Z
+  std::string create(Gpu& gpu);
+  void destroy(Gpu& gpu);
+};
+
+struct MeshBuffers {
+  Buffer positions, attributes, indices;
+};
+
+struct GpuScene {
+  Scene cpu;  // finalized copy; GpuMesh::cpu points into it
+  std::vector<MeshBuffers> buffers;
+  std::vector<GpuMesh> meshes;
+  std::vector<Image> textures;
+  VkDescriptorPool materialPool = VK_NULL_HANDLE;
+  std::vector<VkDescriptorSet> materialSets;
+  std::vector<DrawConstants> materialConstants;  // model matrix filled per draw
+  Bounds bounds;
+};
+
+std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pipelines,
+                        const DefaultImages& defaults, const Scene& scene, GpuScene& out);
+void destroyScene(Gpu& gpu, GpuScene& scene);
+
+}  // namespace sample_engine::detail

@@ -1,0 +1,234 @@
+#include "pipelines.h"
+
+#include <vector>
+
+#include "engine_shaders.h"
+#include "vk_check.h"
+
+namespace sample_engine::detail {
+namespace {
+
+template <size_t N>
+std::string makeModule(VkDevice device, const uint32_t (&code)[N], VkShaderModule& out) {
+  VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  ci.codeSize = N * sizeof(uint32_t);
+  ci.pCode = code;
+  SE_VK_TRY(vkCreateShaderModule(device, &ci, nullptr, &out));
+  return {};
+}
+
+std::string makeSetLayout(VkDevice device, std::vector<VkDescriptorSetLayoutBinding> bindings,
+                          VkDescriptorSetLayout& out) {
+  VkDescriptorSetLayoutCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  ci.bindingCount = uint32_t(bindings.size());
+  ci.pBindings = bindings.data();
+  SE_VK_TRY(vkCreateDescriptorSetLayout(device, &ci, nullptr, &out));
+  return {};
+}
+
+VkDescriptorSetLayoutBinding samplerBinding(uint32_t binding) {
+  return {binding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+}
+
+struct PipelineDesc {
+  VkShaderModule vert = VK_NULL_HANDLE;
+  VkShaderModule frag = VK_NULL_HANDLE;
+  bool sceneVertices = true;   // positions (binding 0) + attributes (binding 1)
+  bool positionsOnly = false;  // binding 0 only
+  std::vector<VkFormat> colorFormats;
+  VkFormat depthFormat = VK_FORMAT_UNDEFINED;
+  bool depthTest = false, depthWrite = false;
+  VkCompareOp depthCompare = VK_COMPARE_OP_LESS;
+  bool depthBias = false;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+};
+
+std::string makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out) {
+  std::vector<VkPipelineShaderStageCreateInfo> stages;
+  stages.push_back({VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT,
+                    d.vert, "main", nullptr});
+  if (d.frag)
+    stages.push_back({VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
+                      VK_SHADER_STAGE_FRAGMENT_BIT, d.frag, "main", nullptr});
+  std::vector<VkVertexInputBindingDescription> bindings;
+  std::vector<VkVertexInputAttributeDescription> attributes;
+  if (d.sceneVertices || d.positionsOnly) {
+    bindings.push_back({0, 12, VK_VERTEX_INPUT_RATE_VERTEX});
+    attributes.push_back({0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0});
+  }
+  if (d.sceneVertices && !d.positionsOnly) {
+    bindings.push_back({1, 36, VK_VERTEX_INPUT_RATE_VERTEX});
+    attributes.push_back({1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0});
+    attributes.push_back({2, 1, VK_FORMAT_R32G32_SFLOAT, 12});
+    attributes.push_back({3, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 20});
+  }
+  VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+  vi.vertexBindingDescriptionCount = uint32_t(bindings.size());
+  vi.pVertexBindingDescriptions = bindings.data();
+  vi.vertexAttributeDescriptionCount = uint32_t(attributes.size());
+  vi.pVertexAttributeDescriptions = attributes.data();
+  VkPipelineInputAssemblyStateCreateInfo ia{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+  ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+  VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+  vp.viewportCount = 1;
+  vp.scissorCount = 1;
+  VkPipelineRasterizationStateCreateInfo rs{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+  rs.polygonMode = VK_POLYGON_MODE_FILL;
+  rs.cullMode = VK_CULL_MODE_NONE;  // glTF double-sided materials and open meshes; shaders face normals
+  rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+  rs.depthBiasEnable = d.depthBias;
+  rs.lineWidth = 1.0f;
+  VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+  ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+  VkPipelineDepthStencilStateCreateInfo ds{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+  ds.depthTestEnable = d.depthTest;
+  ds.depthWriteEnable = d.depthWrite;
+  ds.depthCompareOp = d.depthCompare;
+  std::vector<VkPipelineColorBlendAttachmentState> blends(d.colorFormats.size());
+  for (auto& b : blends)
+    b.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
+                       VK_COLOR_COMPONENT_A_BIT;
+  VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+  cb.attachmentCount = uint32_t(blends.size());
+  cb.pAttachments = blends.data();
+  std::vector<VkDynamicState> dyn = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+  if (d.depthBias) dyn.push_back(VK_DYNAMIC_STATE_DEPTH_BIAS);
+  VkPipelineDynamicStateCreateInfo dy{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+  dy.dynamicStateCount = uint32_t(dyn.size());
+  dy.pDynamicStates = dyn.data();
+  VkPipelineRenderingCreateInfo ri{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+  ri.colorAttachmentCount = uint32_t(d.colorFormats.size());
+  ri.pColorAttachmentFormats = d.colorFormats.data();
+  ri.depthAttachmentFormat = d.depthFormat;
+  VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+  ci.pNext = &ri;
+  ci.stageCount = uint32_t(stages.size());
+  ci.pStages = stages.data();
+  ci.pVertexInputState = &vi;
+  ci.pInputAssemblyState = &ia;
+  ci.pViewportState = &vp;
+  ci.pRasterizationState = &rs;
+  ci.pMultisampleState = &ms;
+  ci.pDepthStencilState = &ds;
+  ci.pColorBlendState = &cb;
+  ci.pDynamicState = &dy;
+  ci.layout = d.layout;
+  SE_VK_TRY(vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &out));
+  return {};
+}
+
+std::string makeSampler(VkDevice device, VkFilter filter, VkSamplerAddressMode mode, bool compare, float maxLod,
+                        VkSampler& out) {
+  VkSamplerCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  ci.magFilter = ci.minFilter = filter;
+  ci.mipmapMode = filter == VK_FILTER_LINEAR ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  ci.addressModeU = ci.addressModeV = ci.addressModeW = mode;
+  ci.compareEnable = compare;
+  ci.compareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
+  ci.maxLod = maxLod;
+  ci.borderColor = VK_BORDER_COLOR_FLOAT_OPAQUE_WHITE;
+  SE_VK_TRY(vkCreateSampler(device, &ci, nullptr, &out));
+  return {};
+}
+
+}  // namespace
+
+std::string Pipelines::create(VkDevice device) {
+  std::string e;
+  auto check = [&](std::string r) {
+    if (e.empty()) e = std::move(r);
+    return e.empty();
+  };
+  check(makeSetLayout(device,
+                      {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1,
+                        VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, nullptr}},
+                      frameSetLayout));
+  check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2)}, materialSetLayout));
+  check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3)},
+                      lightingSetLayout));
+  check(makeSetLayout(device, {samplerBinding(0)}, tonemapSetLayout));
+  if (!e.empty()) return e;
+
+  VkPushConstantRange drawRange{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                                sizeof(DrawConstants)};
+  VkDescriptorSetLayout sets[3] = {frameSetLayout, materialSetLayout, lightingSetLayout};
+  VkPipelineLayoutCreateInfo lci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  lci.setLayoutCount = 3;
+  lci.pSetLayouts = sets;
+  lci.pushConstantRangeCount = 1;
+  lci.pPushConstantRanges = &drawRange;
+  SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &sceneLayout));
+  VkPushConstantRange tonemapRange{VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(float)};
+  lci.setLayoutCount = 1;
+  lci.pSetLayouts = &tonemapSetLayout;
+  lci.pPushConstantRanges = &tonemapRange;
+  SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &tonemapLayout));
+
+  VkShaderModule meshVert = VK_NULL_HANDLE, shadowVert = VK_NULL_HANDLE, prepassFrag = VK_NULL_HANDLE,
+                 forwardFrag = VK_NULL_HANDLE, fullscreenVert = VK_NULL_HANDLE, tonemapFrag = VK_NULL_HANDLE;
+  check(makeModule(device, spirv::mesh_vert, meshVert));
+  check(makeModule(device, spirv::shadow_vert, shadowVert));
+  check(makeModule(device, spirv::prepass_frag, prepassFrag));
+  check(makeModule(device, spirv::forward_frag, forwardFrag));
+  check(makeModule(device, spirv::fullscreen_vert, fullscreenVert));
+  check(makeModule(device, spirv::tonemap_frag, tonemapFrag));
+  if (e.empty()) {
+    PipelineDesc d;
+    d.vert = shadowVert;
+    d.positionsOnly = true;
+    d.depthFormat = kDepthFormat;
+    d.depthTest = d.depthWrite = true;
+    d.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
+    d.depthBias = true;
+    d.layout = sceneLayout;
+    check(makePipeline(device, d, shadow));
+
+    d = {};
+    d.vert = meshVert;
+    d.frag = prepassFrag;
+    d.colorFormats = {kNormalFormat, kNormalFormat};
+    d.depthFormat = kDepthFormat;
+    d.depthTest = d.depthWrite = true;
+    d.depthCompare = VK_COMPARE_OP_LESS;
+    d.layout = sceneLayout;
+    check(makePipeline(device, d, prepass));
+
+    d.frag = forwardFrag;
+    d.colorFormats = {kHdrFormat};
+    d.depthWrite = false;
+    d.depthCompare = VK_COMPARE_OP_EQUAL;  // only the surface the pre-pass kept gets shaded
+    check(makePipeline(device, d, forward));
+
+    d = {};
+    d.vert = fullscreenVert;
+    d.frag = tonemapFrag;
+    d.sceneVertices = false;
+    d.colorFormats = {kLdrFormat};
+    d.layout = tonemapLayout;
+    check(makePipeline(device, d, tonemap));
+  }
+  for (VkShaderModule m : {meshVert, shadowVert, prepassFrag, forwardFrag, fullscreenVert, tonemapFrag})
+    if (m) vkDestroyShaderModule(device, m, nullptr);
+  if (!e.empty()) return e;
+
+  check(makeSampler(device, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, false, VK_LOD_CLAMP_NONE,
+                    materialSampler));
+  check(makeSampler(device, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, 0.0f, screenSampler));
+  check(makeSampler(device, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER, true, 0.0f, shadowSampler));
+  check(makeSampler(device, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, 0.0f, nearestSampler));
+  return e;
+}
+
+void Pipelines::destroy(VkDevice device) {
+  for (VkPipeline p : {shadow, prepass, forward, tonemap})
+    if (p) vkDestroyPipeline(device, p, nullptr);
+  for (VkPipelineLayout l : {sceneLayout, tonemapLayout})
+    if (l) vkDestroyPipelineLayout(device, l, nullptr);
+  for (VkDescriptorSetLayout l : {frameSetLayout, materialSetLayout, lightingSetLayout, tonemapSetLayout})
+    if (l) vkDestroyDescriptorSetLayout(device, l, nullptr);
+  for (VkSampler s : {materialSampler, screenSampler, shadowSampler, nearestSampler})
+    if (s) vkDestroySampler(device, s, nullptr);
+  *this = {};
+}
+
+}  // namespace sample_engine::detail

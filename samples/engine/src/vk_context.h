@@ -1,0 +1,40 @@
+// Instance, debug messenger, physical-device choice and device creation.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sample_engine/engine.h"
+
+namespace sample_engine::detail {
+
+struct ValidationCounters {
+  std::atomic<uint32_t> errors{0};
+  std::atomic<uint32_t> warnings{0};
+};
+
+struct VulkanContext {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  uint32_t queueFamily = 0;
+  DeviceInfo info;
+  std::vector<std::string> deviceExtensions;
+  bool swapchainEnabled = false;
+  bool accelerationStructureEnabled = false;  // VK_KHR_acceleration_structure among the device extensions
+  float timestampPeriodNs = 1.0f;
+  bool timestampsSupported = false;
+  VkPhysicalDeviceProperties properties{};
+  std::unique_ptr<ValidationCounters> counters = std::make_unique<ValidationCounters>();
+
+  // Returns an error message, empty on success. On failure the partially created objects are destroyed
+  // by destroy().
+  std::string create(const EngineConfig& config);
+  void destroy();
+};
+
+}  // namespace sample_engine::detail

@@ -1,0 +1,127 @@
+// The Raybridge context adopts the engine's Vulkan device. It never creates a device, never submits work and
+// never waits on the engine's queues; everything that does GPU work records into a command buffer the engine
+// passes in.
+//
+// Thread safety: a Context is externally synchronised. Calls on one context (and on the services and passes
+// created from it) must not overlap; distinct contexts may be used from distinct threads.
+#pragma once
+
+#include <raybridge/result.h>
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+namespace rb {
+
+struct DeviceFunctions;
+
+// What the engine hands over. A zero-initialised ContextDesc is invalid only because the four handles below
+// are required; every other field's zero value is a documented default.
+struct ContextDesc {
+  VkInstance instance = VK_NULL_HANDLE;                     // required
+  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;          // required
+  VkDevice device = VK_NULL_HANDLE;                          // required; see requiredDeviceExtensions()
+  PFN_vkGetInstanceProcAddr getInstanceProcAddr = nullptr;   // required; every Vulkan function is loaded from it
+  uint32_t framesInFlight = 0;                               // 0 = 2; at most 8
+  const VkAllocationCallbacks* allocationCallbacks = nullptr;  // nullptr = the driver's allocator
+  // Optional second queue for asynchronous BLAS rebuilds of deforming meshes. VK_NULL_HANDLE = none: such
+  // rebuilds are recorded into the engine's frame command buffer instead (always the case on lavapipe, which
+  // has one queue family).
+  VkQueue asyncComputeQueue = VK_NULL_HANDLE;
+  uint32_t asyncComputeQueueFamily = 0;  // family of asyncComputeQueue; ignored when it is VK_NULL_HANDLE
+  uint32_t mainQueueFamily = 0;          // family of the engine's queue that executes Raybridge's recordings
+};
+
+// Device extensions the engine must enable on its VkDevice for Raybridge (Vulkan 1.2 or newer).
+std::span<const char* const> requiredDeviceExtensions();
+
+// Feature structures the engine must chain into VkDeviceCreateInfo::pNext with every listed feature enabled.
+// Fill one with enableRequiredFeatures() and link `chainHead()` into the engine's own chain, e.g.
+//   rb::RequiredFeatures f; f.link(&engineFeatures2); createInfo.pNext = f.chainHead();
+struct RequiredFeatures {
+  VkPhysicalDeviceVulkan12Features vulkan12{};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR accelerationStructure{};
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR rayTracingPipeline{};
+  RequiredFeatures();  // sets sTypes, chains the structs and turns every required feature on
+  // Appends `next` after the last Raybridge struct and returns the head of the chain.
+  void* link(void* next);
+  void* chainHead() { return &vulkan12; }
+};
+
+// Device properties Raybridge reads once at creation.
+struct DeviceInfo {
+  std::string deviceName;
+  std::string driverName;  // e.g. "llvmpipe" or "NVIDIA"
+  std::string driverInfo;  // driver version string
+  uint32_t apiVersion = 0;
+  uint32_t vendorId = 0;
+  bool isCpu = false;  // a software rasteriser such as lavapipe
+  uint32_t shaderGroupHandleSize = 0;
+  uint32_t shaderGroupHandleAlignment = 0;
+  uint32_t shaderGroupBaseAlignment = 0;
+  uint32_t maxRayRecursionDepth = 0;
+  uint32_t minAccelerationStructureScratchOffsetAlignment = 0;
+  uint64_t maxPrimitiveCount = 0;
+  uint64_t maxInstanceCount = 0;
+  float timestampPeriodNs = 0.0f;  // nanoseconds per timestamp tick
+  bool timestampsSupported = false;
+};
+
+// Device memory Raybridge holds, by what it is for. Buffers no enabled effect reads are never allocated, so a
+// disabled effect shows zero bytes in its category.
+enum class MemoryCategory : uint8_t {
+  BlasStorage = 0,   // suballocation blocks holding BLASes
+  Scratch,           // build scratch memory
+  Tlas,              // TLAS storage, scratch and instance buffers
+  ShaderTables,      // shader binding tables and pipeline constants
+  PassImages,        // images owned by the effect passes (history, intermediate results)
+  PassBuffers,       // other buffers owned by the effect passes
+  Count
+};
+const char* toString(MemoryCategory category);
+
+struct MemoryStats {
+  VkDeviceSize bytes[static_cast<size_t>(MemoryCategory::Count)] = {};
+  uint32_t allocations = 0;  // live VkDeviceMemory objects
+  VkDeviceSize total() const {
+    VkDeviceSize sum = 0;
+    for (VkDeviceSize b : bytes) sum += b;
+    return sum;
+  }
+  VkDeviceSize of(MemoryCategory c) const { return bytes[static_cast<size_t>(c)]; }
+};
+
+class Context {
+ public:
+  static Result<std::unique_ptr<Context>> create(const ContextDesc& desc);
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  // Marks the start of a new frame. Contract: when the engine calls this, the GPU has finished all work the
+  // engine submitted before its previous `framesInFlight` calls to beginFrame (the usual wait on the frame
+  // slot's fence). Objects retired that long ago are destroyed here.
+  void beginFrame();
+  // The engine guarantees the device is idle (after vkDeviceWaitIdle, say): every deferred release happens now.
+  void releaseAfterIdle();
+
+  uint64_t frameIndex() const;        // number of beginFrame calls so far
+  uint32_t framesInFlight() const;
+  const DeviceInfo& deviceInfo() const;
+  VkDevice device() const;
+  VkPhysicalDevice physicalDevice() const;
+  MemoryStats memoryStats() const;
+
+  // Internal: the per-context function table and shared machinery used by the services and passes.
+  struct Impl;
+  Impl& impl() { return *impl_; }
+  const DeviceFunctions& vk() const;
+
+ private:
+  explicit Context(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rb

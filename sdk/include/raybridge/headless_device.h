@@ -1,0 +1,82 @@
+// A headless Vulkan device for Raybridge's samples, tests and benchmarks: it plays the engine's part
+// (instance, device, queue, one-shot submissions). Engines that have their own device do not need it.
+//
+// Device choice: a GPU with ray tracing pipelines if there is one, otherwise a CPU implementation (lavapipe).
+// `HeadlessDeviceDesc::deviceNameFilter` or the environment variable RAYBRIDGE_DEVICE (a case-insensitive
+// substring of the device name, e.g. "llvmpipe" or "H100") overrides the choice.
+//
+// Thread safety: not thread-safe; use one HeadlessDevice from one thread at a time.
+#pragma once
+
+#include <raybridge/context.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rb {
+
+struct HeadlessDeviceDesc {
+  const char* deviceNameFilter = nullptr;  // nullptr = $RAYBRIDGE_DEVICE if set, else automatic choice
+  bool enableValidation = false;  // VK_LAYER_KHRONOS_validation + debug messenger; also on when $RAYBRIDGE_VALIDATION=1
+  bool requireValidation = false;  // fail creation when validation was asked for but the layer is missing
+  uint32_t framesInFlight = 0;     // 0 = 2; copied into contextDesc()
+};
+
+// A buffer made by the headless device for samples and tests (the engine's buffers in a real integration).
+struct HeadlessBuffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceAddress address = 0;  // 0 unless created with VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT
+  VkDeviceSize size = 0;
+  void* mapped = nullptr;  // non-null for host-visible buffers
+};
+
+class HeadlessDevice {
+ public:
+  static Result<std::unique_ptr<HeadlessDevice>> create(const HeadlessDeviceDesc& desc = {});
+  ~HeadlessDevice();
+  HeadlessDevice(const HeadlessDevice&) = delete;
+  HeadlessDevice& operator=(const HeadlessDevice&) = delete;
+
+  VkInstance instance() const;
+  VkPhysicalDevice physicalDevice() const;
+  VkDevice device() const;
+  VkQueue queue() const;
+  uint32_t queueFamily() const;
+  PFN_vkGetInstanceProcAddr getInstanceProcAddr() const;
+  // Instance-level function loaded from the headless instance (handy for tests that call Vulkan directly).
+  PFN_vkVoidFunction instanceProc(const char* name) const;
+  PFN_vkVoidFunction deviceProc(const char* name) const;
+  // A ContextDesc filled with this device's handles.
+  ContextDesc contextDesc() const;
+  std::string deviceName() const;
+
+  // Validation messages of severity error seen since creation (always 0 when validation is off).
+  uint32_t validationErrorCount() const;
+  const std::vector<std::string>& validationErrors() const;
+  bool validationEnabled() const;
+
+  // One-shot recording: begin() returns a command buffer in the recording state; submitAndWait() ends,
+  // submits and waits for it, then frees it.
+  Result<VkCommandBuffer> beginCommands();
+  Status submitAndWait(VkCommandBuffer cmd);
+
+  // Creates a buffer. Device-local unless hostVisible; `data` (size bytes) is uploaded through a staging copy
+  // for device-local buffers and memcpy'd otherwise.
+  Result<HeadlessBuffer> createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, bool hostVisible,
+                                      const void* data = nullptr);
+  // Copies a device-local buffer's contents back to `out` (size bytes).
+  Status readBuffer(const HeadlessBuffer& buffer, void* out, VkDeviceSize size);
+  void destroyBuffer(HeadlessBuffer& buffer);
+  Status waitIdle();
+
+  struct Impl;
+
+ private:
+  explicit HeadlessDevice(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rb

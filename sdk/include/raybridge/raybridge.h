@@ -1,0 +1,8 @@
+// Raybridge: ray-traced effects for rasterizing Vulkan engines. Include this or the individual headers.
+#pragma once
+
+#include <raybridge/acceleration_structures.h>
+#include <raybridge/context.h>
+#include <raybridge/headless_device.h>
+#include <raybridge/primary_ray_pass.h>
+#include <raybridge/result.h>

@@ -1,0 +1,596 @@
+// The BLAS side of the acceleration-structure service: registration and dedup, budgets and eviction, batched
+// builds and refits, compaction, statistics.
+#include <raybridge/acceleration_structures.h>
+
+#include <algorithm>
+#include <string>
+
+#include "as_service_impl.h"
+
+namespace rb {
+
+namespace {
+
+constexpr VkDeviceSize kDefaultScratchBudget = 64ull << 20;
+constexpr VkDeviceSize kDefaultBlockBytes = 32ull << 20;
+constexpr size_t kMaxTimings = 64;
+
+VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
+
+std::string meshName(const BlasEntry& e, uint32_t index) {
+  return e.mesh.desc.debugName ? std::string("mesh '") + e.mesh.desc.debugName + "'"
+                               : "mesh #" + std::to_string(index);
+}
+
+}  // namespace
+
+void recordAsBarrier(const DeviceFunctions& vk, VkCommandBuffer cmd, VkPipelineStageFlags dstStages) {
+  VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  barrier.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
+  barrier.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
+  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, dstStages, 0, 1, &barrier, 0,
+                          nullptr, 0, nullptr);
+}
+
+AccelerationStructureService::Impl::Impl(Context& context, const AsServiceDesc& d)
+    : ctx(context),
+      c(context.impl()),
+      desc(d),
+      storage(context, d.storageBlockBytes ? d.storageBlockBytes : kDefaultBlockBytes) {
+  if (desc.scratchBudgetBytes == 0) desc.scratchBudgetBytes = kDefaultScratchBudget;
+  if (desc.storageBlockBytes == 0) desc.storageBlockBytes = kDefaultBlockBytes;
+  tlasSlots.resize(c.desc.framesInFlight);
+  entries.emplace_back();  // index 0 is never used, so a zero handle is always the null handle
+}
+
+AccelerationStructureService::Impl::~Impl() {
+  // Contract: the GPU is done with everything this service recorded. Retired objects reference the storage
+  // allocator, so they are released before it goes.
+  for (uint32_t i = 1; i < entries.size(); ++i) {
+    if (entries[i].state != BlasState::Free) destroyEntry(i);
+  }
+  for (TlasSlot& s : tlasSlots) {
+    if (s.tlas) c.vk.vkDestroyAccelerationStructureKHR(c.desc.device, s.tlas, c.allocator());
+    destroyBuffer(ctx, s.storage);
+    destroyBuffer(ctx, s.scratch);
+    destroyBuffer(ctx, s.instances);
+  }
+  for (BuildBatch& b : inFlightBatches) {
+    if (b.timestamps) c.vk.vkDestroyQueryPool(c.desc.device, b.timestamps, c.allocator());
+    if (b.compactedSizes) c.vk.vkDestroyQueryPool(c.desc.device, b.compactedSizes, c.allocator());
+  }
+  for (VkQueryPool p : freeTimestampPools) c.vk.vkDestroyQueryPool(c.desc.device, p, c.allocator());
+  destroyBuffer(ctx, scratch);
+  c.releaseRetired(true);
+}
+
+VkDeviceSize AccelerationStructureService::Impl::scratchAlignment() const {
+  return std::max<VkDeviceSize>(c.info.minAccelerationStructureScratchOffsetAlignment, 1);
+}
+
+VkBuildAccelerationStructureFlagsKHR AccelerationStructureService::Impl::blasFlags(const BlasEntry& e) const {
+  if (e.mesh.desc.role == MeshRole::Dynamic) {
+    return VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR |
+           VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR;
+  }
+  VkBuildAccelerationStructureFlagsKHR f = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  if (!desc.disableCompaction) f |= VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR;
+  return f;
+}
+
+void AccelerationStructureService::Impl::buildGeometry(const BlasEntry& e, VkAccelerationStructureGeometryKHR& g,
+                                                      VkAccelerationStructureBuildRangeInfoKHR& range) const {
+  const MeshDesc& m = e.mesh.desc;
+  g = VkAccelerationStructureGeometryKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  g.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+  g.flags = m.nonOpaque ? 0 : VK_GEOMETRY_OPAQUE_BIT_KHR;
+  auto& t = g.geometry.triangles;
+  t.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
+  t.vertexFormat = m.vertexFormat;
+  t.vertexData.deviceAddress = m.vertexAddress;
+  t.vertexStride = m.vertexStride;
+  t.maxVertex = m.vertexCount - 1;
+  t.indexType = m.indexType == IndexType::Uint32   ? VK_INDEX_TYPE_UINT32
+                : m.indexType == IndexType::Uint16 ? VK_INDEX_TYPE_UINT16
+                                                   : VK_INDEX_TYPE_NONE_KHR;
+  t.indexData.deviceAddress = m.indexAddress;
+  range = VkAccelerationStructureBuildRangeInfoKHR{};
+  range.primitiveCount = m.triangleCount;
+}
+
+Result<VkAccelerationStructureKHR> AccelerationStructureService::Impl::createAs(VkAccelerationStructureTypeKHR type,
+                                                                              VkBuffer buffer, VkDeviceSize offset,
+                                                                              VkDeviceSize size) {
+  VkAccelerationStructureCreateInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
+  info.buffer = buffer;
+  info.offset = offset;
+  info.size = size;
+  info.type = type;
+  VkAccelerationStructureKHR as = VK_NULL_HANDLE;
+  VkResult r = c.vk.vkCreateAccelerationStructureKHR(c.desc.device, &info, c.allocator(), &as);
+  if (r != VK_SUCCESS) return vulkanError(r, "vkCreateAccelerationStructureKHR");
+  return as;
+}
+
+Result<BlasEntry*> AccelerationStructureService::Impl::lookup(MeshHandle h, const char* what) {
+  if (h.isNull()) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, std::string(what) + ": the mesh handle is null"};
+  }
+  if (h.index >= entries.size() || entries[h.index].generation != h.generation ||
+      entries[h.index].state == BlasState::Free) {
+    return Error{ErrorCode::StaleHandle, VK_SUCCESS,
+                 std::string(what) + ": mesh handle {index " + std::to_string(h.index) + ", generation " +
+                     std::to_string(h.generation) + "} refers to a mesh that was destroyed or evicted"};
+  }
+  BlasEntry& e = entries[h.index];
+  if (e.refCount == 0) {
+    return Error{ErrorCode::StaleHandle, VK_SUCCESS,
+                 std::string(what) + ": " + meshName(e, h.index) +
+                     " was released (releaseMesh); register it again to use it"};
+  }
+  return &e;
+}
+
+void AccelerationStructureService::Impl::destroyEntry(uint32_t index) {
+  BlasEntry& e = entries[index];
+  auto it = byKey.find(e.key);
+  if (it != byKey.end() && it->second == index) byKey.erase(it);
+  if (e.state == BlasState::Queued) {
+    queue.erase(std::remove(queue.begin(), queue.end(), index), queue.end());
+  }
+  if (e.as) {
+    VkAccelerationStructureKHR as = e.as;
+    StorageAllocation alloc = e.storage;
+    c.retire([this, as, alloc] {
+      c.vk.vkDestroyAccelerationStructureKHR(c.desc.device, as, c.allocator());
+      storage.free(alloc);
+    });
+  }
+  reservedBytes -= alignUp(e.currentSize ? e.currentSize : e.sizes.accelerationStructureSize,
+                           AsStorageAllocator::kAlignment);
+  uint32_t generation = e.generation + 1;
+  e = BlasEntry{};
+  e.generation = generation == 0 ? 1 : generation;
+  freeSlots.push_back(index);
+}
+
+Status AccelerationStructureService::Impl::makeRoom(VkDeviceSize bytes, const std::string& forWhat) {
+  if (desc.blasBudgetBytes == 0) return {};
+  while (reservedBytes + bytes > desc.blasBudgetBytes) {
+    uint32_t victim = 0;
+    uint64_t oldest = UINT64_MAX;
+    for (uint32_t i = 1; i < entries.size(); ++i) {
+      const BlasEntry& e = entries[i];
+      if (e.state == BlasState::Free || e.refCount > 0) continue;
+      bool inLatestTlas = e.lastTlasSerial != 0 && e.lastTlasSerial == tlasSerial;
+      bool inFlight = e.lastTlasSerial != 0 && c.frame < e.lastUsedFrame + c.desc.framesInFlight;
+      if (inLatestTlas || inFlight) continue;
+      if (e.releasedOrder < oldest) {
+        oldest = e.releasedOrder;
+        victim = i;
+      }
+    }
+    if (victim == 0) {
+      return Error{ErrorCode::OutOfBudget, VK_SUCCESS,
+                   forWhat + " needs " + std::to_string(bytes) + " bytes of BLAS storage but the budget of " +
+                       std::to_string(desc.blasBudgetBytes) + " bytes has " + std::to_string(reservedBytes) +
+                       " bytes held by meshes that are registered or referenced by a TLAS in flight; raise "
+                       "AsServiceDesc::blasBudgetBytes or release meshes"};
+    }
+    destroyEntry(victim);
+    ++counters.evictions;
+  }
+  return {};
+}
+
+AccelerationStructureService::AccelerationStructureService(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+AccelerationStructureService::~AccelerationStructureService() = default;
+
+Result<std::unique_ptr<AccelerationStructureService>> AccelerationStructureService::create(Context& context,
+                                                                                          const AsServiceDesc& desc) {
+  if (desc.storageBlockBytes != 0 && desc.storageBlockBytes < (1u << 16)) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "AsServiceDesc::storageBlockBytes is " + std::to_string(desc.storageBlockBytes) +
+                     "; use 0 (32 MiB) or at least 64 KiB"};
+  }
+  return std::unique_ptr<AccelerationStructureService>(
+      new AccelerationStructureService(std::make_unique<Impl>(context, desc)));
+}
+
+Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& desc) {
+  Impl& s = *impl_;
+  Result<ValidatedMesh> v = validateMesh(desc, s.c.vk, s.c.desc.physicalDevice, s.c.info.maxPrimitiveCount);
+  if (!v) return v.error();
+  bool dedupable = v->desc.role == MeshRole::Static || v->desc.contentKey != 0;
+  if (dedupable) {
+    if (auto it = s.byKey.find(v->key); it != s.byKey.end()) {
+      BlasEntry& e = s.entries[it->second];
+      ++e.refCount;
+      ++s.counters.dedupHits;
+      ++s.counters.registrations;
+      return MeshHandle{it->second, e.generation};
+    }
+  }
+  BlasEntry e;
+  e.mesh = v.value();
+  e.key = v->key;
+  VkAccelerationStructureGeometryKHR geometry;
+  VkAccelerationStructureBuildRangeInfoKHR range;
+  s.buildGeometry(e, geometry, range);
+  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  info.flags = s.blasFlags(e);
+  info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  info.geometryCount = 1;
+  info.pGeometries = &geometry;
+  s.c.vk.vkGetAccelerationStructureBuildSizesKHR(s.c.desc.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR,
+                                                 &info, &range.primitiveCount, &e.sizes);
+  VkDeviceSize need = alignUp(e.sizes.accelerationStructureSize, AsStorageAllocator::kAlignment);
+  std::string name = desc.debugName ? std::string("mesh '") + desc.debugName + "'" : "a mesh";
+  if (Status st = s.makeRoom(need, "registering " + name); !st) return st.error();
+
+  uint32_t index;
+  if (!s.freeSlots.empty()) {
+    index = s.freeSlots.back();
+    s.freeSlots.pop_back();
+    e.generation = s.entries[index].generation;
+  } else {
+    index = static_cast<uint32_t>(s.entries.size());
+    s.entries.emplace_back();
+    e.generation = 1;
+  }
+  e.state = BlasState::Queued;
+  e.refCount = 1;
+  s.entries[index] = e;
+  s.queue.push_back(index);
+  if (dedupable) s.byKey[e.key] = index;
+  s.reservedBytes += need;
+  ++s.counters.registrations;
+  return MeshHandle{index, e.generation};
+}
+
+Status AccelerationStructureService::releaseMesh(MeshHandle mesh) {
+  Impl& s = *impl_;
+  Result<BlasEntry*> e = s.lookup(mesh, "releaseMesh");
+  if (!e) return e.error();
+  BlasEntry& entry = *e.value();
+  if (--entry.refCount > 0) return {};
+  bool cacheable = s.byKey.count(entry.key) && s.byKey[entry.key] == mesh.index;
+  if (entry.state == BlasState::Queued || !cacheable) {
+    // Nothing to gain from keeping it: never built, or (dynamic) no registration can ever match it again.
+    s.destroyEntry(mesh.index);
+  } else {
+    entry.releasedOrder = ++s.releaseCounter;
+  }
+  return {};
+}
+
+Status AccelerationStructureService::updateMesh(MeshHandle mesh) {
+  Impl& s = *impl_;
+  Result<BlasEntry*> e = s.lookup(mesh, "updateMesh");
+  if (!e) return e.error();
+  if (e.value()->mesh.desc.role != MeshRole::Dynamic) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "updateMesh: " + meshName(*e.value(), mesh.index) +
+                     " was registered with MeshRole::Static; register deforming meshes as MeshRole::Dynamic"};
+  }
+  if (e.value()->state == BlasState::Built) e.value()->needsRefit = true;
+  return {};
+}
+
+void AccelerationStructureService::Impl::resolveBatches() {
+  std::vector<BuildBatch> keep;
+  for (BuildBatch& b : inFlightBatches) {
+    if (c.frame < b.frame + c.desc.framesInFlight) {
+      keep.push_back(b);
+      continue;
+    }
+    if (b.timestamps) {
+      uint64_t ticks[2] = {0, 0};
+      VkResult r = c.vk.vkGetQueryPoolResults(c.desc.device, b.timestamps, 0, 2, sizeof(ticks), ticks,
+                                              sizeof(uint64_t), VK_QUERY_RESULT_64_BIT);
+      if (r == VK_NOT_READY) {
+        keep.push_back(b);
+        continue;
+      }
+      if (r == VK_SUCCESS) {
+        BuildBatchTiming t{b.frame, b.builds, b.triangles,
+                           double(ticks[1] - ticks[0]) * c.info.timestampPeriodNs * 1e-6};
+        timings.push_back(t);
+        if (timings.size() > kMaxTimings) timings.erase(timings.begin());
+      }
+      freeTimestampPools.push_back(b.timestamps);
+    }
+    if (b.compactedSizes) {
+      std::vector<uint64_t> sizes(b.compactEntries.size(), 0);
+      VkResult r = c.vk.vkGetQueryPoolResults(c.desc.device, b.compactedSizes, 0,
+                                              static_cast<uint32_t>(sizes.size()), sizes.size() * sizeof(uint64_t),
+                                              sizes.data(), sizeof(uint64_t), VK_QUERY_RESULT_64_BIT);
+      if (r == VK_SUCCESS) {
+        for (size_t i = 0; i < sizes.size(); ++i) {
+          BlasEntry& e = entries[b.compactEntries[i]];
+          if (e.generation != b.compactGenerations[i] || e.state != BlasState::Built || !e.compactionPending) continue;
+          e.compactionPending = false;
+          // Lavapipe reports the built size: a copy would cost time and save nothing.
+          if (sizes[i] == 0 || sizes[i] * 50 >= e.builtSize * 49) {
+            ++counters.compactionsSkipped;
+          } else {
+            e.compactedSize = sizes[i];
+          }
+        }
+      }
+      c.vk.vkDestroyQueryPool(c.desc.device, b.compactedSizes, c.allocator());
+    }
+  }
+  inFlightBatches = std::move(keep);
+}
+
+Status AccelerationStructureService::Impl::recordCompactions(VkCommandBuffer cmd, bool& recordedAny) {
+  bool copied = false;
+  for (uint32_t i = 1; i < entries.size(); ++i) {
+    BlasEntry& e = entries[i];
+    if (e.state != BlasState::Built || e.compactedSize == 0 || e.compacted) continue;
+    Result<StorageAllocation> alloc = storage.allocate(e.compactedSize);
+    if (!alloc) return alloc.error();
+    Result<VkAccelerationStructureKHR> as = createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                     storage.buffer(alloc->block), alloc->offset, e.compactedSize);
+    if (!as) {
+      storage.free(alloc.value());
+      return as.error();
+    }
+    VkCopyAccelerationStructureInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR};
+    copy.src = e.as;
+    copy.dst = as.value();
+    copy.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR;
+    c.vk.vkCmdCopyAccelerationStructureKHR(cmd, &copy);
+    VkAccelerationStructureKHR old = e.as;
+    StorageAllocation oldAlloc = e.storage;
+    c.retire([this, old, oldAlloc] {
+      c.vk.vkDestroyAccelerationStructureKHR(c.desc.device, old, c.allocator());
+      storage.free(oldAlloc);
+    });
+    reservedBytes -= alignUp(e.currentSize, AsStorageAllocator::kAlignment);
+    reservedBytes += alloc->size;
+    e.as = as.value();
+    e.storage = alloc.value();
+    e.currentSize = e.compactedSize;
+    VkAccelerationStructureDeviceAddressInfoKHR ai{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
+    ai.accelerationStructure = e.as;
+    e.address = c.vk.vkGetAccelerationStructureDeviceAddressKHR(c.desc.device, &ai);
+    e.compacted = true;
+    ++counters.blasCompacted;
+    copied = true;
+  }
+  if (copied) {
+    recordedAny = true;
+    recordAsBarrier(c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
+  }
+  return {};
+}
+
+Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd, std::vector<uint32_t>& batch,
+                                                           bool refit, VkDeviceSize scratchBytes,
+                                                           bool& recordedAny) {
+  if (batch.empty()) return {};
+  const VkDeviceSize align = scratchAlignment();
+  // Scratch: the persistent buffer when the batch fits the budget, else transient scratch for this batch.
+  GpuBuffer transient;
+  VkDeviceAddress scratchBase = 0;
+  if (scratchBytes > desc.scratchBudgetBytes) {
+    Result<GpuBuffer> t = createBuffer(ctx, scratchBytes + align,
+                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                                       MemoryLocation::DeviceLocal, MemoryCategory::Scratch, "oversized BLAS scratch");
+    if (!t) return t.error();
+    transient = t.value();
+    scratchBase = alignUp(transient.address, align);
+  } else {
+    if (!scratch.valid()) {
+      Result<GpuBuffer> t = createBuffer(
+          ctx, desc.scratchBudgetBytes + align,
+          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT, MemoryLocation::DeviceLocal,
+          MemoryCategory::Scratch, "BLAS build scratch");
+      if (!t) return t.error();
+      scratch = t.value();
+    }
+    scratchBase = alignUp(scratch.address, align);
+  }
+
+  std::vector<VkAccelerationStructureGeometryKHR> geometries(batch.size());
+  std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges(batch.size());
+  std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> rangePtrs(batch.size());
+  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos(batch.size());
+  BuildBatch record;
+  record.frame = c.frame;
+  VkDeviceSize offset = 0;
+  for (size_t i = 0; i < batch.size(); ++i) {
+    BlasEntry& e = entries[batch[i]];
+    if (!refit) {
+      Result<StorageAllocation> alloc = storage.allocate(e.sizes.accelerationStructureSize);
+      if (!alloc) return alloc.error();
+      Result<VkAccelerationStructureKHR> as =
+          createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, storage.buffer(alloc->block), alloc->offset,
+                   e.sizes.accelerationStructureSize);
+      if (!as) {
+        storage.free(alloc.value());
+        return as.error();
+      }
+      e.as = as.value();
+      e.storage = alloc.value();
+      VkAccelerationStructureDeviceAddressInfoKHR ai{
+          VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
+      ai.accelerationStructure = e.as;
+      e.address = c.vk.vkGetAccelerationStructureDeviceAddressKHR(c.desc.device, &ai);
+      e.builtSize = e.sizes.accelerationStructureSize;
+      e.currentSize = e.builtSize;
+    }
+    buildGeometry(e, geometries[i], ranges[i]);
+    rangePtrs[i] = &ranges[i];
+    VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
+    info = VkAccelerationStructureBuildGeometryInfoKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+    info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+    info.flags = blasFlags(e);
+    info.mode = refit ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+    info.srcAccelerationStructure = refit ? e.as : VK_NULL_HANDLE;
+    info.dstAccelerationStructure = e.as;
+    info.geometryCount = 1;
+    info.pGeometries = &geometries[i];
+    info.scratchData.deviceAddress = scratchBase + offset;
+    offset += alignUp(refit ? e.sizes.updateScratchSize : e.sizes.buildScratchSize, align);
+    record.triangles += e.mesh.desc.triangleCount;
+    if (!refit && (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR)) {
+      record.compactEntries.push_back(batch[i]);
+      record.compactGenerations.push_back(e.generation);
+      e.compactionPending = true;
+    }
+  }
+  record.builds = static_cast<uint32_t>(batch.size());
+
+  if (!desc.disableTimestamps && c.info.timestampsSupported) {
+    if (freeTimestampPools.empty()) {
+      VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+      qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+      qi.queryCount = 2;
+      VkQueryPool pool;
+      VkResult r = c.vk.vkCreateQueryPool(c.desc.device, &qi, c.allocator(), &pool);
+      if (r != VK_SUCCESS) return vulkanError(r, "vkCreateQueryPool (build timestamps)");
+      freeTimestampPools.push_back(pool);
+    }
+    record.timestamps = freeTimestampPools.back();
+    freeTimestampPools.pop_back();
+    c.vk.vkCmdResetQueryPool(cmd, record.timestamps, 0, 2);
+  }
+  if (!record.compactEntries.empty()) {
+    VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qi.queryType = VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR;
+    qi.queryCount = static_cast<uint32_t>(record.compactEntries.size());
+    VkResult r = c.vk.vkCreateQueryPool(c.desc.device, &qi, c.allocator(), &record.compactedSizes);
+    if (r != VK_SUCCESS) return vulkanError(r, "vkCreateQueryPool (compacted sizes)");
+    c.vk.vkCmdResetQueryPool(cmd, record.compactedSizes, 0, qi.queryCount);
+  }
+
+  // Orders this batch after earlier users of the scratch memory and the storage (earlier batches, earlier
+  // frames on the same queue).
+  recordAsBarrier(c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
+  if (record.timestamps) {
+    c.vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, record.timestamps, 0);
+  }
+  c.vk.vkCmdBuildAccelerationStructuresKHR(cmd, static_cast<uint32_t>(infos.size()), infos.data(), rangePtrs.data());
+  if (record.timestamps) {
+    c.vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, record.timestamps, 1);
+  }
+  recordAsBarrier(c.vk, cmd,
+                  VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR);
+  if (record.compactedSizes) {
+    std::vector<VkAccelerationStructureKHR> handles;
+    for (uint32_t idx : record.compactEntries) handles.push_back(entries[idx].as);
+    c.vk.vkCmdWriteAccelerationStructuresPropertiesKHR(cmd, static_cast<uint32_t>(handles.size()), handles.data(),
+                                                      VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR,
+                                                      record.compactedSizes, 0);
+  }
+  for (uint32_t idx : batch) {
+    entries[idx].state = BlasState::Built;
+    entries[idx].needsRefit = false;
+  }
+  if (transient.valid()) retireBuffer(ctx, transient);
+  inFlightBatches.push_back(std::move(record));
+  recordedAny = true;
+  return {};
+}
+
+Result<uint32_t> AccelerationStructureService::recordPendingWork(VkCommandBuffer cmd) {
+  Impl& s = *impl_;
+  if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "recordPendingWork: cmd is VK_NULL_HANDLE"};
+  s.resolveBatches();
+  bool recordedAny = false;
+  if (Status st = s.recordCompactions(cmd, recordedAny); !st) return st.error();
+
+  const VkDeviceSize align = s.scratchAlignment();
+  // Refits of deforming meshes first: they are cheap and their TLAS instances are already live.
+  std::vector<uint32_t> batch;
+  VkDeviceSize batchScratch = 0;
+  for (uint32_t i = 1; i < s.entries.size(); ++i) {
+    BlasEntry& e = s.entries[i];
+    if (e.state != BlasState::Built || !e.needsRefit) continue;
+    VkDeviceSize need = alignUp(e.sizes.updateScratchSize, align);
+    if (!batch.empty() && batchScratch + need > s.desc.scratchBudgetBytes) {
+      if (Status st = s.recordBuildBatch(cmd, batch, true, batchScratch, recordedAny); !st) return st.error();
+      batch.clear();
+      batchScratch = 0;
+    }
+    batch.push_back(i);
+    batchScratch += need;
+  }
+  if (Status st = s.recordBuildBatch(cmd, batch, true, batchScratch, recordedAny); !st) return st.error();
+
+  uint64_t trianglesThisCall = 0;
+  const uint64_t triangleCap = s.desc.maxBuildTrianglesPerCall;
+  batch.clear();
+  batchScratch = 0;
+  while (!s.queue.empty()) {
+    uint32_t index = s.queue.front();
+    BlasEntry& e = s.entries[index];
+    VkDeviceSize need = alignUp(e.sizes.buildScratchSize, align);
+    if (triangleCap && trianglesThisCall > 0 && trianglesThisCall + e.mesh.desc.triangleCount > triangleCap) break;
+    if (!batch.empty() && batchScratch + need > s.desc.scratchBudgetBytes) {
+      if (Status st = s.recordBuildBatch(cmd, batch, false, batchScratch, recordedAny); !st) return st.error();
+      batch.clear();
+      batchScratch = 0;
+    }
+    s.queue.pop_front();
+    batch.push_back(index);
+    batchScratch += need;
+    trianglesThisCall += e.mesh.desc.triangleCount;
+  }
+  if (Status st = s.recordBuildBatch(cmd, batch, false, batchScratch, recordedAny); !st) return st.error();
+  (void)recordedAny;
+  return static_cast<uint32_t>(s.queue.size());
+}
+
+Result<bool> AccelerationStructureService::isBuilt(MeshHandle mesh) const {
+  Result<BlasEntry*> e = impl_->lookup(mesh, "isBuilt");
+  if (!e) return e.error();
+  return e.value()->state == BlasState::Built;
+}
+
+Result<VkDeviceAddress> AccelerationStructureService::blasAddress(MeshHandle mesh) const {
+  Result<BlasEntry*> e = impl_->lookup(mesh, "blasAddress");
+  if (!e) return e.error();
+  if (e.value()->state != BlasState::Built) {
+    return Error{ErrorCode::NotReady, VK_SUCCESS, "blasAddress: the mesh's BLAS build has not been recorded yet"};
+  }
+  return e.value()->address;
+}
+
+AsStats AccelerationStructureService::stats() const {
+  Impl& s = *impl_;
+  s.resolveBatches();
+  AsStats out = s.counters;
+  out.meshHandles = out.blasCount = out.blasQueued = 0;
+  out.triangles = out.blasBytes = out.blasBytesBeforeCompaction = 0;
+  for (uint32_t i = 1; i < s.entries.size(); ++i) {
+    const BlasEntry& e = s.entries[i];
+    if (e.state == BlasState::Free) continue;
+    ++out.blasCount;
+    if (e.refCount > 0) ++out.meshHandles;
+    if (e.state == BlasState::Queued) {
+      ++out.blasQueued;
+      continue;
+    }
+    out.triangles += e.mesh.desc.triangleCount;
+    out.blasBytesBeforeCompaction += e.builtSize;
+    out.blasBytes += e.currentSize;
+  }
+  out.bytesPerTriangle = out.triangles ? double(out.blasBytes) / double(out.triangles) : 0.0;
+  out.storageBlocks = s.storage.blockCount();
+  out.storageBlockBytes = s.storage.blockBytes();
+  out.storageUsedBytes = s.storage.usedBytes();
+  out.scratchBytes = s.scratch.allocatedBytes;
+  out.tlasBytes = 0;
+  for (const TlasSlot& t : s.tlasSlots) {
+    out.tlasBytes += t.storage.allocatedBytes + t.scratch.allocatedBytes + t.instances.allocatedBytes;
+  }
+  out.batches = s.timings;
+  return out;
+}
+
+}  // namespace rb

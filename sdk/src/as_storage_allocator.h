@@ -1,0 +1,48 @@
+// Packs acceleration-structure storage into large device buffers at the required 256-byte alignment instead
+// of one buffer (and one VkDeviceMemory) per BLAS.
+#pragma once
+
+#include <vector>
+
+#include "gpu_memory.h"
+
+namespace rb {
+
+struct StorageAllocation {
+  uint32_t block = UINT32_MAX;
+  VkDeviceSize offset = 0;
+  VkDeviceSize size = 0;  // aligned size held
+  bool valid() const { return block != UINT32_MAX; }
+};
+
+class AsStorageAllocator {
+ public:
+  static constexpr VkDeviceSize kAlignment = 256;  // VkAccelerationStructureCreateInfoKHR::offset rule
+
+  AsStorageAllocator(Context& ctx, VkDeviceSize blockBytes) : ctx_(ctx), blockBytes_(blockBytes) {}
+  ~AsStorageAllocator();
+
+  Result<StorageAllocation> allocate(VkDeviceSize size);
+  // Returns the range at once: call it when no frame in flight can use the range any more.
+  void free(const StorageAllocation& allocation);
+  VkBuffer buffer(uint32_t block) const { return blocks_[block].buffer.buffer; }
+
+  uint32_t blockCount() const;
+  VkDeviceSize blockBytes() const;  // device memory held
+  VkDeviceSize usedBytes() const;
+
+ private:
+  struct Range {
+    VkDeviceSize offset, size;
+  };
+  struct Block {
+    GpuBuffer buffer;
+    std::vector<Range> freeRanges;  // sorted by offset, coalesced
+    VkDeviceSize used = 0;
+  };
+  Context& ctx_;
+  VkDeviceSize blockBytes_;
+  std::vector<Block> blocks_;  // a destroyed block keeps its slot (invalid buffer) so indices stay stable
+};
+
+}  // namespace rb

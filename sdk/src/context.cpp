@@ -1,0 +1,241 @@
+#include <raybridge/context.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "context_impl.h"
+
+namespace rb {
+
+namespace {
+
+constexpr const char* kRequiredExtensions[] = {
+    VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+    VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME,
+    VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
+    VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME,
+};
+
+Status checkExtensions(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice, const std::string& deviceName) {
+  uint32_t count = 0;
+  vk.vkEnumerateDeviceExtensionProperties(physicalDevice, nullptr, &count, nullptr);
+  std::vector<VkExtensionProperties> available(count);
+  vk.vkEnumerateDeviceExtensionProperties(physicalDevice, nullptr, &count, available.data());
+  std::string missing;
+  for (const char* name : kRequiredExtensions) {
+    bool found = std::any_of(available.begin(), available.end(),
+                             [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+    if (!found) missing += std::string(missing.empty() ? "" : ", ") + name;
+  }
+  if (!missing.empty()) {
+    return Error{ErrorCode::MissingExtension, VK_SUCCESS,
+                 "device '" + deviceName + "' does not support the extensions Raybridge needs: " + missing +
+                     ". Use a device with hardware or software ray tracing pipelines (e.g. Mesa 25 lavapipe)."};
+  }
+  return {};
+}
+
+Status checkFeatures(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice, const std::string& deviceName) {
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR rt{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rt};
+  VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as};
+  VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &v12};
+  vk.vkGetPhysicalDeviceFeatures2(physicalDevice, &f2);
+  std::string missing;
+  auto need = [&](VkBool32 v, const char* name) {
+    if (!v) missing += std::string(missing.empty() ? "" : ", ") + name;
+  };
+  need(v12.bufferDeviceAddress, "bufferDeviceAddress");
+  need(v12.descriptorIndexing, "descriptorIndexing");
+  need(v12.runtimeDescriptorArray, "runtimeDescriptorArray");
+  need(v12.shaderSampledImageArrayNonUniformIndexing, "shaderSampledImageArrayNonUniformIndexing");
+  need(v12.scalarBlockLayout, "scalarBlockLayout");
+  need(as.accelerationStructure, "accelerationStructure");
+  need(rt.rayTracingPipeline, "rayTracingPipeline");
+  if (!missing.empty()) {
+    return Error{ErrorCode::MissingFeature, VK_SUCCESS,
+                 "device '" + deviceName + "' does not support the features Raybridge needs: " + missing};
+  }
+  return {};
+}
+
+}  // namespace
+
+std::span<const char* const> requiredDeviceExtensions() { return kRequiredExtensions; }
+
+RequiredFeatures::RequiredFeatures() {
+  vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+  vulkan12.pNext = &accelerationStructure;
+  vulkan12.bufferDeviceAddress = VK_TRUE;
+  vulkan12.descriptorIndexing = VK_TRUE;
+  vulkan12.runtimeDescriptorArray = VK_TRUE;
+  vulkan12.shaderSampledImageArrayNonUniformIndexing = VK_TRUE;
+  vulkan12.scalarBlockLayout = VK_TRUE;
+  accelerationStructure.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
+  accelerationStructure.pNext = &rayTracingPipeline;
+  accelerationStructure.accelerationStructure = VK_TRUE;
+  rayTracingPipeline.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR;
+  rayTracingPipeline.pNext = nullptr;
+  rayTracingPipeline.rayTracingPipeline = VK_TRUE;
+}
+
+void* RequiredFeatures::link(void* next) {
+  rayTracingPipeline.pNext = next;
+  return chainHead();
+}
+
+const char* toString(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::Ok: return "Ok";
+    case ErrorCode::InvalidArgument: return "InvalidArgument";
+    case ErrorCode::MissingExtension: return "MissingExtension";
+    case ErrorCode::MissingFeature: return "MissingFeature";
+    case ErrorCode::NoSuitableDevice: return "NoSuitableDevice";
+    case ErrorCode::VulkanError: return "VulkanError";
+    case ErrorCode::OutOfBudget: return "OutOfBudget";
+    case ErrorCode::StaleHandle: return "StaleHandle";
+    case ErrorCode::NotReady: return "NotReady";
+  }
+  return "Unknown";
+}
+
+const char* toString(MemoryCategory category) {
+  switch (category) {
+    case MemoryCategory::BlasStorage: return "blas_storage";
+    case MemoryCategory::Scratch: return "scratch";
+    case MemoryCategory::Tlas: return "tlas";
+    case MemoryCategory::ShaderTables: return "shader_tables";
+    case MemoryCategory::PassImages: return "pass_images";
+    case MemoryCategory::PassBuffers: return "pass_buffers";
+    case MemoryCategory::Count: break;
+  }
+  return "unknown";
+}
+
+Result<std::unique_ptr<Context>> Context::create(const ContextDesc& desc) {
+  auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, m}; };
+  if (!desc.instance) return invalid("ContextDesc::instance is VK_NULL_HANDLE; pass the engine's VkInstance");
+  if (!desc.physicalDevice) {
+    return invalid("ContextDesc::physicalDevice is VK_NULL_HANDLE; pass the engine's VkPhysicalDevice");
+  }
+  if (!desc.device) return invalid("ContextDesc::device is VK_NULL_HANDLE; pass the engine's VkDevice");
+  if (!desc.getInstanceProcAddr) {
+    return invalid("ContextDesc::getInstanceProcAddr is null; pass vkGetInstanceProcAddr of the engine's loader");
+  }
+  if (desc.framesInFlight > 8) {
+    return invalid("ContextDesc::framesInFlight is " + std::to_string(desc.framesInFlight) + "; use 1..8 (0 = 2)");
+  }
+
+  auto impl = std::make_unique<Impl>();
+  impl->desc = desc;
+  if (impl->desc.framesInFlight == 0) impl->desc.framesInFlight = 2;
+  DeviceFunctions& vk = impl->vk;
+
+  // Instance-level queries first, so a device without the extensions gets a message naming them rather than
+  // one naming a missing function pointer.
+  vk.vkGetPhysicalDeviceProperties2 = reinterpret_cast<PFN_vkGetPhysicalDeviceProperties2>(
+      desc.getInstanceProcAddr(desc.instance, "vkGetPhysicalDeviceProperties2"));
+  vk.vkGetPhysicalDeviceFeatures2 = reinterpret_cast<PFN_vkGetPhysicalDeviceFeatures2>(
+      desc.getInstanceProcAddr(desc.instance, "vkGetPhysicalDeviceFeatures2"));
+  vk.vkEnumerateDeviceExtensionProperties = reinterpret_cast<PFN_vkEnumerateDeviceExtensionProperties>(
+      desc.getInstanceProcAddr(desc.instance, "vkEnumerateDeviceExtensionProperties"));
+  if (!vk.vkGetPhysicalDeviceProperties2 || !vk.vkGetPhysicalDeviceFeatures2 ||
+      !vk.vkEnumerateDeviceExtensionProperties) {
+    return invalid("the instance does not expose Vulkan 1.1 queries; create it with apiVersion 1.2 or newer");
+  }
+
+  VkPhysicalDeviceAccelerationStructurePropertiesKHR asProps{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
+  VkPhysicalDeviceRayTracingPipelinePropertiesKHR rtProps{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR, &asProps};
+  VkPhysicalDeviceDriverProperties driverProps{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES, &rtProps};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driverProps};
+  vk.vkGetPhysicalDeviceProperties2(desc.physicalDevice, &props);
+  DeviceInfo& info = impl->info;
+  info.deviceName = props.properties.deviceName;
+  info.apiVersion = props.properties.apiVersion;
+  if (VK_API_VERSION_MINOR(info.apiVersion) < 2 && VK_API_VERSION_MAJOR(info.apiVersion) == 1) {
+    return Error{ErrorCode::MissingFeature, VK_SUCCESS,
+                 "device '" + info.deviceName + "' supports Vulkan " +
+                     std::to_string(VK_API_VERSION_MAJOR(info.apiVersion)) + "." +
+                     std::to_string(VK_API_VERSION_MINOR(info.apiVersion)) + "; Raybridge needs Vulkan 1.2 or newer"};
+  }
+  if (Status s = checkExtensions(vk, desc.physicalDevice, info.deviceName); !s) return s.error();
+  if (Status s = checkFeatures(vk, desc.physicalDevice, info.deviceName); !s) return s.error();
+
+  if (const char* missing = loadDeviceFunctions(vk, desc.getInstanceProcAddr, desc.instance, desc.device)) {
+    return Error{ErrorCode::MissingExtension, VK_SUCCESS,
+                 std::string("Vulkan function ") + missing +
+                     " could not be loaded from the engine's device: enable every extension in "
+                     "rb::requiredDeviceExtensions() and the features of rb::RequiredFeatures when creating it"};
+  }
+
+  info.driverName = driverProps.driverName;
+  info.driverInfo = driverProps.driverInfo;
+  info.vendorId = props.properties.vendorID;
+  info.isCpu = props.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  info.shaderGroupHandleSize = rtProps.shaderGroupHandleSize;
+  info.shaderGroupHandleAlignment = rtProps.shaderGroupHandleAlignment;
+  info.shaderGroupBaseAlignment = rtProps.shaderGroupBaseAlignment;
+  info.maxRayRecursionDepth = rtProps.maxRayRecursionDepth;
+  info.minAccelerationStructureScratchOffsetAlignment = asProps.minAccelerationStructureScratchOffsetAlignment;
+  info.maxPrimitiveCount = asProps.maxPrimitiveCount;
+  info.maxInstanceCount = asProps.maxInstanceCount;
+  info.timestampPeriodNs = props.properties.limits.timestampPeriod;
+  info.timestampsSupported = props.properties.limits.timestampComputeAndGraphics == VK_TRUE;
+  vk.vkGetPhysicalDeviceMemoryProperties(desc.physicalDevice, &impl->memoryProperties);
+
+  return std::unique_ptr<Context>(new Context(std::move(impl)));
+}
+
+Context::Context(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+Context::~Context() { impl_->releaseRetired(/*deviceIdle=*/true); }
+
+void Context::beginFrame() {
+  ++impl_->frame;
+  impl_->releaseRetired(false);
+}
+
+void Context::releaseAfterIdle() { impl_->releaseRetired(true); }
+
+uint64_t Context::frameIndex() const { return impl_->frame; }
+uint32_t Context::framesInFlight() const { return impl_->desc.framesInFlight; }
+const DeviceInfo& Context::deviceInfo() const { return impl_->info; }
+VkDevice Context::device() const { return impl_->desc.device; }
+VkPhysicalDevice Context::physicalDevice() const { return impl_->desc.physicalDevice; }
+MemoryStats Context::memoryStats() const { return impl_->memory; }
+const DeviceFunctions& Context::vk() const { return impl_->vk; }
+
+void Context::Impl::releaseRetired(bool deviceIdle) {
+  // Released in retirement order: a later release may depend on an earlier one still existing.
+  std::vector<PendingRelease> keep;
+  std::vector<PendingRelease> due;
+  for (PendingRelease& p : pendingReleases) {
+    if (deviceIdle || p.frame + desc.framesInFlight <= frame) {
+      due.push_back(std::move(p));
+    } else {
+      keep.push_back(std::move(p));
+    }
+  }
+  pendingReleases = std::move(keep);
+  for (PendingRelease& p : due) p.release();
+}
+
+int32_t Context::Impl::findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required,
+                                      VkMemoryPropertyFlags preferred) const {
+  int32_t fallback = -1;
+  for (uint32_t i = 0; i < memoryProperties.memoryTypeCount; ++i) {
+    if (!(typeBits & (1u << i))) continue;
+    VkMemoryPropertyFlags flags = memoryProperties.memoryTypes[i].propertyFlags;
+    if ((flags & required) != required) continue;
+    if ((flags & preferred) == preferred) return static_cast<int32_t>(i);
+    if (fallback < 0) fallback = static_cast<int32_t>(i);
+  }
+  return fallback;
+}
+
+}  // namespace rb

@@ -1,0 +1,40 @@
+// Context internals shared by the services and passes: the function table, device facts, memory
+// accounting and the deferred-release queue.
+#pragma once
+
+#include <raybridge/context.h>
+
+#include <functional>
+#include <vector>
+
+#include "device_functions.h"
+
+namespace rb {
+
+struct Context::Impl {
+  ContextDesc desc{};
+  DeviceFunctions vk{};
+  DeviceInfo info{};
+  VkPhysicalDeviceMemoryProperties memoryProperties{};
+  uint64_t frame = 0;
+  MemoryStats memory{};
+
+  struct PendingRelease {
+    uint64_t frame;  // frame in which it was retired
+    std::function<void()> release;
+  };
+  std::vector<PendingRelease> pendingReleases;
+
+  // Runs `release` once no frame that may have used the object is in flight any more.
+  void retire(std::function<void()> release) { pendingReleases.push_back({frame, std::move(release)}); }
+  void releaseRetired(bool deviceIdle);
+  int32_t findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
+  const VkAllocationCallbacks* allocator() const { return desc.allocationCallbacks; }
+};
+
+// Builds an Error for a failed Vulkan call: "<what> failed: VK_ERROR_... ".
+Error vulkanError(VkResult result, const std::string& what);
+const char* toString(VkResult result);
+const char* formatName(VkFormat format);
+
+}  // namespace rb

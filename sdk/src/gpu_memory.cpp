@@ -1,0 +1,168 @@
+#include "gpu_memory.h"
+
+#include <string>
+
+#include "context_impl.h"
+
+namespace rb {
+
+namespace {
+
+void account(Context::Impl& c, MemoryCategory category, VkDeviceSize bytes, bool add) {
+  VkDeviceSize& slot = c.memory.bytes[static_cast<size_t>(category)];
+  if (add) {
+    slot += bytes;
+    ++c.memory.allocations;
+  } else {
+    slot -= bytes;
+    --c.memory.allocations;
+  }
+}
+
+Result<VkDeviceMemory> allocate(Context::Impl& c, const VkMemoryRequirements& req, MemoryLocation location,
+                                bool deviceAddress, const char* what) {
+  VkMemoryPropertyFlags required = location == MemoryLocation::HostVisible
+                                       ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                       : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+  int32_t type = c.findMemoryType(req.memoryTypeBits, required, required);
+  if (type < 0 && location == MemoryLocation::DeviceLocal) type = c.findMemoryType(req.memoryTypeBits, 0, 0);
+  if (type < 0) {
+    return Error{ErrorCode::VulkanError, VK_ERROR_OUT_OF_DEVICE_MEMORY,
+                 std::string("no memory type fits ") + what};
+  }
+  VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+  flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+  VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, deviceAddress ? &flags : nullptr};
+  info.allocationSize = req.size;
+  info.memoryTypeIndex = static_cast<uint32_t>(type);
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkResult r = c.vk.vkAllocateMemory(c.desc.device, &info, c.allocator(), &memory);
+  if (r != VK_SUCCESS) {
+    return vulkanError(r, std::string("vkAllocateMemory(") + std::to_string(req.size) + " bytes for " + what + ")");
+  }
+  return memory;
+}
+
+}  // namespace
+
+Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryLocation location,
+                               MemoryCategory category, const char* what) {
+  Context::Impl& c = ctx.impl();
+  GpuBuffer out;
+  out.size = size;
+  out.category = category;
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = size;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VkResult r = c.vk.vkCreateBuffer(c.desc.device, &info, c.allocator(), &out.buffer);
+  if (r != VK_SUCCESS) return vulkanError(r, std::string("vkCreateBuffer for ") + what);
+  VkMemoryRequirements req;
+  c.vk.vkGetBufferMemoryRequirements(c.desc.device, out.buffer, &req);
+  bool deviceAddress = (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0;
+  Result<VkDeviceMemory> memory = allocate(c, req, location, deviceAddress, what);
+  if (!memory) {
+    c.vk.vkDestroyBuffer(c.desc.device, out.buffer, c.allocator());
+    return memory.error();
+  }
+  out.memory = memory.value();
+  out.allocatedBytes = req.size;
+  c.vk.vkBindBufferMemory(c.desc.device, out.buffer, out.memory, 0);
+  if (location == MemoryLocation::HostVisible) {
+    r = c.vk.vkMapMemory(c.desc.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
+    if (r != VK_SUCCESS) {
+      c.vk.vkDestroyBuffer(c.desc.device, out.buffer, c.allocator());
+      c.vk.vkFreeMemory(c.desc.device, out.memory, c.allocator());
+      return vulkanError(r, std::string("vkMapMemory for ") + what);
+    }
+  }
+  if (deviceAddress) {
+    VkBufferDeviceAddressInfo addr{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+    addr.buffer = out.buffer;
+    out.address = c.vk.vkGetBufferDeviceAddress(c.desc.device, &addr);
+  }
+  account(c, category, out.allocatedBytes, true);
+  return out;
+}
+
+void destroyBuffer(Context& ctx, GpuBuffer& buffer) {
+  if (!buffer.valid()) return;
+  Context::Impl& c = ctx.impl();
+  c.vk.vkDestroyBuffer(c.desc.device, buffer.buffer, c.allocator());
+  c.vk.vkFreeMemory(c.desc.device, buffer.memory, c.allocator());
+  account(c, buffer.category, buffer.allocatedBytes, false);
+  buffer = GpuBuffer{};
+}
+
+void retireBuffer(Context& ctx, GpuBuffer& buffer) {
+  if (!buffer.valid()) return;
+  GpuBuffer copy = buffer;
+  buffer = GpuBuffer{};
+  Context* context = &ctx;
+  ctx.impl().retire([context, copy]() mutable { destroyBuffer(*context, copy); });
+}
+
+Result<GpuImage> createStorageImage(Context& ctx, uint32_t width, uint32_t height, VkFormat format,
+                                    VkImageUsageFlags extraUsage, MemoryCategory category, const char* what) {
+  Context::Impl& c = ctx.impl();
+  GpuImage out;
+  out.format = format;
+  out.width = width;
+  out.height = height;
+  out.category = category;
+  VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  info.imageType = VK_IMAGE_TYPE_2D;
+  info.format = format;
+  info.extent = {width, height, 1};
+  info.mipLevels = 1;
+  info.arrayLayers = 1;
+  info.samples = VK_SAMPLE_COUNT_1_BIT;
+  info.tiling = VK_IMAGE_TILING_OPTIMAL;
+  info.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | extraUsage;
+  info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkResult r = c.vk.vkCreateImage(c.desc.device, &info, c.allocator(), &out.image);
+  if (r != VK_SUCCESS) return vulkanError(r, std::string("vkCreateImage for ") + what);
+  VkMemoryRequirements req;
+  c.vk.vkGetImageMemoryRequirements(c.desc.device, out.image, &req);
+  Result<VkDeviceMemory> memory = allocate(c, req, MemoryLocation::DeviceLocal, false, what);
+  if (!memory) {
+    c.vk.vkDestroyImage(c.desc.device, out.image, c.allocator());
+    return memory.error();
+  }
+  out.memory = memory.value();
+  out.allocatedBytes = req.size;
+  c.vk.vkBindImageMemory(c.desc.device, out.image, out.memory, 0);
+  VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+  view.image = out.image;
+  view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+  view.format = format;
+  view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  r = c.vk.vkCreateImageView(c.desc.device, &view, c.allocator(), &out.view);
+  if (r != VK_SUCCESS) {
+    c.vk.vkDestroyImage(c.desc.device, out.image, c.allocator());
+    c.vk.vkFreeMemory(c.desc.device, out.memory, c.allocator());
+    return vulkanError(r, std::string("vkCreateImageView for ") + what);
+  }
+  account(c, category, out.allocatedBytes, true);
+  return out;
+}
+
+void destroyImage(Context& ctx, GpuImage& image) {
+  if (!image.valid()) return;
+  Context::Impl& c = ctx.impl();
+  c.vk.vkDestroyImageView(c.desc.device, image.view, c.allocator());
+  c.vk.vkDestroyImage(c.desc.device, image.image, c.allocator());
+  c.vk.vkFreeMemory(c.desc.device, image.memory, c.allocator());
+  account(c, image.category, image.allocatedBytes, false);
+  image = GpuImage{};
+}
+
+void retireImage(Context& ctx, GpuImage& image) {
+  if (!image.valid()) return;
+  GpuImage copy = image;
+  image = GpuImage{};
+  Context* context = &ctx;
+  ctx.impl().retire([context, copy]() mutable { destroyImage(*context, copy); });
+}
+
+}  // namespace rb

@@ -1,0 +1,48 @@
+// Buffers and images with their memory, allocated through the context's table and counted per category.
+#pragma once
+
+#include <raybridge/context.h>
+
+namespace rb {
+
+enum class MemoryLocation : uint8_t {
+  DeviceLocal,   // fastest for the GPU
+  HostVisible,   // host-visible and coherent, persistently mapped (upload rings, readback)
+};
+
+struct GpuBuffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceAddress address = 0;  // set when usage includes SHADER_DEVICE_ADDRESS
+  VkDeviceSize size = 0;        // requested size
+  VkDeviceSize allocatedBytes = 0;
+  void* mapped = nullptr;
+  MemoryCategory category = MemoryCategory::PassBuffers;
+  bool valid() const { return buffer != VK_NULL_HANDLE; }
+};
+
+struct GpuImage {
+  VkImage image = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  uint32_t width = 0, height = 0;
+  VkDeviceSize allocatedBytes = 0;
+  MemoryCategory category = MemoryCategory::PassImages;
+  bool valid() const { return image != VK_NULL_HANDLE; }
+};
+
+Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryLocation location,
+                               MemoryCategory category, const char* what);
+// Destroys now. Use retireBuffer() when the GPU may still read it.
+void destroyBuffer(Context& ctx, GpuBuffer& buffer);
+// Destroys once the frames in flight that may use it are done (Context::beginFrame contract).
+void retireBuffer(Context& ctx, GpuBuffer& buffer);
+
+// A 2D storage + sampled image with one mip and its view, left in VK_IMAGE_LAYOUT_UNDEFINED.
+Result<GpuImage> createStorageImage(Context& ctx, uint32_t width, uint32_t height, VkFormat format,
+                                    VkImageUsageFlags extraUsage, MemoryCategory category, const char* what);
+void destroyImage(Context& ctx, GpuImage& image);
+void retireImage(Context& ctx, GpuImage& image);
+
+}  // namespace rb

@@ -1,0 +1,120 @@
+#include "mesh_validation.h"
+
+#include <string>
+
+#include "content_hash.h"
+#include "context_impl.h"
+
+namespace rb {
+
+uint32_t vertexFormatSize(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_R32G32B32_SFLOAT: return 12;
+    case VK_FORMAT_R32G32_SFLOAT: return 8;
+    case VK_FORMAT_R32G32B32A32_SFLOAT: return 16;
+    case VK_FORMAT_R16G16B16A16_SFLOAT: return 8;
+    case VK_FORMAT_R16G16_SFLOAT: return 4;
+    case VK_FORMAT_R16G16B16A16_SNORM: return 8;
+    case VK_FORMAT_R16G16_SNORM: return 4;
+    case VK_FORMAT_R8G8B8A8_SNORM: return 4;
+    default: return 0;
+  }
+}
+
+Result<ValidatedMesh> validateMesh(const MeshDesc& in, const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
+                                   uint64_t maxPrimitiveCount) {
+  std::string name = in.debugName ? std::string("mesh '") + in.debugName + "'" : std::string("mesh");
+  auto invalid = [&](const std::string& m) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, name + ": " + m};
+  };
+  ValidatedMesh out;
+  MeshDesc& d = out.desc;
+  d = in;
+  d.hostVertices = nullptr;
+  d.hostIndices = nullptr;
+  if (d.vertexFormat == VK_FORMAT_UNDEFINED) d.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+  uint32_t formatSize = vertexFormatSize(d.vertexFormat);
+  VkFormatProperties fp{};
+  vk.vkGetPhysicalDeviceFormatProperties(physicalDevice, d.vertexFormat, &fp);
+  if (formatSize == 0 || !(fp.bufferFeatures & VK_FORMAT_FEATURE_ACCELERATION_STRUCTURE_VERTEX_BUFFER_BIT_KHR)) {
+    return invalid(std::string("vertexFormat ") + formatName(d.vertexFormat) + " (" +
+                   std::to_string(static_cast<int>(d.vertexFormat)) +
+                   ") cannot be used for acceleration structure builds on this device; use "
+                   "VK_FORMAT_R32G32B32_SFLOAT (or another format with "
+                   "VK_FORMAT_FEATURE_ACCELERATION_STRUCTURE_VERTEX_BUFFER_BIT_KHR)");
+  }
+  if (d.vertexStride == 0) d.vertexStride = formatSize;
+  if (d.vertexStride < formatSize) {
+    return invalid("vertexStride " + std::to_string(d.vertexStride) + " is smaller than the vertex format (" +
+                   std::to_string(formatSize) + " bytes)");
+  }
+  if (d.vertexStride % 4 != 0 && formatSize >= 4) {
+    // The spec requires the stride to be a multiple of the format's smallest component.
+    return invalid("vertexStride " + std::to_string(d.vertexStride) + " must be a multiple of 4 for this format");
+  }
+  if (d.vertexAddress == 0) return invalid("vertexAddress is 0; pass the device address of the position buffer");
+  if (d.triangleCount == 0) return invalid("triangleCount is 0; a mesh needs at least one triangle");
+  if (d.triangleCount > maxPrimitiveCount) {
+    return invalid("triangleCount " + std::to_string(d.triangleCount) + " exceeds the device limit of " +
+                   std::to_string(maxPrimitiveCount) + " primitives per BLAS; split the mesh");
+  }
+  if (d.vertexCount == 0) return invalid("vertexCount is 0");
+  VkDeviceSize vertexBytes = VkDeviceSize(d.vertexCount - 1) * d.vertexStride + formatSize;
+  if (vertexBytes > d.vertexBufferBytes) {
+    return invalid("vertexCount " + std::to_string(d.vertexCount) + " with stride " + std::to_string(d.vertexStride) +
+                   " reads " + std::to_string(vertexBytes) + " bytes but vertexBufferBytes declares " +
+                   std::to_string(d.vertexBufferBytes));
+  }
+  uint64_t indexCount = uint64_t(d.triangleCount) * 3;
+  switch (d.indexType) {
+    case IndexType::Uint32: out.indexSize = 4; break;
+    case IndexType::Uint16: out.indexSize = 2; break;
+    case IndexType::None: out.indexSize = 0; break;
+    default: return invalid("indexType " + std::to_string(static_cast<int>(d.indexType)) + " is not a valid IndexType");
+  }
+  if (out.indexSize) {
+    if (d.indexAddress == 0) return invalid("indexAddress is 0 but indexType is not IndexType::None");
+    if (d.indexAddress % out.indexSize != 0) {
+      return invalid("indexAddress is not aligned to the index size (" + std::to_string(out.indexSize) + " bytes)");
+    }
+    if (indexCount * out.indexSize > d.indexBufferBytes) {
+      return invalid("triangleCount " + std::to_string(d.triangleCount) + " reads " +
+                     std::to_string(indexCount * out.indexSize) + " index bytes but indexBufferBytes declares " +
+                     std::to_string(d.indexBufferBytes));
+    }
+  } else {
+    if (indexCount > d.vertexCount) {
+      return invalid("non-indexed triangleCount " + std::to_string(d.triangleCount) + " needs " +
+                     std::to_string(indexCount) + " vertices but vertexCount is " + std::to_string(d.vertexCount));
+    }
+    d.indexAddress = 0;
+    d.indexBufferBytes = 0;
+  }
+  if (in.hostIndices && out.indexSize) {
+    // With a CPU copy at hand, an index past the vertex range is caught here instead of reading out of bounds.
+    for (uint64_t i = 0; i < indexCount; ++i) {
+      uint32_t v = out.indexSize == 4 ? static_cast<const uint32_t*>(in.hostIndices)[i]
+                                      : static_cast<const uint16_t*>(in.hostIndices)[i];
+      if (v >= d.vertexCount) {
+        return invalid("index " + std::to_string(i) + " is " + std::to_string(v) + " but vertexCount is " +
+                       std::to_string(d.vertexCount));
+      }
+    }
+  }
+
+  uint64_t layout = hashCombine(hashCombine(d.vertexFormat, d.vertexStride),
+                                hashCombine(uint64_t(d.indexType) << 32 | d.triangleCount,
+                                            uint64_t(d.vertexCount) << 1 | (d.nonOpaque ? 1 : 0)));
+  if (d.contentKey != 0) {
+    out.key = hashCombine(0x6b6579ull, d.contentKey);
+  } else if (in.hostVertices && (in.hostIndices || !out.indexSize)) {
+    uint64_t h = hashBytes(in.hostVertices, static_cast<size_t>(vertexBytes), layout);
+    if (out.indexSize) h = hashBytes(in.hostIndices, static_cast<size_t>(indexCount * out.indexSize), h);
+    out.key = hashCombine(0x636f6e74656e74ull, h);
+  } else {
+    out.key = hashCombine(hashCombine(0x6964656e74ull, layout), hashCombine(d.vertexAddress, d.indexAddress));
+  }
+  return out;
+}
+
+}  // namespace rb

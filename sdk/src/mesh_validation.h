@@ -1,0 +1,21 @@
+// Checks a MeshDesc against the device and the engine's declared buffer sizes, and derives its dedup key.
+#pragma once
+
+#include <raybridge/acceleration_structures.h>
+
+#include "device_functions.h"
+
+namespace rb {
+
+struct ValidatedMesh {
+  MeshDesc desc;  // with defaults resolved (format, stride); host pointers cleared
+  uint64_t key = 0;
+  uint32_t indexSize = 0;  // bytes per index, 0 for non-indexed
+};
+
+uint32_t vertexFormatSize(VkFormat format);  // 0 for formats Raybridge does not know
+
+Result<ValidatedMesh> validateMesh(const MeshDesc& desc, const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
+                                   uint64_t maxPrimitiveCount);
+
+}  // namespace rb

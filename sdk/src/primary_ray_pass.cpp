@@ -1,0 +1,137 @@
+#include <raybridge/primary_ray_pass.h>
+
+#include <cmath>
+#include <string>
+
+#include "context_impl.h"
+#include "ray_tracing_pipeline.h"
+#include "raybridge_shaders.h"
+
+namespace rb {
+
+namespace {
+
+struct PrimaryConstants {
+  float eye[4];
+  float right[4];
+  float up[4];
+  float forward[4];
+  uint32_t size[2];
+  float tMin;
+  float tMax;
+};
+
+void cross(const float a[3], const float b[3], float out[3]) {
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+float normalize(float v[3]) {
+  float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (len > 0.0f) {
+    v[0] /= len;
+    v[1] /= len;
+    v[2] /= len;
+  }
+  return len;
+}
+
+}  // namespace
+
+Result<CameraBasis> computeCameraBasis(const PrimaryRayCamera& camera, uint32_t width, uint32_t height) {
+  auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, m}; };
+  if (width == 0 || height == 0) {
+    return invalid("image size " + std::to_string(width) + "x" + std::to_string(height) + " is empty");
+  }
+  float fov = camera.verticalFovDegrees == 0.0f ? 60.0f : camera.verticalFovDegrees;
+  if (!(fov > 0.0f && fov < 180.0f)) {
+    return invalid("verticalFovDegrees " + std::to_string(fov) + " is outside (0, 180)");
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(camera.eye[i]) || !std::isfinite(camera.target[i])) {
+      return invalid("camera eye and target must be finite numbers");
+    }
+  }
+  CameraBasis b;
+  for (int i = 0; i < 3; ++i) {
+    b.eye[i] = camera.eye[i];
+    b.forward[i] = camera.target[i] - camera.eye[i];
+  }
+  if (normalize(b.forward) == 0.0f) return invalid("camera eye equals target; they must differ to define a view");
+  float up[3] = {camera.upHint[0], camera.upHint[1], camera.upHint[2]};
+  cross(b.forward, up, b.right);
+  if (normalize(b.right) < 1e-6f) {
+    return invalid("camera up hint is parallel to the view direction; choose another up vector");
+  }
+  cross(b.right, b.forward, b.up);
+  normalize(b.up);
+  float tanHalf = std::tan(fov * 0.5f * 3.14159265358979f / 180.0f);
+  float aspect = float(width) / float(height);
+  for (int i = 0; i < 3; ++i) {
+    b.right[i] *= tanHalf * aspect;
+    b.up[i] *= tanHalf;
+  }
+  return b;
+}
+
+struct PrimaryRayPass::Impl {
+  Context& ctx;
+  RayTracingPipeline pipeline;
+  explicit Impl(Context& c) : ctx(c) {}
+  ~Impl() { pipeline.destroy(ctx); }
+};
+
+PrimaryRayPass::PrimaryRayPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+PrimaryRayPass::~PrimaryRayPass() = default;
+
+Result<std::unique_ptr<PrimaryRayPass>> PrimaryRayPass::create(Context& context) {
+  RayTracingPipelineDesc desc;
+  desc.name = "primary ray pass";
+  desc.raygen = SpirvModule::of(spirv::primary_rgen);
+  desc.misses = {SpirvModule::of(spirv::primary_rmiss)};
+  desc.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::primary_rchit), {}}};
+  desc.bindings = {
+      {0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr},
+      {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr},
+      {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr},
+  };
+  desc.pushConstantBytes = sizeof(PrimaryConstants);
+  auto impl = std::make_unique<Impl>(context);
+  Result<RayTracingPipeline> p = RayTracingPipeline::create(context, desc);
+  if (!p) return p.error();
+  impl->pipeline = p.value();
+  return std::unique_ptr<PrimaryRayPass>(new PrimaryRayPass(std::move(impl)));
+}
+
+Status PrimaryRayPass::record(VkCommandBuffer cmd, VkAccelerationStructureKHR tlas, const PrimaryRayCamera& camera,
+                              const PrimaryRayTargets& targets) {
+  auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, m}; };
+  if (!cmd) return invalid("PrimaryRayPass::record: cmd is VK_NULL_HANDLE");
+  if (!tlas) return invalid("PrimaryRayPass::record: tlas is VK_NULL_HANDLE; build one with recordTlasBuild()");
+  if (!targets.hitDistance || !targets.hitIds) {
+    return invalid("PrimaryRayPass::record: targets.hitDistance and targets.hitIds are required");
+  }
+  Result<CameraBasis> basis = computeCameraBasis(camera, targets.width, targets.height);
+  if (!basis) return Error{basis.error().code, VK_SUCCESS, "PrimaryRayPass::record: " + basis.error().message};
+  PrimaryConstants pc{};
+  for (int i = 0; i < 3; ++i) {
+    pc.eye[i] = basis->eye[i];
+    pc.right[i] = basis->right[i];
+    pc.up[i] = basis->up[i];
+    pc.forward[i] = basis->forward[i];
+  }
+  pc.size[0] = targets.width;
+  pc.size[1] = targets.height;
+  pc.tMin = camera.tMin;
+  pc.tMax = camera.tMax > 0.0f ? camera.tMax : 1e30f;
+  DescriptorWrites w;
+  w.accelerationStructure(0, tlas);
+  w.storageImage(1, targets.hitDistance);
+  w.storageImage(2, targets.hitIds);
+  impl_->pipeline.bind(impl_->ctx, cmd, w.writes, &pc, sizeof(pc));
+  impl_->pipeline.trace(impl_->ctx, cmd, targets.width, targets.height);
+  return {};
+}
+
+}  // namespace rb

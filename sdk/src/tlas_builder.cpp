@@ -1,0 +1,204 @@
+// The TLAS side of the acceleration-structure service: one TLAS per frame slot, rebuilt or refit every frame
+// from the engine's instance list.
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "as_service_impl.h"
+#include "content_hash.h"
+
+namespace rb {
+
+namespace {
+
+VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
+
+// Grows `buffer` to hold `bytes`, retiring the old one (a frame in flight may still read it).
+Status ensureBuffer(Context& ctx, GpuBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage,
+                    MemoryLocation location, const char* what) {
+  if (buffer.valid() && buffer.size >= bytes) return {};
+  retireBuffer(ctx, buffer);
+  Result<GpuBuffer> b = createBuffer(ctx, bytes, usage, location, MemoryCategory::Tlas, what);
+  if (!b) return b.error();
+  buffer = b.value();
+  return {};
+}
+
+}  // namespace
+
+Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer cmd,
+                                                               std::span<const Instance> instances,
+                                                               const TlasBuildOptions& options) {
+  Impl& s = *impl_;
+  Context::Impl& c = s.c;
+  if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "recordTlasBuild: cmd is VK_NULL_HANDLE"};
+  if (instances.size() > c.info.maxInstanceCount) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "recordTlasBuild: " + std::to_string(instances.size()) + " instances exceed the device limit of " +
+                     std::to_string(c.info.maxInstanceCount)};
+  }
+  const uint32_t slotIndex = static_cast<uint32_t>(c.frame % c.desc.framesInFlight);
+  TlasSlot& slot = s.tlasSlots[slotIndex];
+
+  // Instance buffer: grown geometrically so a growing scene does not reallocate every frame.
+  const uint32_t count = static_cast<uint32_t>(instances.size());
+  if (count > slot.instanceCapacity || !slot.instances.valid()) {
+    uint32_t capacity = std::max<uint32_t>({count, slot.instanceCapacity + slot.instanceCapacity / 2, 64u});
+    retireBuffer(s.ctx, slot.instances);
+    Status st = ensureBuffer(s.ctx, slot.instances, VkDeviceSize(capacity) * sizeof(VkAccelerationStructureInstanceKHR),
+                             VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR |
+                                 VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                             MemoryLocation::HostVisible, "TLAS instance buffer");
+    if (!st) return st.error();
+    slot.instanceCapacity = capacity;
+  }
+
+  // Validate every handle before writing anything, so a bad list leaves the previous state untouched.
+  for (uint32_t i = 0; i < count; ++i) {
+    const Instance& in = instances[i];
+    const MeshHandle h = in.mesh;
+    if (h.isNull() || h.index >= s.entries.size() || s.entries[h.index].generation != h.generation ||
+        s.entries[h.index].state == BlasState::Free || s.entries[h.index].refCount == 0) {
+      return Error{ErrorCode::StaleHandle, VK_SUCCESS,
+                   "recordTlasBuild: instances[" + std::to_string(i) + "] refers to " +
+                       (h.isNull() ? std::string("the null mesh handle")
+                                   : "mesh handle {index " + std::to_string(h.index) + ", generation " +
+                                         std::to_string(h.generation) + "}, which was released, evicted or never "
+                                         "registered")};
+    }
+    if (in.customIndex > 0xFFFFFFu) {
+      return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                   "recordTlasBuild: instances[" + std::to_string(i) + "].customIndex " +
+                       std::to_string(in.customIndex) + " does not fit in 24 bits"};
+    }
+    if (in.sbtRecordOffset > 0xFFFFFFu) {
+      return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                   "recordTlasBuild: instances[" + std::to_string(i) + "].sbtRecordOffset does not fit in 24 bits"};
+    }
+  }
+
+  const uint64_t serial = s.tlasSerial + 1;
+  auto* out = static_cast<VkAccelerationStructureInstanceKHR*>(slot.instances.mapped);
+  uint32_t written = 0, skipped = 0;
+  uint64_t signature = 0;
+  const bool rebase = options.originOffset[0] != 0.0 || options.originOffset[1] != 0.0 || options.originOffset[2] != 0.0;
+  for (uint32_t i = 0; i < count; ++i) {
+    const Instance& in = instances[i];
+    BlasEntry& e = s.entries[in.mesh.index];
+    if (e.state != BlasState::Built) {
+      ++skipped;
+      continue;
+    }
+    VkAccelerationStructureInstanceKHR inst;
+    std::memcpy(&inst.transform, in.transform, sizeof(inst.transform));
+    if (rebase) {
+      for (int row = 0; row < 3; ++row) {
+        inst.transform.matrix[row][3] =
+            static_cast<float>(static_cast<double>(in.transform[row * 4 + 3]) - options.originOffset[row]);
+      }
+    }
+    inst.instanceCustomIndex = in.customIndex;
+    inst.mask = in.mask;
+    inst.instanceShaderBindingTableRecordOffset = in.sbtRecordOffset;
+    inst.flags = in.flags;
+    inst.accelerationStructureReference = e.address;
+    out[written++] = inst;
+    e.lastUsedFrame = c.frame;
+    e.lastTlasSerial = serial;
+    signature = hashCombine(signature, e.address);
+  }
+  s.tlasSerial = serial;
+
+  VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  geometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
+  geometry.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
+  geometry.geometry.instances.arrayOfPointers = VK_FALSE;
+  geometry.geometry.instances.data.deviceAddress = slot.instances.address;
+
+  const bool wantUpdate = options.mode == TlasBuildMode::UpdateIfPossible;
+  // A refit must start from an intact TLAS built for the same instances: the one recorded last, in whichever
+  // slot, with the same BLASes in the same order.
+  const TlasSlot* source = nullptr;
+  if (wantUpdate && s.lastTlasSlot < s.tlasSlots.size()) {
+    const TlasSlot& prev = s.tlasSlots[s.lastTlasSlot];
+    if (prev.tlas && prev.allowsUpdate && prev.builtInstanceCount == written && prev.blasSignature == signature) {
+      source = &prev;
+    }
+  }
+
+  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
+  info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR |
+               (wantUpdate ? VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR : 0);
+  info.geometryCount = 1;
+  info.pGeometries = &geometry;
+  // Sized for the buffer's capacity so small fluctuations in the instance count reuse the same storage.
+  uint32_t sizeFor = std::max(slot.instanceCapacity, 1u);
+  VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
+  c.vk.vkGetAccelerationStructureBuildSizesKHR(c.desc.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info,
+                                               &sizeFor, &sizes);
+
+  bool flagsChanged = slot.allowsUpdate != wantUpdate;
+  if (!slot.tlas || slot.storageCapacity < sizes.accelerationStructureSize || flagsChanged) {
+    if (source == &slot) source = nullptr;  // rebuilding storage of the source itself
+    if (slot.tlas) {
+      VkAccelerationStructureKHR old = slot.tlas;
+      c.retire([&c, old] { c.vk.vkDestroyAccelerationStructureKHR(c.desc.device, old, c.allocator()); });
+      slot.tlas = VK_NULL_HANDLE;
+    }
+    if (slot.storageCapacity < sizes.accelerationStructureSize) {
+      retireBuffer(s.ctx, slot.storage);
+      Status st = ensureBuffer(s.ctx, slot.storage, sizes.accelerationStructureSize,
+                               VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR |
+                                   VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                               MemoryLocation::DeviceLocal, "TLAS storage");
+      if (!st) return st.error();
+      slot.storageCapacity = sizes.accelerationStructureSize;
+    }
+    Result<VkAccelerationStructureKHR> as = s.createAs(VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR,
+                                                       slot.storage.buffer, 0, slot.storageCapacity);
+    if (!as) return as.error();
+    slot.tlas = as.value();
+    slot.allowsUpdate = wantUpdate;
+  }
+
+  const VkDeviceSize align = s.scratchAlignment();
+  VkDeviceSize scratchNeed = std::max(sizes.buildScratchSize, sizes.updateScratchSize) + align;
+  if (Status st = ensureBuffer(s.ctx, slot.scratch, scratchNeed,
+                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                               MemoryLocation::DeviceLocal, "TLAS scratch");
+      !st) {
+    return st.error();
+  }
+
+  info.mode = source ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  info.srcAccelerationStructure = source ? source->tlas : VK_NULL_HANDLE;
+  info.dstAccelerationStructure = slot.tlas;
+  info.scratchData.deviceAddress = alignUp(slot.scratch.address, align);
+  VkAccelerationStructureBuildRangeInfoKHR range{};
+  range.primitiveCount = written;
+  const VkAccelerationStructureBuildRangeInfoKHR* rangePtr = &range;
+
+  // Earlier BLAS builds and this slot's previous use of its scratch must be complete.
+  recordAsBarrier(c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
+  c.vk.vkCmdBuildAccelerationStructuresKHR(cmd, 1, &info, &rangePtr);
+  recordAsBarrier(c.vk, cmd,
+                  VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
+
+  slot.builtInstanceCount = written;
+  slot.blasSignature = signature;
+  s.lastTlasSlot = slotIndex;
+  s.counters.lastTlasInstances = written;
+
+  TlasInfo result;
+  result.tlas = slot.tlas;
+  VkAccelerationStructureDeviceAddressInfoKHR ai{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
+  ai.accelerationStructure = slot.tlas;
+  result.address = c.vk.vkGetAccelerationStructureDeviceAddressKHR(c.desc.device, &ai);
+  result.instanceCount = written;
+  result.skippedInstances = skipped;
+  result.updated = source != nullptr;
+  return result;
+}
+
+}  // namespace rb
