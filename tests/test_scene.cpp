@@ -1,6 +1,7 @@
 #include "test_scene.h"
 
 #include <cmath>
+#include <cstring>
 
 namespace rbtest {
 
@@ -59,6 +60,89 @@ void addToEmbree(EmbreeScene& embree, const TestScene& scene) {
     embree.addInstance(scene.meshes[scene.instances[i].mesh], scene.instances[i].transform.data(), i);
   }
   embree.commit();
+}
+
+namespace {
+
+struct PixelRay {
+  float origin[3];
+  float dir[3];
+};
+
+// The same ray the raygen shader builds (see PrimaryRayCamera), for pixel coordinates that may be fractional.
+PixelRay rayThrough(const rb::CameraBasis& b, float px, float py, uint32_t w, uint32_t h) {
+  float nx = px / float(w) * 2.0f - 1.0f, ny = py / float(h) * 2.0f - 1.0f;
+  PixelRay r;
+  float len2 = 0;
+  for (int i = 0; i < 3; ++i) {
+    r.origin[i] = b.eye[i];
+    r.dir[i] = b.forward[i] + nx * b.right[i] - ny * b.up[i];
+    len2 += r.dir[i] * r.dir[i];
+  }
+  for (float& d : r.dir) d /= std::sqrt(len2);
+  return r;
+}
+
+}  // namespace
+
+TraceComparison compareFirstTrace(GpuFixture& fx, const TestScene& scene, VkAccelerationStructureKHR tlas,
+                                  const rb::PrimaryRayCamera& cam, uint32_t W, uint32_t H) {
+  auto pass = rb::PrimaryRayPass::create(fx.ctx());
+  RB_REQUIRE_OK(pass);
+  rb::GpuImage dist = fx.makeImage(W, H, VK_FORMAT_R32_SFLOAT);
+  rb::GpuImage ids = fx.makeImage(W, H, VK_FORMAT_R32G32_UINT);
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    fx.toGeneral(cmd, dist);
+    fx.toGeneral(cmd, ids);
+    RB_REQUIRE_OK(pass.value()->record(cmd, tlas, cam, {dist.view, ids.view, W, H}));
+  });
+  std::vector<uint8_t> distBytes = fx.readImage(dist, 4), idBytes = fx.readImage(ids, 8);
+  fx.destroyImage(dist);
+  fx.destroyImage(ids);
+  const float* gpuT = reinterpret_cast<const float*>(distBytes.data());
+  const uint32_t* gpuIds = reinterpret_cast<const uint32_t*>(idBytes.data());
+
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  auto basis = rb::computeCameraBasis(cam, W, H);
+  RB_REQUIRE_OK(basis);
+  TraceComparison c;
+  for (uint32_t y = 0; y < H; ++y) {
+    for (uint32_t x = 0; x < W; ++x) {
+      PixelRay r = rayThrough(basis.value(), x + 0.5f, y + 0.5f, W, H);
+      ReferenceHit ref = embree.intersect(r.origin, r.dir, 0.0f, 1e30f);
+      // A ray within one pixel of a silhouette: a ray offset by up to one pixel sees another object, another
+      // hit/miss outcome, or a depth discontinuity.
+      bool silhouette = false;
+      for (int dy = -1; dy <= 1 && !silhouette; ++dy) {
+        for (int dx = -1; dx <= 1 && !silhouette; ++dx) {
+          if (!dx && !dy) continue;
+          PixelRay n = rayThrough(basis.value(), x + 0.5f + dx, y + 0.5f + dy, W, H);
+          ReferenceHit nh = embree.intersect(n.origin, n.dir, 0.0f, 1e30f);
+          silhouette = nh.hit != ref.hit ||
+                       (ref.hit && (nh.instanceId != ref.instanceId || std::fabs(nh.t - ref.t) > 0.2f * ref.t));
+        }
+      }
+      if (silhouette) {
+        ++c.silhouettes;
+        continue;
+      }
+      ++c.compared;
+      size_t p = size_t(y) * W + x;
+      bool gpuHit = gpuT[p] > 0.0f;
+      if (gpuHit == ref.hit) ++c.hitMissAgree;
+      if (ref.hit) ++c.hits;
+      if (gpuHit && ref.hit) {
+        ++c.hitsCompared;
+        if (std::fabs(gpuT[p] - ref.t) <= 1e-4f * ref.t) ++c.distanceAgree;
+        if (gpuIds[2 * p + 1] == ref.instanceId) ++c.sameInstance;
+      } else if (!gpuHit) {
+        ++c.misses;
+        if (gpuIds[2 * p] == 0xFFFFFFFFu && gpuIds[2 * p + 1] == 0xFFFFFFFFu) ++c.missIdsCorrect;
+      }
+    }
+  }
+  return c;
 }
 
 }  // namespace rbtest

@@ -38,4 +38,13 @@ BuiltScene buildScene(GpuFixture& fx, rb::AccelerationStructureService& service,
 void destroyScene(GpuFixture& fx, BuiltScene& built);
 void addToEmbree(EmbreeScene& embree, const TestScene& scene);
 
+// Traces the scene's TLAS with the first-trace pass and compares every pixel away from silhouettes with
+// Embree tracing the same rays.
+struct TraceComparison {
+  uint32_t compared = 0, silhouettes = 0, hits = 0;
+  uint32_t hitMissAgree = 0, hitsCompared = 0, distanceAgree = 0, sameInstance = 0, missIdsCorrect = 0, misses = 0;
+};
+TraceComparison compareFirstTrace(GpuFixture& fx, const TestScene& scene, VkAccelerationStructureKHR tlas,
+                                  const rb::PrimaryRayCamera& camera, uint32_t width, uint32_t height);
+
 }  // namespace rbtest

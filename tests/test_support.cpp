@@ -49,8 +49,10 @@ UploadedMesh GpuFixture::upload(const rbsamples::CpuMesh& mesh, bool withHostCop
   out.desc.indexBufferBytes = out.indices.size;
   out.desc.triangleCount = mesh.triangleCount();
   if (withHostCopies) {
-    out.desc.hostVertices = mesh.positions.data();
-    out.desc.hostIndices = mesh.indices.data();
+    // Kept alive with the upload: callers often pass a temporary mesh.
+    out.source = std::make_shared<const rbsamples::CpuMesh>(mesh);
+    out.desc.hostVertices = out.source->positions.data();
+    out.desc.hostIndices = out.source->indices.data();
   }
   return out;
 }

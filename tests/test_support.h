@@ -21,7 +21,8 @@ namespace rbtest {
 struct UploadedMesh {
   rb::HeadlessBuffer vertices;
   rb::HeadlessBuffer indices;
-  rb::MeshDesc desc;
+  rb::MeshDesc desc;  // its host pointers point into `source`
+  std::shared_ptr<const rbsamples::CpuMesh> source;
 };
 
 class GpuFixture {

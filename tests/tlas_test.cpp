@@ -1,0 +1,193 @@
+// TLAS: 10,000 instances build and trace correctly; refits; instances of meshes not yet built are skipped.
+#include <catch2/catch_test_macros.hpp>
+
+#include <cmath>
+#include <cstring>
+
+#include "test_scene.h"
+
+using namespace rbtest;
+
+TEST_CASE("a 10,000-instance TLAS builds and traces like Embree", "[as][tlas][embree]") {
+  GpuFixture fx;
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  TestScene scene;
+  const float mn[3] = {-0.4f, 0.0f, -0.4f}, mx[3] = {0.4f, 1.0f, 0.4f};
+  scene.meshes.push_back(rbsamples::makeBox(mn, mx));
+  scene.meshes.push_back(rbsamples::makeSphere(0.45f, 12, 6));
+  scene.meshes.push_back(rbsamples::makeGrid(120.0f, 8));  // ground, so the gaps between instances hit too
+  for (int z = 0; z < 100; ++z) {
+    for (int x = 0; x < 100; ++x) {
+      // Heights vary so neighbouring instances overlap in view and the nearest one must win.
+      float height = 0.5f + 0.5f * float((x * 7 + z * 13) % 5);
+      std::array<float, 12> t = {1, 0, 0, float(x) - 49.5f, 0, height, 0, 0, 0, 0, 1, float(z) - 49.5f};
+      scene.instances.push_back({uint32_t((x + z) % 2), t});
+    }
+  }
+  scene.instances.push_back({2, translation(0, 0, 0)});
+  BuiltScene built = buildScene(fx, *service.value(), scene);
+  CHECK(built.tlas.instanceCount == 10001);
+  CHECK(service.value()->stats().blasCount == 3);
+  CHECK(service.value()->stats().lastTlasInstances == 10001);
+
+  rb::PrimaryRayCamera cam;
+  // Close enough that instances span many pixels, looking across the field so thousands of them are in view.
+  float eye[3] = {-52.0f, 9.0f, -52.0f}, target[3] = {-38.0f, 0.0f, -40.0f};
+  std::memcpy(cam.eye, eye, sizeof eye);
+  std::memcpy(cam.target, target, sizeof target);
+  cam.verticalFovDegrees = 60.0f;
+  TraceComparison c = compareFirstTrace(fx, scene, built.tlas.tlas, cam, 256, 192);
+  INFO("compared " << c.compared << ", silhouettes " << c.silhouettes << ", hits " << c.hits);
+  REQUIRE(c.hits > 1000);
+  CHECK(double(c.hitMissAgree) / c.compared >= 0.999);
+  CHECK(double(c.distanceAgree) / c.hitsCompared >= 0.999);
+  CHECK(double(c.sameInstance) / c.hitsCompared >= 0.999);
+  destroyScene(fx, built);
+}
+
+TEST_CASE("TLAS refits when only transforms change and rebuilds when the meshes change", "[as][tlas]") {
+  GpuFixture fx;
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  auto& s = *service.value();
+  TestScene scene = makeConformanceScene();
+  BuiltScene built = buildScene(fx, s, scene);
+  rb::TlasBuildOptions update;
+  update.mode = rb::TlasBuildMode::UpdateIfPossible;
+
+  rb::TlasInfo first, second, third;
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    auto t = s.recordTlasBuild(cmd, built.instances, update);
+    RB_REQUIRE_OK(t);
+    first = t.value();
+  });
+  CHECK(!first.updated);  // the previous TLAS was built without ALLOW_UPDATE
+  // Move the sphere instance up by 0.5: same meshes in the same order, so a refit is valid.
+  built.instances[1].transform[7] += 0.5f;
+  scene.instances[1].transform[7] += 0.5f;
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    auto t = s.recordTlasBuild(cmd, built.instances, update);
+    RB_REQUIRE_OK(t);
+    second = t.value();
+  });
+  CHECK(second.updated);
+  // The refit TLAS traces like Embree over the moved scene.
+  rb::PrimaryRayCamera cam;
+  float eye[3] = {-9.0f, 4.5f, 11.0f}, target[3] = {0.5f, 0.8f, -0.5f};
+  std::memcpy(cam.eye, eye, sizeof eye);
+  std::memcpy(cam.target, target, sizeof target);
+  TraceComparison c = compareFirstTrace(fx, scene, second.tlas, cam, 96, 64);
+  CHECK(double(c.hitMissAgree) / c.compared >= 0.999);
+  CHECK(double(c.distanceAgree) / c.hitsCompared >= 0.999);
+
+  // Swapping which mesh an instance uses invalidates the refit.
+  std::swap(built.instances[1].mesh, built.instances[3].mesh);
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    auto t = s.recordTlasBuild(cmd, built.instances, update);
+    RB_REQUIRE_OK(t);
+    third = t.value();
+  });
+  CHECK(!third.updated);
+  destroyScene(fx, built);
+}
+
+TEST_CASE("instances of meshes still queued are skipped, never referenced", "[as][tlas]") {
+  GpuFixture fx;
+  rb::AsServiceDesc desc;
+  desc.maxBuildTrianglesPerCall = 1;  // one build per call
+  auto service = rb::AccelerationStructureService::create(fx.ctx(), desc);
+  RB_REQUIRE_OK(service);
+  auto& s = *service.value();
+  UploadedMesh a = fx.upload(rbsamples::makeSphere(1, 8, 4)), b = fx.upload(rbsamples::makeGrid(2, 4));
+  auto ha = s.registerMesh(a.desc), hb = s.registerMesh(b.desc);
+  RB_REQUIRE_OK(ha);
+  RB_REQUIRE_OK(hb);
+  std::vector<rb::Instance> inst(2);
+  inst[0].mesh = ha.value();
+  inst[1].mesh = hb.value();
+  rb::TlasInfo info;
+  uint32_t left = 99;
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    auto l = s.recordPendingWork(cmd);
+    RB_REQUIRE_OK(l);
+    left = l.value();
+    auto t = s.recordTlasBuild(cmd, inst);
+    RB_REQUIRE_OK(t);
+    info = t.value();
+  });
+  CHECK(left == 1);
+  CHECK(info.instanceCount == 1);
+  CHECK(info.skippedInstances == 1);
+  CHECK(s.isBuilt(ha.value()).value());
+  CHECK(!s.isBuilt(hb.value()).value());
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    auto l = s.recordPendingWork(cmd);
+    RB_REQUIRE_OK(l);
+    left = l.value();
+    auto t = s.recordTlasBuild(cmd, inst);
+    RB_REQUIRE_OK(t);
+    info = t.value();
+  });
+  CHECK(left == 0);
+  CHECK(info.instanceCount == 2);
+  CHECK(info.skippedInstances == 0);
+  fx.destroy(a);
+  fx.destroy(b);
+}
+
+TEST_CASE("a dynamic mesh is refit in place after its vertices change", "[as][dynamic]") {
+  GpuFixture fx;
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  auto& s = *service.value();
+  TestScene scene;
+  scene.meshes.push_back(rbsamples::makeGrid(4.0f, 8));
+  scene.instances.push_back({0, translation(0, 0, 0)});
+  UploadedMesh m = fx.upload(scene.meshes[0]);
+  m.desc.role = rb::MeshRole::Dynamic;
+  // Host-visible vertices so the "engine" can deform them in place.
+  fx.device().destroyBuffer(m.vertices);
+  auto v = fx.device().createBuffer(scene.meshes[0].positions.size() * 4,
+                                    VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
+                                        VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
+                                    true, scene.meshes[0].positions.data());
+  RB_REQUIRE_OK(v);
+  m.vertices = v.value();
+  m.desc.vertexAddress = m.vertices.address;
+  auto h = s.registerMesh(m.desc);
+  RB_REQUIRE_OK(h);
+  rb::Instance inst;
+  inst.mesh = h.value();
+  rb::TlasInfo tlas;
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    RB_REQUIRE_OK(s.recordPendingWork(cmd));
+    tlas = s.recordTlasBuild(cmd, std::span(&inst, 1)).value();
+  });
+  // Lift the whole grid by 1.5 and refit.
+  float* p = static_cast<float*>(m.vertices.mapped);
+  for (size_t i = 1; i < scene.meshes[0].positions.size(); i += 3) p[i] += 1.5f;
+  for (size_t i = 1; i < scene.meshes[0].positions.size(); i += 3) scene.meshes[0].positions[i] += 1.5f;
+  RB_REQUIRE_OK(s.updateMesh(h.value()));
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    RB_REQUIRE_OK(s.recordPendingWork(cmd));
+    tlas = s.recordTlasBuild(cmd, std::span(&inst, 1)).value();
+  });
+  rb::PrimaryRayCamera cam;
+  float eye[3] = {0.3f, 6.0f, 0.2f}, target[3] = {0, 0, 0};
+  std::memcpy(cam.eye, eye, sizeof eye);
+  std::memcpy(cam.target, target, sizeof target);
+  TraceComparison c = compareFirstTrace(fx, scene, tlas.tlas, cam, 64, 64);
+  REQUIRE(c.hitsCompared > 100);
+  CHECK(c.distanceAgree == c.hitsCompared);  // distances match the lifted grid, not the original
+
+  // A static mesh cannot be refit.
+  UploadedMesh st = fx.upload(rbsamples::makeSphere(1, 8, 4));
+  auto hs = s.registerMesh(st.desc);
+  RB_REQUIRE_OK(hs);
+  auto bad = s.updateMesh(hs.value());
+  REQUIRE(!bad.ok());
+  CHECK(bad.error().message.find("MeshRole::Dynamic") != std::string::npos);
+  fx.destroy(st);
+  fx.destroy(m);
+}
