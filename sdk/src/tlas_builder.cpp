@@ -198,6 +198,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   result.instanceCount = written;
   result.skippedInstances = skipped;
   result.updated = source != nullptr;
+  for (int i = 0; i < 3; ++i) result.originOffset[i] = options.originOffset[i];
   return result;
 }
 

@@ -69,6 +69,6 @@ void main() {
   vec3 specularWeight = environmentBrdf(f0, s.roughness, nDotV);
   vec3 reflected = frame.inputs.z != 0u ? texture(externalReflection, screenUv).rgb : ambient * ao;
   color += reflected * specularWeight;
-  color += draw.emissive.rgb;
+  color += s.emissive;
   outColor = vec4(color, 1.0);
 }

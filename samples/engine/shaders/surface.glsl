@@ -2,6 +2,7 @@
 layout(set = 1, binding = 0) uniform sampler2D baseColorTex;          // sRGB view
 layout(set = 1, binding = 1) uniform sampler2D metallicRoughnessTex;  // G roughness, B metallic
 layout(set = 1, binding = 2) uniform sampler2D normalTex;
+layout(set = 1, binding = 3) uniform sampler2D emissiveTex;          // sRGB view
 
 layout(location = 0) in vec3 inWorldPos;
 layout(location = 1) in vec3 inNormal;
@@ -15,6 +16,7 @@ struct Surface {
   vec3 baseColor;
   float metallic;
   float roughness;  // perceptual
+  vec3 emissive;
 };
 
 Surface evaluateSurface() {
@@ -40,5 +42,6 @@ Surface evaluateSurface() {
   s.baseColor = base.rgb;
   s.metallic = clamp(draw.material.x * mr.b, 0.0, 1.0);
   s.roughness = clamp(draw.material.y * mr.g, 0.02, 1.0);
+  s.emissive = draw.emissive.rgb * texture(emissiveTex, inUv).rgb;
   return s;
 }

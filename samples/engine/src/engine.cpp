@@ -80,6 +80,7 @@ Engine::Impl::~Impl() {
     vkDeviceWaitIdle(ctx.device);
     destroySwapchain(true);
     destroyTargets();
+    gpu.destroy(targets.shadowMap);
     if (sceneLoaded) destroyScene(gpu, scene);
     for (FrameResources& f : frames) {
       if (f.timestamps) vkDestroyQueryPool(ctx.device, f.timestamps, nullptr);

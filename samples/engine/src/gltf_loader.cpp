@@ -157,6 +157,7 @@ struct Loader {
       out.baseColorTexture = textureImage(pbr.baseColorTexture.index);
       out.metallicRoughnessTexture = textureImage(pbr.metallicRoughnessTexture.index);
       out.normalTexture = textureImage(m.normalTexture.index);
+      out.emissiveTexture = textureImage(m.emissiveTexture.index);
       out.normalScale = float(m.normalTexture.scale);
       if (m.alphaMode == "BLEND" || m.alphaMode == "MASK")
         result.warnings.push_back("material '" + m.name + "': alphaMode " + m.alphaMode + " rendered as opaque");
@@ -291,7 +292,7 @@ SceneLoadResult loadGltf(const std::string& path) {
     loader.convertMaterials();
     // Textures that failed to decode must not be referenced.
     for (Material& m : result.scene.materials)
-      for (int* t : {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture})
+      for (int* t : {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture, &m.emissiveTexture})
         if (*t >= 0 && result.scene.textures[*t].rgba8.empty()) *t = -1;
 
     std::vector<int> roots;

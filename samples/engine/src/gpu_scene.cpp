@@ -231,7 +231,7 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
 
   // --- Materials ---
   const uint32_t materialCount = uint32_t(s.materials.size());
-  VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3 * materialCount};
+  VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4 * materialCount};
   VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pci.maxSets = materialCount;
   pci.poolSizeCount = 1;
@@ -251,16 +251,18 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
       if (texture < 0 || !out.textures[texture].image) return fallback.view;
       return srgb ? out.textures[texture].altView : out.textures[texture].view;
     };
-    VkDescriptorImageInfo infos[3] = {
+    VkDescriptorImageInfo infos[4] = {
         {pipelines.materialSampler, view(mat.baseColorTexture, defaults.white, true),
          VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
         {pipelines.materialSampler, view(mat.metallicRoughnessTexture, defaults.white, false),
          VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
         {pipelines.materialSampler, view(mat.normalTexture, defaults.flatNormal, false),
+         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+        {pipelines.materialSampler, view(mat.emissiveTexture, defaults.white, true),
          VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     w.dstSet = out.materialSets[m];
-    w.descriptorCount = 3;
+    w.descriptorCount = 4;
     w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     w.pImageInfo = infos;
     vkUpdateDescriptorSets(gpu.device(), 1, &w, 0, nullptr);

@@ -143,7 +143,8 @@ std::string Pipelines::create(VkDevice device) {
                       {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1,
                         VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, nullptr}},
                       frameSetLayout));
-  check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2)}, materialSetLayout));
+  check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3)},
+                      materialSetLayout));
   check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3)},
                       lightingSetLayout));
   check(makeSetLayout(device, {samplerBinding(0)}, tonemapSetLayout));

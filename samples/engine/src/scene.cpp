@@ -104,7 +104,7 @@ void finalizeScene(Scene& scene) {
   if (scene.materials.empty()) scene.materials.push_back(Material{.name = "default"});
   const int textureCount = static_cast<int>(scene.textures.size());
   for (Material& mat : scene.materials) {
-    for (int* t : {&mat.baseColorTexture, &mat.metallicRoughnessTexture, &mat.normalTexture})
+    for (int* t : {&mat.baseColorTexture, &mat.metallicRoughnessTexture, &mat.normalTexture, &mat.emissiveTexture})
       if (*t >= textureCount) *t = -1;
   }
   for (MeshData& m : scene.meshes) {

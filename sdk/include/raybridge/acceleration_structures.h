@@ -98,6 +98,7 @@ struct TlasInfo {
   uint32_t instanceCount = 0;    // instances written into the TLAS
   uint32_t skippedInstances = 0; // instances whose mesh has no built BLAS yet (queued beyond the budget)
   bool updated = false;          // true if refit rather than rebuilt
+  double originOffset[3] = {0.0, 0.0, 0.0};  // TlasBuildOptions::originOffset it was built with
 };
 
 struct AsServiceDesc {

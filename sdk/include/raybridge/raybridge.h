@@ -3,6 +3,9 @@
 
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/context.h>
+#include <raybridge/effects.h>
+#include <raybridge/gbuffer.h>
 #include <raybridge/headless_device.h>
 #include <raybridge/primary_ray_pass.h>
 #include <raybridge/result.h>
+#include <raybridge/shadow_pass.h>

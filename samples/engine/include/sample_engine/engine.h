@@ -28,6 +28,14 @@ namespace sample_engine {
 
 inline constexpr uint32_t kFramesInFlight = 2;
 
+// A zeroed Vulkan struct with its sType set (avoids -Wmissing-field-initializers in including code).
+template <typename T>
+T vkStruct(VkStructureType type) {
+  T value{};
+  value.sType = type;
+  return value;
+}
+
 struct EngineConfig {
   // Enables VK_LAYER_KHRONOS_validation plus a debug messenger that counts (and prints) errors.
   bool enableValidation = false;
@@ -47,9 +55,12 @@ struct EngineConfig {
   // OR-ed into the engine's own. The chain must stay alive during Engine::create().
   const void* deviceFeaturesPNext = nullptr;
   VkPhysicalDeviceFeatures extraFeatures10{};
-  VkPhysicalDeviceVulkan11Features extraFeatures11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
-  VkPhysicalDeviceVulkan12Features extraFeatures12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  VkPhysicalDeviceVulkan13Features extraFeatures13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceVulkan11Features extraFeatures11 =
+      vkStruct<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
+  VkPhysicalDeviceVulkan12Features extraFeatures12 =
+      vkStruct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
+  VkPhysicalDeviceVulkan13Features extraFeatures13 =
+      vkStruct<VkPhysicalDeviceVulkan13Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
   // Substring of the device name to pick. Empty: environment variable SAMPLE_ENGINE_DEVICE, else the
   // first discrete GPU, else the first device that works.
   std::string deviceNameFilter;
@@ -83,7 +94,7 @@ struct FrameParams {
   Camera camera;
   Sun sun;
   glm::vec3 skyColor{0.45f, 0.62f, 0.9f};  // linear; background and constant ambient light
-  float ambientIntensity = 0.5f;
+  float ambientIntensity = 0.4f;
   float exposure = 1.0f;
   ShadowSettings shadow;
   LightingInputs lightingInputs;  // the pre-pass hook may change these for the frame

@@ -47,6 +47,7 @@ struct Material {
   int baseColorTexture = -1;
   int metallicRoughnessTexture = -1;  // glTF layout: G = roughness, B = metallic
   int normalTexture = -1;
+  int emissiveTexture = -1;  // sRGB, multiplied by emissiveFactor
 };
 
 // A placement of a mesh in the world.
@@ -66,9 +67,9 @@ struct Camera {
 
 // Directional light. `direction` points TOWARDS the sun (from the surface to the light).
 struct Sun {
-  glm::vec3 direction = glm::normalize(glm::vec3(-0.45f, 0.7f, 0.35f));
+  glm::vec3 direction = glm::normalize(glm::vec3(-0.5f, 0.6f, 0.4f));
   glm::vec3 color{1.0f, 0.96f, 0.9f};
-  float intensity = 3.0f;
+  float intensity = 3.5f;
 };
 
 struct Bounds {

@@ -27,11 +27,19 @@ class Window {
   void requestClose();
   void pollEvents();
   void framebufferSize(int& width, int& height) const;
+
+  // Minimal input for a viewer, so programs need not include GLFW themselves.
+  enum class Key { W, A, S, D, Q, E, LeftShift, Escape };
+  bool keyDown(Key key) const;
+  bool mouseButtonDown(int button) const;  // 0 = left, 1 = right, 2 = middle
+  void cursorPosition(double& x, double& y) const;
+  double takeScrollDelta();                // vertical scroll accumulated since the last call
   void* glfwHandle() const { return window_; }  // GLFWwindow*, for input callbacks
 
  private:
   Window() = default;
   void* window_ = nullptr;
+  double scroll_ = 0.0;
 };
 
 }  // namespace sample_engine

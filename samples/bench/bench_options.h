@@ -1,0 +1,28 @@
+// Command line of raybridge-bench.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rbbench {
+
+struct BenchOptions {
+  std::string scenario = "all";  // one of scenarioNames() or "all"
+  std::string outPath;           // empty = no JSON file
+  bool quick = false;            // smallest sizes and fewest repeats (smoke test, under ~2 minutes on lavapipe)
+  bool full = false;             // the GPU sizes even on a CPU device (1M triangles, ...)
+  uint32_t width = 0;            // 0 = automatic: 1920x1080 on a GPU, smaller on a CPU device
+  uint32_t height = 0;
+  std::string device;            // substring of the device name; empty = $RAYBRIDGE_DEVICE or automatic
+  std::string scenesDir;         // glTF models, one folder each; default <source>/../shared/scenes
+  std::string commandLine;       // as typed, for the report
+  bool help = false;
+};
+
+const std::vector<std::string>& scenarioNames();
+std::string usage();
+// Parses argv; returns false with a message in `error` on a bad command line.
+bool parseOptions(int argc, char** argv, BenchOptions& options, std::string& error);
+
+}  // namespace rbbench

@@ -1,0 +1,87 @@
+// tlas: a TLAS over 1k, 10k, 100k (GPU: 1M) instances of a few small meshes. Host time of recordTlasBuild
+// (std::chrono; it writes the instance buffer) and GPU time of the build (the bench's own timestamps), both as
+// medians of repeated frames after one warm-up frame per frame slot, and per 1,000 instances.
+#include <chrono>
+
+#include "gpu_timer.h"
+#include "report.h"
+#include "scene_meshes.h"
+#include "scenarios.h"
+#include "service_frames.h"
+
+namespace rbbench {
+
+nlohmann::json runTlasScenario(BenchEnv& env) {
+  const BenchSizes& z = env.sizes();
+  const float boxMin[3] = {-0.5f, -0.5f, -0.5f}, boxMax[3] = {0.5f, 0.5f, 0.5f};
+  std::vector<rbsamples::CpuMesh> cpu = {rbsamples::makeSphere(0.5f, 16, 10), rbsamples::makeBox(boxMin, boxMax, 2),
+                                         rbsamples::makeSphere(0.5f, 8, 6), rbsamples::makeGrid(1.0f, 4)};
+  std::vector<UploadedMesh> meshes;
+  auto service = check(rb::AccelerationStructureService::create(env.ctx()), "creating the AS service");
+  std::vector<rb::MeshHandle> handles;
+  for (size_t i = 0; i < cpu.size(); ++i) {
+    meshes.push_back(env.upload(cpu[i], "tlas mesh"));
+    handles.push_back(registerOrThrow(*service, meshes.back().desc, "tlas mesh " + std::to_string(i)));
+  }
+  (void)buildQueued(env, *service);
+
+  Table table("tlas: TLAS over many instances (" + std::to_string(cpu.size()) + " meshes; median of " +
+                  std::to_string(z.tlasRepeats) + " frames)",
+              {{"instances", "instances"}, {"host ms", "hostMedianMs", 3}, {"host ms/1k", "hostMsPer1k", 4},
+               {"GPU ms", "gpuMedianMs", 3}, {"GPU ms/1k", "gpuMsPer1k", 4}, {"TLAS bytes", "tlasBytes"}});
+  GpuTimer timer(env, 2);
+  for (uint32_t count : z.tlasInstances) {
+    env.progress("tlas: " + humanCount(count) + " instances");
+    std::vector<Transform> placement = gridPlacement(count, 1.5f);
+    std::vector<rb::Instance> instances(count);
+    for (uint32_t i = 0; i < count; ++i) {
+      instances[i].mesh = handles[i % handles.size()];
+      instances[i].customIndex = i & 0xFFFFFFu;
+      setTransform(instances[i], placement[i]);
+    }
+    std::vector<double> hostMs, gpuMs;
+    const uint32_t warmup = env.ctx().framesInFlight();
+    for (uint32_t f = 0; f < warmup + z.tlasRepeats; ++f) {
+      double host = 0.0;
+      uint32_t a = 0, b = 0;
+      rb::TlasInfo info;
+      env.runFrame([&](VkCommandBuffer cmd) {
+        timer.reset(cmd);
+        a = timer.mark(cmd);
+        auto t0 = std::chrono::steady_clock::now();
+        info = check(service->recordTlasBuild(cmd, instances), "recordTlasBuild");
+        host = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        b = timer.mark(cmd);
+      });
+      timer.resolve();
+      if (info.instanceCount != count) throw BenchFailure("tlas: the TLAS holds fewer instances than given");
+      if (f < warmup) continue;
+      hostMs.push_back(host);
+      gpuMs.push_back(timer.ms(a, b));
+    }
+    env.settle();
+    const double host = median(hostMs), gpu = median(gpuMs);
+    table.add({{"instances", count},
+               {"hostMedianMs", host},
+               {"hostMsPer1k", host / (count / 1000.0)},
+               {"hostAllMs", hostMs},
+               {"gpuMedianMs", gpu},
+               {"gpuMsPer1k", gpu / (count / 1000.0)},
+               {"gpuAllMs", gpuMs},
+               {"tlasBytes", service->stats().tlasBytes}});
+  }
+  table.print();
+  service.reset();
+  for (UploadedMesh& m : meshes) env.destroy(m);
+  const auto& rows = table.rows();
+  nlohmann::json summary = nlohmann::json::object();
+  if (rows.size() >= 2) {
+    summary["gpuPer1kLargestOverSmallest"] = ratio(rows.back()["gpuMsPer1k"], rows.front()["gpuMsPer1k"]);
+    summary["hostPer1kLargestOverSmallest"] = ratio(rows.back()["hostMsPer1k"], rows.front()["hostMsPer1k"]);
+    summary["hostOverGpuLargest"] = ratio(rows.back()["hostMedianMs"], rows.back()["gpuMedianMs"]);
+  }
+  printSummary(summary);
+  return {{"rows", rows}, {"summary", summary}};
+}
+
+}  // namespace rbbench

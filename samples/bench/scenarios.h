@@ -1,0 +1,26 @@
+// The benchmark scenarios. Each prints its table(s) and returns its rows and summary as JSON.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <vector>
+
+#include "bench_env.h"
+#include "gltf_meshes.h"
+
+namespace rbbench {
+
+// BLAS build GPU time against triangle count (one BLAS per mesh), procedural sizes and glTF models.
+nlohmann::json runBuildScenario(BenchEnv& env, const std::vector<GltfModel>& models);
+// A mesh copied N times: N distinct BLASes against one shared BLAS (dedup) with N instances.
+nlohmann::json runDuplicationScenario(BenchEnv& env);
+// The same mesh as MeshRole::Static (PREFER_FAST_TRACE) and MeshRole::Dynamic (PREFER_FAST_BUILD).
+nlohmann::json runFastBuildScenario(BenchEnv& env);
+// BLAS bytes before and after compaction per mesh size and glTF model.
+nlohmann::json runCompactionScenario(BenchEnv& env, const std::vector<GltfModel>& models);
+// TLAS over many instances: recordTlasBuild host time and TLAS build GPU time.
+nlohmann::json runTlasScenario(BenchEnv& env);
+// Raw primary-ray rate on a finely tessellated scene (and on rays that miss everything).
+nlohmann::json runTraceScenario(BenchEnv& env);
+
+}  // namespace rbbench

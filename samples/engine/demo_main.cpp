@@ -1,0 +1,236 @@
+// raybridge-engine-demo: renders the default demo scene (or a glTF file) headless to a PNG, or opens an
+// interactive viewer with --window.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "sample_engine/engine.h"
+#include "sample_engine/gltf_loader.h"
+#include "sample_engine/procedural.h"
+#include "sample_engine/window.h"
+
+using namespace sample_engine;
+
+namespace {
+
+struct Options {
+  std::string out = "engine_demo.png";
+  std::string exr;
+  std::string scene;
+  uint32_t width = 1280, height = 720;
+  uint32_t shadowMapSize = 2048;
+  uint32_t pcf = 3;
+  bool window = false;
+  bool validation = false;
+  int frames = 0;  // --window: close after this many frames (0 = run until closed)
+};
+
+void usage() {
+  std::printf(
+      "usage: raybridge-engine-demo [--out FILE.png] [--exr FILE.exr] [--width W] [--height H]\n"
+      "                             [--scene FILE.gltf|.glb] [--shadow-map-size N] [--pcf N]\n"
+      "                             [--validation] [--window [--frames N]]\n"
+      "  Headless by default: renders one frame and writes the PNG (and EXR of the HDR image).\n"
+      "  --window opens a viewer: drag = orbit, scroll = zoom, WASD/QE = move, Shift = faster, Esc = quit.\n");
+}
+
+bool parse(int argc, char** argv, Options& o) {
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto next = [&](const char* name) -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", name);
+        return nullptr;
+      }
+      return argv[++i];
+    };
+    const char* v = nullptr;
+    if (a == "--out") { if (!(v = next("--out"))) return false; o.out = v; }
+    else if (a == "--exr") { if (!(v = next("--exr"))) return false; o.exr = v; }
+    else if (a == "--scene") { if (!(v = next("--scene"))) return false; o.scene = v; }
+    else if (a == "--width") { if (!(v = next("--width"))) return false; o.width = uint32_t(std::atoi(v)); }
+    else if (a == "--height") { if (!(v = next("--height"))) return false; o.height = uint32_t(std::atoi(v)); }
+    else if (a == "--shadow-map-size") { if (!(v = next(a.c_str()))) return false; o.shadowMapSize = uint32_t(std::atoi(v)); }
+    else if (a == "--pcf") { if (!(v = next("--pcf"))) return false; o.pcf = uint32_t(std::atoi(v)); }
+    else if (a == "--frames") { if (!(v = next("--frames"))) return false; o.frames = std::atoi(v); }
+    else if (a == "--window") o.window = true;
+    else if (a == "--validation") o.validation = true;
+    else if (a == "--help" || a == "-h") { usage(); std::exit(0); }
+    else {
+      std::fprintf(stderr, "unknown argument %s\n", a.c_str());
+      return false;
+    }
+  }
+  if (o.width == 0 || o.height == 0) {
+    std::fprintf(stderr, "width and height must be positive\n");
+    return false;
+  }
+  return true;
+}
+
+bool loadScene(const Options& o, Scene& scene) {
+  if (o.scene.empty()) {
+    scene = makeDefaultDemoScene();
+    return true;
+  }
+  SceneLoadResult r = loadGltf(o.scene);
+  for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  if (!r.ok()) {
+    std::fprintf(stderr, "error: %s\n", r.error.c_str());
+    return false;
+  }
+  scene = std::move(r.scene);
+  return true;
+}
+
+FrameParams initialParams(const Options& o, const Engine& engine) {
+  FrameParams p;
+  const Scene& s = engine.scene();
+  p.camera = s.camera ? *s.camera : defaultCameraFor(engine.sceneBounds());
+  if (s.sun) p.sun = *s.sun;
+  p.shadow.mapSize = o.shadowMapSize;
+  p.shadow.pcfKernelSize = o.pcf;
+  return p;
+}
+
+void printTimings(const PassTimings& t) {
+  if (!t.valid) return;
+  std::printf("GPU ms: shadow %.2f  prepass %.2f  hook %.2f  lighting %.2f  tonemap %.2f\n", t.shadowMs,
+              t.prepassMs, t.hookMs, t.lightingMs, t.tonemapMs);
+}
+
+int runHeadless(const Options& o) {
+  EngineConfig cfg;
+  cfg.enableValidation = o.validation;
+  auto created = Engine::create(cfg);
+  if (!created) {
+    std::fprintf(stderr, "error: %s\n", created.error.c_str());
+    return 1;
+  }
+  Engine& engine = *created.value;
+  std::printf("device: %s\n", engine.deviceInfo().name.c_str());
+  Scene scene;
+  if (!loadScene(o, scene)) return 1;
+  if (Status s = engine.loadScene(scene); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+  if (Status s = engine.setRenderSize(o.width, o.height); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+  FrameParams params = initialParams(o, engine);
+  auto t0 = std::chrono::steady_clock::now();
+  if (Status s = engine.renderFrame(params); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+  auto ldr = engine.readbackLdr();
+  auto t1 = std::chrono::steady_clock::now();
+  if (!ldr) return std::fprintf(stderr, "error: %s\n", ldr.error.c_str()), 1;
+  if (Status s = writePng(o.out, ldr.value); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+  std::printf("wrote %s (%ux%u), frame + readback %.1f ms\n", o.out.c_str(), o.width, o.height,
+              std::chrono::duration<double, std::milli>(t1 - t0).count());
+  if (!o.exr.empty()) {
+    auto hdr = engine.readbackHdr();
+    if (!hdr) return std::fprintf(stderr, "error: %s\n", hdr.error.c_str()), 1;
+    if (Status s = writeExr(o.exr, hdr.value); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+    std::printf("wrote %s\n", o.exr.c_str());
+  }
+  printTimings(engine.lastTimings());
+  if (o.validation) std::printf("validation errors: %u\n", engine.validationErrorCount());
+  return o.validation && engine.validationErrorCount() > 0 ? 2 : 0;
+}
+
+// Orbit camera: yaw/pitch/distance around a target point.
+struct Orbit {
+  glm::vec3 target;
+  float yaw, pitch, distance;
+
+  static Orbit from(const Camera& c) {
+    glm::vec3 d = c.eye - c.target;
+    float dist = std::max(glm::length(d), 1e-3f);
+    return {c.target, std::atan2(d.x, d.z), std::asin(std::clamp(d.y / dist, -1.0f, 1.0f)), dist};
+  }
+  void apply(Camera& c) const {
+    glm::vec3 dir(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
+    c.target = target;
+    c.eye = target + dir * distance;
+  }
+};
+
+int runWindow(const Options& o) {
+  auto win = Window::create("Raybridge sample engine", int(o.width), int(o.height));
+  if (!win) return std::fprintf(stderr, "error: %s\n", win.error.c_str()), 1;
+  Window& window = *win.value;
+  EngineConfig cfg;
+  cfg.enableValidation = o.validation;
+  cfg.enableSwapchain = true;
+  cfg.instanceExtensions = window.requiredInstanceExtensions();
+  auto created = Engine::create(cfg);
+  if (!created) return std::fprintf(stderr, "error: %s\n", created.error.c_str()), 1;
+  Engine& engine = *created.value;
+  Scene scene;
+  if (!loadScene(o, scene)) return 1;
+  if (Status s = engine.loadScene(scene); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+  auto surface = window.createSurface(engine.instance());
+  if (!surface) return std::fprintf(stderr, "error: %s\n", surface.error.c_str()), 1;
+  int fbw = 0, fbh = 0;
+  window.framebufferSize(fbw, fbh);
+  if (Status s = engine.attachSurface(surface.value, uint32_t(fbw), uint32_t(fbh)); !s)
+    return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+
+  FrameParams params = initialParams(o, engine);
+  Orbit orbit = Orbit::from(params.camera);
+  const float sceneSize = std::max(engine.sceneBounds().radius(), 1.0f);
+  double lastX = 0, lastY = 0;
+  window.cursorPosition(lastX, lastY);
+  auto last = std::chrono::steady_clock::now();
+  int frames = 0;
+  while (!window.shouldClose()) {
+    window.pollEvents();
+    if (window.keyDown(Window::Key::Escape)) window.requestClose();
+    auto now = std::chrono::steady_clock::now();
+    float dt = std::chrono::duration<float>(now - last).count();
+    last = now;
+    double x, y;
+    window.cursorPosition(x, y);
+    if (window.mouseButtonDown(0)) {
+      orbit.yaw -= float(x - lastX) * 0.005f;
+      orbit.pitch = std::clamp(orbit.pitch + float(y - lastY) * 0.005f, -1.5f, 1.5f);
+    }
+    lastX = x;
+    lastY = y;
+    orbit.distance = std::max(orbit.distance * std::pow(0.9f, float(window.takeScrollDelta())), 0.05f);
+    float speed = sceneSize * 0.5f * dt * (window.keyDown(Window::Key::LeftShift) ? 4.0f : 1.0f);
+    glm::vec3 forward(-std::sin(orbit.yaw), 0.0f, -std::cos(orbit.yaw)), right(-forward.z, 0.0f, forward.x);
+    if (window.keyDown(Window::Key::W)) orbit.target += forward * speed;
+    if (window.keyDown(Window::Key::S)) orbit.target -= forward * speed;
+    if (window.keyDown(Window::Key::D)) orbit.target += right * speed;
+    if (window.keyDown(Window::Key::A)) orbit.target -= right * speed;
+    if (window.keyDown(Window::Key::E)) orbit.target.y += speed;
+    if (window.keyDown(Window::Key::Q)) orbit.target.y -= speed;
+    orbit.apply(params.camera);
+
+    int w = 0, h = 0;
+    window.framebufferSize(w, h);
+    if (w == 0 || h == 0) continue;  // minimized
+    VkExtent2D size = engine.renderSize();
+    if (uint32_t(w) != size.width || uint32_t(h) != size.height) engine.resizeSwapchain(uint32_t(w), uint32_t(h));
+    if (Status s = engine.renderFrame(params); !s) {
+      std::fprintf(stderr, "error: %s\n", s.error.c_str());
+      break;
+    }
+    if (++frames % 120 == 0) printTimings(engine.lastTimings());
+    if (o.frames > 0 && frames >= o.frames) window.requestClose();
+  }
+  engine.waitIdle();
+  printTimings(engine.lastTimings());
+  if (o.validation) std::printf("validation errors: %u\n", engine.validationErrorCount());
+  return o.validation && engine.validationErrorCount() > 0 ? 2 : 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  if (!parse(argc, argv, o)) {
+    usage();
+    return 1;
+  }
+  return o.window ? runWindow(o) : runHeadless(o);
+}

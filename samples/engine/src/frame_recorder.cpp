@@ -1,0 +1,358 @@
+// One frame: shadow map -> pre-pass -> hook -> lighting -> tonemap (-> blit to the swapchain).
+#include <algorithm>
+#include <cstring>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "engine_impl.h"
+#include "vk_check.h"
+
+namespace sample_engine {
+
+using namespace detail;
+
+namespace {
+
+constexpr VkImageLayout kDepthReadLayout = VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL;
+constexpr VkImageLayout kReadLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+
+// Orthographic sun camera enclosing the scene's bounding sphere, looking along -direction.
+glm::mat4 lightViewProjection(const Bounds& bounds, const glm::vec3& towardsSun, float& radius) {
+  glm::vec3 center = bounds.valid() ? bounds.center() : glm::vec3(0.0f);
+  radius = bounds.valid() ? std::max(bounds.radius(), 1e-3f) : 1.0f;
+  glm::vec3 l = glm::normalize(towardsSun);
+  glm::vec3 up = std::abs(l.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+  glm::mat4 view = glm::lookAtRH(center + l * (radius * 1.5f), center, up);
+  glm::mat4 proj = glm::orthoRH_ZO(-radius, radius, -radius, radius, 0.0f, radius * 3.0f);
+  return proj * view;
+}
+
+VkRenderingAttachmentInfo colorAttachment(VkImageView view, VkClearColorValue clear) {
+  VkRenderingAttachmentInfo a{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+  a.imageView = view;
+  a.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  a.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  a.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+  a.clearValue.color = clear;
+  return a;
+}
+
+void beginRendering(VkCommandBuffer cmd, VkExtent2D extent, const std::vector<VkRenderingAttachmentInfo>& colors,
+                    const VkRenderingAttachmentInfo* depth) {
+  VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+  ri.renderArea = {{0, 0}, extent};
+  ri.layerCount = 1;
+  ri.colorAttachmentCount = uint32_t(colors.size());
+  ri.pColorAttachments = colors.data();
+  ri.pDepthAttachment = depth;
+  vkCmdBeginRendering(cmd, &ri);
+  VkViewport vp{0.0f, 0.0f, float(extent.width), float(extent.height), 0.0f, 1.0f};
+  VkRect2D scissor{{0, 0}, extent};
+  vkCmdSetViewport(cmd, 0, 1, &vp);
+  vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+enum class DrawPass { Shadow, Prepass, Lighting };
+
+void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass) {
+  uint32_t boundMaterial = UINT32_MAX;
+  for (const Instance& inst : scene.cpu.instances) {
+    const GpuMesh& mesh = scene.meshes[inst.mesh];
+    if (mesh.vertexCount == 0) continue;
+    VkBuffer buffers[2] = {mesh.positionBuffer, mesh.attributeBuffer};
+    VkDeviceSize offsets[2] = {0, 0};
+    vkCmdBindVertexBuffers(cmd, 0, pass == DrawPass::Shadow ? 1 : 2, buffers, offsets);
+    if (pass != DrawPass::Shadow && boundMaterial != mesh.material) {
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.sceneLayout, 1, 1,
+                              &scene.materialSets[mesh.material], 0, nullptr);
+      boundMaterial = mesh.material;
+    }
+    DrawConstants c = scene.materialConstants[mesh.material];
+    c.model = inst.transform;
+    vkCmdPushConstants(cmd, p.sceneLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(c), &c);
+    if (mesh.indexCount > 0) {
+      vkCmdBindIndexBuffer(cmd, mesh.indexBuffer, 0, VK_INDEX_TYPE_UINT32);
+      vkCmdDrawIndexed(cmd, mesh.indexCount, 1, 0, 0, 0);
+    } else {
+      vkCmdDraw(cmd, mesh.vertexCount, 1, 0, 0);
+    }
+  }
+}
+
+void writeImageDescriptors(VkDevice device, VkDescriptorSet set, const std::vector<VkDescriptorImageInfo>& infos) {
+  std::vector<VkWriteDescriptorSet> writes(infos.size(), {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET});
+  for (size_t i = 0; i < infos.size(); ++i) {
+    writes[i].dstSet = set;
+    writes[i].dstBinding = uint32_t(i);
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    writes[i].pImageInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(device, uint32_t(writes.size()), writes.data(), 0, nullptr);
+}
+
+}  // namespace
+
+std::string Engine::Impl::renderFrame(const FrameParams& params) {
+  if (targets.extent.width == 0) return "renderFrame: no render size (call setRenderSize or attachSurface)";
+  const uint32_t shadowSize = std::clamp(params.shadow.mapSize, 1024u, 8192u);
+  if (shadowSize != targets.shadowMapSize) {
+    vkDeviceWaitIdle(ctx.device);
+    if (std::string e = createShadowMap(shadowSize); !e.empty()) return "shadow map: " + e;
+  }
+  const uint32_t slot = currentFrame;
+  FrameResources& frame = frames[slot];
+  if (std::string e = waitFrame(frame); !e.empty()) return e;
+
+  std::optional<uint32_t> imageIndex;
+  if (swapchain.swapchain) {
+    uint32_t index = 0;
+    VkResult r = vkAcquireNextImageKHR(ctx.device, swapchain.swapchain, UINT64_MAX, frame.imageAcquired,
+                                       VK_NULL_HANDLE, &index);
+    if (r == VK_ERROR_OUT_OF_DATE_KHR) return createSwapchain(swapchain.extent.width, swapchain.extent.height);
+    if (r != VK_SUCCESS && r != VK_SUBOPTIMAL_KHR) return vkFailure("vkAcquireNextImageKHR", r);
+    imageIndex = index;
+  }
+
+  // --- Uniforms ---
+  const VkExtent2D extent = targets.extent;
+  const Bounds bounds = sceneLoaded ? scene.bounds : Bounds{};
+  FrameUniforms u{};
+  u.view = viewMatrix(params.camera);
+  u.proj = projectionMatrix(params.camera, float(extent.width) / float(extent.height));
+  u.viewProj = u.proj * u.view;
+  u.invViewProj = glm::inverse(u.viewProj);
+  float lightRadius = 1.0f;
+  u.lightViewProj = lightViewProjection(bounds, params.sun.direction, lightRadius);
+  u.cameraPos = glm::vec4(params.camera.eye, 1.0f);
+  u.sunDirection = glm::vec4(glm::normalize(params.sun.direction), 0.0f);
+  u.sunRadiance = glm::vec4(params.sun.color * params.sun.intensity, 0.0f);
+  u.sky = glm::vec4(params.skyColor, params.ambientIntensity);
+  u.viewport = glm::vec4(extent.width, extent.height, 1.0f / extent.width, 1.0f / extent.height);
+  const uint32_t taps = std::clamp(params.shadow.pcfKernelSize | 1u, 1u, 9u);
+  u.shadow = glm::vec4(1.0f / float(shadowSize), float(taps),
+                       params.shadow.normalOffset * 2.0f * lightRadius / float(shadowSize), 0.0f);
+  // inputs are filled after the hook; the uniform buffer is written before submission.
+
+  SE_VK_TRY(vkResetCommandBuffer(frame.cmd, 0));
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  SE_VK_TRY(vkBeginCommandBuffer(frame.cmd, &bi));
+  frame.frameNumber = ++frameCounter;
+  recordFrame(frame, params, u, imageIndex);
+  SE_VK_TRY(vkEndCommandBuffer(frame.cmd));
+
+  // --- Submit (and present) ---
+  VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+  cbi.commandBuffer = frame.cmd;
+  VkSemaphoreSubmitInfo waitInfo{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  waitInfo.semaphore = frame.imageAcquired;
+  waitInfo.stageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;  // only the final blit touches the image
+  VkSemaphoreSubmitInfo signalInfo{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  signalInfo.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+  VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  si.commandBufferInfoCount = 1;
+  si.pCommandBufferInfos = &cbi;
+  if (imageIndex) {
+    signalInfo.semaphore = swapchain.renderFinished[*imageIndex];
+    si.waitSemaphoreInfoCount = 1;
+    si.pWaitSemaphoreInfos = &waitInfo;
+    si.signalSemaphoreInfoCount = 1;
+    si.pSignalSemaphoreInfos = &signalInfo;
+  }
+  SE_VK_TRY(vkResetFences(ctx.device, 1, &frame.fence));
+  SE_VK_TRY(vkQueueSubmit2(ctx.queue, 1, &si, frame.fence));
+  frame.timingsPending = frame.timestamps != VK_NULL_HANDLE;
+  lastSubmittedSlot = slot;
+  currentFrame = (currentFrame + 1) % kFramesInFlight;
+  frameRendered = true;
+
+  if (imageIndex) {
+    VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
+    pi.waitSemaphoreCount = 1;
+    pi.pWaitSemaphores = &swapchain.renderFinished[*imageIndex];
+    pi.swapchainCount = 1;
+    pi.pSwapchains = &swapchain.swapchain;
+    pi.pImageIndices = &*imageIndex;
+    VkResult r = vkQueuePresentKHR(ctx.queue, &pi);
+    if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR)
+      return createSwapchain(swapchain.extent.width, swapchain.extent.height);
+    if (r != VK_SUCCESS) return vkFailure("vkQueuePresentKHR", r);
+  }
+  return {};
+}
+
+void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params, const FrameUniforms& uniformsIn,
+                               std::optional<uint32_t> swapchainImage) {
+  VkCommandBuffer cmd = frame.cmd;
+  const VkExtent2D extent = targets.extent;
+  const bool haveScene = sceneLoaded;
+  auto timestamp = [&](TimestampSlot s) {
+    if (frame.timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, frame.timestamps, s);
+  };
+  if (frame.timestamps) vkCmdResetQueryPool(cmd, frame.timestamps, 0, kTsCount);
+  timestamp(kTsStart);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 0, 1, &frame.frameSet, 0,
+                          nullptr);
+
+  // (1) Shadow map. Previous contents are discarded (UNDEFINED); the barrier also orders this write after
+  // the previous frame's sampling.
+  imageBarrier(cmd, targets.shadowMap.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+               VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
+               VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+  {
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = targets.shadowMap.view;
+    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {1.0f, 0};
+    beginRendering(cmd, {targets.shadowMapSize, targets.shadowMapSize}, {}, &depth);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.shadow);
+    vkCmdSetDepthBias(cmd, params.shadow.depthBiasConstant, 0.0f, params.shadow.depthBiasSlope);
+    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Shadow);
+    vkCmdEndRendering(cmd);
+  }
+  imageBarrier(cmd, targets.shadowMap.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+               kReadLayout, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+               VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+  timestamp(kTsShadowEnd);
+
+  // (2) Depth + normal pre-pass. The previous frame's readers may include the hook's own passes (any
+  // stage), hence ALL_COMMANDS as the source scope.
+  imageBarrier(cmd, targets.depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+               VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
+               VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+  for (const Image* img : {&targets.normalRoughness, &targets.geometricNormal})
+    imageBarrier(cmd, img->image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
+                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+  {
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = targets.depth.view;
+    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {1.0f, 0};
+    beginRendering(cmd, extent,
+                   {colorAttachment(targets.normalRoughness.view, {}), colorAttachment(targets.geometricNormal.view, {})},
+                   &depth);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.prepass);
+    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Prepass);
+    vkCmdEndRendering(cmd);
+  }
+  // Readable by anything the hook records; depth stays usable as the lighting pass's read-only attachment.
+  imageBarrier(cmd, targets.depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+               kDepthReadLayout, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+               VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+  for (const Image* img : {&targets.normalRoughness, &targets.geometricNormal})
+    imageBarrier(cmd, img->image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, kReadLayout,
+                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+  timestamp(kTsPrepassEnd);
+
+  // (3) Extension point.
+  LightingInputs inputs = params.lightingInputs;
+  if (hook) {
+    PrepassHookInfo info;
+    info.commandBuffer = cmd;
+    info.frameIndex = uint32_t(&frame - frames.data());
+    info.frameNumber = frame.frameNumber;
+    info.extent = extent;
+    info.depth = {targets.depth.image, targets.depth.view, kDepthFormat, kDepthReadLayout};
+    info.normalRoughness = {targets.normalRoughness.image, targets.normalRoughness.view, kNormalFormat, kReadLayout};
+    info.geometricNormal = {targets.geometricNormal.image, targets.geometricNormal.view, kNormalFormat, kReadLayout};
+    info.reversedZ = false;
+    info.view = uniformsIn.view;
+    info.proj = uniformsIn.proj;
+    info.viewProj = uniformsIn.viewProj;
+    info.invView = glm::inverse(uniformsIn.view);
+    info.invProj = glm::inverse(uniformsIn.proj);
+    info.invViewProj = uniformsIn.invViewProj;
+    info.cameraPosition = params.camera.eye;
+    info.sunDirection = glm::vec3(uniformsIn.sunDirection);
+    hook(info, inputs);
+    // Whatever the hook wrote becomes visible to the lighting pass (layouts are the hook's business).
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT,
+                  VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+  }
+  timestamp(kTsHookEnd);
+
+  FrameUniforms u = uniformsIn;
+  u.inputs = glm::uvec4(inputs.sunVisibility != VK_NULL_HANDLE, inputs.ambientOcclusion != VK_NULL_HANDLE,
+                        inputs.reflection != VK_NULL_HANDLE, 0u);
+  std::memcpy(frame.uniforms.mapped, &u, sizeof(u));  // host-coherent; the submission makes it visible
+  writeImageDescriptors(
+      ctx.device, frame.lightingSet,
+      {{pipelines.shadowSampler, targets.shadowMap.view, kReadLayout},
+       {pipelines.screenSampler, inputs.sunVisibility ? inputs.sunVisibility : defaults.white.view, kReadLayout},
+       {pipelines.screenSampler, inputs.ambientOcclusion ? inputs.ambientOcclusion : defaults.white.view, kReadLayout},
+       {pipelines.screenSampler, inputs.reflection ? inputs.reflection : defaults.black.view, kReadLayout}});
+  writeImageDescriptors(ctx.device, frame.tonemapSet, {{pipelines.nearestSampler, targets.hdr.view, kReadLayout}});
+
+  // (4) Forward lighting: EQUAL test against the pre-pass depth, background keeps the sky clear color.
+  imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+               VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
+               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+  {
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = targets.depth.view;
+    depth.imageLayout = kDepthReadLayout;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_NONE;  // read-only: no write access at the end of the pass
+    VkClearColorValue sky{{params.skyColor.r, params.skyColor.g, params.skyColor.b, 1.0f}};
+    beginRendering(cmd, extent, {colorAttachment(targets.hdr.view, sky)}, &depth);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.forward);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 2, 1, &frame.lightingSet, 0,
+                            nullptr);
+    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Lighting);
+    vkCmdEndRendering(cmd);
+  }
+  timestamp(kTsLightingEnd);
+
+  // (5) Tonemap into the 8-bit sRGB target, left in TRANSFER_SRC_OPTIMAL for readback / swapchain blit.
+  imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+               kReadLayout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+               VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+  imageBarrier(cmd, targets.ldr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+               VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
+               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+  {
+    beginRendering(cmd, extent, {colorAttachment(targets.ldr.view, {})}, nullptr);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.tonemap);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.tonemapLayout, 0, 1, &frame.tonemapSet, 0,
+                            nullptr);
+    vkCmdPushConstants(cmd, pipelines.tonemapLayout, VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(float), &params.exposure);
+    vkCmdDraw(cmd, 3, 1, 0, 0);
+    vkCmdEndRendering(cmd);
+  }
+  imageBarrier(cmd, targets.ldr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+               VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+               VK_ACCESS_2_TRANSFER_READ_BIT);
+  timestamp(kTsTonemapEnd);
+
+  // (6) Present path: blit (with channel swizzle if the swapchain is BGRA) into the acquired image.
+  if (swapchainImage) {
+    VkImage dst = swapchain.images[*swapchainImage];
+    imageBarrier(cmd, dst, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+                 VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    VkImageBlit blit{};
+    blit.srcSubresource = blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    blit.srcOffsets[1] = {int32_t(extent.width), int32_t(extent.height), 1};
+    blit.dstOffsets[1] = {int32_t(swapchain.extent.width), int32_t(swapchain.extent.height), 1};
+    vkCmdBlitImage(cmd, targets.ldr.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dst,
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_NEAREST);
+    imageBarrier(cmd, dst, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                 VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_NONE, 0);
+  }
+}
+
+}  // namespace sample_engine

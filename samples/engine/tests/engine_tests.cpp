@@ -1,0 +1,281 @@
+// Sample engine tests: headless rendering on whatever device exists (lavapipe in CI) with validation on.
+#include <filesystem>
+#include <fstream>
+
+#include <catch2/catch_test_macros.hpp>
+
+#include "sample_engine/engine.h"
+#include "sample_engine/gltf_loader.h"
+#include "sample_engine/procedural.h"
+
+using namespace sample_engine;
+
+namespace {
+
+constexpr uint32_t kWidth = 160, kHeight = 120;
+
+std::unique_ptr<Engine> makeEngine() {
+  EngineConfig cfg;
+  cfg.enableValidation = true;
+  auto r = Engine::create(cfg);
+  INFO(r.error);
+  REQUIRE(r.ok());
+  return std::move(r.value);
+}
+
+FrameParams paramsFor(const Engine& engine) {
+  FrameParams p;
+  p.camera = engine.scene().camera ? *engine.scene().camera : defaultCameraFor(engine.sceneBounds());
+  if (engine.scene().sun) p.sun = *engine.scene().sun;
+  p.shadow.mapSize = 1024;
+  return p;
+}
+
+ImageRGBA32F renderHdr(Engine& engine, const FrameParams& params) {
+  Status s = engine.renderFrame(params);
+  INFO(s.error);
+  REQUIRE(s.ok());
+  auto hdr = engine.readbackHdr();
+  INFO(hdr.error);
+  REQUIRE(hdr.ok());
+  return std::move(hdr.value);
+}
+
+float luminance(const glm::vec4& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+
+// Average luminance of the bottom quarter of the image: ground only in the demo scene's camera.
+float groundLuminance(const ImageRGBA32F& img) {
+  double sum = 0;
+  uint32_t n = 0;
+  for (uint32_t y = img.height * 3 / 4; y < img.height; ++y)
+    for (uint32_t x = 0; x < img.width; ++x, ++n) sum += luminance(img.at(x, y));
+  return float(sum / n);
+}
+
+// A screen-sized R8 image the test owns and fills from inside the pre-pass hook, the way an add-on would.
+struct ExternalMask {
+  VkDevice device = VK_NULL_HANDLE;
+  VkImage image = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+
+  ExternalMask(Engine& engine, uint32_t w, uint32_t h) : device(engine.device()) {
+    VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    ci.imageType = VK_IMAGE_TYPE_2D;
+    ci.format = VK_FORMAT_R8_UNORM;
+    ci.extent = {w, h, 1};
+    ci.mipLevels = ci.arrayLayers = 1;
+    ci.samples = VK_SAMPLE_COUNT_1_BIT;
+    ci.tiling = VK_IMAGE_TILING_OPTIMAL;
+    ci.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    REQUIRE(vkCreateImage(device, &ci, nullptr, &image) == VK_SUCCESS);
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(device, image, &req);
+    VkPhysicalDeviceMemoryProperties props;
+    vkGetPhysicalDeviceMemoryProperties(engine.physicalDevice(), &props);
+    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = req.size;
+    for (uint32_t i = 0; i < props.memoryTypeCount; ++i)
+      if (req.memoryTypeBits & (1u << i)) {
+        ai.memoryTypeIndex = i;
+        break;
+      }
+    REQUIRE(vkAllocateMemory(device, &ai, nullptr, &memory) == VK_SUCCESS);
+    REQUIRE(vkBindImageMemory(device, image, memory, 0) == VK_SUCCESS);
+    VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    vi.image = image;
+    vi.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    vi.format = VK_FORMAT_R8_UNORM;
+    vi.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    REQUIRE(vkCreateImageView(device, &vi, nullptr, &view) == VK_SUCCESS);
+  }
+  ~ExternalMask() {
+    vkDeviceWaitIdle(device);
+    vkDestroyImageView(device, view, nullptr);
+    vkDestroyImage(device, image, nullptr);
+    vkFreeMemory(device, memory, nullptr);
+  }
+
+  // Records a clear to `value` and leaves the image in SHADER_READ_ONLY_OPTIMAL.
+  void record(VkCommandBuffer cmd, float value) const {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;  // previous frame's lighting pass read it
+    b.dstStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT;
+    b.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dep);
+    VkClearColorValue color{{value, value, value, value}};
+    vkCmdClearColorImage(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &color, 1, &b.subresourceRange);
+    b.srcStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT;
+    b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    b.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
+    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    vkCmdPipelineBarrier2(cmd, &dep);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("procedural meshes have their documented triangle counts", "[procedural]") {
+  CHECK(makePlane(2, 2, 4, 3).triangleCount() == planeTriangleCount(4, 3));
+  CHECK(planeTriangleCount(4, 3) == 24);
+  CHECK(makeBox({1, 1, 1}, 3).triangleCount() == boxTriangleCount(3));
+  CHECK(boxTriangleCount(1) == 12);
+  CHECK(makeSphere(1, 16, 8).triangleCount() == sphereTriangleCount(16, 8));
+  CHECK(sphereTriangleCount(16, 8) == 224);
+  CHECK(makeCylinder(1, 2, 12, 2, true).triangleCount() == cylinderTriangleCount(12, 2, true));
+  CHECK(makeCylinder(1, 2, 12, 2, false).triangleCount() == 48);
+  CHECK(makeArch(2, 0.3f, 3.14159f, 10, 6).triangleCount() == archTriangleCount(10, 6));
+  for (const MeshData& m : makeDefaultDemoScene().meshes) {
+    CHECK(m.normals.size() == m.positions.size());
+    CHECK(m.tangents.size() == m.positions.size());
+    for (uint32_t i : m.indices) REQUIRE(i < m.positions.size());
+  }
+}
+
+TEST_CASE("default scene renders headless without validation errors", "[render]") {
+  auto engine = makeEngine();
+  REQUIRE(engine->loadScene(makeDefaultDemoScene()).ok());
+  REQUIRE(engine->setRenderSize(kWidth, kHeight).ok());
+  FrameParams params = paramsFor(*engine);
+
+  ImageRGBA32F shadowed = renderHdr(*engine, params);
+  auto ldr = engine->readbackLdr();
+  REQUIRE(ldr.ok());
+  REQUIRE(ldr.value.width == kWidth);
+
+  SECTION("sky pixels have the sky color") {
+    for (uint32_t x : {2u, kWidth / 2, kWidth - 3}) {
+      glm::vec4 hdr = shadowed.at(x, 1);
+      CHECK(std::abs(hdr.r - params.skyColor.r) < 2e-3f);
+      CHECK(std::abs(hdr.g - params.skyColor.g) < 2e-3f);
+      CHECK(std::abs(hdr.b - params.skyColor.b) < 2e-3f);
+      glm::u8vec3 expected = tonemapToSrgb8(params.skyColor, params.exposure);
+      glm::u8vec4 got = ldr.value.at(x, 1);
+      for (int c = 0; c < 3; ++c) CHECK(std::abs(int(got[c]) - int(expected[c])) <= 2);
+    }
+  }
+
+  SECTION("shadow maps leave some geometry darker than when fully lit") {
+    // Same frame with an all-lit external visibility: the difference is exactly the shadowed area.
+    ExternalMask ones(*engine, kWidth, kHeight);
+    engine->setPrepassHook([&](const PrepassHookInfo& info, LightingInputs& inputs) {
+      ones.record(info.commandBuffer, 1.0f);
+      inputs.sunVisibility = ones.view;
+    });
+    ImageRGBA32F lit = renderHdr(*engine, params);
+    engine->setPrepassHook({});
+    uint32_t darker = 0;
+    for (uint32_t y = 0; y < kHeight; ++y)
+      for (uint32_t x = 0; x < kWidth; ++x) {
+        float s = luminance(shadowed.at(x, y)), l = luminance(lit.at(x, y));
+        CHECK(s <= l + 1e-3f);
+        if (s < 0.6f * l) ++darker;
+      }
+    INFO("shadowed pixels: " << darker);
+    CHECK(darker > kWidth * kHeight / 100);  // at least 1% of the image is in shadow
+  }
+
+  SECTION("external sun visibility of zeros darkens the ground") {
+    ExternalMask mask(*engine, kWidth, kHeight);
+    float value = 1.0f;
+    engine->setPrepassHook([&](const PrepassHookInfo& info, LightingInputs& inputs) {
+      mask.record(info.commandBuffer, value);
+      inputs.sunVisibility = mask.view;
+    });
+    float lit = groundLuminance(renderHdr(*engine, params));
+    value = 0.0f;
+    float dark = groundLuminance(renderHdr(*engine, params));
+    INFO("ground luminance, visibility 1: " << lit << ", visibility 0: " << dark);
+    CHECK(dark < 0.6f * lit);
+    CHECK(dark > 0.0f);  // ambient remains
+  }
+
+  SECTION("the pre-pass hook sees the documented images, layouts and matrices") {
+    std::vector<uint32_t> frameIndices;
+    engine->setPrepassHook([&](const PrepassHookInfo& info, LightingInputs&) {
+      frameIndices.push_back(info.frameIndex);
+      CHECK(info.commandBuffer != VK_NULL_HANDLE);
+      CHECK(info.extent.width == kWidth);
+      CHECK(info.extent.height == kHeight);
+      CHECK(info.depth.format == VK_FORMAT_D32_SFLOAT);
+      CHECK(info.depth.layout == VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL);
+      CHECK(info.normalRoughness.format == VK_FORMAT_R16G16B16A16_SFLOAT);
+      CHECK(info.normalRoughness.layout == VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+      CHECK(info.geometricNormal.layout == VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+      CHECK(info.depth.view != VK_NULL_HANDLE);
+      CHECK_FALSE(info.reversedZ);
+      glm::mat4 identity = info.viewProj * info.invViewProj;
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) CHECK(std::abs(identity[c][r] - (c == r ? 1.0f : 0.0f)) < 1e-3f);
+      CHECK(std::abs(glm::length(info.sunDirection) - 1.0f) < 1e-4f);
+    });
+    for (int i = 0; i < 3; ++i) REQUIRE(engine->renderFrame(params).ok());
+    REQUIRE(engine->waitIdle().ok());
+    engine->setPrepassHook({});
+    REQUIRE(frameIndices.size() == 3);
+    CHECK(frameIndices[0] != frameIndices[1]);
+    CHECK(frameIndices[0] == frameIndices[2]);
+    PassTimings t = engine->lastTimings();
+    CHECK(t.valid);
+    CHECK(t.lightingMs > 0.0);
+  }
+
+  SECTION("meshes expose buffers for ray-tracing inputs") {
+    REQUIRE(engine->meshes().size() == engine->scene().meshes.size());
+    for (const GpuMesh& m : engine->meshes()) {
+      CHECK(m.positionBuffer != VK_NULL_HANDLE);
+      CHECK(m.positionStride == 12);
+      CHECK(m.vertexCount == m.cpu->positions.size());
+      CHECK(m.indexCount == m.cpu->indices.size());
+      if (engine->deviceInfo().bufferDeviceAddress) CHECK(m.positionAddress != 0);
+    }
+  }
+
+  engine->setPrepassHook({});
+  REQUIRE(engine->waitIdle().ok());
+  CHECK(engine->validationErrorCount() == 0);
+}
+
+TEST_CASE("glTF loader reports errors instead of throwing", "[gltf]") {
+  SceneLoadResult missing = loadGltf("/nonexistent/scene.gltf");
+  CHECK_FALSE(missing.ok());
+  CHECK(missing.error.find("not found") != std::string::npos);
+
+  auto path = std::filesystem::temp_directory_path() / "sample_engine_malformed.gltf";
+  std::ofstream(path) << "{ this is not json";
+  SceneLoadResult malformed = loadGltf(path.string());
+  CHECK_FALSE(malformed.ok());
+  CHECK_FALSE(malformed.error.empty());
+  std::filesystem::remove(path);
+}
+
+TEST_CASE("glTF Box sample loads and renders", "[gltf][render]") {
+  const std::filesystem::path box = std::filesystem::path(RAYBRIDGE_SOURCE_DIR) / ".." / "shared" / "scenes" / "Box" / "Box.gltf";
+  if (!std::filesystem::exists(box)) SKIP("glTF sample not present: " + box.string());
+  SceneLoadResult r = loadGltf(box.string());
+  INFO(r.error);
+  REQUIRE(r.ok());
+  REQUIRE(r.scene.meshes.size() == 1);
+  CHECK(r.scene.meshes[0].triangleCount() == 12);
+  CHECK(r.scene.instances.size() == 1);
+
+  auto engine = makeEngine();
+  REQUIRE(engine->loadScene(r.scene).ok());
+  REQUIRE(engine->setRenderSize(kWidth, kHeight).ok());
+  FrameParams params = paramsFor(*engine);
+  ImageRGBA32F img = renderHdr(*engine, params);
+  glm::vec4 center = img.at(kWidth / 2, kHeight / 2);
+  CHECK(glm::length(glm::vec3(center) - params.skyColor) > 0.05f);  // the box covers the centre
+  REQUIRE(engine->waitIdle().ok());
+  CHECK(engine->validationErrorCount() == 0);
+}

@@ -1,0 +1,36 @@
+// Types shared by the effect passes: lights and per-pass measurements.
+//
+// Thread safety: plain data.
+#pragma once
+
+#include <cstdint>
+
+namespace rb {
+
+enum class LightType : uint8_t {
+  Directional = 0,  // default: the sun
+  Point,
+  Spot,
+};
+
+struct Light {
+  LightType type = LightType::Directional;
+  // Directional: direction towards the light (need not be normalised). Spot: the direction the spot shines.
+  float direction[3] = {0.0f, 1.0f, 0.0f};
+  double position[3] = {0.0, 0.0, 0.0};  // point and spot: world-space position
+  // Directional: angular radius of the light's disk in degrees; 0 = hard shadows (one ray, no noise).
+  float angularRadiusDegrees = 0.0f;
+  float radius = 0.0f;  // point and spot: radius of the emitting disk facing the surface; 0 = hard shadows
+  float range = 0.0f;   // point and spot: beyond it a surface is unlit and traces nothing; 0 = unlimited
+  float spotOuterAngleDegrees = 0.0f;  // spot: half-angle of the cone; 0 = 45 degrees
+};
+
+// What one recorded pass did, resolved once its frame has finished on the GPU.
+struct PassStats {
+  uint64_t frame = 0;        // Context::frameIndex() when recorded; 0 = nothing resolved yet
+  double gpuMs = 0.0;        // GPU time between the pass's first and last command
+  uint64_t rays = 0;         // rays traced, counted by the shaders
+  double raysPerSecond() const { return gpuMs > 0.0 ? double(rays) / (gpuMs * 1e-3) : 0.0; }
+};
+
+}  // namespace rb

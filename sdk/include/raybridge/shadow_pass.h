@@ -1,0 +1,62 @@
+// Ray-traced shadows on the engine's G-buffer: hard (one ray) and soft (several rays over the light's disk)
+// for directional, point and spot lights. Outputs sun/light visibility in [0, 1] and, when asked for, the
+// distance to the nearest occluder.
+//
+// Traces nothing for sky pixels, surfaces whose normal faces away from the light, or pixels outside a spot
+// cone or light range. Ray origins are offset along the geometric normal by the depth buffer's
+// reconstruction error, so grazing light does not cause acne.
+//
+// Thread safety: externally synchronised, like the Context it was created from.
+#pragma once
+
+#include <raybridge/acceleration_structures.h>
+#include <raybridge/effects.h>
+#include <raybridge/gbuffer.h>
+
+#include <memory>
+
+namespace rb {
+
+struct ShadowPassDesc {
+  // Allocate and write the occluder-distance image (for denoisers and contact hardening). false = the
+  // visibility image only, and rays stop at the first occluder they find.
+  bool outputHitDistance = false;
+};
+
+struct ShadowSettings {
+  // Rays per pixel for a soft light (angular radius or radius > 0); 0 = 4. A hard light always uses one.
+  uint32_t raysPerPixel = 0;
+};
+
+// Images owned by the pass, sized to the G-buffer, left in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL after
+// record() with a barrier that makes them readable by fragment and compute shaders.
+struct ShadowOutputs {
+  VkImage visibility = VK_NULL_HANDLE;  // R16_SFLOAT, 1 = lit
+  VkImageView visibilityView = VK_NULL_HANDLE;
+  VkImage hitDistance = VK_NULL_HANDLE;  // R32_SFLOAT, world units; 0 = no occluder; only with outputHitDistance
+  VkImageView hitDistanceView = VK_NULL_HANDLE;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  uint32_t width = 0, height = 0;
+};
+
+class ShadowPass {
+ public:
+  static Result<std::unique_ptr<ShadowPass>> create(Context& context, const ShadowPassDesc& desc = {});
+  ~ShadowPass();
+
+  // Records the shadow rays. `tlas` comes from recordTlasBuild() earlier in submission order (ideally with
+  // originOffset = the camera position); the G-buffer images must be in their declared layouts.
+  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas, const Light& light,
+                const ShadowSettings& settings = {});
+  const ShadowOutputs& outputs() const;
+  // GPU time and rays of the latest recording whose frame has finished.
+  PassStats stats() const;
+
+  struct Impl;
+
+ private:
+  explicit ShadowPass(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rb

@@ -1,0 +1,133 @@
+#include "pass_constants.h"
+
+#include <cmath>
+#include <string>
+
+namespace rb {
+
+namespace {
+
+// Inverse of a column-major 4x4 matrix in double precision; false if singular.
+bool invert4(const float m[16], double out[16]) {
+  double a[16];
+  for (int i = 0; i < 16; ++i) a[i] = m[i];
+  double inv[16];
+  inv[0] = a[5] * a[10] * a[15] - a[5] * a[11] * a[14] - a[9] * a[6] * a[15] + a[9] * a[7] * a[14] +
+           a[13] * a[6] * a[11] - a[13] * a[7] * a[10];
+  inv[4] = -a[4] * a[10] * a[15] + a[4] * a[11] * a[14] + a[8] * a[6] * a[15] - a[8] * a[7] * a[14] -
+           a[12] * a[6] * a[11] + a[12] * a[7] * a[10];
+  inv[8] = a[4] * a[9] * a[15] - a[4] * a[11] * a[13] - a[8] * a[5] * a[15] + a[8] * a[7] * a[13] +
+           a[12] * a[5] * a[11] - a[12] * a[7] * a[9];
+  inv[12] = -a[4] * a[9] * a[14] + a[4] * a[10] * a[13] + a[8] * a[5] * a[14] - a[8] * a[6] * a[13] -
+            a[12] * a[5] * a[10] + a[12] * a[6] * a[9];
+  inv[1] = -a[1] * a[10] * a[15] + a[1] * a[11] * a[14] + a[9] * a[2] * a[15] - a[9] * a[3] * a[14] -
+           a[13] * a[2] * a[11] + a[13] * a[3] * a[10];
+  inv[5] = a[0] * a[10] * a[15] - a[0] * a[11] * a[14] - a[8] * a[2] * a[15] + a[8] * a[3] * a[14] +
+           a[12] * a[2] * a[11] - a[12] * a[3] * a[10];
+  inv[9] = -a[0] * a[9] * a[15] + a[0] * a[11] * a[13] + a[8] * a[1] * a[15] - a[8] * a[3] * a[13] -
+           a[12] * a[1] * a[11] + a[12] * a[3] * a[9];
+  inv[13] = a[0] * a[9] * a[14] - a[0] * a[10] * a[13] - a[8] * a[1] * a[14] + a[8] * a[2] * a[13] +
+            a[12] * a[1] * a[10] - a[12] * a[2] * a[9];
+  inv[2] = a[1] * a[6] * a[15] - a[1] * a[7] * a[14] - a[5] * a[2] * a[15] + a[5] * a[3] * a[14] +
+           a[13] * a[2] * a[7] - a[13] * a[3] * a[6];
+  inv[6] = -a[0] * a[6] * a[15] + a[0] * a[7] * a[14] + a[4] * a[2] * a[15] - a[4] * a[3] * a[14] -
+           a[12] * a[2] * a[7] + a[12] * a[3] * a[6];
+  inv[10] = a[0] * a[5] * a[15] - a[0] * a[7] * a[13] - a[4] * a[1] * a[15] + a[4] * a[3] * a[13] +
+            a[12] * a[1] * a[7] - a[12] * a[3] * a[5];
+  inv[14] = -a[0] * a[5] * a[14] + a[0] * a[6] * a[13] + a[4] * a[1] * a[14] - a[4] * a[2] * a[13] -
+            a[12] * a[1] * a[6] + a[12] * a[2] * a[5];
+  inv[3] = -a[1] * a[6] * a[11] + a[1] * a[7] * a[10] + a[5] * a[2] * a[11] - a[5] * a[3] * a[10] -
+           a[9] * a[2] * a[7] + a[9] * a[3] * a[6];
+  inv[7] = a[0] * a[6] * a[11] - a[0] * a[7] * a[10] - a[4] * a[2] * a[11] + a[4] * a[3] * a[10] +
+           a[8] * a[2] * a[7] - a[8] * a[3] * a[6];
+  inv[11] = -a[0] * a[5] * a[11] + a[0] * a[7] * a[9] + a[4] * a[1] * a[11] - a[4] * a[3] * a[9] -
+            a[8] * a[1] * a[7] + a[8] * a[3] * a[5];
+  inv[15] = a[0] * a[5] * a[10] - a[0] * a[6] * a[9] - a[4] * a[1] * a[10] + a[4] * a[2] * a[9] +
+            a[8] * a[1] * a[6] - a[8] * a[2] * a[5];
+  double det = a[0] * inv[0] + a[1] * inv[4] + a[2] * inv[8] + a[3] * inv[12];
+  if (!std::isfinite(det) || std::fabs(det) < 1e-300) return false;
+  for (int i = 0; i < 16; ++i) out[i] = inv[i] / det;
+  return true;
+}
+
+}  // namespace
+
+VkImageLayout readLayout(const GBufferImage& image) {
+  return image.layout == VK_IMAGE_LAYOUT_UNDEFINED ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL : image.layout;
+}
+
+void cameraPosition(const GBufferDesc& g, double out[3]) {
+  if (g.cameraPosition[0] != 0.0 || g.cameraPosition[1] != 0.0 || g.cameraPosition[2] != 0.0) {
+    for (int i = 0; i < 3; ++i) out[i] = g.cameraPosition[i];
+    return;
+  }
+  double inv[16];
+  if (!invert4(g.view, inv)) {
+    out[0] = out[1] = out[2] = 0.0;
+    return;
+  }
+  for (int i = 0; i < 3; ++i) out[i] = inv[12 + i];
+}
+
+Status fillGBufferConstants(const GBufferDesc& g, const TlasInfo& tlas, uint64_t frame, const char* passName,
+                            PassConstants& out) {
+  auto invalid = [&](const std::string& m) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, std::string(passName) + ": " + m};
+  };
+  if (g.width == 0 || g.height == 0) {
+    return invalid("GBufferDesc size " + std::to_string(g.width) + "x" + std::to_string(g.height) +
+                   " is empty; set width and height to the G-buffer's size");
+  }
+  if (!g.depth.view) return invalid("GBufferDesc::depth.view is VK_NULL_HANDLE; the depth buffer is required");
+  if (!g.normal.view) return invalid("GBufferDesc::normal.view is VK_NULL_HANDLE; a normal image is required");
+  if (!tlas.tlas) return invalid("the TLAS is VK_NULL_HANDLE; build one with recordTlasBuild() first");
+  if (g.normalEncoding != NormalEncoding::WorldFloat && g.normalEncoding != NormalEncoding::Octahedral) {
+    return invalid("GBufferDesc::normalEncoding has an unknown value");
+  }
+  if (g.roughnessInNormalW && g.normalEncoding != NormalEncoding::WorldFloat) {
+    return invalid("GBufferDesc::roughnessInNormalW needs NormalEncoding::WorldFloat (octahedral uses .zw otherwise)");
+  }
+  for (float v : g.view) {
+    if (!std::isfinite(v)) return invalid("GBufferDesc::view contains a non-finite value");
+  }
+  double invProj[16], invView[16];
+  if (!invert4(g.projection, invProj)) {
+    return invalid("GBufferDesc::projection is not invertible; pass the projection matrix used to rasterize");
+  }
+  if (!invert4(g.view, invView)) return invalid("GBufferDesc::view is not invertible");
+  for (int i = 0; i < 16; ++i) out.inverseProjection[i] = static_cast<float>(invProj[i]);
+  for (int c = 0; c < 3; ++c) {
+    // Column c of the rotation part of inverse(view), normalised so a scaled view matrix still reconstructs
+    // lengths in world units through the projection.
+    for (int r = 0; r < 3; ++r) out.viewToWorld[c][r] = static_cast<float>(invView[c * 4 + r]);
+    out.viewToWorld[c][3] = 0.0f;
+  }
+  double cam[3];
+  cameraPosition(g, cam);
+  for (int i = 0; i < 3; ++i) out.cameraToTlas[i] = static_cast<float>(cam[i] - tlas.originOffset[i]);
+  // The depth quantum: one step of the stored value (float depth: 0 = one ulp, computed in the shader).
+  switch (g.depthFormat) {
+    case VK_FORMAT_UNDEFINED:
+    case VK_FORMAT_D32_SFLOAT:
+    case VK_FORMAT_D32_SFLOAT_S8_UINT: out.cameraToTlas[3] = 0.0f; break;
+    case VK_FORMAT_X8_D24_UNORM_PACK32:
+    case VK_FORMAT_D24_UNORM_S8_UINT: out.cameraToTlas[3] = 1.0f / 16777215.0f; break;
+    case VK_FORMAT_D16_UNORM:
+    case VK_FORMAT_D16_UNORM_S8_UINT: out.cameraToTlas[3] = 1.0f / 65535.0f; break;
+    default: return invalid("GBufferDesc::depthFormat is not a depth format");
+  }
+  out.gbuffer[0] = g.width;
+  out.gbuffer[1] = g.height;
+  uint32_t flags = 0;
+  if (g.depthConvention == DepthConvention::ReversedZ) flags |= kGbReversedZ;
+  if (g.normalEncoding == NormalEncoding::Octahedral) flags |= kGbOctahedral;
+  if (g.geometricNormal.view) flags |= kGbGeometricNormal;
+  if (g.roughnessInNormalW) flags |= kGbRoughnessInNormalW;
+  if (g.roughnessMetalness.view) flags |= kGbRoughnessImage;
+  if (g.albedo.view) flags |= kGbAlbedoImage;
+  out.gbuffer[2] = flags;
+  out.gbuffer[3] = static_cast<uint32_t>(frame);
+  return {};
+}
+
+}  // namespace rb

@@ -1,0 +1,39 @@
+// Per-pass measurement: GPU time from timestamp queries and the number of rays traced, counted on the GPU,
+// one slot per frame in flight, read back once the frame is known to be done.
+#pragma once
+
+#include <raybridge/effects.h>
+
+#include <vector>
+
+#include "gpu_memory.h"
+
+namespace rb {
+
+class PassMetrics {
+ public:
+  static constexpr uint32_t kCounterSlots = 256;  // rays are summed into 256 counters to spread atomics
+
+  Status init(Context& ctx, const char* passName);
+  void destroy(Context& ctx);
+
+  // Collects finished frames, then resets this frame's slot. Call before recording the pass.
+  void beginRecording(Context& ctx, VkCommandBuffer cmd);
+  void writeStart(Context& ctx, VkCommandBuffer cmd);
+  void writeEnd(Context& ctx, VkCommandBuffer cmd);
+  // The counter buffer of this frame's slot, for the shader's ray counters.
+  VkBuffer counterBuffer() const { return counters_.buffer; }
+  VkDeviceSize counterOffset(Context& ctx) const;
+  VkDeviceSize counterBytes() const { return kCounterSlots * sizeof(uint32_t); }
+  const PassStats& latest() const { return latest_; }
+
+ private:
+  void collect(Context& ctx);
+  GpuBuffer counters_;  // host-visible, framesInFlight * kCounterSlots uints
+  VkQueryPool timestamps_ = VK_NULL_HANDLE;
+  std::vector<uint64_t> recordedFrame_;  // per slot; UINT64_MAX = nothing pending
+  PassStats latest_;
+  bool timing_ = false;
+};
+
+}  // namespace rb

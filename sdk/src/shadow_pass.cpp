@@ -1,0 +1,156 @@
+#include <raybridge/shadow_pass.h>
+
+#include <cmath>
+#include <string>
+
+#include "context_impl.h"
+#include "gbuffer_sampler.h"
+#include "pass_constants.h"
+#include "pass_images.h"
+#include "pass_metrics.h"
+#include "ray_tracing_pipeline.h"
+#include "raybridge_shaders.h"
+
+namespace rb {
+
+namespace {
+constexpr float kDegrees = 3.14159265358979f / 180.0f;
+}
+
+struct ShadowPass::Impl {
+  Context& ctx;
+  ShadowPassDesc desc;
+  RayTracingPipeline pipeline;
+  VkSampler sampler = VK_NULL_HANDLE;
+  PassImages images;
+  PassMetrics metrics;
+  ShadowOutputs outputs;
+  explicit Impl(Context& c) : ctx(c) {}
+  ~Impl() {
+    pipeline.destroy(ctx);
+    destroySampler(ctx, sampler);
+    images.destroy(ctx);
+    metrics.destroy(ctx);
+  }
+};
+
+ShadowPass::ShadowPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ShadowPass::~ShadowPass() = default;
+
+Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const ShadowPassDesc& desc) {
+  auto impl = std::make_unique<Impl>(context);
+  impl->desc = desc;
+  RayTracingPipelineDesc p;
+  p.name = "shadow pass";
+  p.raygen = SpirvModule::of(spirv::shadow_rgen);
+  p.misses = {SpirvModule::of(spirv::shadow_rmiss)};
+  // The closest-hit shader runs only when the occluder distance is wanted; otherwise rays skip it.
+  p.hitGroups = {HitGroupDesc{desc.outputHitDistance ? SpirvModule::of(spirv::shadow_rchit) : SpirvModule{}, {}}};
+  p.raygenSpecialization = {desc.outputHitDistance ? 1u : 0u};
+  const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
+  p.bindings = {
+      {0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, rg, nullptr},
+      {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
+      {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
+      {3, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
+      {4, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr},
+      {5, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr},
+  };
+  if (desc.outputHitDistance) p.bindings.push_back({6, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
+  p.pushConstantBytes = sizeof(PassConstants);
+  Result<RayTracingPipeline> pipeline = RayTracingPipeline::create(context, p);
+  if (!pipeline) return pipeline.error();
+  impl->pipeline = pipeline.value();
+  Result<VkSampler> sampler = createNearestSampler(context);
+  if (!sampler) return sampler.error();
+  impl->sampler = sampler.value();
+  if (Status s = impl->metrics.init(context, "shadow pass ray counters"); !s) return s.error();
+  return std::unique_ptr<ShadowPass>(new ShadowPass(std::move(impl)));
+}
+
+Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const Light& light,
+                          const ShadowSettings& settings) {
+  Impl& s = *impl_;
+  auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ShadowPass: " + m}; };
+  if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
+  PassConstants pc{};
+  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ShadowPass", pc); !st) return st;
+
+  // Light parameters in the TLAS's space.
+  float dir[3] = {light.direction[0], light.direction[1], light.direction[2]};
+  float len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+  if (!(len > 0.0f) || !std::isfinite(len)) return invalid("Light::direction must be a finite, non-zero vector");
+  for (float& d : dir) d /= len;
+  bool soft;
+  switch (light.type) {
+    case LightType::Directional: {
+      if (!(light.angularRadiusDegrees >= 0.0f && light.angularRadiusDegrees < 45.0f)) {
+        return invalid("Light::angularRadiusDegrees " + std::to_string(light.angularRadiusDegrees) +
+                       " is outside [0, 45)");
+      }
+      for (int i = 0; i < 3; ++i) pc.p0[i] = dir[i];
+      pc.p0[3] = 0.0f;
+      pc.p1[0] = std::tan(light.angularRadiusDegrees * kDegrees);
+      soft = light.angularRadiusDegrees > 0.0f;
+      break;
+    }
+    case LightType::Point:
+    case LightType::Spot: {
+      if (!(light.radius >= 0.0f) || !(light.range >= 0.0f)) {
+        return invalid("Light::radius and Light::range must be >= 0");
+      }
+      for (int i = 0; i < 3; ++i) pc.p0[i] = static_cast<float>(light.position[i] - tlas.originOffset[i]);
+      pc.p0[3] = light.type == LightType::Point ? 1.0f : 2.0f;
+      pc.p1[0] = light.radius;
+      pc.p1[1] = light.range;
+      float outer = light.spotOuterAngleDegrees == 0.0f ? 45.0f : light.spotOuterAngleDegrees;
+      if (light.type == LightType::Spot && !(outer > 0.0f && outer <= 90.0f)) {
+        return invalid("Light::spotOuterAngleDegrees " + std::to_string(outer) + " is outside (0, 90]");
+      }
+      pc.p1[2] = std::cos(outer * kDegrees);
+      for (int i = 0; i < 3; ++i) pc.p2[i] = dir[i];
+      soft = light.radius > 0.0f;
+      break;
+    }
+    default: return invalid("Light::type has an unknown value");
+  }
+  if (settings.raysPerPixel > 4096) {
+    return invalid("ShadowSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " exceeds 4096");
+  }
+  pc.u0[0] = soft ? (settings.raysPerPixel ? settings.raysPerPixel : 4u) : 1u;
+
+  std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16_SFLOAT, "shadow visibility"}};
+  if (s.desc.outputHitDistance) specs.push_back({VK_FORMAT_R32_SFLOAT, "shadow hit distance"});
+  if (Status st = s.images.ensure(s.ctx, g.width, g.height, specs); !st) return st;
+
+  s.metrics.beginRecording(s.ctx, cmd);
+  s.metrics.writeStart(s.ctx, cmd);
+  s.images.beginWrite(s.ctx, cmd);
+  DescriptorWrites w;
+  w.accelerationStructure(0, tlas.tlas);
+  w.sampledImage(1, g.depth.view, s.sampler, readLayout(g.depth));
+  w.sampledImage(2, g.normal.view, s.sampler, readLayout(g.normal));
+  const GBufferImage& geo = g.geometricNormal.view ? g.geometricNormal : g.normal;
+  w.sampledImage(3, geo.view, s.sampler, readLayout(geo));
+  w.storageImage(4, s.images[0].view);
+  w.storageBuffer(5, s.metrics.counterBuffer(), s.metrics.counterOffset(s.ctx), s.metrics.counterBytes());
+  if (s.desc.outputHitDistance) w.storageImage(6, s.images[1].view);
+  s.pipeline.bind(s.ctx, cmd, w.writes, &pc, sizeof pc);
+  s.pipeline.trace(s.ctx, cmd, g.width, g.height);
+  s.images.endWrite(s.ctx, cmd);
+  s.metrics.writeEnd(s.ctx, cmd);
+
+  ShadowOutputs& o = s.outputs;
+  o.visibility = s.images[0].image;
+  o.visibilityView = s.images[0].view;
+  o.hitDistance = s.desc.outputHitDistance ? s.images[1].image : VK_NULL_HANDLE;
+  o.hitDistanceView = s.desc.outputHitDistance ? s.images[1].view : VK_NULL_HANDLE;
+  o.width = g.width;
+  o.height = g.height;
+  return {};
+}
+
+const ShadowOutputs& ShadowPass::outputs() const { return impl_->outputs; }
+PassStats ShadowPass::stats() const { return impl_->metrics.latest(); }
+
+}  // namespace rb
