@@ -21,10 +21,11 @@ function(raybridge_embed_shaders)
     set(part ${out_dir}/${var}.inc)
     add_custom_command(
       OUTPUT ${part}
-      COMMAND ${GLSLANG_VALIDATOR} --quiet --target-env vulkan1.2 ${include_flags} -o ${part}.tmp --vn ${var} ${abs}
-      COMMAND ${CMAKE_COMMAND} -DIN=${part}.tmp -DOUT=${part} -P ${RAYBRIDGE_CMAKE_DIR}/ConstexprShader.cmake
-      DEPENDS ${abs} ${ARG_INCLUDE_DIRS}
-      IMPLICIT_DEPENDS CXX ${abs}
+      COMMAND ${GLSLANG_VALIDATOR} --quiet --target-env vulkan1.2 ${include_flags} -o ${part} --vn ${var}
+              --depfile ${part}.d ${abs}
+      COMMAND ${CMAKE_COMMAND} -DIN=${part} -DOUT=${part} -P ${RAYBRIDGE_CMAKE_DIR}/ConstexprShader.cmake
+      DEPENDS ${abs}
+      DEPFILE ${part}.d
       COMMENT "glslang ${name}"
       VERBATIM)
     list(APPEND parts ${part})

@@ -9,7 +9,7 @@
 // Mirrors rb::PassConstants (sdk/src/pass_constants.h); 208 bytes, under the 256-byte push constant limit.
 layout(push_constant) uniform PassConstants {
   mat4 inverseProjection;
-  vec4 viewToWorld[3];  // columns of the view-to-world rotation
+  vec4 viewToWorld[3];  // xyz: columns of the view-to-world rotation; [0].w: w of the inverse projection at depth 1
   vec4 cameraToTlas;    // xyz: camera position in the TLAS's space; w: depth quantum (0 = float ulp)
   uvec4 gbuffer;        // x: width, y: height, z: RB_GB_* flags, w: frame index (noise seed)
   vec4 p0;              // pass parameters
@@ -33,21 +33,23 @@ bool rbIsSky(float depth) {
 
 uint rbNormalEncoding() { return (pc.gbuffer.z & RB_GB_OCTAHEDRAL) != 0u ? 1u : 0u; }
 
-// The surface point of `pixel` in TLAS space.
-vec3 rbSurfacePoint(uvec2 pixel, float depth) {
-  return pc.cameraToTlas.xyz +
-         rbReconstructCameraRelative(pixel, vec2(pc.gbuffer.xy), depth, pc.inverseProjection, rbViewToWorld());
+vec3 rbCameraRelative(uvec2 pixel, float depth) {
+  return rbReconstructCameraRelative(pixel, vec2(pc.gbuffer.xy), depth, pc.inverseProjection, rbViewToWorld(),
+                                     pc.viewToWorld[0].w, (pc.gbuffer.z & RB_GB_REVERSED_Z) != 0u);
 }
+
+// The surface point of `pixel` in TLAS space.
+vec3 rbSurfacePoint(uvec2 pixel, float depth) { return pc.cameraToTlas.xyz + rbCameraRelative(pixel, depth); }
 
 // A ray origin off the surface: along the geometric normal (turned towards the viewer) by a margin that
 // covers the reconstruction error of a depth-buffer position, then by the float-precision offset.
 vec3 rbRayOrigin(uvec2 pixel, float depth, vec3 geometricNormal, out vec3 facingNormal) {
-  vec3 p = rbReconstructCameraRelative(pixel, vec2(pc.gbuffer.xy), depth, pc.inverseProjection, rbViewToWorld());
+  vec3 p = rbCameraRelative(pixel, depth);
   // One depth quantum further away: the distance between the two reconstructions is the position error.
   float quantum = pc.cameraToTlas.w > 0.0 ? pc.cameraToTlas.w
                                           : abs(uintBitsToFloat(floatBitsToUint(depth) + 1u) - depth);
   float stepDepth = (pc.gbuffer.z & RB_GB_REVERSED_Z) != 0u ? depth - quantum : depth + quantum;
-  vec3 q = rbReconstructCameraRelative(pixel, vec2(pc.gbuffer.xy), stepDepth, pc.inverseProjection, rbViewToWorld());
+  vec3 q = rbCameraRelative(pixel, stepDepth);
   float error = length(q - p);
   facingNormal = dot(geometricNormal, p) > 0.0 ? -geometricNormal : geometricNormal;
   vec3 origin = pc.cameraToTlas.xyz + p + facingNormal * (4.0 * error + 1e-5 * length(p));

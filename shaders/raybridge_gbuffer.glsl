@@ -25,10 +25,17 @@ vec3 rbDecodeNormal(vec4 texel, uint encoding) {
 // Camera-relative world position of a pixel: view-space position from depth through the inverse projection,
 // rotated into world axes (no translation: add the camera position in double precision on the CPU side).
 //   pixel: integer pixel coordinates (top-left origin); size: G-buffer size; depth: raw depth-buffer value.
-vec3 rbReconstructCameraRelative(uvec2 pixel, vec2 size, float depth, mat4 inverseProjection, mat3 viewToWorld) {
+// With standard depth (near 1 far away) w = a * depth + b cancels almost completely; pass
+// wAtDepthOne = a + b (computed in double on the CPU) and w is formed as wAtDepthOne + a * (depth - 1), where
+// depth - 1 is exact. With reversed-Z pass reversedZ = true: the direct form has no cancellation there.
+vec3 rbReconstructCameraRelative(uvec2 pixel, vec2 size, float depth, mat4 inverseProjection, mat3 viewToWorld,
+                                 float wAtDepthOne, bool reversedZ) {
   vec2 ndc = (vec2(pixel) + 0.5) / size * 2.0 - 1.0;
-  vec4 view = inverseProjection * vec4(ndc, depth, 1.0);
-  return viewToWorld * (view.xyz / view.w);
+  vec3 xyz = (inverseProjection * vec4(ndc, depth, 1.0)).xyz;
+  float wxy = inverseProjection[0][3] * ndc.x + inverseProjection[1][3] * ndc.y;
+  float w = reversedZ ? wxy + inverseProjection[2][3] * depth + inverseProjection[3][3]
+                      : wxy + (wAtDepthOne + inverseProjection[2][3] * (depth - 1.0));
+  return viewToWorld * (xyz / w);
 }
 
 #endif

@@ -102,6 +102,8 @@ Status fillGBufferConstants(const GBufferDesc& g, const TlasInfo& tlas, uint64_t
     for (int r = 0; r < 3; ++r) out.viewToWorld[c][r] = static_cast<float>(invView[c * 4 + r]);
     out.viewToWorld[c][3] = 0.0f;
   }
+  // w at depth 1, formed in double: the shader adds the small term a * (depth - 1) to it without cancellation.
+  out.viewToWorld[0][3] = static_cast<float>(invProj[11] + invProj[15]);
   double cam[3];
   cameraPosition(g, cam);
   for (int i = 0; i < 3; ++i) out.cameraToTlas[i] = static_cast<float>(cam[i] - tlas.originOffset[i]);

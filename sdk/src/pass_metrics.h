@@ -25,7 +25,11 @@ class PassMetrics {
   VkBuffer counterBuffer() const { return counters_.buffer; }
   VkDeviceSize counterOffset(Context& ctx) const;
   VkDeviceSize counterBytes() const { return kCounterSlots * sizeof(uint32_t); }
-  const PassStats& latest() const { return latest_; }
+  // Collects finished frames first.
+  const PassStats& latest(Context& ctx) {
+    collect(ctx);
+    return latest_;
+  }
 
  private:
   void collect(Context& ctx);

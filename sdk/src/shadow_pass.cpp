@@ -42,11 +42,11 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
   impl->desc = desc;
   RayTracingPipelineDesc p;
   p.name = "shadow pass";
-  p.raygen = SpirvModule::of(spirv::shadow_rgen);
+  p.raygen = desc.outputHitDistance ? SpirvModule::of(spirv::shadow_distance_rgen) : SpirvModule::of(spirv::shadow_rgen);
   p.misses = {SpirvModule::of(spirv::shadow_rmiss)};
-  // The closest-hit shader runs only when the occluder distance is wanted; otherwise rays skip it.
-  p.hitGroups = {HitGroupDesc{desc.outputHitDistance ? SpirvModule::of(spirv::shadow_rchit) : SpirvModule{}, {}}};
-  p.raygenSpecialization = {desc.outputHitDistance ? 1u : 0u};
+  // The closest-hit shader runs only when the occluder distance is wanted; otherwise rays skip it by flag.
+  // (A hit group without shaders would do, but crashes validation layer 1.3.239 in vkCmdTraceRaysKHR.)
+  p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::shadow_rchit), {}}};
   const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
   p.bindings = {
       {0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, rg, nullptr},
@@ -151,6 +151,6 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
 }
 
 const ShadowOutputs& ShadowPass::outputs() const { return impl_->outputs; }
-PassStats ShadowPass::stats() const { return impl_->metrics.latest(); }
+PassStats ShadowPass::stats() const { return impl_->metrics.latest(impl_->ctx); }
 
 }  // namespace rb

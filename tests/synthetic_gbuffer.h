@@ -1,0 +1,69 @@
+// A G-buffer made by the Embree reference instead of a rasterizer: exact depth and geometric normals of a
+// test scene, uploaded as the images an engine would hand to Raybridge. Lets the effect passes be checked
+// against ground truth without any engine in the loop.
+#pragma once
+
+#include <raybridge/raybridge.h>
+
+#include <glm/glm.hpp>
+
+#include <vector>
+
+#include "embree_reference.h"
+#include "test_scene.h"
+
+namespace rbtest {
+
+struct SyntheticView {
+  glm::dvec3 eye{0.0};
+  glm::dvec3 target{0.0, 0.0, -1.0};
+  glm::dvec3 up{0.0, 1.0, 0.0};
+  double fovYDegrees = 60.0;
+  uint32_t width = 128, height = 96;
+  bool reversedZ = false;
+  float nearPlane = 0.05f;
+  float farPlane = 500.0f;
+};
+
+// CPU-side G-buffer: per pixel the exact hit (world position in double, geometric normal facing the eye).
+struct CpuGBuffer {
+  SyntheticView view;
+  glm::mat4 viewMatrix{1.0f};  // camera-relative: rotation only (the translation lives in cameraPosition)
+  glm::mat4 projection{1.0f};
+  std::vector<float> depth;          // hardware depth values
+  std::vector<glm::vec4> normal;     // world normal (xyz), w = 0
+  std::vector<uint8_t> hit;          // 1 where the primary ray hit
+  std::vector<glm::dvec3> position;  // world position of the hit
+  std::vector<uint32_t> instance;    // instance id of the hit
+};
+
+// Traces the primary rays with Embree over `scene` (instances given in world space).
+CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& view);
+
+// The G-buffer uploaded: D32 depth and RGBA32F normal images in SHADER_READ_ONLY_OPTIMAL.
+class GpuGBuffer {
+ public:
+  GpuGBuffer(GpuFixture& fx, const CpuGBuffer& cpu);
+  ~GpuGBuffer();
+  // The contract as an engine would fill it; cameraPosition carries the eye in double.
+  rb::GBufferDesc desc() const { return desc_; }
+
+ private:
+  struct Image {
+    VkImage image = VK_NULL_HANDLE;
+    VkImageView view = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+  };
+  Image upload(VkFormat format, VkImageAspectFlags aspect, const void* data, size_t bytes);
+  GpuFixture& fx_;
+  Image depth_, normal_;
+  rb::GBufferDesc desc_;
+};
+
+// Reads a pass output (in SHADER_READ_ONLY_OPTIMAL, left so) back: raw bytes, or R16F/R32F as floats.
+std::vector<uint8_t> readPassImage(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height,
+                                   uint32_t bytesPerPixel);
+std::vector<float> readR16f(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height);
+std::vector<float> readR32f(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height);
+
+}  // namespace rbtest
