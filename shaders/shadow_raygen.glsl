@@ -15,8 +15,8 @@ layout(set = 0, binding = 0) uniform accelerationStructureEXT tlas;
 layout(set = 0, binding = 1) uniform sampler2D gDepth;
 layout(set = 0, binding = 2) uniform sampler2D gNormal;
 layout(set = 0, binding = 3) uniform sampler2D gGeometricNormal;
-layout(set = 0, binding = 4, r16f) uniform writeonly image2D outVisibility;
-layout(set = 0, binding = 5) buffer RayCounters { uint rayCount[256]; };
+layout(set = 0, binding = 4) buffer RayCounters { uint rayCount[256]; };
+layout(set = 0, binding = 5, r16f) uniform writeonly image2D outVisibility;
 #ifdef RB_WRITE_HIT_DISTANCE
 layout(set = 0, binding = 6, r32f) uniform writeonly image2D outHitDistance;
 #endif

@@ -4,11 +4,7 @@
 #include <string>
 
 #include "context_impl.h"
-#include "gbuffer_sampler.h"
-#include "pass_constants.h"
-#include "pass_images.h"
-#include "pass_metrics.h"
-#include "ray_tracing_pipeline.h"
+#include "pass_core.h"
 #include "raybridge_shaders.h"
 
 namespace rb {
@@ -20,18 +16,10 @@ constexpr float kDegrees = 3.14159265358979f / 180.0f;
 struct ShadowPass::Impl {
   Context& ctx;
   ShadowPassDesc desc;
-  RayTracingPipeline pipeline;
-  VkSampler sampler = VK_NULL_HANDLE;
-  PassImages images;
-  PassMetrics metrics;
+  PassCore core;
   ShadowOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() {
-    pipeline.destroy(ctx);
-    destroySampler(ctx, sampler);
-    images.destroy(ctx);
-    metrics.destroy(ctx);
-  }
+  ~Impl() { core.destroy(ctx); }
 };
 
 ShadowPass::ShadowPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -43,28 +31,16 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
   RayTracingPipelineDesc p;
   p.name = "shadow pass";
   p.raygen = desc.outputHitDistance ? SpirvModule::of(spirv::shadow_distance_rgen) : SpirvModule::of(spirv::shadow_rgen);
-  p.misses = {SpirvModule::of(spirv::shadow_rmiss)};
+  p.misses = {SpirvModule::of(spirv::occlusion_rmiss)};
   // The closest-hit shader runs only when the occluder distance is wanted; otherwise rays skip it by flag.
   // (A hit group without shaders would do, but crashes validation layer 1.3.239 in vkCmdTraceRaysKHR.)
-  p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::shadow_rchit), {}}};
+  p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::occlusion_rchit), {}}};
   const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
-  p.bindings = {
-      {0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, rg, nullptr},
-      {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
-      {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
-      {3, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
-      {4, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr},
-      {5, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr},
-  };
+  p.bindings = PassCore::commonBindings();
+  p.bindings.push_back({5, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
   if (desc.outputHitDistance) p.bindings.push_back({6, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
   p.pushConstantBytes = sizeof(PassConstants);
-  Result<RayTracingPipeline> pipeline = RayTracingPipeline::create(context, p);
-  if (!pipeline) return pipeline.error();
-  impl->pipeline = pipeline.value();
-  Result<VkSampler> sampler = createNearestSampler(context);
-  if (!sampler) return sampler.error();
-  impl->sampler = sampler.value();
-  if (Status s = impl->metrics.init(context, "shadow pass ray counters"); !s) return s.error();
+  if (Status s = impl->core.init(context, p); !s) return s.error();
   return std::unique_ptr<ShadowPass>(new ShadowPass(std::move(impl)));
 }
 
@@ -121,36 +97,25 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
 
   std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16_SFLOAT, "shadow visibility"}};
   if (s.desc.outputHitDistance) specs.push_back({VK_FORMAT_R32_SFLOAT, "shadow hit distance"});
-  if (Status st = s.images.ensure(s.ctx, g.width, g.height, specs); !st) return st;
-
-  s.metrics.beginRecording(s.ctx, cmd);
-  s.metrics.writeStart(s.ctx, cmd);
-  s.images.beginWrite(s.ctx, cmd);
+  if (Status st = s.core.begin(s.ctx, cmd, g, specs); !st) return st;
+  const PassImages& images = s.core.images;
   DescriptorWrites w;
-  w.accelerationStructure(0, tlas.tlas);
-  w.sampledImage(1, g.depth.view, s.sampler, readLayout(g.depth));
-  w.sampledImage(2, g.normal.view, s.sampler, readLayout(g.normal));
-  const GBufferImage& geo = g.geometricNormal.view ? g.geometricNormal : g.normal;
-  w.sampledImage(3, geo.view, s.sampler, readLayout(geo));
-  w.storageImage(4, s.images[0].view);
-  w.storageBuffer(5, s.metrics.counterBuffer(), s.metrics.counterOffset(s.ctx), s.metrics.counterBytes());
-  if (s.desc.outputHitDistance) w.storageImage(6, s.images[1].view);
-  s.pipeline.bind(s.ctx, cmd, w.writes, &pc, sizeof pc);
-  s.pipeline.trace(s.ctx, cmd, g.width, g.height);
-  s.images.endWrite(s.ctx, cmd);
-  s.metrics.writeEnd(s.ctx, cmd);
+  s.core.writeCommon(s.ctx, w, g, tlas);
+  w.storageImage(5, images[0].view);
+  if (s.desc.outputHitDistance) w.storageImage(6, images[1].view);
+  s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
 
   ShadowOutputs& o = s.outputs;
-  o.visibility = s.images[0].image;
-  o.visibilityView = s.images[0].view;
-  o.hitDistance = s.desc.outputHitDistance ? s.images[1].image : VK_NULL_HANDLE;
-  o.hitDistanceView = s.desc.outputHitDistance ? s.images[1].view : VK_NULL_HANDLE;
+  o.visibility = images[0].image;
+  o.visibilityView = images[0].view;
+  o.hitDistance = s.desc.outputHitDistance ? images[1].image : VK_NULL_HANDLE;
+  o.hitDistanceView = s.desc.outputHitDistance ? images[1].view : VK_NULL_HANDLE;
   o.width = g.width;
   o.height = g.height;
   return {};
 }
 
 const ShadowOutputs& ShadowPass::outputs() const { return impl_->outputs; }
-PassStats ShadowPass::stats() const { return impl_->metrics.latest(impl_->ctx); }
+PassStats ShadowPass::stats() const { return impl_->core.metrics.latest(impl_->ctx); }
 
 }  // namespace rb

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <raybridge/acceleration_structures.h>
+#include <raybridge/ao_pass.h>
 #include <raybridge/context.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>

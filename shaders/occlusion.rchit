@@ -1,5 +1,5 @@
 #version 460
 #extension GL_EXT_ray_tracing : require
-// Only used when the hit distance is requested: the nearest occluder's distance.
+// Shadow and AO rays that want the nearest occluder's distance (rays that do not, skip this shader).
 layout(location = 0) rayPayloadInEXT float hitT;
 void main() { hitT = gl_HitTEXT; }

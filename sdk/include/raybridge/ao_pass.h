@@ -1,0 +1,53 @@
+// Ray-traced ambient occlusion on the engine's G-buffer: n cosine-weighted rays over the hemisphere around
+// the G-buffer normal, limited to a range. Output: the open fraction
+//   AO(p) = (1/pi) * integral over the hemisphere of V_R(p, w) cos(theta) dw,   1 = fully open.
+// Two estimators, as in the thesis: binary occlusion, and distance-weighted ("distance rays"), where a hit at
+// distance t counts t / R open, so far occluders fade out.
+//
+// Thread safety: externally synchronised, like the Context it was created from.
+#pragma once
+
+#include <raybridge/acceleration_structures.h>
+#include <raybridge/effects.h>
+#include <raybridge/gbuffer.h>
+
+#include <memory>
+
+namespace rb {
+
+enum class AoEstimator : uint8_t {
+  Binary = 0,        // default: a hit within the range occludes; rays stop at the first hit
+  DistanceWeighted,  // a hit at distance t counts t / range open; rays find the nearest hit
+};
+
+struct AoSettings {
+  uint32_t raysPerPixel = 0;  // 0 = 4
+  float range = 0.0f;         // world units; 0 = 1.0. Use a large value (e.g. 1e6) for unlimited range.
+  AoEstimator estimator = AoEstimator::Binary;
+};
+
+// Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record().
+struct AoOutputs {
+  VkImage ao = VK_NULL_HANDLE;  // R16_SFLOAT open fraction; sky pixels are 1
+  VkImageView aoView = VK_NULL_HANDLE;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  uint32_t width = 0, height = 0;
+};
+
+class AoPass {
+ public:
+  static Result<std::unique_ptr<AoPass>> create(Context& context);
+  ~AoPass();
+
+  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas, const AoSettings& settings = {});
+  const AoOutputs& outputs() const;
+  PassStats stats() const;
+
+  struct Impl;
+
+ private:
+  explicit AoPass(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rb

@@ -1,0 +1,72 @@
+#include <raybridge/ao_pass.h>
+
+#include <cmath>
+#include <string>
+
+#include "context_impl.h"
+#include "pass_core.h"
+#include "raybridge_shaders.h"
+
+namespace rb {
+
+struct AoPass::Impl {
+  Context& ctx;
+  PassCore core;
+  AoOutputs outputs;
+  explicit Impl(Context& c) : ctx(c) {}
+  ~Impl() { core.destroy(ctx); }
+};
+
+AoPass::AoPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+AoPass::~AoPass() = default;
+
+Result<std::unique_ptr<AoPass>> AoPass::create(Context& context) {
+  auto impl = std::make_unique<Impl>(context);
+  RayTracingPipelineDesc p;
+  p.name = "AO pass";
+  p.raygen = SpirvModule::of(spirv::ao_rgen);
+  p.misses = {SpirvModule::of(spirv::occlusion_rmiss)};
+  p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::occlusion_rchit), {}}};
+  p.bindings = PassCore::commonBindings();
+  p.bindings.push_back({5, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr});
+  p.pushConstantBytes = sizeof(PassConstants);
+  if (Status s = impl->core.init(context, p); !s) return s.error();
+  return std::unique_ptr<AoPass>(new AoPass(std::move(impl)));
+}
+
+Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const AoSettings& settings) {
+  Impl& s = *impl_;
+  auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "AoPass: " + m}; };
+  if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
+  float range = settings.range == 0.0f ? 1.0f : settings.range;
+  if (!(range > 0.0f) || !std::isfinite(range)) {
+    return invalid("AoSettings::range " + std::to_string(settings.range) + " must be a positive number");
+  }
+  if (settings.raysPerPixel > 4096) {
+    return invalid("AoSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " exceeds 4096");
+  }
+  if (settings.estimator != AoEstimator::Binary && settings.estimator != AoEstimator::DistanceWeighted) {
+    return invalid("AoSettings::estimator has an unknown value");
+  }
+  PassConstants pc{};
+  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "AoPass", pc); !st) return st;
+  pc.p0[0] = range;
+  pc.u0[0] = settings.raysPerPixel ? settings.raysPerPixel : 4u;
+  pc.u0[1] = settings.estimator == AoEstimator::DistanceWeighted ? 1u : 0u;
+
+  if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}}); !st) return st;
+  DescriptorWrites w;
+  s.core.writeCommon(s.ctx, w, g, tlas);
+  w.storageImage(5, s.core.images[0].view);
+  s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  s.outputs.ao = s.core.images[0].image;
+  s.outputs.aoView = s.core.images[0].view;
+  s.outputs.width = g.width;
+  s.outputs.height = g.height;
+  return {};
+}
+
+const AoOutputs& AoPass::outputs() const { return impl_->outputs; }
+PassStats AoPass::stats() const { return impl_->core.metrics.latest(impl_->ctx); }
+
+}  // namespace rb

@@ -1,0 +1,61 @@
+#include "pass_core.h"
+
+#include "gbuffer_sampler.h"
+
+namespace rb {
+
+Status PassCore::init(Context& ctx, const RayTracingPipelineDesc& desc) {
+  Result<RayTracingPipeline> p = RayTracingPipeline::create(ctx, desc);
+  if (!p) return p.error();
+  pipeline = p.value();
+  Result<VkSampler> s = createNearestSampler(ctx);
+  if (!s) return s.error();
+  sampler = s.value();
+  return metrics.init(ctx, desc.name);
+}
+
+void PassCore::destroy(Context& ctx) {
+  pipeline.destroy(ctx);
+  destroySampler(ctx, sampler);
+  images.destroy(ctx);
+  metrics.destroy(ctx);
+}
+
+std::vector<VkDescriptorSetLayoutBinding> PassCore::commonBindings() {
+  const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
+  return {
+      {0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, rg, nullptr},
+      {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
+      {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
+      {3, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
+      {4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr},
+  };
+}
+
+void PassCore::writeCommon(Context& ctx, DescriptorWrites& w, const GBufferDesc& g, const TlasInfo& tlas) const {
+  w.accelerationStructure(0, tlas.tlas);
+  w.sampledImage(1, g.depth.view, sampler, readLayout(g.depth));
+  w.sampledImage(2, g.normal.view, sampler, readLayout(g.normal));
+  const GBufferImage& geo = g.geometricNormal.view ? g.geometricNormal : g.normal;
+  w.sampledImage(3, geo.view, sampler, readLayout(geo));
+  w.storageBuffer(4, metrics.counterBuffer(), metrics.counterOffset(ctx), metrics.counterBytes());
+}
+
+Status PassCore::begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
+                       const std::vector<PassImages::Spec>& outputs) {
+  if (Status s = images.ensure(ctx, g.width, g.height, outputs); !s) return s;
+  metrics.beginRecording(ctx, cmd);
+  metrics.writeStart(ctx, cmd);
+  images.beginWrite(ctx, cmd);
+  return {};
+}
+
+void PassCore::traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const PassConstants& pc,
+                           const GBufferDesc& g) {
+  pipeline.bind(ctx, cmd, w.writes, &pc, sizeof pc);
+  pipeline.trace(ctx, cmd, g.width, g.height);
+  images.endWrite(ctx, cmd);
+  metrics.writeEnd(ctx, cmd);
+}
+
+}  // namespace rb

@@ -1,0 +1,36 @@
+// What every G-buffer ray tracing pass has: its pipeline, the G-buffer sampler, its output images and its
+// measurements, with the recording steps they share.
+#pragma once
+
+#include <raybridge/acceleration_structures.h>
+#include <raybridge/gbuffer.h>
+
+#include "pass_constants.h"
+#include "pass_images.h"
+#include "pass_metrics.h"
+#include "ray_tracing_pipeline.h"
+
+namespace rb {
+
+struct PassCore {
+  RayTracingPipeline pipeline;
+  VkSampler sampler = VK_NULL_HANDLE;
+  PassImages images;
+  PassMetrics metrics;
+
+  Status init(Context& ctx, const RayTracingPipelineDesc& desc);
+  void destroy(Context& ctx);
+
+  // The bindings every pass starts with: 0 TLAS, 1 depth, 2 normal, 3 geometric normal (or the normal),
+  // 4 ray counters. Pass-specific bindings follow from 5.
+  static std::vector<VkDescriptorSetLayoutBinding> commonBindings();
+  void writeCommon(Context& ctx, DescriptorWrites& w, const GBufferDesc& g, const TlasInfo& tlas) const;
+
+  // Ensures the outputs, starts the measurements and makes the outputs writable.
+  Status begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const std::vector<PassImages::Spec>& outputs);
+  // Traces one ray generation invocation per G-buffer pixel, then makes the outputs readable.
+  void traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const PassConstants& pc,
+                   const GBufferDesc& g);
+};
+
+}  // namespace rb
