@@ -52,7 +52,7 @@ vec3 rbRayOrigin(uvec2 pixel, float depth, vec3 geometricNormal, out vec3 facing
   vec3 q = rbCameraRelative(pixel, stepDepth);
   float error = length(q - p);
   facingNormal = dot(geometricNormal, p) > 0.0 ? -geometricNormal : geometricNormal;
-  vec3 origin = pc.cameraToTlas.xyz + p + facingNormal * (4.0 * error + 1e-5 * length(p));
+  vec3 origin = pc.cameraToTlas.xyz + p + facingNormal * (16.0 * error + 1e-5 * length(p));
   return rbOffsetRayOrigin(origin, facingNormal);
 }
 

@@ -27,15 +27,15 @@ BenchSizes pickSizes(const BenchOptions& o, bool isCpu) {
     s.gltfRepeatsOnce = true;
   } else if (isCpu && !o.full) {  // sizes for a 2-core lavapipe run of a few minutes
     s.buildTriangles = {1000, 10000, 100000, 300000};
-    s.buildRepeats = 5;
+    s.buildRepeats = 9;
     s.duplicationTriangles = 20000;
     s.duplicationCopies = {1, 4, 16, 64};
     s.fastTriangles = 100000;
-    s.fastRepeats = 5;
+    s.fastRepeats = 9;
     s.tlasInstances = {1000, 10000, 100000};
-    s.tlasRepeats = 5;
+    s.tlasRepeats = 9;
     s.traceTriangles = 200000;
-    s.traceRepeats = 3;
+    s.traceRepeats = 5;
   } else {  // a GPU, or --full
     s.buildTriangles = {1000, 10000, 100000, 1000000};
     if (o.full && !isCpu) s.buildTriangles.push_back(4000000);

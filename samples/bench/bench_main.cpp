@@ -84,11 +84,21 @@ int run(const BenchOptions& options) {
       {"tlas", [&] { return runTlasScenario(env); }},
       {"trace", [&] { return runTraceScenario(env); }},
   };
+  // A failing scenario is reported and the others still run (a GPU session is too costly to lose whole).
+  std::vector<std::string> failures;
   for (const Entry& e : entries) {
     if (!wanted(e.name)) continue;
     const auto t0 = std::chrono::steady_clock::now();
     env.progress(std::string("scenario ") + e.name);
-    doc["scenarios"][e.name] = e.fn();
+    try {
+      doc["scenarios"][e.name] = e.fn();
+    } catch (const BenchFailure& f) {
+      std::fprintf(stderr, "raybridge-bench: scenario %s failed: %s\n", e.name, f.what());
+      doc["scenarios"][e.name] = {{"error", f.what()}};
+      failures.push_back(std::string(e.name) + ": " + f.what());
+      check(env.device().waitIdle(), "vkDeviceWaitIdle after a failed scenario");
+      env.settle();
+    }
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     doc["secondsPerScenario"][e.name] = s;
     env.progress(std::string("scenario ") + e.name + " done in " + std::to_string(s) + " s");
@@ -96,6 +106,7 @@ int run(const BenchOptions& options) {
   check(env.device().waitIdle(), "vkDeviceWaitIdle");
 
   const uint32_t errors = env.device().validationErrorCount();
+  doc["failures"] = failures;
   doc["validation"] = {{"enabled", env.device().validationEnabled()}, {"errors", errors},
                        {"messages", env.device().validationErrors()}};
   doc["totalSeconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -106,6 +117,11 @@ int run(const BenchOptions& options) {
     std::printf("\nwrote %s\n", options.outPath.c_str());
   }
   std::printf("total %.1f s\n", doc["totalSeconds"].get<double>());
+  if (!failures.empty()) {
+    std::fprintf(stderr, "raybridge-bench: %zu scenario(s) failed; first: %s\n", failures.size(),
+                 failures.front().c_str());
+    return 1;
+  }
   if (env.device().validationEnabled() && errors > 0) {
     std::fprintf(stderr, "raybridge-bench: the validation layer reported %u error(s); first: %s\n", errors,
                  env.device().validationErrors().front().c_str());

@@ -57,7 +57,7 @@ Mat4 localMatrix(const tinygltf::Node& n) {
   return mul(t, mul(r, s));
 }
 
-// Reads accessor element `i`, component `c` as a double (float or normalised/unnormalised integers).
+// Address of accessor element `i` (honours the buffer view's byte stride).
 const unsigned char* elementPtr(const tinygltf::Model& m, const tinygltf::Accessor& a, size_t i) {
   const tinygltf::BufferView& v = m.bufferViews[a.bufferView];
   size_t stride = a.ByteStride(v);
@@ -67,25 +67,29 @@ const unsigned char* elementPtr(const tinygltf::Model& m, const tinygltf::Access
 bool appendPrimitive(const tinygltf::Model& m, const tinygltf::Primitive& p, rbsamples::CpuMesh& out) {
   if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES) return false;
   auto pos = p.attributes.find("POSITION");
-  if (pos == p.attributes.end() || p.indices < 0) return false;
+  if (pos == p.attributes.end()) return false;
   const tinygltf::Accessor& pa = m.accessors[pos->second];
-  const tinygltf::Accessor& ia = m.accessors[p.indices];
-  if (pa.bufferView < 0 || ia.bufferView < 0 || pa.sparse.isSparse) return false;
+  if (pa.bufferView < 0 || pa.sparse.isSparse) return false;
   if (pa.type != TINYGLTF_TYPE_VEC3 || pa.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT) return false;
+  const tinygltf::Accessor* ia = p.indices >= 0 ? &m.accessors[p.indices] : nullptr;
+  if (ia && ia->bufferView < 0) return false;
   const uint32_t base = out.vertexCount();
   for (size_t i = 0; i < pa.count; ++i) {
     const float* f = reinterpret_cast<const float*>(elementPtr(m, pa, i));
     out.positions.insert(out.positions.end(), {f[0], f[1], f[2]});
   }
-  const size_t triIndices = ia.count / 3 * 3;
+  // Non-indexed primitives: every three consecutive vertices form a triangle.
+  const size_t triIndices = (ia ? ia->count : pa.count) / 3 * 3;
   for (size_t i = 0; i < triIndices; ++i) {
-    const unsigned char* e = elementPtr(m, ia, i);
-    uint32_t v = 0;
-    switch (ia.componentType) {
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *e; break;
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: v = *reinterpret_cast<const uint16_t*>(e); break;
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: v = *reinterpret_cast<const uint32_t*>(e); break;
-      default: return false;
+    uint32_t v = static_cast<uint32_t>(i);
+    if (ia) {
+      const unsigned char* e = elementPtr(m, *ia, i);
+      switch (ia->componentType) {
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *e; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: v = *reinterpret_cast<const uint16_t*>(e); break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: v = *reinterpret_cast<const uint32_t*>(e); break;
+        default: return false;
+      }
     }
     if (v >= pa.count) return false;
     out.indices.push_back(base + v);
@@ -132,7 +136,7 @@ bool loadOne(const std::filesystem::path& file, GltfModel& out, std::string& err
     for (int root : m.scenes[scene].nodes) visit(visit, root, identity());
   }
   if (out.meshes.empty() || out.instances.empty()) {
-    error = "no indexed triangle mesh with float POSITION in its default scene";
+    error = "no triangle mesh with float POSITION in its default scene";
     return false;
   }
   return true;

@@ -22,6 +22,7 @@ struct GltfModel {
   uint64_t uniqueTriangles() const;
 };
 
+// Primitives: triangle lists with float POSITION, indexed (8/16/32-bit) or not; others are left out.
 // Loads every model folder under `dir` (the first .gltf or .glb file in each), sorted by name. Models that fail
 // to load or hold no triangles are reported in `messages` and skipped. Returns an empty list (with a message)
 // when `dir` does not exist or glTF support was not compiled in.

@@ -58,6 +58,7 @@ nlohmann::json measure(BenchEnv& env, rb::PrimaryRayPass& pass, const UploadedMe
           {"blasBytes", st.blasBytes},
           {"buildGpuMs", build.gpuMs},
           {"buildBatches", build.batches},
+          {"timingComplete", build.complete},
           {"tlasGpuMs", timer.ms(a, b)},
           {"traceMs", trace.medianMs},
           {"hitFraction", trace.hitFraction}};

@@ -17,6 +17,7 @@ BatchSum batchesOfFrame(const rb::AsStats& stats, uint64_t frame) {
 }
 
 BatchSum buildQueued(BenchEnv& env, rb::AccelerationStructureService& service) {
+  const uint32_t queued = service.stats().blasQueued;
   uint64_t frame = 0;
   uint32_t left = 0;
   env.runFrame([&](VkCommandBuffer cmd) {
@@ -29,6 +30,12 @@ BatchSum buildQueued(BenchEnv& env, rb::AccelerationStructureService& service) {
   if (sum.batches == 0) {
     throw BenchFailure("the service resolved no build timing for frame " + std::to_string(frame) +
                        " (AsStats::batches)");
+  }
+  if (sum.builds != queued) {
+    sum.complete = false;
+    env.progress("warning: the service resolved timings for " + std::to_string(sum.builds) + " of " +
+                 std::to_string(queued) + " builds of frame " + std::to_string(frame) +
+                 " (AsStats::batches keeps the last 64 batches); the time is a lower bound");
   }
   return sum;
 }

@@ -281,7 +281,7 @@ Status AccelerationStructureService::updateMesh(MeshHandle mesh) {
 void AccelerationStructureService::Impl::resolveBatches() {
   std::vector<BuildBatch> keep;
   for (BuildBatch& b : inFlightBatches) {
-    if (c.frame < b.frame + c.desc.framesInFlight) {
+    if (!c.frameDone(b.frame)) {
       keep.push_back(b);
       continue;
     }
@@ -295,9 +295,12 @@ void AccelerationStructureService::Impl::resolveBatches() {
       }
       if (r == VK_SUCCESS) {
         BuildBatchTiming t{b.frame, b.builds, b.triangles,
-                           double(ticks[1] - ticks[0]) * c.info.timestampPeriodNs * 1e-6};
+                           double(c.info.timestampTicks(ticks[0], ticks[1])) * c.info.timestampPeriodNs * 1e-6};
         timings.push_back(t);
-        if (timings.size() > kMaxTimings) timings.erase(timings.begin());
+        if (timings.size() > kMaxTimings) {
+          timings.erase(timings.begin());
+          ++counters.batchTimingsDropped;
+        }
       }
       freeTimestampPools.push_back(b.timestamps);
     }

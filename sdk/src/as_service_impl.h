@@ -63,6 +63,7 @@ struct TlasSlot {
   bool allowsUpdate = false;
   uint32_t builtInstanceCount = 0;
   uint64_t blasSignature = 0;  // hash of the BLAS addresses in order, to decide if a refit is valid
+  uint64_t writtenFrame = UINT64_MAX;  // frame whose instances the buffer holds
 };
 
 struct AccelerationStructureService::Impl {

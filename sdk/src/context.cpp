@@ -87,6 +87,14 @@ void* RequiredFeatures::link(void* next) {
   return chainHead();
 }
 
+void RequiredFeatures::mergeVulkan12Into(VkPhysicalDeviceVulkan12Features& f) const {
+  f.bufferDeviceAddress |= vulkan12.bufferDeviceAddress;
+  f.descriptorIndexing |= vulkan12.descriptorIndexing;
+  f.runtimeDescriptorArray |= vulkan12.runtimeDescriptorArray;
+  f.shaderSampledImageArrayNonUniformIndexing |= vulkan12.shaderSampledImageArrayNonUniformIndexing;
+  f.scalarBlockLayout |= vulkan12.scalarBlockLayout;
+}
+
 const char* toString(ErrorCode code) {
   switch (code) {
     case ErrorCode::Ok: return "Ok";
@@ -185,8 +193,17 @@ Result<std::unique_ptr<Context>> Context::create(const ContextDesc& desc) {
   info.maxPrimitiveCount = asProps.maxPrimitiveCount;
   info.maxInstanceCount = asProps.maxInstanceCount;
   info.timestampPeriodNs = props.properties.limits.timestampPeriod;
-  info.timestampsSupported = props.properties.limits.timestampComputeAndGraphics == VK_TRUE;
   vk.vkGetPhysicalDeviceMemoryProperties(desc.physicalDevice, &impl->memoryProperties);
+  uint32_t familyCount = 0;
+  vk.vkGetPhysicalDeviceQueueFamilyProperties(desc.physicalDevice, &familyCount, nullptr);
+  std::vector<VkQueueFamilyProperties> families(familyCount);
+  vk.vkGetPhysicalDeviceQueueFamilyProperties(desc.physicalDevice, &familyCount, families.data());
+  if (desc.mainQueueFamily >= familyCount) {
+    return invalid("ContextDesc::mainQueueFamily " + std::to_string(desc.mainQueueFamily) + " is not a queue family of '" +
+                   info.deviceName + "' (it has " + std::to_string(familyCount) + ")");
+  }
+  info.timestampValidBits = families[desc.mainQueueFamily].timestampValidBits;
+  info.timestampsSupported = info.timestampValidBits != 0 && props.properties.limits.timestampPeriod > 0.0f;
 
   return std::unique_ptr<Context>(new Context(std::move(impl)));
 }
@@ -200,7 +217,11 @@ void Context::beginFrame() {
   impl_->releaseRetired(false);
 }
 
-void Context::releaseAfterIdle() { impl_->releaseRetired(true); }
+void Context::releaseAfterIdle() {
+  impl_->idleSeen = true;
+  impl_->idleThrough = impl_->frame;
+  impl_->releaseRetired(true);
+}
 
 uint64_t Context::frameIndex() const { return impl_->frame; }
 uint32_t Context::framesInFlight() const { return impl_->desc.framesInFlight; }

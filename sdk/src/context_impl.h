@@ -17,6 +17,9 @@ struct Context::Impl {
   DeviceInfo info{};
   VkPhysicalDeviceMemoryProperties memoryProperties{};
   uint64_t frame = 0;
+  // Every frame up to this one is known to be done because the engine said the device was idle.
+  uint64_t idleThrough = 0;
+  bool idleSeen = false;
   MemoryStats memory{};
 
   struct PendingRelease {
@@ -28,6 +31,10 @@ struct Context::Impl {
   // Runs `release` once no frame that may have used the object is in flight any more.
   void retire(std::function<void()> release) { pendingReleases.push_back({frame, std::move(release)}); }
   void releaseRetired(bool deviceIdle);
+  // True once the GPU has finished the work recorded in `recordedFrame` (beginFrame contract or idle).
+  bool frameDone(uint64_t recordedFrame) const {
+    return recordedFrame + desc.framesInFlight <= frame || (idleSeen && recordedFrame <= idleThrough);
+  }
   int32_t findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
   const VkAllocationCallbacks* allocator() const { return desc.allocationCallbacks; }
 };

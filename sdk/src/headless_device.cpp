@@ -363,12 +363,19 @@ Result<HeadlessBuffer> HeadlessDevice::createBuffer(VkDeviceSize size, VkBufferU
       return staging.error();
     }
     Result<VkCommandBuffer> cmd = beginCommands();
-    if (!cmd) return cmd.error();
+    if (!cmd) {
+      destroyBuffer(staging.value());
+      destroyBuffer(out);
+      return cmd.error();
+    }
     VkBufferCopy region{0, 0, size};
     d.dp<PFN_vkCmdCopyBuffer>("vkCmdCopyBuffer")(cmd.value(), staging->buffer, out.buffer, 1, &region);
     Status s = submitAndWait(cmd.value());
     destroyBuffer(staging.value());
-    if (!s) return s.error();
+    if (!s) {
+      destroyBuffer(out);
+      return s.error();
+    }
   }
   return out;
 }
@@ -381,7 +388,10 @@ Status HeadlessDevice::readBuffer(const HeadlessBuffer& buffer, void* out, VkDev
   Result<HeadlessBuffer> staging = createBuffer(size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
   if (!staging) return staging.error();
   Result<VkCommandBuffer> cmd = beginCommands();
-  if (!cmd) return cmd.error();
+  if (!cmd) {
+    destroyBuffer(staging.value());
+    return cmd.error();
+  }
   VkBufferCopy region{0, 0, size};
   impl_->dp<PFN_vkCmdCopyBuffer>("vkCmdCopyBuffer")(cmd.value(), buffer.buffer, staging->buffer, 1, &region);
   Status s = submitAndWait(cmd.value());

@@ -43,7 +43,7 @@ void PassMetrics::collect(Context& ctx) {
   Context::Impl& c = ctx.impl();
   for (uint32_t slot = 0; slot < recordedFrame_.size(); ++slot) {
     uint64_t f = recordedFrame_[slot];
-    if (f == UINT64_MAX || c.frame < f + c.desc.framesInFlight) continue;
+    if (f == UINT64_MAX || !c.frameDone(f)) continue;
     PassStats s;
     s.frame = f;
     const uint32_t* counts = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(counters_.mapped) +
@@ -53,7 +53,7 @@ void PassMetrics::collect(Context& ctx) {
       uint64_t ticks[2] = {0, 0};
       if (c.vk.vkGetQueryPoolResults(c.desc.device, timestamps_, 2 * slot, 2, sizeof ticks, ticks, sizeof(uint64_t),
                                      VK_QUERY_RESULT_64_BIT) == VK_SUCCESS) {
-        s.gpuMs = double(ticks[1] - ticks[0]) * c.info.timestampPeriodNs * 1e-6;
+        s.gpuMs = double(c.info.timestampTicks(ticks[0], ticks[1])) * c.info.timestampPeriodNs * 1e-6;
       }
     }
     if (s.frame >= latest_.frame) latest_ = s;

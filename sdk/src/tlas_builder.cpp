@@ -39,6 +39,14 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   }
   const uint32_t slotIndex = static_cast<uint32_t>(c.frame % c.desc.framesInFlight);
   TlasSlot& slot = s.tlasSlots[slotIndex];
+  if (slot.writtenFrame == c.frame) {
+    // The slot's instance buffer is read when the command buffer executes: a second list would overwrite
+    // the first before the GPU reads it.
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "recordTlasBuild: already called in frame " + std::to_string(c.frame) +
+                     "; call Context::beginFrame() between frames, or use a second AccelerationStructureService "
+                     "for a second TLAS in one frame"};
+  }
 
   // Instance buffer: grown geometrically so a growing scene does not reallocate every frame.
   const uint32_t count = static_cast<uint32_t>(instances.size());
@@ -77,6 +85,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     }
   }
 
+  slot.writtenFrame = c.frame;
   const uint64_t serial = s.tlasSerial + 1;
   auto* out = static_cast<VkAccelerationStructureInstanceKHR*>(slot.instances.mapped);
   uint32_t written = 0, skipped = 0;

@@ -145,6 +145,7 @@ struct AsStats {
   VkDeviceSize tlasBytes = 0;          // TLAS storage, scratch and instance buffers over all frame slots
   uint32_t lastTlasInstances = 0;
   std::vector<BuildBatchTiming> batches;  // the most recent batches with resolved timings (at most 64)
+  uint64_t batchTimingsDropped = 0;       // older resolved timings no longer in `batches`
 };
 
 class AccelerationStructureService {
@@ -166,7 +167,8 @@ class AccelerationStructureService {
   // barrier that makes them visible to TLAS builds. Returns how many builds are still queued.
   Result<uint32_t> recordPendingWork(VkCommandBuffer cmd);
   // Writes this frame slot's instance buffer and records the TLAS build, followed by a barrier that makes the
-  // TLAS readable by ray tracing shaders. Instances of meshes not built yet are skipped (counted).
+  // TLAS readable by ray tracing shaders. Instances of meshes not built yet are skipped (counted). Once per
+  // frame (between Context::beginFrame calls); a second call in the same frame is refused.
   Result<TlasInfo> recordTlasBuild(VkCommandBuffer cmd, std::span<const Instance> instances,
                                    const TlasBuildOptions& options = {});
 

@@ -48,6 +48,13 @@ struct RequiredFeatures {
   // Appends `next` after the last Raybridge struct and returns the head of the chain.
   void* link(void* next);
   void* chainHead() { return &vulkan12; }
+  // For engines that fill their own VkPhysicalDeviceVulkan12Features: OR Raybridge's 1.2 features into it,
+  // and chain only the extension structs (acceleration structure -> ray tracing pipeline -> `next`).
+  void mergeVulkan12Into(VkPhysicalDeviceVulkan12Features& engineFeatures) const;
+  void* extensionChain(void* next) {
+    rayTracingPipeline.pNext = next;
+    return &accelerationStructure;
+  }
 };
 
 // Device properties Raybridge reads once at creation.
@@ -66,7 +73,13 @@ struct DeviceInfo {
   uint64_t maxPrimitiveCount = 0;
   uint64_t maxInstanceCount = 0;
   float timestampPeriodNs = 0.0f;  // nanoseconds per timestamp tick
+  uint32_t timestampValidBits = 0; // of the queue family executing Raybridge's work
   bool timestampsSupported = false;
+  // Ticks from `start` to `end`, modulo the counter's valid bits.
+  uint64_t timestampTicks(uint64_t start, uint64_t end) const {
+    uint64_t mask = timestampValidBits >= 64 ? ~0ull : (1ull << timestampValidBits) - 1;
+    return (end - start) & mask;
+  }
 };
 
 // Device memory Raybridge holds, by what it is for. Buffers no enabled effect reads are never allocated, so a
@@ -104,7 +117,8 @@ class Context {
   // engine submitted before its previous `framesInFlight` calls to beginFrame (the usual wait on the frame
   // slot's fence). Objects retired that long ago are destroyed here.
   void beginFrame();
-  // The engine guarantees the device is idle (after vkDeviceWaitIdle, say): every deferred release happens now.
+  // The engine guarantees the device is idle (after vkDeviceWaitIdle, say): every deferred release happens now,
+  // and every query (build timings, compacted sizes, pass statistics) recorded so far can be read.
   void releaseAfterIdle();
 
   uint64_t frameIndex() const;        // number of beginFrame calls so far

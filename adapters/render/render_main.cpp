@@ -1,0 +1,255 @@
+// raybridge-render: one headless image of a scene with the sample engine, in raster mode (the engine's shadow
+// maps) or hybrid mode (Raybridge's ray-traced shadows through the adapter), plus optional dumps and stats.
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "frame_capture.h"
+#include "raybridge_sample_engine_adapter.h"
+#include "render_options.h"
+#include "sample_engine/gltf_loader.h"
+#include "sample_engine/procedural.h"
+
+namespace se = sample_engine;
+using namespace rbRender;
+
+namespace {
+
+int fail(const std::string& message, int code = 1) {
+  std::fprintf(stderr, "raybridge-render: error: %s\n", message.c_str());
+  return code;
+}
+
+se::Result<se::Scene> loadScene(const RenderOptions& o) {
+  using R = se::Result<se::Scene>;
+  if (o.scene.empty()) return R::success(se::makeDefaultDemoScene());
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(o.scene, ec))
+    return R::failure("--scene: file '" + o.scene + "' does not exist or is not a file");
+  se::SceneLoadResult r = se::loadGltf(o.scene);
+  for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", o.scene.c_str(), w.c_str());
+  if (!r.ok()) return R::failure("--scene: cannot load glTF '" + o.scene + "': " + r.error);
+  if (r.scene.instances.empty()) return R::failure("--scene: '" + o.scene + "' has no triangle meshes to render");
+  return R::success(std::move(r.scene));
+}
+
+// The camera of the options, else the scene's, else one framed on the bounds; near/far fitted to the bounds.
+se::Camera chooseCamera(const RenderOptions& o, const se::Scene& scene, const se::Bounds& bounds, std::string& source) {
+  if (!o.eye) {
+    source = scene.camera ? "scene" : "bounds";
+    return scene.camera ? *scene.camera : se::defaultCameraFor(bounds);
+  }
+  source = "option";
+  se::Camera c;
+  c.eye = *o.eye;
+  c.target = *o.target;
+  c.fovYDegrees = o.fovYDegrees;
+  const float radius = bounds.valid() ? std::max(bounds.radius(), 1e-3f) : 1.0f;
+  const float distance = bounds.valid() ? glm::length(c.eye - bounds.center()) : 0.0f;
+  c.zFar = distance + radius * 2.0f;
+  c.zNear = std::clamp(distance - radius * 1.5f, c.zFar * 1e-4f, c.zFar * 0.1f);
+  return c;
+}
+
+nlohmann::json vec(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+
+se::ImageRGBA32F toExr(const CapturedFrame& f, const std::vector<float>& values, int channels) {
+  se::ImageRGBA32F img;
+  img.width = f.width;
+  img.height = f.height;
+  img.pixels.resize(size_t(f.width) * f.height * 4);
+  for (size_t i = 0; i < size_t(f.width) * f.height; ++i) {
+    for (int c = 0; c < 3; ++c) img.pixels[i * 4 + c] = values[i * channels + (channels == 1 ? 0 : c)];
+    img.pixels[i * 4 + 3] = 1.0f;
+  }
+  return img;
+}
+
+// Distance along each pixel-centre primary ray from the eye to the surface, from the depth buffer.
+std::vector<float> distances(const CapturedFrame& f, const glm::mat4& viewProj, const glm::vec3& eye) {
+  const glm::dmat4 inv = glm::inverse(glm::dmat4(viewProj));
+  std::vector<float> out(size_t(f.width) * f.height, 0.0f);
+  for (uint32_t y = 0; y < f.height; ++y) {
+    for (uint32_t x = 0; x < f.width; ++x) {
+      const size_t i = size_t(y) * f.width + x;
+      const double d = f.depth[i];
+      if (d >= 1.0) continue;  // sky: cleared to the far plane
+      glm::dvec4 p = inv * glm::dvec4((x + 0.5) / f.width * 2.0 - 1.0, (y + 0.5) / f.height * 2.0 - 1.0, d, 1.0);
+      out[i] = float(glm::length(glm::dvec3(p) / p.w - glm::dvec3(eye)));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  RenderOptions o;
+  if (std::string e = parseRenderOptions(argc, argv, o); !e.empty()) {
+    std::fprintf(stderr, "%s", renderUsage());
+    return fail(e, 2);
+  }
+  if (o.help) return std::printf("%s", renderUsage()), 0;
+  if (const char* v = std::getenv("RAYBRIDGE_VALIDATION"); v && std::string(v) == "1") o.validation = true;
+  const bool hybrid = o.mode == Mode::Hybrid;
+
+  auto scene = loadScene(o);  // before any Vulkan work, so bad input fails fast
+  if (!scene) return fail(scene.error);
+
+  // The same device in both modes (Raybridge's extensions enabled), so raster and hybrid compare like for like.
+  rb::RequiredFeatures features;
+  se::EngineConfig config;
+  config.enableValidation = o.validation;
+  config.deviceNameFilter = o.device;
+  rbAdapter::configureEngine(config, features);
+  auto created = se::Engine::create(config);
+  if (!created) return fail("engine: " + created.error);
+  se::Engine& engine = *created.value;
+  if (se::Status s = engine.loadScene(scene.value); !s) return fail(s.error);
+  if (se::Status s = engine.setRenderSize(o.width, o.height); !s) return fail(s.error);
+
+  se::FrameParams params;
+  std::string cameraSource;
+  params.camera = chooseCamera(o, engine.scene(), engine.sceneBounds(), cameraSource);
+  if (o.sun) params.sun.direction = glm::normalize(*o.sun);
+  else if (engine.scene().sun) params.sun = *engine.scene().sun;
+  params.sun.direction = glm::normalize(params.sun.direction);
+
+  std::unique_ptr<rbAdapter::Adapter> adapter;
+  if (hybrid) {
+    rbAdapter::AdapterConfig ac;
+    ac.normals = o.geometricNormals ? rbAdapter::GBufferNormals::Geometric : rbAdapter::GBufferNormals::Shading;
+    auto a = rbAdapter::Adapter::create(engine, ac);
+    if (!a) return fail("adapter: " + a.error);
+    adapter = std::move(a.value);
+    adapter->settings().sunAngularRadiusDegrees = o.sunRadiusDegrees;
+    adapter->settings().shadowRaysPerPixel = o.shadowRays;
+  }
+  std::unique_ptr<FrameCapture> capture;
+  if (o.dump) {
+    auto c = FrameCapture::create(engine);
+    if (!c) return fail(c.error);
+    capture = std::move(c.value);
+  }
+  bool captureNext = false;
+  std::string captureError;
+  glm::mat4 capturedViewProj{1.0f};
+  engine.setPrepassHook([&](const se::PrepassHookInfo& info, se::LightingInputs& inputs) {
+    if (adapter) adapter->recordFrame(info, inputs);
+    if (!captureNext) return;
+    captureNext = false;
+    capturedViewProj = info.viewProj;
+    const bool geometric = o.geometricNormals;
+    VkImage visibility = adapter && inputs.sunVisibility ? adapter->shadowPass()->outputs().visibility : VK_NULL_HANDLE;
+    if (se::Status s = capture->record(info, geometric ? info.geometricNormal : info.normalRoughness, visibility); !s)
+      captureError = s.error;
+  });
+
+  for (uint32_t f = 0; f < o.frames; ++f) {
+    if (se::Status s = engine.renderFrame(params); !s) return fail(s.error);
+  }
+  if (se::Status s = engine.waitIdle(); !s) return fail(s.error);
+  const se::PassTimings timings = engine.lastTimings();  // the last frame, without capture copies
+  if (capture) {  // one more identical frame that also copies its pre-pass and visibility images
+    captureNext = true;
+    if (se::Status s = engine.renderFrame(params); !s) return fail(s.error);
+  }
+  auto ldr = engine.readbackLdr();  // waits for the GPU
+  if (!ldr) return fail(ldr.error);
+  auto hdr = engine.readbackHdr();
+  if (!hdr) return fail(hdr.error);
+  if (adapter && !adapter->lastError().empty()) return fail("Raybridge: " + adapter->lastError());
+  if (!captureError.empty()) return fail(captureError);
+
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec) return fail("--out: cannot create folder '" + o.out + "': " + ec.message());
+  const std::filesystem::path out(o.out);
+  if (se::Status s = se::writePng((out / "final.png").string(), ldr.value); !s) return fail(s.error);
+  if (se::Status s = se::writeExr((out / "final.exr").string(), hdr.value); !s) return fail(s.error);
+  std::printf("wrote %s and %s (%ux%u, %s)\n", (out / "final.png").c_str(), (out / "final.exr").c_str(), o.width,
+              o.height, hybrid ? "hybrid" : "raster");
+
+  // Statistics. The SDK resolves a pass's GPU time kFramesInFlight frames after recording it.
+  nlohmann::json stats;
+  const double engineTotal =
+      timings.shadowMs + timings.prepassMs + timings.hookMs + timings.lightingMs + timings.tonemapMs;
+  stats["mode"] = hybrid ? "hybrid" : "raster";
+  stats["width"] = o.width;
+  stats["height"] = o.height;
+  stats["frames"] = o.frames;
+  stats["gbuffer_normals"] = o.geometricNormals ? "geometric" : "shading";
+  stats["scene"] = o.scene.empty() ? "procedural demo scene" : o.scene;
+  stats["device"] = {{"name", engine.deviceInfo().name}};
+  stats["camera"] = {{"eye", vec(params.camera.eye)},     {"target", vec(params.camera.target)},
+                     {"fovy_degrees", params.camera.fovYDegrees}, {"z_near", params.camera.zNear},
+                     {"z_far", params.camera.zFar},        {"source", cameraSource}};
+  stats["sun"] = {{"direction", vec(params.sun.direction)},
+                  {"angular_radius_degrees", hybrid ? o.sunRadiusDegrees : 0.0f},
+                  {"rays_per_pixel", hybrid ? (o.sunRadiusDegrees > 0.0f ? o.shadowRays : 1u) : 0u}};
+  stats["engine_gpu_ms"] = {{"valid", timings.valid},         {"shadow_map", timings.shadowMs},
+                            {"prepass", timings.prepassMs},   {"hook", timings.hookMs},
+                            {"lighting", timings.lightingMs}, {"tonemap", timings.tonemapMs},
+                            {"frame_total", engineTotal}};
+  uint64_t sceneTriangles = 0;
+  for (const se::Instance& inst : engine.scene().instances) sceneTriangles += engine.scene().meshes[inst.mesh].triangleCount();
+  stats["triangles"] = sceneTriangles;
+  stats["instances"] = engine.scene().instances.size();
+  stats["rays_traced"] = 0;
+  if (adapter) {
+    const rb::DeviceInfo& di = adapter->context().deviceInfo();
+    stats["device"]["driver"] = di.driverName;
+    stats["device"]["driver_info"] = di.driverInfo;
+    const rb::PassStats shadow = adapter->shadowPass()->stats();
+    const rb::AsStats as = adapter->accelerationStructures().stats();
+    double buildMs = 0.0;
+    for (const rb::BuildBatchTiming& b : as.batches) buildMs += b.gpuMs;
+    const rb::MemoryStats mem = adapter->context().memoryStats();
+    nlohmann::json memory;
+    for (size_t c = 0; c < size_t(rb::MemoryCategory::Count); ++c)
+      memory[rb::toString(rb::MemoryCategory(c))] = mem.bytes[c];
+    memory["total"] = mem.total();
+    stats["rays_traced"] = shadow.rays;
+    stats["raybridge"] = {
+        {"shadow_pass", {{"gpu_ms", shadow.gpuMs}, {"rays", shadow.rays}, {"rays_per_second", shadow.raysPerSecond()},
+                         {"frame", shadow.frame}}},
+        {"acceleration_structures",
+         {{"blas_build_gpu_ms", buildMs}, {"build_batches", as.batches.size()}, {"blas_count", as.blasCount},
+          {"blas_triangles", as.triangles}, {"blas_bytes", as.blasBytes}, {"tlas_bytes", as.tlasBytes},
+          {"scratch_bytes", as.scratchBytes}, {"storage_block_bytes", as.storageBlockBytes},
+          {"dedup_hits", as.dedupHits}, {"tlas_instances", adapter->lastTlas().instanceCount},
+          {"tlas_skipped_instances", adapter->lastTlas().skippedInstances}}},
+        {"memory_bytes", memory}};
+    std::printf("Raybridge: shadow pass %.2f ms GPU, %llu rays (%.1f Mrays/s); BLAS build %.2f ms, %llu bytes\n",
+                shadow.gpuMs, static_cast<unsigned long long>(shadow.rays), shadow.raysPerSecond() * 1e-6, buildMs,
+                static_cast<unsigned long long>(as.blasBytes));
+  }
+  std::printf("engine GPU ms: shadow map %.2f  prepass %.2f  hook %.2f  lighting %.2f  tonemap %.2f  total %.2f\n",
+              timings.shadowMs, timings.prepassMs, timings.hookMs, timings.lightingMs, timings.tonemapMs, engineTotal);
+  stats["validation"] = {{"enabled", o.validation}, {"errors", engine.validationErrorCount()}};
+
+  if (o.dump) {
+    const CapturedFrame f = capture->read();
+    auto write = [&](const char* name, const se::ImageRGBA32F& img) -> std::string {
+      se::Status s = se::writeExr((out / name).string(), img, /*halfFloat=*/false);
+      return s ? std::string() : s.error;
+    };
+    std::string e = write("depth.exr", toExr(f, distances(f, capturedViewProj, params.camera.eye), 1));
+    if (e.empty()) e = write("normal.exr", toExr(f, f.normal, 4));
+    if (e.empty() && !f.visibility.empty()) e = write("shadow.exr", toExr(f, f.visibility, 1));
+    if (!e.empty()) return fail(e);
+    std::ofstream json(out / "stats.json");
+    json << stats.dump(2) << "\n";
+    if (!json) return fail("cannot write " + (out / "stats.json").string());
+    std::printf("wrote depth.exr, normal.exr%s, stats.json\n", f.visibility.empty() ? "" : ", shadow.exr");
+  }
+  if (o.validation) {
+    std::printf("validation errors: %u\n", engine.validationErrorCount());
+    if (engine.validationErrorCount() > 0) return fail("the validation layer reported errors", 3);
+  }
+  engine.setPrepassHook({});
+  return 0;
+}

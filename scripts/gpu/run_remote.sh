@@ -1,0 +1,166 @@
+#!/usr/bin/env bash
+# Runs the benchmark and the tests on the GPU machine (NVIDIA, no Vulkan loader, no network) from the folder
+# .devcarry/ that scripts/gpu/prepare.sh assembled and the device tool carried. Run from the repository root:
+#
+#   bash scripts/gpu/run_remote.sh [all|bench|tests]      (default all)
+#
+# Results go to $OUT (the device tool brings that folder back): bench_gpu.json, bench_gpu.log, tests_gpu.log,
+# summary.txt, env.txt. Every step's exit code is recorded; the script exits non-zero if any step failed.
+# The whole run stays under RB_TIME_BUDGET seconds (default 500, inside the tool's 10-minute command limit):
+# a step that would start after the budget is skipped and counted as failed.
+#
+# Environment:
+#   OUT=DIR             where results go (set by the device tool; default ./out/gpu)
+#   RB_DRY_RUN=1        local rehearsal: no dpkg -x into /, no ldconfig, no VK_DRIVER_FILES (uses this machine's
+#                       loader and drivers, e.g. lavapipe). Also implied when not running as root.
+#   RB_BENCH_ARGS=...   benchmark arguments (default: --scenario all --full)
+#   RB_TIME_BUDGET=500  seconds for the whole run
+#   RB_RUNTIME_DIR=DIR  where .devcarry is unpacked (default /tmp/raybridge-devcarry)
+set -u
+
+MODE="${1:-all}"
+case "$MODE" in all|bench|tests) ;; *) echo "usage: $0 [all|bench|tests]" >&2; exit 2 ;; esac
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+cd "$ROOT"
+CARRY="$ROOT/.devcarry"
+OUT="${OUT:-$ROOT/out/gpu}"
+RT="${RB_RUNTIME_DIR:-/tmp/raybridge-devcarry}"
+BUDGET="${RB_TIME_BUDGET:-500}"
+NVIDIA_ICD=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+DRY="${RB_DRY_RUN:-0}"
+if [ "$(id -u)" != 0 ] && [ "$DRY" != 1 ]; then
+  echo "[gpu] not root: dry run (no dpkg -x into /, no ldconfig)"
+  DRY=1
+fi
+mkdir -p "$OUT"
+SUMMARY="$OUT/summary.txt"
+: >"$SUMMARY"
+STEPS=()
+FAILED=0
+
+say() { echo "[gpu] $*"; }
+record() {  # NAME RC SECONDS
+  STEPS+=("$(printf '%-28s rc=%-4s %6ss' "$1" "$2" "$3")")
+  [ "$2" = 0 ] || FAILED=$((FAILED + 1))
+}
+left() { echo $((BUDGET - SECONDS)); }
+# step NAME TIMEOUT LOG CMD...: runs CMD with a timeout no longer than what is left of the budget, appending to LOG.
+step() {
+  local name="$1" limit="$2" logfile="$3"
+  shift 3
+  local remaining
+  remaining=$(left)
+  if [ "$remaining" -lt 20 ]; then
+    say "skipping $name: the time budget is spent"
+    echo "== $name: skipped (time budget spent)" >>"$logfile"
+    record "$name" skipped 0
+    return
+  fi
+  [ "$limit" -gt "$((remaining - 10))" ] && limit=$((remaining - 10))
+  say "running $name (limit ${limit}s)"
+  echo "== $name: $*" >>"$logfile"
+  local t0=$SECONDS rc
+  timeout --kill-after=10 "$limit" "$@" >>"$logfile" 2>&1
+  rc=$?
+  [ "$rc" = 124 ] && echo "== $name: timed out after ${limit}s" >>"$logfile"
+  echo "== $name: exit code $rc after $((SECONDS - t0))s" >>"$logfile"
+  record "$name" "$rc" "$((SECONDS - t0))"
+}
+finish() {
+  {
+    echo "raybridge GPU run: mode $MODE, $(date -u +%Y-%m-%dT%H:%M:%SZ), ${SECONDS}s, dry run $DRY"
+    printf '%s\n' "${STEPS[@]}"
+    echo "failed steps: $FAILED"
+  } | tee "$SUMMARY"
+  [ "$FAILED" = 0 ]
+  exit $?
+}
+
+# ---- unpack the carried folder -----------------------------------------------------------------------------
+[ -d "$CARRY/bin" ] || { say "no .devcarry/bin: run scripts/gpu/prepare.sh here first and carry .devcarry"; record carry 1 0; finish; }
+rm -rf "$RT"
+cp -r "$CARRY" "$RT"
+find "$RT" -type f -name '*.gz' -exec gunzip -f {} +
+chmod +x "$RT"/bin/* 2>/dev/null
+say "unpacked .devcarry into $RT ($(du -sh "$RT" | cut -f1))"
+
+# ---- Vulkan loader and driver ------------------------------------------------------------------------------
+t0=$SECONDS
+if [ "$DRY" = 1 ]; then
+  say "dry run: using this machine's Vulkan loader and drivers"
+  record loader 0 0
+else
+  rc=0
+  for deb in "$RT"/debs/*.deb; do dpkg -x "$deb" / || rc=$?; done
+  ldconfig || rc=$?
+  ldconfig -p | grep -q 'libvulkan.so.1 ' || { say "libvulkan.so.1 is still missing after dpkg -x"; rc=1; }
+  record loader "$rc" $((SECONDS - t0))
+  if [ -f "$NVIDIA_ICD" ]; then
+    export VK_DRIVER_FILES="$NVIDIA_ICD"
+  else
+    say "warning: $NVIDIA_ICD not found; leaving the driver choice to the loader"
+  fi
+fi
+LIBPATH="$RT/lib"
+# The carried libstdc++ only when the machine's own lacks the newest symbol version the binaries use.
+need_cxx="$(cat "$RT/lib-fallback/GLIBCXX_NEEDED" 2>/dev/null)"
+sys_cxx="$(ldconfig -p | awk '/libstdc\+\+\.so\.6 .*x86-64/ { print $NF; exit }')"
+if [ -n "$need_cxx" ] && { [ -z "$sys_cxx" ] || ! grep -aq "$need_cxx" "$sys_cxx"; }; then
+  say "the system libstdc++ (${sys_cxx:-none}) lacks $need_cxx: using the carried one"
+  LIBPATH="$LIBPATH:$RT/lib-fallback"
+fi
+need_c="$(cat "$RT/lib-fallback/GLIBC_NEEDED" 2>/dev/null)"
+sys_c="$(ldconfig -p | awk '/libc\.so\.6 .*x86-64/ { print $NF; exit }')"
+if [ -n "$need_c" ] && [ -n "$sys_c" ] && ! grep -aq "$need_c" "$sys_c"; then
+  say "warning: the system glibc ($sys_c) lacks $need_c; the binaries will not start (build on an older glibc)"
+fi
+export LD_LIBRARY_PATH="$LIBPATH${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+export VK_LAYER_PATH="$RT/layers"
+
+# Tests look for glTF models at <source dir compiled in>/../shared/scenes; point that path at the carried copy.
+SRC_DIR="$(cat "$RT/source_dir.txt" 2>/dev/null || echo "")"
+SCENES="$RT/data/scenes"
+if [ -n "$SRC_DIR" ] && [ -d "$SCENES" ] && [ ! -e "$SRC_DIR/../shared/scenes" ]; then
+  if [ "$DRY" = 1 ]; then
+    say "dry run: not creating $SRC_DIR/../shared/scenes"
+  else
+    mkdir -p "$SRC_DIR/../shared" && ln -s "$SCENES" "$SRC_DIR/../shared/scenes" && say "linked $SRC_DIR/../shared/scenes"
+  fi
+fi
+
+{
+  echo "date: $(date -u +%Y-%m-%dT%H:%M:%SZ)"
+  echo "host: $(uname -a)"
+  echo "dry run: $DRY"
+  echo "VK_DRIVER_FILES=${VK_DRIVER_FILES:-}"
+  echo "VK_LAYER_PATH=$VK_LAYER_PATH"
+  echo "LD_LIBRARY_PATH=$LD_LIBRARY_PATH"
+  command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv
+  ldconfig -p | grep libvulkan
+  cat "$RT/manifest.txt" 2>/dev/null | head -n 4
+  echo "ldd raybridge-bench:"
+  ldd "$RT/bin/raybridge-bench"
+} >"$OUT/env.txt" 2>&1
+
+# ---- benchmark (full sizes, validation off) ----------------------------------------------------------------
+if [ "$MODE" = all ] || [ "$MODE" = bench ]; then
+  read -r -a BENCH_ARGS <<<"${RB_BENCH_ARGS:---scenario all --full}"
+  : >"$OUT/bench_gpu.log"
+  RAYBRIDGE_VALIDATION=0 step bench 300 "$OUT/bench_gpu.log" \
+    "$RT/bin/raybridge-bench" "${BENCH_ARGS[@]}" --scenes "$SCENES" --out "$OUT/bench_gpu.json"
+  grep -E '^raybridge-bench on|^total' "$OUT/bench_gpu.log"
+fi
+
+# ---- tests (validation on) ---------------------------------------------------------------------------------
+if [ "$MODE" = all ] || [ "$MODE" = tests ]; then
+  : >"$OUT/tests_gpu.log"
+  while IFS='|' read -r name exe args; do
+    [ -n "$name" ] || continue
+    read -r -a targs <<<"$args"
+    [ "$name" = bench_smoke ] && targs+=(--scenes "$SCENES" --out "$OUT/bench_smoke_gpu.json")
+    RAYBRIDGE_VALIDATION=1 step "test $name" 240 "$OUT/tests_gpu.log" "$RT/bin/$exe" "${targs[@]}"
+  done <"$RT/tests.txt"
+  grep -E '^(All tests passed|test cases:)|FAILED|validation\]' "$OUT/tests_gpu.log" | head -n 40
+fi
+
+finish

@@ -1,0 +1,27 @@
+// Compute pipeline plumbing for the image-space passes (the denoiser): one push-descriptor set and push
+// constants, like RayTracingPipeline.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "ray_tracing_pipeline.h"
+
+namespace rb {
+
+class ComputePipeline {
+ public:
+  static Result<ComputePipeline> create(Context& ctx, const SpirvModule& shader,
+                                        const std::vector<VkDescriptorSetLayoutBinding>& bindings,
+                                        uint32_t pushConstantBytes, const char* name);
+  void destroy(Context& ctx);
+  // Binds, pushes the descriptors and constants, and dispatches 8x8 groups over width x height.
+  void dispatch(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes,
+                const void* constants, uint32_t constantBytes, uint32_t width, uint32_t height) const;
+
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+};
+
+}  // namespace rb

@@ -1,0 +1,260 @@
+#include <raybridge/denoiser.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "compute_pipeline.h"
+#include "context_impl.h"
+#include "gbuffer_sampler.h"
+#include "pass_constants.h"
+#include "pass_images.h"
+#include "pass_metrics.h"
+#include "raybridge_shaders.h"
+
+namespace rb {
+
+namespace {
+
+// Mirrors DenoiseConstants in shaders/denoise_common.glsl.
+struct DenoiseConstants {
+  float inverseProjection[16];
+  float viewToWorld[3][4];
+  float previousViewProjection[16];
+  float cameraDelta[4];
+  uint32_t size[4];
+  float params[4];
+};
+static_assert(sizeof(DenoiseConstants) == 224, "must match shaders/denoise_common.glsl");
+
+// column-major a * b for 4x4 matrices in double.
+void multiply(const double a[16], const double b[16], double out[16]) {
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      double s = 0.0;
+      for (int k = 0; k < 4; ++k) s += a[k * 4 + r] * b[c * 4 + k];
+      out[c * 4 + r] = s;
+    }
+  }
+}
+
+}  // namespace
+
+struct Denoiser::Impl {
+  Context& ctx;
+  ComputePipeline temporal, atrous;
+  VkSampler sampler = VK_NULL_HANDLE;
+  // 0,1: history ping-pong (RG16F); 2,3: view distance ping-pong (R32F); 4,5: spatial ping-pong (R16F)
+  PassImages images;
+  PassMetrics metrics;
+  DenoiseOutputs outputs;
+  uint32_t parity = 0;       // which of each ping-pong pair this frame writes
+  bool historyValid = false;
+  double previousViewProjection[16] = {};
+  double previousCamera[3] = {};
+  explicit Impl(Context& c) : ctx(c) {}
+  ~Impl() {
+    temporal.destroy(ctx);
+    atrous.destroy(ctx);
+    destroySampler(ctx, sampler);
+    images.destroy(ctx);
+    metrics.destroy(ctx);
+  }
+};
+
+Denoiser::Denoiser(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Denoiser::~Denoiser() = default;
+
+Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context) {
+  auto impl = std::make_unique<Impl>(context);
+  const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+  auto sampled = [&](uint32_t b) {
+    return VkDescriptorSetLayoutBinding{b, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs, nullptr};
+  };
+  auto storage = [&](uint32_t b) {
+    return VkDescriptorSetLayoutBinding{b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, nullptr};
+  };
+  Result<ComputePipeline> t = ComputePipeline::create(
+      context, SpirvModule::of(spirv::denoise_temporal_comp),
+      {sampled(0), sampled(1), sampled(2), sampled(3), sampled(4), storage(5), storage(6)}, sizeof(DenoiseConstants),
+      "denoiser temporal");
+  if (!t) return t.error();
+  impl->temporal = t.value();
+  Result<ComputePipeline> a =
+      ComputePipeline::create(context, SpirvModule::of(spirv::denoise_atrous_comp),
+                              {sampled(0), sampled(1), sampled(2), storage(3)}, sizeof(DenoiseConstants),
+                              "denoiser a-trous");
+  if (!a) return a.error();
+  impl->atrous = a.value();
+  Result<VkSampler> s = createNearestSampler(context);
+  if (!s) return s.error();
+  impl->sampler = s.value();
+  if (Status st = impl->metrics.init(context, "denoiser"); !st) return st.error();
+  return std::unique_ptr<Denoiser>(new Denoiser(std::move(impl)));
+}
+
+void Denoiser::resetHistory() { impl_->historyValid = false; }
+const DenoiseOutputs& Denoiser::outputs() const { return impl_->outputs; }
+PassStats Denoiser::stats() const { return impl_->metrics.latest(impl_->ctx); }
+
+Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
+                        const DenoiseSettings& settings) {
+  Impl& s = *impl_;
+  Context& ctx = s.ctx;
+  auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "Denoiser: " + m}; };
+  if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
+  if (!signal) return invalid("signal is VK_NULL_HANDLE; pass the noisy image's view");
+  if (settings.spatialIterations > 6) return invalid("DenoiseSettings::spatialIterations exceeds 6");
+  if (settings.disableTemporal && settings.disableSpatial) {
+    return invalid("both temporal and spatial filtering are disabled; use the raw signal instead");
+  }
+  // The G-buffer checks and camera terms are those of the ray tracing passes (no TLAS involved here).
+  PassConstants pass{};
+  TlasInfo noTlas;
+  noTlas.tlas = reinterpret_cast<VkAccelerationStructureKHR>(uintptr_t(1));  // fillGBufferConstants wants one
+  if (Status st = fillGBufferConstants(g, noTlas, ctx.frameIndex(), "Denoiser", pass); !st) return st;
+  DenoiseConstants pc{};
+  std::memcpy(pc.inverseProjection, pass.inverseProjection, sizeof pc.inverseProjection);
+  std::memcpy(pc.viewToWorld, pass.viewToWorld, sizeof pc.viewToWorld);
+  uint32_t flags = 0;
+  if (g.depthConvention == DepthConvention::ReversedZ) flags |= 1u;
+  if (g.normalEncoding == NormalEncoding::Octahedral) flags |= 2u;
+  if (g.motionVectors.view) flags |= 8u;
+  pc.size[0] = g.width;
+  pc.size[1] = g.height;
+  pc.cameraDelta[3] = settings.depthSigma > 0.0f ? settings.depthSigma : 0.02f;
+  pc.params[0] = settings.normalPower > 0.0f ? settings.normalPower : 32.0f;
+
+  // This frame's camera: projection * rotation-only view, kept for next frame's reprojection.
+  double camera[3];
+  cameraPosition(g, camera);
+  double proj[16], viewRot[16] = {};
+  for (int i = 0; i < 16; ++i) proj[i] = g.projection[i];
+  for (int c = 0; c < 3; ++c) {
+    for (int r = 0; r < 3; ++r) viewRot[c * 4 + r] = g.view[c * 4 + r];
+  }
+  viewRot[15] = 1.0;
+  double viewProjection[16];
+  multiply(proj, viewRot, viewProjection);
+
+  std::vector<PassImages::Spec> specs = {
+      {VK_FORMAT_R16G16_SFLOAT, "denoiser history A"}, {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},
+      {VK_FORMAT_R32_SFLOAT, "denoiser distance A"},   {VK_FORMAT_R32_SFLOAT, "denoiser distance B"},
+      {VK_FORMAT_R16_SFLOAT, "denoiser spatial A"},    {VK_FORMAT_R16_SFLOAT, "denoiser spatial B"}};
+  bool resized = s.images.size() == 0 || s.images[0].width != g.width || s.images[0].height != g.height;
+  if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
+  if (resized) s.historyValid = false;
+  const PassImages& im = s.images;
+  const DeviceFunctions& vk = ctx.vk();
+  const uint32_t cur = s.parity, prev = 1 - s.parity;
+
+  s.metrics.beginRecording(ctx, cmd);
+  s.metrics.writeStart(ctx, cmd);
+  // The images written this frame start undefined; last frame's history and distance are read as they are.
+  std::vector<VkImageMemoryBarrier> barriers;
+  auto barrier = [&](const GpuImage& img, VkImageLayout from, VkImageLayout to, VkAccessFlags src, VkAccessFlags dst) {
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.srcAccessMask = src;
+    b.dstAccessMask = dst;
+    b.oldLayout = from;
+    b.newLayout = to;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = img.image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    barriers.push_back(b);
+  };
+  auto flush = [&](VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) {
+    vk.vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, static_cast<uint32_t>(barriers.size()),
+                            barriers.data());
+    barriers.clear();
+  };
+  const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | cs |
+                                       VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
+  const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  const bool temporal = !settings.disableTemporal;
+  const bool historyUsable = temporal && s.historyValid;
+  if (!historyUsable) {
+    // Nothing valid to read: give last frame's images a defined layout for the descriptor reads.
+    barrier(im[prev], VK_IMAGE_LAYOUT_UNDEFINED, ro, 0, VK_ACCESS_SHADER_READ_BIT);
+    barrier(im[2 + prev], VK_IMAGE_LAYOUT_UNDEFINED, ro, 0, VK_ACCESS_SHADER_READ_BIT);
+  }
+  barrier(im[cur], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
+          VK_ACCESS_SHADER_WRITE_BIT);
+  barrier(im[2 + cur], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
+          VK_ACCESS_SHADER_WRITE_BIT);
+  barrier(im[4], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
+          VK_ACCESS_SHADER_WRITE_BIT);
+  barrier(im[5], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
+          VK_ACCESS_SHADER_WRITE_BIT);
+  flush(readers, cs);
+
+  VkImageView current = signal;  // what the next stage reads
+  const GpuImage* last = nullptr;
+  if (temporal) {
+    uint32_t maxHistory = settings.maxHistoryFrames ? settings.maxHistoryFrames : 32u;
+    pc.size[2] = flags | (historyUsable ? 4u : 0u);
+    pc.size[3] = maxHistory;
+    for (int i = 0; i < 16; ++i) pc.previousViewProjection[i] = static_cast<float>(s.previousViewProjection[i]);
+    for (int i = 0; i < 3; ++i) pc.cameraDelta[i] = static_cast<float>(camera[i] - s.previousCamera[i]);
+    DescriptorWrites w;
+    w.sampledImage(0, g.depth.view, s.sampler, readLayout(g.depth));
+    const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
+    w.sampledImage(1, motion.view, s.sampler, readLayout(motion));
+    w.sampledImage(2, signal, s.sampler, ro);
+    w.sampledImage(3, im[prev].view, s.sampler, ro);
+    w.sampledImage(4, im[2 + prev].view, s.sampler, ro);
+    w.storageImage(5, im[cur].view);
+    w.storageImage(6, im[2 + cur].view);
+    s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
+    barrier(im[cur], VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
+    barrier(im[2 + cur], VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
+    flush(cs, readers);
+    current = im[cur].view;  // .r holds the accumulated value
+    last = &im[cur];
+    s.historyValid = true;
+    s.parity = prev;
+  }
+  if (!settings.disableSpatial) {
+    uint32_t iterations = settings.spatialIterations ? settings.spatialIterations : 3u;
+    pc.size[2] = flags;
+    for (uint32_t i = 0; i < iterations; ++i) {
+      const GpuImage& out = im[4 + (i % 2)];
+      if (i >= 2) {
+        // Reusing a ping-pong image read two steps ago: back to GENERAL for writing.
+        barrier(out, ro, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_SHADER_WRITE_BIT);
+        flush(cs, cs);
+      }
+      pc.size[3] = 1u << i;
+      DescriptorWrites w;
+      w.sampledImage(0, g.depth.view, s.sampler, readLayout(g.depth));
+      w.sampledImage(1, g.normal.view, s.sampler, readLayout(g.normal));
+      w.sampledImage(2, current, s.sampler, ro);
+      w.storageImage(3, out.view);
+      s.atrous.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
+      barrier(out, VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
+      flush(cs, readers);
+      current = out.view;
+      last = &out;
+    }
+    // A spatial image this frame did not write is still in GENERAL: keep every image's layout known.
+    if (iterations == 1) {
+      barrier(im[5], VK_IMAGE_LAYOUT_GENERAL, ro, 0, VK_ACCESS_SHADER_READ_BIT);
+      flush(cs, readers);
+    }
+  } else {
+    barrier(im[4], VK_IMAGE_LAYOUT_GENERAL, ro, 0, VK_ACCESS_SHADER_READ_BIT);
+    barrier(im[5], VK_IMAGE_LAYOUT_GENERAL, ro, 0, VK_ACCESS_SHADER_READ_BIT);
+    flush(cs, readers);
+  }
+  s.metrics.writeEnd(ctx, cmd);
+  std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
+  std::memcpy(s.previousCamera, camera, sizeof camera);
+  s.outputs.denoised = last->image;
+  s.outputs.denoisedView = last->view;
+  s.outputs.width = g.width;
+  s.outputs.height = g.height;
+  return {};
+}
+
+}  // namespace rb
