@@ -15,7 +15,7 @@ layout(set = 0, binding = 0) uniform accelerationStructureEXT tlas;
 layout(set = 0, binding = 1) uniform sampler2D gDepth;
 layout(set = 0, binding = 2) uniform sampler2D gNormal;
 layout(set = 0, binding = 3) uniform sampler2D gGeometricNormal;
-layout(set = 0, binding = 4) buffer RayCounters { uint rayCount[256]; };
+layout(set = 0, binding = 4) buffer RayCounters { uint rayCount[4096]; };
 layout(set = 0, binding = 5, r16f) uniform writeonly image2D outVisibility;
 #ifdef RB_WRITE_HIT_DISTANCE
 layout(set = 0, binding = 6, r32f) uniform writeonly image2D outHitDistance;
@@ -107,5 +107,5 @@ void main() {
 #ifdef RB_WRITE_HIT_DISTANCE
   imageStore(outHitDistance, ip, vec4(nearest));
 #endif
-  if (rays != 0u) atomicAdd(rayCount[(pixel.x * 7u + pixel.y * 13u) & 255u], rays);
+  if (rays != 0u) atomicAdd(rayCount[(pixel.x & 63u) | ((pixel.y & 63u) << 6)], rays);
 }

@@ -1,6 +1,7 @@
 // Tests of the sample-engine adapter and raybridge-render: bad input, a dumped hybrid render, raster vs hybrid
 // shadows on the demo scene, no pass memory without effects. The validation layer is on; any error fails.
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -22,8 +23,19 @@ struct RunResult {
   std::string output;  // stdout and stderr
 };
 
+// The render command built with these tests; RAYBRIDGE_RENDER overrides it where the binaries were moved
+// (the GPU machine runs a carried copy).
+std::string renderExecutable() {
+  const char* overridden = std::getenv("RAYBRIDGE_RENDER");
+  return overridden && *overridden ? overridden : RAYBRIDGE_RENDER_EXE;
+}
+
 RunResult runRender(const std::string& args) {
-  const std::string command = std::string("\"") + RAYBRIDGE_RENDER_EXE + "\" --validation " + args + " 2>&1";
+  std::string command = "\"";
+  command += renderExecutable();
+  command += "\" --validation ";
+  command += args;
+  command += " 2>&1";
   RunResult r;
   FILE* pipe = popen(command.c_str(), "r");
   REQUIRE(pipe != nullptr);

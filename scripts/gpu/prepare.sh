@@ -16,7 +16,7 @@
 #   lib/      shared libraries the binaries and the layer need, outside glibc and the C++ runtime (per ldd)
 #   lib-fallback/  libstdc++ and libgcc_s, used there only if the machine's own are too old
 #   layers/   VkLayer_khronos_validation.json (library_path relative to itself) and its .so
-#   debs/     Debian's libvulkan1 (amd64), unpacked with dpkg -x on the GPU machine (it has no loader)
+#   debs/     Debian's libvulkan1 and the libglvnd family (amd64; NVIDIA's ICD, libGLX_nvidia, needs libGLdispatch), unpacked with dpkg -x on the GPU machine (it has no loader)
 #   data/scenes/  .gltf/.glb/.bin of the glTF models (no textures)
 #   tests.txt     one test per line: NAME|BINARY|ARGS, run with RAYBRIDGE_VALIDATION=1
 #   source_dir.txt  the source path compiled into the binaries (tests look for <it>/../shared/scenes)
@@ -150,10 +150,10 @@ log "libraries: $(cd "$CARRY/lib" && ls | tr '\n' ' ')"
 # ---- 5. the Vulkan loader package --------------------------------------------------------------------------
 APT_OPTS=(-oAPT::Architecture=amd64 -oAPT::Architectures=amd64 -oDir::State::Lists=/tmp/amd64)
 mkdir -p /tmp/amd64/partial
-if ! (cd "$CARRY/debs" && apt-get "${APT_OPTS[@]}" download libvulkan1 >/dev/null 2>&1); then
+if ! (cd "$CARRY/debs" && apt-get "${APT_OPTS[@]}" download libvulkan1 libglvnd0 libglx0 libegl1 libgl1 libopengl0 libgles2 >/dev/null 2>&1); then
   log "apt-get download failed; updating the amd64 package lists and retrying"
   apt-get "${APT_OPTS[@]}" update -q >/dev/null
-  (cd "$CARRY/debs" && apt-get "${APT_OPTS[@]}" download libvulkan1) || die "could not download libvulkan1"
+  (cd "$CARRY/debs" && apt-get "${APT_OPTS[@]}" download libvulkan1 libglvnd0 libglx0 libegl1 libgl1 libopengl0 libgles2) || die "could not download libvulkan1 and libglvnd"
 fi
 ls "$CARRY"/debs/libvulkan1_*_amd64.deb >/dev/null || die "no libvulkan1 amd64 .deb in debs/"
 

@@ -4,8 +4,8 @@
 #
 #   bash scripts/gpu/run_remote.sh [all|bench|tests]      (default all)
 #
-# Results go to $OUT (the device tool brings that folder back): bench_gpu.json, bench_gpu.log, tests_gpu.log,
-# summary.txt, env.txt. Every step's exit code is recorded; the script exits non-zero if any step failed.
+# Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
+# tests_gpu.log, render_gpu.log, render_gpu.tar.gz (stats.json and final.png of each render), summary.txt, env.txt. Every step's exit code is recorded; the script exits non-zero if any step failed.
 # The whole run stays under RB_TIME_BUDGET seconds (default 500, inside the tool's 10-minute command limit):
 # a step that would start after the budget is skipped and counted as failed.
 #
@@ -19,7 +19,7 @@
 set -u
 
 MODE="${1:-all}"
-case "$MODE" in all|bench|tests) ;; *) echo "usage: $0 [all|bench|tests]" >&2; exit 2 ;; esac
+case "$MODE" in all|bench|tests|render) ;; *) echo "usage: $0 [all|bench|tests|render]" >&2; exit 2 ;; esac
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 cd "$ROOT"
 CARRY="$ROOT/.devcarry"
@@ -116,6 +116,15 @@ if [ -n "$need_c" ] && [ -n "$sys_c" ] && ! grep -aq "$need_c" "$sys_c"; then
 fi
 export LD_LIBRARY_PATH="$LIBPATH${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export VK_LAYER_PATH="$RT/layers"
+export RAYBRIDGE_RENDER="$RT/bin/raybridge-render"  # the adapter tests run the carried render command
+# NVIDIA's ICD needs a static TLS block; dlopen'ed after Embree/TBB (the tests) it finds none left, so the
+# driver's TLS library is loaded at start-up instead.
+for tls in /usr/local/nvidia/lib64/libnvidia-tls.so.* /usr/lib/x86_64-linux-gnu/libnvidia-tls.so.*; do
+  if [ -e "$tls" ]; then
+    export LD_PRELOAD="$tls${LD_PRELOAD:+:$LD_PRELOAD}"
+    break
+  fi
+done
 
 # Tests look for glTF models at <source dir compiled in>/../shared/scenes; point that path at the carried copy.
 SRC_DIR="$(cat "$RT/source_dir.txt" 2>/dev/null || echo "")"
@@ -151,13 +160,29 @@ if [ "$MODE" = all ] || [ "$MODE" = bench ]; then
   grep -E '^raybridge-bench on|^total' "$OUT/bench_gpu.log"
 fi
 
+# ---- render command: frame times raster vs hybrid at 1920x1080 (validation off) -------------------------------
+if [ "$MODE" = all ] || [ "$MODE" = render ]; then
+  : >"$OUT/render_gpu.log"
+  RENDER="$RT/bin/raybridge-render"
+  RDIR="$(mktemp -d)"
+  for variant in "raster|--mode raster" "hybrid|--mode hybrid" "hybrid_soft|--mode hybrid --sun-radius 0.5 --shadow-rays 8"; do
+    name="${variant%%|*}"
+    read -r -a vargs <<<"${variant#*|}"
+    RAYBRIDGE_VALIDATION=0 step "render $name" 60 "$OUT/render_gpu.log" \
+      "$RENDER" --width 1920 --height 1080 --frames 12 --dump "${vargs[@]}" --out "$RDIR/$name"
+  done
+  # One archive: the tool brings back at most 8 files.
+  tar -C "$RDIR" -czf "$OUT/render_gpu.tar.gz" --exclude='*.exr' . 2>/dev/null
+  grep -E 'engine GPU ms|Raybridge:' "$OUT/render_gpu.log"
+fi
+
 # ---- tests (validation on) ---------------------------------------------------------------------------------
 if [ "$MODE" = all ] || [ "$MODE" = tests ]; then
   : >"$OUT/tests_gpu.log"
   while IFS='|' read -r name exe args; do
     [ -n "$name" ] || continue
     read -r -a targs <<<"$args"
-    [ "$name" = bench_smoke ] && targs+=(--scenes "$SCENES" --out "$OUT/bench_smoke_gpu.json")
+    [ "$name" = bench_smoke ] && targs+=(--scenes "$SCENES" --out "$(mktemp -d)/bench_smoke_gpu.json")
     RAYBRIDGE_VALIDATION=1 step "test $name" 240 "$OUT/tests_gpu.log" "$RT/bin/$exe" "${targs[@]}"
   done <"$RT/tests.txt"
   grep -E '^(All tests passed|test cases:)|FAILED|validation\]' "$OUT/tests_gpu.log" | head -n 40

@@ -12,7 +12,9 @@ namespace rb {
 
 class PassMetrics {
  public:
-  static constexpr uint32_t kCounterSlots = 256;  // rays are summed into 256 counters to spread atomics
+  // Rays are summed into 4096 counters, one per pixel of a 64x64 tile: neighbouring invocations (one warp or
+  // subgroup) never add to the same address, so the atomics do not serialise.
+  static constexpr uint32_t kCounterSlots = 4096;
 
   Status init(Context& ctx, const char* passName);
   void destroy(Context& ctx);
