@@ -7,7 +7,7 @@
 
 namespace rbtest {
 
-CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& v) {
+CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& v, const std::vector<float>& roughness) {
   CpuGBuffer g;
   g.view = v;
   const glm::dvec3 forward = glm::normalize(v.target - v.eye);
@@ -46,7 +46,7 @@ CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& v) {
       g.depth[i] = float(clip.z / clip.w);
       glm::dvec3 ng = glm::normalize(glm::dvec3(h.geometricNormal[0], h.geometricNormal[1], h.geometricNormal[2]));
       if (glm::dot(ng, dir) > 0) ng = -ng;
-      g.normal[i] = glm::vec4(glm::vec3(ng), 0.0f);
+      g.normal[i] = glm::vec4(glm::vec3(ng), h.instanceId < roughness.size() ? roughness[h.instanceId] : 0.0f);
       g.hit[i] = 1;
       g.position[i] = v.eye + rel;
       g.instance[i] = h.instanceId;
@@ -121,6 +121,7 @@ GpuGBuffer::GpuGBuffer(GpuFixture& fx, const CpuGBuffer& cpu) : fx_(fx) {
   desc_.depth = {depth_.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   desc_.depthConvention = cpu.view.reversedZ ? rb::DepthConvention::ReversedZ : rb::DepthConvention::Standard;
   desc_.normal = {normal_.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  desc_.roughnessInNormalW = true;
   std::memcpy(desc_.view, &cpu.viewMatrix[0][0], sizeof desc_.view);
   std::memcpy(desc_.projection, &cpu.projection[0][0], sizeof desc_.projection);
   desc_.cameraPosition[0] = cpu.view.eye.x;

@@ -37,8 +37,10 @@ struct CpuGBuffer {
   std::vector<uint32_t> instance;    // instance id of the hit
 };
 
-// Traces the primary rays with Embree over `scene` (instances given in world space).
-CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& view);
+// Traces the primary rays with Embree over `scene` (instances given in world space). `roughness`, indexed by
+// instance, goes to the normal image's w (GBufferDesc::roughnessInNormalW); empty = 0 everywhere.
+CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& view,
+                        const std::vector<float>& roughness = {});
 
 // The G-buffer uploaded: D32 depth and RGBA32F normal images in SHADER_READ_ONLY_OPTIMAL.
 class GpuGBuffer {
@@ -47,6 +49,12 @@ class GpuGBuffer {
   ~GpuGBuffer();
   // The contract as an engine would fill it; cameraPosition carries the eye in double.
   rb::GBufferDesc desc() const { return desc_; }
+  rb::TlasBuildOptions cameraRelativeTlas(bool shadingRecords = false) const {
+    rb::TlasBuildOptions o;
+    for (int i = 0; i < 3; ++i) o.originOffset[i] = desc_.cameraPosition[i];
+    o.writeShadingRecords = shadingRecords;
+    return o;
+  }
 
  private:
   struct Image {

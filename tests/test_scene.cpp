@@ -36,6 +36,7 @@ BuiltScene buildScene(GpuFixture& fx, rb::AccelerationStructureService& service,
     inst.mesh = b.handles[scene.instances[i].mesh];
     std::copy(scene.instances[i].transform.begin(), scene.instances[i].transform.end(), inst.transform);
     inst.customIndex = i;
+    inst.material = scene.instances[i].material;
     b.instances.push_back(inst);
   }
   fx.runFrame([&](VkCommandBuffer cmd) {

@@ -15,6 +15,7 @@ namespace rbtest {
 struct SceneInstance {
   uint32_t mesh;
   std::array<float, 12> transform;
+  uint32_t material = 0;
 };
 
 struct TestScene {

@@ -54,6 +54,7 @@ AccelerationStructureService::Impl::~Impl() {
     destroyBuffer(ctx, s.storage);
     destroyBuffer(ctx, s.scratch);
     destroyBuffer(ctx, s.instances);
+    destroyBuffer(ctx, s.shading);
   }
   for (BuildBatch& b : inFlightBatches) {
     if (b.timestamps) c.vk.vkDestroyQueryPool(c.desc.device, b.timestamps, c.allocator());
@@ -590,7 +591,8 @@ AsStats AccelerationStructureService::stats() const {
   out.scratchBytes = s.scratch.allocatedBytes;
   out.tlasBytes = 0;
   for (const TlasSlot& t : s.tlasSlots) {
-    out.tlasBytes += t.storage.allocatedBytes + t.scratch.allocatedBytes + t.instances.allocatedBytes;
+    out.tlasBytes += t.storage.allocatedBytes + t.scratch.allocatedBytes + t.instances.allocatedBytes +
+                     t.shading.allocatedBytes;
   }
   out.batches = s.timings;
   return out;

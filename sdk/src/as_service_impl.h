@@ -58,6 +58,7 @@ struct TlasSlot {
   GpuBuffer storage;
   GpuBuffer scratch;
   GpuBuffer instances;  // host-visible VkAccelerationStructureInstanceKHR array
+  GpuBuffer shading;    // host-visible ShadingRecord array (only with writeShadingRecords)
   uint32_t instanceCapacity = 0;
   VkDeviceSize storageCapacity = 0;
   bool allowsUpdate = false;
@@ -103,6 +104,15 @@ struct AccelerationStructureService::Impl {
   VkBuildAccelerationStructureFlagsKHR blasFlags(const BlasEntry& e) const;
   VkDeviceSize scratchAlignment() const;
 };
+
+// Where a TLAS instance's surface data is, for hit shading (mirrors ShadingRecord in
+// shaders/raybridge_shading_records.glsl).
+struct ShadingRecord {
+  uint64_t positions, indices, normals, texcoords;
+  uint32_t positionStride, normalStride, texcoordStride, indexType;  // indexType: 0 u32, 1 u16, 2 none
+  uint32_t material, positionFormat, pad0, pad1;
+};
+static_assert(sizeof(ShadingRecord) == 64, "must match shaders/raybridge_shading_records.glsl");
 
 void recordAsBarrier(const DeviceFunctions& vk, VkCommandBuffer cmd, VkPipelineStageFlags dstStages);
 

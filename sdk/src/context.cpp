@@ -53,6 +53,8 @@ Status checkFeatures(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
   need(v12.runtimeDescriptorArray, "runtimeDescriptorArray");
   need(v12.shaderSampledImageArrayNonUniformIndexing, "shaderSampledImageArrayNonUniformIndexing");
   need(v12.scalarBlockLayout, "scalarBlockLayout");
+  need(v12.descriptorBindingPartiallyBound, "descriptorBindingPartiallyBound");
+  need(v12.descriptorBindingVariableDescriptorCount, "descriptorBindingVariableDescriptorCount");
   need(as.accelerationStructure, "accelerationStructure");
   need(rt.rayTracingPipeline, "rayTracingPipeline");
   if (!missing.empty()) {
@@ -74,6 +76,8 @@ RequiredFeatures::RequiredFeatures() {
   vulkan12.runtimeDescriptorArray = VK_TRUE;
   vulkan12.shaderSampledImageArrayNonUniformIndexing = VK_TRUE;
   vulkan12.scalarBlockLayout = VK_TRUE;
+  vulkan12.descriptorBindingPartiallyBound = VK_TRUE;
+  vulkan12.descriptorBindingVariableDescriptorCount = VK_TRUE;
   accelerationStructure.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
   accelerationStructure.pNext = &rayTracingPipeline;
   accelerationStructure.accelerationStructure = VK_TRUE;
@@ -93,6 +97,8 @@ void RequiredFeatures::mergeVulkan12Into(VkPhysicalDeviceVulkan12Features& f) co
   f.runtimeDescriptorArray |= vulkan12.runtimeDescriptorArray;
   f.shaderSampledImageArrayNonUniformIndexing |= vulkan12.shaderSampledImageArrayNonUniformIndexing;
   f.scalarBlockLayout |= vulkan12.scalarBlockLayout;
+  f.descriptorBindingPartiallyBound |= vulkan12.descriptorBindingPartiallyBound;
+  f.descriptorBindingVariableDescriptorCount |= vulkan12.descriptorBindingVariableDescriptorCount;
 }
 
 const char* toString(ErrorCode code) {

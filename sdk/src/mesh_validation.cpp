@@ -102,6 +102,11 @@ Result<ValidatedMesh> validateMesh(const MeshDesc& in, const DeviceFunctions& vk
     }
   }
 
+  if (d.normalAddress && d.normalStride == 0) d.normalStride = 12;
+  if (d.texcoordAddress && d.texcoordStride == 0) d.texcoordStride = 8;
+  if ((d.normalAddress && d.normalStride < 12) || (d.texcoordAddress && d.texcoordStride < 8)) {
+    return invalid("normalStride must be >= 12 and texcoordStride >= 8 bytes");
+  }
   uint64_t layout = hashCombine(hashCombine(d.vertexFormat, d.vertexStride),
                                 hashCombine(uint64_t(d.indexType) << 32 | d.triangleCount,
                                             uint64_t(d.vertexCount) << 1 | (d.nonOpaque ? 1 : 0)));

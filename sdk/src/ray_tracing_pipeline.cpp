@@ -36,9 +36,11 @@ Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTra
   p.pushConstantStages = VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR |
                          VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR | VK_SHADER_STAGE_ANY_HIT_BIT_KHR;
   VkPushConstantRange range{p.pushConstantStages, 0, desc.pushConstantBytes};
+  std::vector<VkDescriptorSetLayout> setLayouts = {p.setLayout};
+  setLayouts.insert(setLayouts.end(), desc.extraSetLayouts.begin(), desc.extraSetLayouts.end());
   VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pl.setLayoutCount = 1;
-  pl.pSetLayouts = &p.setLayout;
+  pl.setLayoutCount = static_cast<uint32_t>(setLayouts.size());
+  pl.pSetLayouts = setLayouts.data();
   pl.pushConstantRangeCount = desc.pushConstantBytes ? 1 : 0;
   pl.pPushConstantRanges = &range;
   r = c.vk.vkCreatePipelineLayout(c.desc.device, &pl, c.allocator(), &p.layout);

@@ -28,6 +28,7 @@ struct RayTracingPipelineDesc {
   std::vector<SpirvModule> misses;
   std::vector<HitGroupDesc> hitGroups;
   std::vector<VkDescriptorSetLayoutBinding> bindings;  // set 0, pushed with vkCmdPushDescriptorSetKHR
+  std::vector<VkDescriptorSetLayout> extraSetLayouts;   // sets 1.. (owned by the caller), bound by the caller
   std::vector<uint32_t> raygenSpecialization;  // value of constant_id i in the raygen shader
   uint32_t pushConstantBytes = 0;
   uint32_t maxRecursionDepth = 1;

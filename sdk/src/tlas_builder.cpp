@@ -61,6 +61,16 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     slot.instanceCapacity = capacity;
   }
 
+  if (options.writeShadingRecords) {
+    VkDeviceSize need = VkDeviceSize(std::max(slot.instanceCapacity, 1u)) * sizeof(ShadingRecord);
+    if (slot.shading.size < need) {
+      retireBuffer(s.ctx, slot.shading);
+      Status st = ensureBuffer(s.ctx, slot.shading, need, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                               MemoryLocation::HostVisible, "TLAS shading records");
+      if (!st) return st.error();
+    }
+  }
+
   // Validate every handle before writing anything, so a bad list leaves the previous state untouched.
   for (uint32_t i = 0; i < count; ++i) {
     const Instance& in = instances[i];
@@ -88,6 +98,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   slot.writtenFrame = c.frame;
   const uint64_t serial = s.tlasSerial + 1;
   auto* out = static_cast<VkAccelerationStructureInstanceKHR*>(slot.instances.mapped);
+  auto* records = options.writeShadingRecords ? static_cast<ShadingRecord*>(slot.shading.mapped) : nullptr;
   uint32_t written = 0, skipped = 0;
   uint64_t signature = 0;
   const bool rebase = options.originOffset[0] != 0.0 || options.originOffset[1] != 0.0 || options.originOffset[2] != 0.0;
@@ -111,6 +122,21 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     inst.instanceShaderBindingTableRecordOffset = in.sbtRecordOffset;
     inst.flags = in.flags;
     inst.accelerationStructureReference = e.address;
+    if (records) {
+      const MeshDesc& m = e.mesh.desc;
+      ShadingRecord r{};
+      r.positions = m.vertexAddress;
+      r.indices = m.indexAddress;
+      r.normals = m.normalAddress;
+      r.texcoords = m.texcoordAddress;
+      r.positionStride = m.vertexStride;
+      r.normalStride = m.normalStride;
+      r.texcoordStride = m.texcoordStride;
+      r.indexType = m.indexType == IndexType::Uint32 ? 0u : m.indexType == IndexType::Uint16 ? 1u : 2u;
+      r.material = in.material;
+      r.positionFormat = static_cast<uint32_t>(m.vertexFormat);
+      records[written] = r;
+    }
     out[written++] = inst;
     e.lastUsedFrame = c.frame;
     e.lastTlasSerial = serial;
@@ -208,6 +234,10 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   result.skippedInstances = skipped;
   result.updated = source != nullptr;
   for (int i = 0; i < 3; ++i) result.originOffset[i] = options.originOffset[i];
+  if (records) {
+    result.shadingRecords = slot.shading.buffer;
+    result.shadingRecordsBytes = VkDeviceSize(std::max(written, 1u)) * sizeof(ShadingRecord);
+  }
   return result;
 }
 

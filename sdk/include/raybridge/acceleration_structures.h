@@ -67,6 +67,14 @@ struct MeshDesc {
   const void* hostVertices = nullptr;  // optional CPU copy, laid out like the GPU buffer (vertexCount*stride)
   const void* hostIndices = nullptr;   // optional CPU copy of the indices (triangleCount*3 indices)
   const char* debugName = nullptr;     // optional; appears in error messages
+
+  // Optional vertex attributes, read (by device address, in place) where reflection rays hit the mesh. The
+  // same vertex indexing as the positions. 0 = absent: hits use the triangle's geometric normal and
+  // texture coordinate (0, 0). The buffers need VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT.
+  VkDeviceAddress normalAddress = 0;    // R32G32B32_SFLOAT object-space normals
+  uint32_t normalStride = 0;            // 0 = 12
+  VkDeviceAddress texcoordAddress = 0;  // R32G32_SFLOAT texture coordinates (glTF convention, v down)
+  uint32_t texcoordStride = 0;          // 0 = 8
 };
 
 // One TLAS instance. Instance{} is the identity transform, visible to every ray mask.
@@ -78,6 +86,7 @@ struct Instance {
   uint8_t mask = 0xFF;       // default: visible to all rays
   uint32_t sbtRecordOffset = 0;
   VkGeometryInstanceFlagsKHR flags = 0;
+  uint32_t material = 0;  // index into ReflectionPass::setMaterials(); read only by passes that shade hits
 };
 
 enum class TlasBuildMode : uint8_t {
@@ -90,6 +99,9 @@ struct TlasBuildOptions {
   // Subtracted (in double precision) from every instance's translation, so a camera-relative TLAS keeps full
   // float precision far from the world origin. Default 0: world space.
   double originOffset[3] = {0.0, 0.0, 0.0};
+  // Also write, per TLAS instance, where its vertex data and material are (TlasInfo::shadingRecords), for
+  // passes that shade the surfaces rays hit (reflections). false = no such buffer is allocated.
+  bool writeShadingRecords = false;
 };
 
 struct TlasInfo {
@@ -99,6 +111,10 @@ struct TlasInfo {
   uint32_t skippedInstances = 0; // instances whose mesh has no built BLAS yet (queued beyond the budget)
   bool updated = false;          // true if refit rather than rebuilt
   double originOffset[3] = {0.0, 0.0, 0.0};  // TlasBuildOptions::originOffset it was built with
+  // With TlasBuildOptions::writeShadingRecords: a storage buffer of one record per TLAS instance (indexed by
+  // gl_InstanceID), valid for this frame. VK_NULL_HANDLE otherwise.
+  VkBuffer shadingRecords = VK_NULL_HANDLE;
+  VkDeviceSize shadingRecordsBytes = 0;
 };
 
 struct AsServiceDesc {

@@ -9,5 +9,6 @@
 #include <raybridge/gbuffer.h>
 #include <raybridge/headless_device.h>
 #include <raybridge/primary_ray_pass.h>
+#include <raybridge/reflection_pass.h>
 #include <raybridge/result.h>
 #include <raybridge/shadow_pass.h>

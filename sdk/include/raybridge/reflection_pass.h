@@ -1,0 +1,73 @@
+// Ray-traced mirror and glossy reflections on the engine's G-buffer. Pixels whose roughness is under a
+// threshold trace one ray (or more) along the mirror direction (glossy: a GGX lobe sampled by visible
+// normals); all others trace nothing. Where a ray hits, the surface is shaded with its material (base colour
+// factor and texture, metallic-roughness factor and texture, emissive) lit by the sun, with a shadow ray, and
+// the sky's ambient light; a ray that escapes returns the sky colour. Output: the radiance arriving along the
+// reflected direction (not yet weighted by the surface's Fresnel term, which the engine's shading applies).
+//
+// Needs: roughness in the G-buffer (GBufferDesc::roughnessInNormalW or roughnessMetalness), a TLAS built
+// with TlasBuildOptions::writeShadingRecords, Instance::material set, and the engine's materials and
+// textures given to setMaterials().
+//
+// Thread safety: externally synchronised, like the Context it was created from.
+#pragma once
+
+#include <raybridge/acceleration_structures.h>
+#include <raybridge/effects.h>
+#include <raybridge/gbuffer.h>
+
+#include <memory>
+#include <span>
+
+namespace rb {
+
+inline constexpr uint32_t kNoTexture = 0xFFFFFFFFu;
+
+// A surface material as the reflection hits shade it (glTF metallic-roughness).
+struct Material {
+  float baseColor[4] = {1.0f, 1.0f, 1.0f, 1.0f};  // linear RGBA factor
+  float metallic = 0.0f;
+  float roughness = 1.0f;                  // perceptual
+  float emissive[3] = {0.0f, 0.0f, 0.0f};  // linear radiance
+  uint32_t baseColorTexture = kNoTexture;  // index into the textures of setMaterials (sRGB view: decoded)
+  uint32_t metallicRoughnessTexture = kNoTexture;  // glTF layout: G = roughness, B = metallic
+};
+
+struct ReflectionSettings {
+  float roughnessThreshold = 0.0f;  // 0 = 0.3: rougher surfaces trace no reflection ray
+  uint32_t raysPerPixel = 0;        // 0 = 1 (glossy surfaces are noisy at 1; denoise or accumulate)
+  float sunDirection[3] = {0.0f, 1.0f, 0.0f};  // towards the sun
+  float sunRadiance[3] = {3.0f, 3.0f, 3.0f};   // linear, the sun's colour times intensity
+  float skyRadiance[3] = {0.45f, 0.62f, 0.9f}; // linear, returned by rays that escape
+  float ambientIntensity = 0.0f;               // 0 = 0.4: sky light on hit surfaces, times skyRadiance
+};
+
+// Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
+struct ReflectionOutputs {
+  VkImage radiance = VK_NULL_HANDLE;  // R16G16B16A16_SFLOAT: rgb radiance, a = 1 where rays were traced
+  VkImageView radianceView = VK_NULL_HANDLE;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  uint32_t width = 0, height = 0;
+};
+
+class ReflectionPass {
+ public:
+  static Result<std::unique_ptr<ReflectionPass>> create(Context& context);
+  ~ReflectionPass();
+
+  // The engine's materials and texture views (2D, sampled, in SHADER_READ_ONLY_OPTIMAL while used). Call
+  // when they change; the previous table is released once frames in flight are done with it.
+  Status setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures);
+  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas,
+                const ReflectionSettings& settings = {});
+  const ReflectionOutputs& outputs() const;
+  PassStats stats() const;
+
+  struct Impl;
+
+ private:
+  explicit ReflectionPass(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rb

@@ -1,0 +1,12 @@
+#version 460
+#extension GL_EXT_ray_tracing : require
+#extension GL_GOOGLE_include_directive : require
+// A reflection ray that escapes sees the sky.
+#include "pass_inputs.glsl"
+
+struct ReflectionPayload {
+  vec3 radiance;
+};
+layout(location = 0) rayPayloadInEXT ReflectionPayload payload;
+
+void main() { payload.radiance = pc.p2.xyz; }

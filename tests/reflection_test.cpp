@@ -1,0 +1,165 @@
+// The reflection pass: a mirror shows what Embree says it reflects, in the right colour; surfaces above the
+// roughness threshold trace nothing.
+#include <catch2/catch_test_macros.hpp>
+
+#include <glm/glm.hpp>
+
+#include <cmath>
+#include <cstring>
+
+#include "synthetic_gbuffer.h"
+
+using namespace rbtest;
+
+namespace {
+
+float halfToFloat(uint16_t h) {
+  uint32_t sign = (h >> 15) & 1, exp = (h >> 10) & 31, mant = h & 1023;
+  float v = exp == 0 ? std::ldexp(float(mant), -24) : std::ldexp(float(mant | 1024), int(exp) - 25);
+  return sign ? -v : v;
+}
+
+struct ReflectionRun {
+  std::vector<glm::vec4> radiance;
+  rb::PassStats stats;
+};
+
+ReflectionRun runReflections(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu,
+                             const std::vector<rb::Material>& materials, const rb::ReflectionSettings& settings) {
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  auto pass = rb::ReflectionPass::create(fx.ctx());
+  RB_REQUIRE_OK(pass);
+  RB_REQUIRE_OK(pass.value()->setMaterials(materials, {}));
+  BuiltScene built = buildScene(fx, *service.value(), scene);
+  GpuGBuffer gbuffer(fx, cpu);
+  rb::GBufferDesc desc = gbuffer.desc();
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    auto tlas = service.value()->recordTlasBuild(cmd, built.instances, gbuffer.cameraRelativeTlas(true));
+    RB_REQUIRE_OK(tlas);
+    RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas.value(), settings));
+  });
+  std::vector<uint8_t> raw = readPassImage(fx, pass.value()->outputs().radiance, desc.width, desc.height, 8);
+  ReflectionRun run;
+  run.radiance.resize(size_t(desc.width) * desc.height);
+  for (size_t i = 0; i < run.radiance.size(); ++i) {
+    uint16_t h[4];
+    std::memcpy(h, raw.data() + 8 * i, 8);
+    run.radiance[i] = glm::vec4(halfToFloat(h[0]), halfToFloat(h[1]), halfToFloat(h[2]), halfToFloat(h[3]));
+  }
+  for (uint32_t i = 0; i < fx.ctx().framesInFlight(); ++i) fx.ctx().beginFrame();
+  run.stats = pass.value()->stats();
+  (void)fx.device().waitIdle();
+  destroyScene(fx, built);
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("a mirror reflects a coloured box where Embree says it should", "[reflection][embree]") {
+  GpuFixture fx;
+  TestScene scene;
+  scene.meshes.push_back(rbsamples::makeGrid(12.0f, 12));
+  const float mn[3] = {-0.6f, 0.0f, -0.6f}, mx[3] = {0.6f, 1.5f, 0.6f};
+  scene.meshes.push_back(rbsamples::makeBox(mn, mx, 2));
+  scene.instances.push_back({0, translation(0, 0, 0), 0});
+  scene.instances.push_back({1, translation(0, 0, -1.5f), 1});
+  std::vector<rb::Material> materials(2);
+  materials[1].baseColor[0] = 0.8f;
+  materials[1].baseColor[1] = 0.05f;
+  materials[1].baseColor[2] = 0.05f;
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  SyntheticView view;
+  view.eye = {0.3, 1.2, 4.0};
+  view.target = {0.0, 0.2, -1.0};
+  view.width = 96;
+  view.height = 72;
+  rb::ReflectionSettings settings;
+  settings.sunDirection[0] = 0.3f;
+  settings.sunDirection[1] = 1.0f;
+  settings.sunDirection[2] = 0.6f;
+
+  SECTION("mirror floor") {
+    CpuGBuffer cpu = traceGBuffer(embree, view, {0.0f, 1.0f});  // floor a mirror, box rough
+    ReflectionRun run = runReflections(fx, scene, cpu, materials, settings);
+    uint32_t boxInMirror = 0, red = 0, skyInMirror = 0, sky = 0, boxPixels = 0, boxTraced = 0, floorPixels = 0;
+    for (uint32_t y = 1; y + 1 < view.height; ++y) {
+      for (uint32_t x = 1; x + 1 < view.width; ++x) {
+        size_t i = size_t(y) * view.width + x;
+        if (!cpu.hit[i]) continue;
+        if (cpu.instance[i] == 1) {
+          ++boxPixels;
+          boxTraced += run.radiance[i].a != 0.0f;  // rough: no ray
+          continue;
+        }
+        ++floorPixels;
+        // Where does the mirror ray from this floor point go? Skip pixels whose neighbours disagree (edges).
+        auto mirrorHit = [&](size_t j) {
+          glm::dvec3 v = glm::normalize(cpu.position[j] - view.eye);
+          glm::dvec3 r = glm::reflect(v, glm::dvec3(0, 1, 0));
+          glm::dvec3 o = cpu.position[j] + glm::dvec3(0, 1e-4, 0);
+          float of[3] = {float(o.x), float(o.y), float(o.z)}, d[3] = {float(r.x), float(r.y), float(r.z)};
+          ReferenceHit h = embree.intersect(of, d, 0.0f, 1e30f);
+          return h.hit ? int(h.instanceId) : -1;
+        };
+        int target = mirrorHit(i);
+        bool edge = false;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            size_t j = size_t(int(y) + dy) * view.width + size_t(int(x) + dx);
+            edge |= !cpu.hit[j] || cpu.instance[j] != 0 || mirrorHit(j) != target;
+          }
+        }
+        if (edge) continue;
+        glm::vec4 c = run.radiance[i];
+        REQUIRE(c.a == 1.0f);  // a mirror pixel traced its ray
+        if (target == 1) {
+          ++boxInMirror;
+          red += c.r > 3.0f * c.g && c.r > 3.0f * c.b && c.r > 0.05f;
+        } else if (target < 0) {
+          ++skyInMirror;
+          sky += std::fabs(c.r - settings.skyRadiance[0]) < 2e-3f && std::fabs(c.g - settings.skyRadiance[1]) < 2e-3f &&
+                 std::fabs(c.b - settings.skyRadiance[2]) < 2e-3f;
+        }
+      }
+    }
+    INFO("box in mirror " << boxInMirror << " (" << red << " red), sky " << skyInMirror << " (" << sky << ")");
+    REQUIRE(boxInMirror > 100);
+    REQUIRE(skyInMirror > 100);
+    CHECK(red == boxInMirror);
+    CHECK(sky == skyInMirror);
+    CHECK(boxTraced == 0);
+    // Rays are counted: exactly one per pixel that traced (every floor pixel, no box pixel).
+    uint64_t tracedPixels = 0, allFloor = 0;
+    for (size_t i = 0; i < run.radiance.size(); ++i) {
+      tracedPixels += run.radiance[i].a != 0.0f;
+      allFloor += cpu.hit[i] && cpu.instance[i] == 0;
+    }
+    CHECK(tracedPixels == allFloor);
+    CHECK(run.stats.rays == tracedPixels);
+    CHECK(floorPixels > 0);
+    CHECK(boxPixels > 0);
+  }
+
+  SECTION("a surface rougher than the threshold traces no reflection rays") {
+    CpuGBuffer cpu = traceGBuffer(embree, view, {0.8f, 1.0f});
+    ReflectionRun run = runReflections(fx, scene, cpu, materials, settings);
+    uint32_t traced = 0;
+    for (const glm::vec4& c : run.radiance) traced += c.a != 0.0f;
+    CHECK(traced == 0);
+    CHECK(run.stats.rays == 0);
+  }
+}
+
+TEST_CASE("reflection input errors name the problem", "[reflection][bad-input]") {
+  GpuFixture fx;
+  auto pass = rb::ReflectionPass::create(fx.ctx());
+  RB_REQUIRE_OK(pass);
+  rb::Material m;
+  m.baseColorTexture = 3;
+  auto s = pass.value()->setMaterials(std::span(&m, 1), {});
+  REQUIRE(!s.ok());
+  CHECK(s.error().message.find("texture 3") != std::string::npos);
+  CHECK(!pass.value()->setMaterials({}, {}).ok());
+}
