@@ -13,6 +13,7 @@ layout(set = 0, binding = 3) uniform sampler2D historyIn;      // x: accumulated
 layout(set = 0, binding = 4) uniform sampler2D distanceIn;     // previous frame's view distance
 layout(set = 0, binding = 5, rg16f) uniform writeonly image2D historyOut;
 layout(set = 0, binding = 6, r32f) uniform writeonly image2D distanceOut;
+layout(set = 0, binding = 7, r16f) uniform writeonly image2D valueOut;  // the accumulated value alone
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -23,6 +24,7 @@ void main() {
   if (rbDnSky(depth)) {
     imageStore(historyOut, ip, vec4(value, 0.0, 0.0, 0.0));
     imageStore(distanceOut, ip, vec4(0.0));
+    imageStore(valueOut, ip, vec4(value));
     return;
   }
   vec3 rel = rbDnCameraRelative(pixel, depth);
@@ -49,4 +51,5 @@ void main() {
     }
   }
   imageStore(historyOut, ip, vec4(accumulated, frames, 0.0, 0.0));
+  imageStore(valueOut, ip, vec4(accumulated));
 }

@@ -44,7 +44,8 @@ struct Denoiser::Impl {
   Context& ctx;
   ComputePipeline temporal, atrous;
   VkSampler sampler = VK_NULL_HANDLE;
-  // 0,1: history ping-pong (RG16F); 2,3: view distance ping-pong (R32F); 4,5: spatial ping-pong (R16F)
+  // 0,1: history ping-pong (RG16F); 2,3: view distance ping-pong (R32F); 4,5: spatial ping-pong (R16F);
+  // 6: this frame's temporal result (R16F)
   PassImages images;
   PassMetrics metrics;
   DenoiseOutputs outputs;
@@ -76,7 +77,8 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context) {
   };
   Result<ComputePipeline> t = ComputePipeline::create(
       context, SpirvModule::of(spirv::denoise_temporal_comp),
-      {sampled(0), sampled(1), sampled(2), sampled(3), sampled(4), storage(5), storage(6)}, sizeof(DenoiseConstants),
+      {sampled(0), sampled(1), sampled(2), sampled(3), sampled(4), storage(5), storage(6), storage(7)},
+      sizeof(DenoiseConstants),
       "denoiser temporal");
   if (!t) return t.error();
   impl->temporal = t.value();
@@ -122,7 +124,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   if (g.motionVectors.view) flags |= 8u;
   pc.size[0] = g.width;
   pc.size[1] = g.height;
-  pc.cameraDelta[3] = settings.depthSigma > 0.0f ? settings.depthSigma : 0.02f;
+  pc.cameraDelta[3] = settings.depthSigma > 0.0f ? settings.depthSigma : 0.005f;
   pc.params[0] = settings.normalPower > 0.0f ? settings.normalPower : 32.0f;
 
   // This frame's camera: projection * rotation-only view, kept for next frame's reprojection.
@@ -140,7 +142,8 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   std::vector<PassImages::Spec> specs = {
       {VK_FORMAT_R16G16_SFLOAT, "denoiser history A"}, {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},
       {VK_FORMAT_R32_SFLOAT, "denoiser distance A"},   {VK_FORMAT_R32_SFLOAT, "denoiser distance B"},
-      {VK_FORMAT_R16_SFLOAT, "denoiser spatial A"},    {VK_FORMAT_R16_SFLOAT, "denoiser spatial B"}};
+      {VK_FORMAT_R16_SFLOAT, "denoiser spatial A"},    {VK_FORMAT_R16_SFLOAT, "denoiser spatial B"},
+      {VK_FORMAT_R16_SFLOAT, "denoiser temporal result"}};
   bool resized = s.images.size() == 0 || s.images[0].width != g.width || s.images[0].height != g.height;
   if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
   if (resized) s.historyValid = false;
@@ -187,6 +190,8 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
           VK_ACCESS_SHADER_WRITE_BIT);
   barrier(im[5], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
           VK_ACCESS_SHADER_WRITE_BIT);
+  barrier(im[6], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
+          VK_ACCESS_SHADER_WRITE_BIT);
   flush(readers, cs);
 
   VkImageView current = signal;  // what the next stage reads
@@ -206,17 +211,19 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
     w.sampledImage(4, im[2 + prev].view, s.sampler, ro);
     w.storageImage(5, im[cur].view);
     w.storageImage(6, im[2 + cur].view);
+    w.storageImage(7, im[6].view);
     s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
     barrier(im[cur], VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
     barrier(im[2 + cur], VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
+    barrier(im[6], VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
     flush(cs, readers);
-    current = im[cur].view;  // .r holds the accumulated value
-    last = &im[cur];
+    current = im[6].view;
+    last = &im[6];
     s.historyValid = true;
     s.parity = prev;
   }
   if (!settings.disableSpatial) {
-    uint32_t iterations = settings.spatialIterations ? settings.spatialIterations : 3u;
+    uint32_t iterations = settings.spatialIterations ? settings.spatialIterations : 2u;
     pc.size[2] = flags;
     for (uint32_t i = 0; i < iterations; ++i) {
       const GpuImage& out = im[4 + (i % 2)];
@@ -245,6 +252,10 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   } else {
     barrier(im[4], VK_IMAGE_LAYOUT_GENERAL, ro, 0, VK_ACCESS_SHADER_READ_BIT);
     barrier(im[5], VK_IMAGE_LAYOUT_GENERAL, ro, 0, VK_ACCESS_SHADER_READ_BIT);
+    flush(cs, readers);
+  }
+  if (!temporal) {
+    barrier(im[6], VK_IMAGE_LAYOUT_GENERAL, ro, 0, VK_ACCESS_SHADER_READ_BIT);
     flush(cs, readers);
   }
   s.metrics.writeEnd(ctx, cmd);

@@ -18,9 +18,9 @@ namespace rb {
 struct DenoiseSettings {
   bool disableTemporal = false;   // false = accumulate over frames
   bool disableSpatial = false;    // false = run the a-trous filter
-  uint32_t spatialIterations = 0; // 0 = 3 (steps 1, 2, 4: a 29x29 footprint)
+  uint32_t spatialIterations = 0; // 0 = 2 (steps 1 and 2: a 13x13 footprint; 3 over-blurs 4-ray AO)
   uint32_t maxHistoryFrames = 0;  // 0 = 32: the running mean forgets more slowly than this
-  float depthSigma = 0.0f;        // 0 = 0.02: plane-distance tolerance relative to view distance, per step
+  float depthSigma = 0.0f;        // 0 = 0.005: plane-distance tolerance relative to view distance, per step
   float normalPower = 0.0f;       // 0 = 32: exponent of the normal similarity weight
 };
 
