@@ -83,6 +83,7 @@ int run(const BenchOptions& options) {
       {"compaction", [&] { return runCompactionScenario(env, models); }},
       {"tlas", [&] { return runTlasScenario(env); }},
       {"trace", [&] { return runTraceScenario(env); }},
+      {"gigarays", [&] { return runGigaRaysScenario(env); }},
   };
   // A failing scenario is reported and the others still run (a GPU session is too costly to lose whole).
   std::vector<std::string> failures;

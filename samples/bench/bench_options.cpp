@@ -7,7 +7,7 @@ namespace rbbench {
 
 const std::vector<std::string>& scenarioNames() {
   static const std::vector<std::string> names = {"build", "duplication", "fastbuild-vs-fasttrace",
-                                                 "compaction", "tlas", "trace"};
+                                                 "compaction", "tlas", "trace", "gigarays"};
   return names;
 }
 

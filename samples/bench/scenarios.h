@@ -22,5 +22,7 @@ nlohmann::json runCompactionScenario(BenchEnv& env, const std::vector<GltfModel>
 nlohmann::json runTlasScenario(BenchEnv& env);
 // Raw primary-ray rate on a finely tessellated scene (and on rays that miss everything).
 nlohmann::json runTraceScenario(BenchEnv& env);
+// The thesis's stress (many rays per pixel, all hit) and miss scenarios: the device's raw trace rate.
+nlohmann::json runGigaRaysScenario(BenchEnv& env);
 
 }  // namespace rbbench
