@@ -14,25 +14,16 @@ namespace {
 
 std::vector<float> runAo(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu, const rb::AoSettings& settings,
                          rb::PassStats* stats = nullptr) {
-  auto service = rb::AccelerationStructureService::create(fx.ctx());
-  RB_REQUIRE_OK(service);
   auto pass = rb::AoPass::create(fx.ctx());
   RB_REQUIRE_OK(pass);
-  BuiltScene built = buildScene(fx, *service.value(), scene);
-  GpuGBuffer gbuffer(fx, cpu);
-  rb::GBufferDesc desc = gbuffer.desc();
-  rb::TlasBuildOptions options;
-  for (int i = 0; i < 3; ++i) options.originOffset[i] = desc.cameraPosition[i];
-  fx.runFrame([&](VkCommandBuffer cmd) {
-    auto tlas = service.value()->recordTlasBuild(cmd, built.instances, options);
-    RB_REQUIRE_OK(tlas);
-    RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas.value(), settings));
-  });
-  std::vector<float> ao = readR16f(fx, pass.value()->outputs().ao, desc.width, desc.height);
-  for (uint32_t i = 0; i < fx.ctx().framesInFlight(); ++i) fx.ctx().beginFrame();
+  std::vector<float> ao;
+  runPassFrame(
+      fx, scene, cpu, false,
+      [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
+        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, settings));
+      },
+      [&](const rb::GBufferDesc& desc) { ao = readR16f(fx, pass.value()->outputs().ao, desc.width, desc.height); });
   if (stats) *stats = pass.value()->stats();
-  (void)fx.device().waitIdle();
-  destroyScene(fx, built);
   return ao;
 }
 

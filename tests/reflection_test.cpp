@@ -26,31 +26,25 @@ struct ReflectionRun {
 
 ReflectionRun runReflections(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu,
                              const std::vector<rb::Material>& materials, const rb::ReflectionSettings& settings) {
-  auto service = rb::AccelerationStructureService::create(fx.ctx());
-  RB_REQUIRE_OK(service);
   auto pass = rb::ReflectionPass::create(fx.ctx());
   RB_REQUIRE_OK(pass);
   RB_REQUIRE_OK(pass.value()->setMaterials(materials, {}));
-  BuiltScene built = buildScene(fx, *service.value(), scene);
-  GpuGBuffer gbuffer(fx, cpu);
-  rb::GBufferDesc desc = gbuffer.desc();
-  fx.runFrame([&](VkCommandBuffer cmd) {
-    auto tlas = service.value()->recordTlasBuild(cmd, built.instances, gbuffer.cameraRelativeTlas(true));
-    RB_REQUIRE_OK(tlas);
-    RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas.value(), settings));
-  });
-  std::vector<uint8_t> raw = readPassImage(fx, pass.value()->outputs().radiance, desc.width, desc.height, 8);
   ReflectionRun run;
-  run.radiance.resize(size_t(desc.width) * desc.height);
-  for (size_t i = 0; i < run.radiance.size(); ++i) {
-    uint16_t h[4];
-    std::memcpy(h, raw.data() + 8 * i, 8);
-    run.radiance[i] = glm::vec4(halfToFloat(h[0]), halfToFloat(h[1]), halfToFloat(h[2]), halfToFloat(h[3]));
-  }
-  for (uint32_t i = 0; i < fx.ctx().framesInFlight(); ++i) fx.ctx().beginFrame();
+  runPassFrame(
+      fx, scene, cpu, true,
+      [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
+        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, settings));
+      },
+      [&](const rb::GBufferDesc& desc) {
+        std::vector<uint8_t> raw = readPassImage(fx, pass.value()->outputs().radiance, desc.width, desc.height, 8);
+        run.radiance.resize(size_t(desc.width) * desc.height);
+        for (size_t i = 0; i < run.radiance.size(); ++i) {
+          uint16_t h[4];
+          std::memcpy(h, raw.data() + 8 * i, 8);
+          run.radiance[i] = glm::vec4(halfToFloat(h[0]), halfToFloat(h[1]), halfToFloat(h[2]), halfToFloat(h[3]));
+        }
+      });
   run.stats = pass.value()->stats();
-  (void)fx.device().waitIdle();
-  destroyScene(fx, built);
   return run;
 }
 

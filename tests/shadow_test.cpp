@@ -23,36 +23,28 @@ struct ShadowRun {
 // visibility back.
 ShadowRun runShadowPass(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu, const rb::Light& light,
                         uint32_t raysPerPixel = 0, bool withDistance = false) {
-  auto service = rb::AccelerationStructureService::create(fx.ctx());
-  RB_REQUIRE_OK(service);
   rb::ShadowPassDesc passDesc;
   passDesc.outputHitDistance = withDistance;
   auto pass = rb::ShadowPass::create(fx.ctx(), passDesc);
   RB_REQUIRE_OK(pass);
-  BuiltScene built = buildScene(fx, *service.value(), scene);
-  GpuGBuffer gbuffer(fx, cpu);
-  rb::GBufferDesc desc = gbuffer.desc();
-  rb::TlasBuildOptions options;  // camera-relative, as an engine should build it
-  for (int i = 0; i < 3; ++i) options.originOffset[i] = desc.cameraPosition[i];
   rb::ShadowSettings settings;
   settings.raysPerPixel = raysPerPixel;
-  fx.runFrame([&](VkCommandBuffer cmd) {
-    auto tlas = service.value()->recordTlasBuild(cmd, built.instances, options);
-    RB_REQUIRE_OK(tlas);
-    RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas.value(), light, settings));
-  });
   ShadowRun run;
-  run.visibility = readR16f(fx, pass.value()->outputs().visibility, desc.width, desc.height);
-  if (withDistance) {
-    REQUIRE(pass.value()->outputs().hitDistance != VK_NULL_HANDLE);
-    run.hitDistance = readR32f(fx, pass.value()->outputs().hitDistance, desc.width, desc.height);
-  } else {
-    CHECK(pass.value()->outputs().hitDistance == VK_NULL_HANDLE);  // not asked for: not allocated
-  }
-  for (uint32_t i = 0; i < fx.ctx().framesInFlight(); ++i) fx.ctx().beginFrame();
+  runPassFrame(
+      fx, scene, cpu, false,
+      [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
+        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, light, settings));
+      },
+      [&](const rb::GBufferDesc& desc) {
+        run.visibility = readR16f(fx, pass.value()->outputs().visibility, desc.width, desc.height);
+        if (withDistance) {
+          REQUIRE(pass.value()->outputs().hitDistance != VK_NULL_HANDLE);
+          run.hitDistance = readR32f(fx, pass.value()->outputs().hitDistance, desc.width, desc.height);
+        } else {
+          CHECK(pass.value()->outputs().hitDistance == VK_NULL_HANDLE);  // not asked for: not allocated
+        }
+      });
   run.stats = pass.value()->stats();
-  (void)fx.device().waitIdle();
-  destroyScene(fx, built);
   return run;
 }
 

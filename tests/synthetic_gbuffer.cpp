@@ -140,6 +140,24 @@ GpuGBuffer::~GpuGBuffer() {
   }
 }
 
+void runPassFrame(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu, bool shadingRecords,
+                  const PassRecorder& record, const PassReadback& readback) {
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  BuiltScene built = buildScene(fx, *service.value(), scene);
+  GpuGBuffer gbuffer(fx, cpu);
+  rb::GBufferDesc desc = gbuffer.desc();
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    auto tlas = service.value()->recordTlasBuild(cmd, built.instances, gbuffer.cameraRelativeTlas(shadingRecords));
+    RB_REQUIRE_OK(tlas);
+    record(cmd, desc, tlas.value());
+  });
+  readback(desc);
+  for (uint32_t i = 0; i < fx.ctx().framesInFlight(); ++i) fx.ctx().beginFrame();
+  (void)fx.device().waitIdle();
+  destroyScene(fx, built);
+}
+
 namespace {
 float halfToFloat(uint16_t h) {
   uint32_t sign = (h >> 15) & 1, exp = (h >> 10) & 31, mant = h & 1023;

@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include <functional>
 #include <vector>
 
 #include "embree_reference.h"
@@ -67,6 +68,14 @@ class GpuGBuffer {
   Image depth_, normal_;
   rb::GBufferDesc desc_;
 };
+
+// One frame of effect passes on a synthetic G-buffer: builds `scene`, uploads `cpu`, builds a camera-relative
+// TLAS (with shading records when asked), calls `record` inside the frame and `readback` after it (while the
+// G-buffer and the scene still exist), then settles the frames in flight so the passes' statistics resolve.
+using PassRecorder = std::function<void(VkCommandBuffer, const rb::GBufferDesc&, const rb::TlasInfo&)>;
+using PassReadback = std::function<void(const rb::GBufferDesc&)>;
+void runPassFrame(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu, bool shadingRecords,
+                  const PassRecorder& record, const PassReadback& readback);
 
 // Reads a pass output (in SHADER_READ_ONLY_OPTIMAL, left so) back: raw bytes, or R16F/R32F as floats.
 std::vector<uint8_t> readPassImage(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height,

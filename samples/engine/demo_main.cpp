@@ -1,5 +1,6 @@
 // raybridge-engine-demo: renders the default demo scene (or a glTF file) headless to a PNG, or opens an
 // interactive viewer with --window.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,17 +24,23 @@ struct Options {
   uint32_t width = 1280, height = 720;
   uint32_t shadowMapSize = 2048;
   uint32_t pcf = 3;
+  uint32_t ssaoKernel = 0;      // 0 = SSAO off
+  uint32_t probeResolution = 0;  // 0 = constant-sky reflections
+  std::string effectsPrefix;     // writes PREFIX_ssao.png / PREFIX_shadow.png
   bool window = false;
   bool validation = false;
-  int frames = 0;  // --window: close after this many frames (0 = run until closed)
+  int frames = 0;  // --window: close after this many frames (0 = run until closed); headless: frames to render
 };
 
 void usage() {
   std::printf(
       "usage: raybridge-engine-demo [--out FILE.png] [--exr FILE.exr] [--width W] [--height H]\n"
       "                             [--scene FILE.gltf|.glb] [--shadow-map-size N] [--pcf N]\n"
-      "                             [--validation] [--window [--frames N]]\n"
+      "                             [--ssao KERNEL] [--probe RES] [--effects PREFIX]\n"
+      "                             [--validation] [--frames N] [--window]\n"
       "  Headless by default: renders one frame and writes the PNG (and EXR of the HDR image).\n"
+      "  --ssao enables the engine's SSAO with KERNEL samples, --probe a RES^2-per-face reflection probe;\n"
+      "  --effects writes the shadow-map visibility (and SSAO) images as PREFIX_shadow.png / PREFIX_ssao.png.\n"
       "  --window opens a viewer: drag = orbit, scroll = zoom, WASD/QE = move, Shift = faster, Esc = quit.\n");
 }
 
@@ -55,6 +62,9 @@ bool parse(int argc, char** argv, Options& o) {
     else if (a == "--height") { if (!(v = next("--height"))) return false; o.height = uint32_t(std::atoi(v)); }
     else if (a == "--shadow-map-size") { if (!(v = next(a.c_str()))) return false; o.shadowMapSize = uint32_t(std::atoi(v)); }
     else if (a == "--pcf") { if (!(v = next("--pcf"))) return false; o.pcf = uint32_t(std::atoi(v)); }
+    else if (a == "--ssao") { if (!(v = next("--ssao"))) return false; o.ssaoKernel = uint32_t(std::atoi(v)); }
+    else if (a == "--probe") { if (!(v = next("--probe"))) return false; o.probeResolution = uint32_t(std::atoi(v)); }
+    else if (a == "--effects") { if (!(v = next("--effects"))) return false; o.effectsPrefix = v; }
     else if (a == "--frames") { if (!(v = next("--frames"))) return false; o.frames = std::atoi(v); }
     else if (a == "--window") o.window = true;
     else if (a == "--validation") o.validation = true;
@@ -93,13 +103,50 @@ FrameParams initialParams(const Options& o, const Engine& engine) {
   if (s.sun) p.sun = *s.sun;
   p.shadow.mapSize = o.shadowMapSize;
   p.shadow.pcfKernelSize = o.pcf;
+  p.ssao.enabled = o.ssaoKernel > 0;
+  p.ssao.kernelSize = o.ssaoKernel;
+  p.reflectionProbe.enabled = o.probeResolution > 0;
+  p.reflectionProbe.resolution = o.probeResolution;
+  p.outputShadowVisibility = !o.effectsPrefix.empty();
   return p;
+}
+
+// A [0,1] float image as a gray PNG.
+Status writeGray(const std::string& path, const std::vector<float>& values, uint32_t width, uint32_t height) {
+  ImageRGBA8 img;
+  img.width = width;
+  img.height = height;
+  img.pixels.resize(size_t(width) * height * 4);
+  for (size_t i = 0; i < values.size(); ++i) {
+    const uint8_t v = uint8_t(std::clamp(values[i], 0.0f, 1.0f) * 255.0f + 0.5f);
+    img.pixels[i * 4 + 0] = img.pixels[i * 4 + 1] = img.pixels[i * 4 + 2] = v;
+    img.pixels[i * 4 + 3] = 255;
+  }
+  return writePng(path, img);
+}
+
+int writeEffects(const Options& o, Engine& engine) {
+  const VkExtent2D size = engine.renderSize();
+  auto shadow = engine.readbackShadowVisibility();
+  if (!shadow) return std::fprintf(stderr, "error: %s\n", shadow.error.c_str()), 1;
+  if (Status s = writeGray(o.effectsPrefix + "_shadow.png", shadow.value, size.width, size.height); !s)
+    return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+  if (o.ssaoKernel > 0) {
+    auto ssao = engine.readbackSsao();
+    if (!ssao) return std::fprintf(stderr, "error: %s\n", ssao.error.c_str()), 1;
+    if (Status s = writeGray(o.effectsPrefix + "_ssao.png", ssao.value, size.width, size.height); !s)
+      return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+  }
+  std::printf("wrote %s_*.png\n", o.effectsPrefix.c_str());
+  return 0;
 }
 
 void printTimings(const PassTimings& t) {
   if (!t.valid) return;
-  std::printf("GPU ms: shadow %.2f  prepass %.2f  hook %.2f  lighting %.2f  tonemap %.2f\n", t.shadowMs,
-              t.prepassMs, t.hookMs, t.lightingMs, t.tonemapMs);
+  std::printf("GPU ms: shadow %.2f  probe %.2f%s  prepass %.2f  ssao %.2f  shadow-vis %.2f  hook %.2f  lighting %.2f"
+              "  tonemap %.2f\n",
+              t.shadowMs, t.probeMs, t.probeCaptured ? " (captured)" : "", t.prepassMs, t.ssaoMs,
+              t.shadowVisibilityMs, t.hookMs, t.lightingMs, t.tonemapMs);
 }
 
 int runHeadless(const Options& o) {
@@ -117,6 +164,15 @@ int runHeadless(const Options& o) {
   if (Status s = engine.loadScene(scene); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
   if (Status s = engine.setRenderSize(o.width, o.height); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
   FrameParams params = initialParams(o, engine);
+  // Extra frames (--frames N) give steady-state timings; the first one's are printed too (probe capture).
+  for (int i = 1; i < o.frames; ++i) {
+    if (Status s = engine.renderFrame(params); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+    if (i == 1) {
+      if (Status s = engine.waitIdle(); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+      std::printf("first frame ");
+      printTimings(engine.lastTimings());
+    }
+  }
   auto t0 = std::chrono::steady_clock::now();
   if (Status s = engine.renderFrame(params); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
   auto ldr = engine.readbackLdr();
@@ -131,6 +187,8 @@ int runHeadless(const Options& o) {
     if (Status s = writeExr(o.exr, hdr.value); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
     std::printf("wrote %s\n", o.exr.c_str());
   }
+  if (!o.effectsPrefix.empty())
+    if (int rc = writeEffects(o, engine); rc != 0) return rc;
   printTimings(engine.lastTimings());
   if (o.validation) std::printf("validation errors: %u\n", engine.validationErrorCount());
   return o.validation && engine.validationErrorCount() > 0 ? 2 : 0;

@@ -1,33 +1,22 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Forward PBR lighting: GGX specular + Lambert diffuse for the sun, constant-sky ambient, with optional
-// external sun visibility / AO / reflection images replacing the engine's own terms.
+// external sun visibility / AO / reflection images replacing the engine's own terms. Also used (depth LESS)
+// to capture the reflection probe, with frame.probe.x = 0 and no screen-space inputs.
 #include "common.glsl"
 #include "surface.glsl"
+#include "shadow_sampling.glsl"
 
 layout(set = 2, binding = 0) uniform sampler2DShadow shadowMap;
 layout(set = 2, binding = 1) uniform sampler2D externalVisibility;
 layout(set = 2, binding = 2) uniform sampler2D externalAo;
 layout(set = 2, binding = 3) uniform sampler2D externalReflection;
+// Reflection probe (engine-captured cubemap with mips); a 1x1 black cube when no probe is in use.
+layout(set = 2, binding = 4) uniform samplerCube probeCube;
 
 layout(location = 0) out vec4 outColor;
 
 const float PI = 3.14159265358979;
-
-float shadowMapVisibility(vec3 worldPos, vec3 ng) {
-  // Normal offset moves the lookup off the surface to avoid acne on slopes.
-  vec4 lp = frame.lightViewProj * vec4(worldPos + ng * frame.shadow.z, 1.0);
-  vec3 ndc = lp.xyz / lp.w;
-  vec2 uv = ndc.xy * 0.5 + 0.5;
-  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || ndc.z >= 1.0) return 1.0;
-  int taps = int(frame.shadow.y);
-  int half_ = taps / 2;
-  float sum = 0.0;
-  for (int y = -half_; y <= half_; ++y)
-    for (int x = -half_; x <= half_; ++x)
-      sum += texture(shadowMap, vec3(uv + vec2(x, y) * frame.shadow.x, ndc.z));
-  return sum / float(taps * taps);
-}
 
 // Karis' analytic approximation of the split-sum environment BRDF.
 vec3 environmentBrdf(vec3 f0, float roughness, float nDotV) {
@@ -59,15 +48,23 @@ void main() {
   vec3 specular = d * vis * f;
   vec3 diffuse = (1.0 - f) * (1.0 - s.metallic) * s.baseColor / PI;
 
-  float sunVisibility = frame.inputs.x != 0u ? clamp(texture(externalVisibility, screenUv).r, 0.0, 1.0)
-                                             : (nDotL > 0.0 ? shadowMapVisibility(inWorldPos, s.ng) : 0.0);
+  float visibility = frame.inputs.x != 0u ? clamp(texture(externalVisibility, screenUv).r, 0.0, 1.0)
+                                          : sunVisibility(shadowMap, inWorldPos, s.n, s.ng);
   float ao = frame.inputs.y != 0u ? clamp(texture(externalAo, screenUv).r, 0.0, 1.0) : 1.0;
 
-  vec3 color = (diffuse + specular) * frame.sunRadiance.rgb * nDotL * sunVisibility;
+  vec3 color = (diffuse + specular) * frame.sunRadiance.rgb * nDotL * visibility;
   vec3 ambient = frame.sky.rgb * frame.sky.w;
   color += ambient * s.baseColor * (1.0 - s.metallic) * ao;  // Lambert under a uniform sky
   vec3 specularWeight = environmentBrdf(f0, s.roughness, nDotV);
-  vec3 reflected = frame.inputs.z != 0u ? texture(externalReflection, screenUv).rgb : ambient * ao;
+  // External reflection > reflection probe > constant sky. The probe is sharp at mip 0 and blurrier with
+  // roughness (box-filtered mips: an approximation of the GGX lobe, good enough for a fallback).
+  vec3 reflected = ambient * ao;
+  if (frame.inputs.z != 0u) {
+    reflected = texture(externalReflection, screenUv).rgb;
+  } else if (frame.probe.x > 0.5) {
+    vec3 r = reflect(-s.v, s.n);
+    reflected = textureLod(probeCube, r, s.roughness * frame.probe.y).rgb * ao;
+  }
   color += reflected * specularWeight;
   color += s.emissive;
   outColor = vec4(color, 1.0);

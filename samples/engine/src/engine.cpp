@@ -17,12 +17,16 @@ std::string Engine::Impl::init(const EngineConfig& config) {
   gpu.init(ctx.physicalDevice, ctx.device, ctx.queue, ctx.queueFamily);
   if (std::string e = pipelines.create(ctx.device); !e.empty()) return e;
   if (std::string e = defaults.create(gpu); !e.empty()) return e;
+  if (std::string e = probe.create(gpu, ctx, pipelines); !e.empty()) return e;
 
+  // Per frame: frame uniforms, lighting inputs, tonemap input and the three effect passes' inputs.
+  constexpr uint32_t kSetsPerFrame = 6;
+  constexpr uint32_t kSamplersPerFrame = kLightingSetBindings + 1 + 3 * kScreenSetBindings;
   const VkDevice dev = ctx.device;
   VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, kFramesInFlight},
-                                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 5 * kFramesInFlight}};
+                                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kSamplersPerFrame * kFramesInFlight}};
   VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pci.maxSets = 3 * kFramesInFlight;
+  pci.maxSets = kSetsPerFrame * kFramesInFlight;
   pci.poolSizeCount = 2;
   pci.pPoolSizes = sizes;
   SE_VK_TRY(vkCreateDescriptorPool(dev, &pci, nullptr, &framePool));
@@ -47,17 +51,21 @@ std::string Engine::Impl::init(const EngineConfig& config) {
                                          f.uniforms);
         !e.empty())
       return e;
-    VkDescriptorSetLayout layouts[3] = {pipelines.frameSetLayout, pipelines.lightingSetLayout,
-                                        pipelines.tonemapSetLayout};
-    VkDescriptorSet sets[3];
+    VkDescriptorSetLayout layouts[kSetsPerFrame] = {pipelines.frameSetLayout,  pipelines.lightingSetLayout,
+                                                    pipelines.tonemapSetLayout, pipelines.screenSetLayout,
+                                                    pipelines.screenSetLayout,  pipelines.screenSetLayout};
+    VkDescriptorSet sets[kSetsPerFrame];
     VkDescriptorSetAllocateInfo dai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     dai.descriptorPool = framePool;
-    dai.descriptorSetCount = 3;
+    dai.descriptorSetCount = kSetsPerFrame;
     dai.pSetLayouts = layouts;
     SE_VK_TRY(vkAllocateDescriptorSets(dev, &dai, sets));
     f.frameSet = sets[0];
     f.lightingSet = sets[1];
     f.tonemapSet = sets[2];
+    f.ssaoSet = sets[3];
+    f.ssaoBlurSet = sets[4];
+    f.shadowVisibilitySet = sets[5];
     VkDescriptorBufferInfo bi{f.uniforms.buffer, 0, sizeof(FrameUniforms)};
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     w.dstSet = f.frameSet;
@@ -90,6 +98,7 @@ Engine::Impl::~Impl() {
       if (f.pool) vkDestroyCommandPool(ctx.device, f.pool, nullptr);
     }
     if (framePool) vkDestroyDescriptorPool(ctx.device, framePool, nullptr);
+    probe.destroy(gpu);
     defaults.destroy(gpu);
     pipelines.destroy(ctx.device);
     gpu.shutdown();
@@ -138,6 +147,7 @@ uint64_t Engine::frameNumber() const { return impl_->frameCounter; }
 Status Engine::loadScene(const Scene& scene) {
   try {
     vkDeviceWaitIdle(impl_->ctx.device);
+    ++impl_->sceneVersion;
     if (impl_->sceneLoaded) destroyScene(impl_->gpu, impl_->scene);
     impl_->sceneLoaded = true;  // partially uploaded resources are destroyed like a full scene
     std::string e = uploadScene(impl_->gpu, impl_->ctx, impl_->pipelines, impl_->defaults, scene, impl_->scene);
@@ -183,8 +193,10 @@ std::string Engine::Impl::createShadowMap(uint32_t size) {
 }
 
 void Engine::Impl::destroyTargets() {
-  for (Image* i : {&targets.depth, &targets.normalRoughness, &targets.geometricNormal, &targets.hdr, &targets.ldr})
+  for (Image* i : {&targets.depth, &targets.normalRoughness, &targets.geometricNormal, &targets.hdr, &targets.ldr,
+                   &targets.ssaoRaw, &targets.ssao, &targets.shadowVisibility})
     gpu.destroy(*i);
+  ssaoRendered = shadowVisibilityRendered = false;
   targets.extent = {};
 }
 
@@ -218,10 +230,14 @@ void Engine::Impl::collectTimings(FrameResources& frame) {
   timingsFrameNumber = frame.frameNumber;
   auto ms = [&](TimestampSlot a, TimestampSlot b) { return double(ts[b] - ts[a]) * ctx.timestampPeriodNs * 1e-6; };
   timings.shadowMs = ms(kTsStart, kTsShadowEnd);
-  timings.prepassMs = ms(kTsShadowEnd, kTsPrepassEnd);
-  timings.hookMs = ms(kTsPrepassEnd, kTsHookEnd);
+  timings.probeMs = ms(kTsShadowEnd, kTsProbeEnd);
+  timings.prepassMs = ms(kTsProbeEnd, kTsPrepassEnd);
+  timings.ssaoMs = ms(kTsPrepassEnd, kTsSsaoEnd);
+  timings.shadowVisibilityMs = ms(kTsSsaoEnd, kTsShadowVisibilityEnd);
+  timings.hookMs = ms(kTsShadowVisibilityEnd, kTsHookEnd);
   timings.lightingMs = ms(kTsHookEnd, kTsLightingEnd);
   timings.tonemapMs = ms(kTsLightingEnd, kTsTonemapEnd);
+  timings.probeCaptured = frame.probeCaptured;
   timings.valid = true;
 }
 
@@ -335,6 +351,38 @@ Result<ImageRGBA32F> Engine::readbackHdr() {
     img.pixels[i] = halfToFloat(h);
   }
   return R::success(std::move(img));
+}
+
+namespace {
+
+// Reads an effect image (kEffectFormat, SHADER_READ_ONLY_OPTIMAL) of the last frame as floats.
+Result<std::vector<float>> readEffectImage(Engine& engine, Engine::Impl& impl, const Image& image, bool rendered,
+                                           const char* what) {
+  using R = Result<std::vector<float>>;
+  if (Status s = engine.waitIdle(); !s) return R::failure(s.error);
+  if (!impl.frameRendered || !rendered || !image.image)
+    return R::failure(std::string(what) + ": the last frame did not produce it");
+  std::vector<uint8_t> raw;
+  if (std::string e = readImage(impl, image, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 2, raw); !e.empty())
+    return R::failure(std::string(what) + ": " + e);
+  std::vector<float> out(raw.size() / 2);
+  for (size_t i = 0; i < out.size(); ++i) {
+    uint16_t h;
+    std::memcpy(&h, &raw[i * 2], 2);
+    out[i] = halfToFloat(h);
+  }
+  return R::success(std::move(out));
+}
+
+}  // namespace
+
+Result<std::vector<float>> Engine::readbackShadowVisibility() {
+  return readEffectImage(*this, *impl_, impl_->targets.shadowVisibility, impl_->shadowVisibilityRendered,
+                         "readbackShadowVisibility");
+}
+
+Result<std::vector<float>> Engine::readbackSsao() {
+  return readEffectImage(*this, *impl_, impl_->targets.ssao, impl_->ssaoRendered, "readbackSsao");
 }
 
 }  // namespace sample_engine

@@ -1,5 +1,5 @@
-// Engine internals shared by engine.cpp (setup, scene, readback), frame_recorder.cpp (the frame) and
-// swapchain.cpp (presentation).
+// Engine internals shared by engine.cpp (setup, scene, readback), frame_recorder.cpp (the frame),
+// effect_passes.cpp (SSAO, shadow visibility) and swapchain.cpp (presentation).
 #pragma once
 
 #include <array>
@@ -8,6 +8,7 @@
 #include "gpu_memory.h"
 #include "gpu_scene.h"
 #include "pipelines.h"
+#include "reflection_probe.h"
 #include "sample_engine/engine.h"
 #include "vk_context.h"
 
@@ -17,7 +18,10 @@ namespace sample_engine {
 enum TimestampSlot : uint32_t {
   kTsStart,
   kTsShadowEnd,
+  kTsProbeEnd,
   kTsPrepassEnd,
+  kTsSsaoEnd,
+  kTsShadowVisibilityEnd,
   kTsHookEnd,
   kTsLightingEnd,
   kTsTonemapEnd,
@@ -33,8 +37,12 @@ struct FrameResources {
   VkDescriptorSet frameSet = VK_NULL_HANDLE;
   VkDescriptorSet lightingSet = VK_NULL_HANDLE;
   VkDescriptorSet tonemapSet = VK_NULL_HANDLE;
+  VkDescriptorSet ssaoSet = VK_NULL_HANDLE;             // screen-pass inputs (Pipelines::screenSetLayout)
+  VkDescriptorSet ssaoBlurSet = VK_NULL_HANDLE;
+  VkDescriptorSet shadowVisibilitySet = VK_NULL_HANDLE;
   VkQueryPool timestamps = VK_NULL_HANDLE;
   bool timingsPending = false;              // submitted with timestamps, not read back yet
+  bool probeCaptured = false;               // this frame recorded a probe capture
   uint64_t frameNumber = 0;
 };
 
@@ -43,6 +51,8 @@ struct FrameResources {
 struct RenderTargets {
   detail::Image depth, normalRoughness, geometricNormal, hdr, ldr;
   detail::Image shadowMap;
+  // Effect images (kEffectFormat, left in SHADER_READ_ONLY_OPTIMAL), created on first use at this extent.
+  detail::Image ssaoRaw, ssao, shadowVisibility;
   VkExtent2D extent{};
   uint32_t shadowMapSize = 0;
 };
@@ -63,6 +73,8 @@ struct Engine::Impl {
   detail::DefaultImages defaults;
   detail::GpuScene scene;
   bool sceneLoaded = false;
+  uint64_t sceneVersion = 0;  // bumped by loadScene (the reflection probe recaptures)
+  detail::ReflectionProbe probe;
   VkDescriptorPool framePool = VK_NULL_HANDLE;
   std::array<FrameResources, kFramesInFlight> frames;
   RenderTargets targets;
@@ -71,6 +83,8 @@ struct Engine::Impl {
   uint32_t currentFrame = 0;
   uint64_t frameCounter = 0;
   bool frameRendered = false;  // targets hold a finished frame (for readback)
+  bool ssaoRendered = false;   // the last submitted frame wrote targets.ssao
+  bool shadowVisibilityRendered = false;
   std::optional<uint32_t> lastSubmittedSlot;
   PassTimings timings;
   uint64_t timingsFrameNumber = 0;
@@ -86,7 +100,13 @@ struct Engine::Impl {
   // frame_recorder.cpp
   std::string renderFrame(const FrameParams& params);
   void recordFrame(FrameResources& frame, const FrameParams& params, const detail::FrameUniforms& uniforms,
-                   std::optional<uint32_t> swapchainImage);
+                   std::optional<uint32_t> swapchainImage, bool captureProbe, const detail::ProbeKey& probeKey);
+
+  // effect_passes.cpp: create the effect images a frame needs, then record the passes (each leaves its
+  // output in SHADER_READ_ONLY_OPTIMAL, visible to fragment shaders).
+  std::string ensureEffectImages(const FrameParams& params);
+  void recordSsao(FrameResources& frame, const SsaoSettings& settings);
+  void recordShadowVisibility(FrameResources& frame);
 
   // swapchain.cpp
   std::string createSwapchain(uint32_t width, uint32_t height);

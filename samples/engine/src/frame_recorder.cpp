@@ -1,10 +1,12 @@
-// One frame: shadow map -> pre-pass -> hook -> lighting -> tonemap (-> blit to the swapchain).
+// One frame: shadow map -> [probe capture] -> pre-pass -> [SSAO] -> [shadow visibility] -> hook -> lighting
+// -> tonemap (-> blit to the swapchain).
 #include <algorithm>
 #include <cstring>
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "engine_impl.h"
+#include "render_utils.h"
 #include "vk_check.h"
 
 namespace sample_engine {
@@ -27,70 +29,6 @@ glm::mat4 lightViewProjection(const Bounds& bounds, const glm::vec3& towardsSun,
   return proj * view;
 }
 
-VkRenderingAttachmentInfo colorAttachment(VkImageView view, VkClearColorValue clear) {
-  VkRenderingAttachmentInfo a{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-  a.imageView = view;
-  a.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-  a.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-  a.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-  a.clearValue.color = clear;
-  return a;
-}
-
-void beginRendering(VkCommandBuffer cmd, VkExtent2D extent, const std::vector<VkRenderingAttachmentInfo>& colors,
-                    const VkRenderingAttachmentInfo* depth) {
-  VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-  ri.renderArea = {{0, 0}, extent};
-  ri.layerCount = 1;
-  ri.colorAttachmentCount = uint32_t(colors.size());
-  ri.pColorAttachments = colors.data();
-  ri.pDepthAttachment = depth;
-  vkCmdBeginRendering(cmd, &ri);
-  VkViewport vp{0.0f, 0.0f, float(extent.width), float(extent.height), 0.0f, 1.0f};
-  VkRect2D scissor{{0, 0}, extent};
-  vkCmdSetViewport(cmd, 0, 1, &vp);
-  vkCmdSetScissor(cmd, 0, 1, &scissor);
-}
-
-enum class DrawPass { Shadow, Prepass, Lighting };
-
-void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass) {
-  uint32_t boundMaterial = UINT32_MAX;
-  for (const Instance& inst : scene.cpu.instances) {
-    const GpuMesh& mesh = scene.meshes[inst.mesh];
-    if (mesh.vertexCount == 0) continue;
-    VkBuffer buffers[2] = {mesh.positionBuffer, mesh.attributeBuffer};
-    VkDeviceSize offsets[2] = {0, 0};
-    vkCmdBindVertexBuffers(cmd, 0, pass == DrawPass::Shadow ? 1 : 2, buffers, offsets);
-    if (pass != DrawPass::Shadow && boundMaterial != mesh.material) {
-      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.sceneLayout, 1, 1,
-                              &scene.materialSets[mesh.material], 0, nullptr);
-      boundMaterial = mesh.material;
-    }
-    DrawConstants c = scene.materialConstants[mesh.material];
-    c.model = inst.transform;
-    vkCmdPushConstants(cmd, p.sceneLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(c), &c);
-    if (mesh.indexCount > 0) {
-      vkCmdBindIndexBuffer(cmd, mesh.indexBuffer, 0, VK_INDEX_TYPE_UINT32);
-      vkCmdDrawIndexed(cmd, mesh.indexCount, 1, 0, 0, 0);
-    } else {
-      vkCmdDraw(cmd, mesh.vertexCount, 1, 0, 0);
-    }
-  }
-}
-
-void writeImageDescriptors(VkDevice device, VkDescriptorSet set, const std::vector<VkDescriptorImageInfo>& infos) {
-  std::vector<VkWriteDescriptorSet> writes(infos.size(), {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET});
-  for (size_t i = 0; i < infos.size(); ++i) {
-    writes[i].dstSet = set;
-    writes[i].dstBinding = uint32_t(i);
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    writes[i].pImageInfo = &infos[i];
-  }
-  vkUpdateDescriptorSets(device, uint32_t(writes.size()), writes.data(), 0, nullptr);
-}
-
 }  // namespace
 
 std::string Engine::Impl::renderFrame(const FrameParams& params) {
@@ -100,6 +38,10 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
     vkDeviceWaitIdle(ctx.device);
     if (std::string e = createShadowMap(shadowSize); !e.empty()) return "shadow map: " + e;
   }
+  const uint32_t probeResolution = ReflectionProbe::clampResolution(params.reflectionProbe.resolution);
+  if (params.reflectionProbe.enabled)
+    if (std::string e = probe.prepare(probeResolution); !e.empty()) return "reflection probe: " + e;
+  if (std::string e = ensureEffectImages(params); !e.empty()) return "effect images: " + e;
   const uint32_t slot = currentFrame;
   FrameResources& frame = frames[slot];
   if (std::string e = waitFrame(frame); !e.empty()) return e;
@@ -132,14 +74,32 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   const uint32_t taps = std::clamp(params.shadow.pcfKernelSize | 1u, 1u, 9u);
   u.shadow = glm::vec4(1.0f / float(shadowSize), float(taps),
                        params.shadow.normalOffset * 2.0f * lightRadius / float(shadowSize), 0.0f);
-  // inputs are filled after the hook; the uniform buffer is written before submission.
+  u.invProj = glm::inverse(u.proj);
+  // inputs and probe are filled after the hook; the uniform buffer is written before submission.
+
+  // The probe is static: captured again only when something it depends on changed.
+  ProbeKey probeKey;
+  bool captureProbe = false;
+  if (params.reflectionProbe.enabled) {
+    probeKey = ProbeKey{sceneVersion,
+                        probeResolution,
+                        ReflectionProbe::positionFor(params.reflectionProbe, bounds),
+                        u.sunDirection,
+                        u.sunRadiance,
+                        u.sky,
+                        u.shadow,
+                        u.lightViewProj,
+                        params.shadow.depthBiasConstant,
+                        params.shadow.depthBiasSlope};
+    captureProbe = probe.needsCapture(probeKey);
+  }
 
   SE_VK_TRY(vkResetCommandBuffer(frame.cmd, 0));
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   SE_VK_TRY(vkBeginCommandBuffer(frame.cmd, &bi));
   frame.frameNumber = ++frameCounter;
-  recordFrame(frame, params, u, imageIndex);
+  recordFrame(frame, params, u, imageIndex, captureProbe, probeKey);
   SE_VK_TRY(vkEndCommandBuffer(frame.cmd));
 
   // --- Submit (and present) ---
@@ -166,6 +126,8 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   lastSubmittedSlot = slot;
   currentFrame = (currentFrame + 1) % kFramesInFlight;
   frameRendered = true;
+  ssaoRendered = params.ssao.enabled;
+  shadowVisibilityRendered = params.outputShadowVisibility;
 
   if (imageIndex) {
     VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
@@ -183,7 +145,7 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
 }
 
 void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params, const FrameUniforms& uniformsIn,
-                               std::optional<uint32_t> swapchainImage) {
+                               std::optional<uint32_t> swapchainImage, bool captureProbe, const ProbeKey& probeKey) {
   VkCommandBuffer cmd = frame.cmd;
   const VkExtent2D extent = targets.extent;
   const bool haveScene = sceneLoaded;
@@ -220,6 +182,17 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
                VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
   timestamp(kTsShadowEnd);
 
+  // (1b) Reflection probe: six forward-shaded faces + mips, only when its inputs changed. It uses this
+  // frame's shadow map (already in its read layout) and binds its own set 0, so ours is rebound after.
+  frame.probeCaptured = captureProbe;
+  if (captureProbe) {
+    probe.recordCapture(cmd, uint32_t(&frame - frames.data()), uniformsIn, probeKey, haveScene ? &scene : nullptr,
+                        targets.shadowMap.view, defaults);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 0, 1, &frame.frameSet, 0,
+                            nullptr);
+  }
+  timestamp(kTsProbeEnd);
+
   // (2) Depth + normal pre-pass. The previous frame's readers may include the hook's own passes (any
   // stage), hence ALL_COMMANDS as the source scope.
   imageBarrier(cmd, targets.depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
@@ -255,6 +228,13 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
                  VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
   timestamp(kTsPrepassEnd);
 
+  // (2b) The engine's own screen-space effects. SSAO runs whenever enabled (also next to an external AO
+  // input, so both can be read back from one frame); the shadow-visibility image only on request.
+  if (params.ssao.enabled) recordSsao(frame, params.ssao);
+  timestamp(kTsSsaoEnd);
+  if (params.outputShadowVisibility) recordShadowVisibility(frame);
+  timestamp(kTsShadowVisibilityEnd);
+
   // (3) Extension point.
   LightingInputs inputs = params.lightingInputs;
   if (hook) {
@@ -283,16 +263,23 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
   }
   timestamp(kTsHookEnd);
 
+  // External inputs win over the engine's own SSAO / probe.
+  const VkImageView ao = inputs.ambientOcclusion ? inputs.ambientOcclusion
+                          : params.ssao.enabled  ? targets.ssao.view
+                                                 : VK_NULL_HANDLE;
+  const bool useProbe = params.reflectionProbe.enabled && probe.captured() && !inputs.reflection;
   FrameUniforms u = uniformsIn;
-  u.inputs = glm::uvec4(inputs.sunVisibility != VK_NULL_HANDLE, inputs.ambientOcclusion != VK_NULL_HANDLE,
+  u.inputs = glm::uvec4(inputs.sunVisibility != VK_NULL_HANDLE, ao != VK_NULL_HANDLE,
                         inputs.reflection != VK_NULL_HANDLE, 0u);
+  u.probe = glm::vec4(useProbe ? 1.0f : 0.0f, probe.maxLod(), 0.0f, 0.0f);
   std::memcpy(frame.uniforms.mapped, &u, sizeof(u));  // host-coherent; the submission makes it visible
   writeImageDescriptors(
       ctx.device, frame.lightingSet,
       {{pipelines.shadowSampler, targets.shadowMap.view, kReadLayout},
        {pipelines.screenSampler, inputs.sunVisibility ? inputs.sunVisibility : defaults.white.view, kReadLayout},
-       {pipelines.screenSampler, inputs.ambientOcclusion ? inputs.ambientOcclusion : defaults.white.view, kReadLayout},
-       {pipelines.screenSampler, inputs.reflection ? inputs.reflection : defaults.black.view, kReadLayout}});
+       {pipelines.screenSampler, ao ? ao : defaults.white.view, kReadLayout},
+       {pipelines.screenSampler, inputs.reflection ? inputs.reflection : defaults.black.view, kReadLayout},
+       {pipelines.cubeSampler, useProbe ? probe.view() : probe.fallbackView(), kReadLayout}});
   writeImageDescriptors(ctx.device, frame.tonemapSet, {{pipelines.nearestSampler, targets.hdr.view, kReadLayout}});
 
   // (4) Forward lighting: EQUAL test against the pre-pass depth, background keeps the sky clear color.
@@ -308,6 +295,9 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     VkClearColorValue sky{{params.skyColor.r, params.skyColor.g, params.skyColor.b, 1.0f}};
     beginRendering(cmd, extent, {colorAttachment(targets.hdr.view, sky)}, &depth);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.forward);
+    // Set 0 again: the effect passes' pipeline layout (other push constants) disturbed the binding.
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 0, 1, &frame.frameSet, 0,
+                            nullptr);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 2, 1, &frame.lightingSet, 0,
                             nullptr);
     if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Lighting);

@@ -60,13 +60,15 @@ std::string Gpu::createImage(const ImageDesc& desc, Image& out) {
   out.format = desc.format;
   out.extent = desc.extent;
   out.mipLevels = desc.mipLevels;
+  out.layers = desc.cube ? 6 : 1;
   VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-  ci.flags = desc.altViewFormat != VK_FORMAT_UNDEFINED ? VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT : 0;
+  ci.flags = (desc.altViewFormat != VK_FORMAT_UNDEFINED ? VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT : 0) |
+             (desc.cube ? VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT : 0);
   ci.imageType = VK_IMAGE_TYPE_2D;
   ci.format = desc.format;
   ci.extent = {desc.extent.width, desc.extent.height, 1};
   ci.mipLevels = desc.mipLevels;
-  ci.arrayLayers = 1;
+  ci.arrayLayers = out.layers;
   ci.samples = VK_SAMPLE_COUNT_1_BIT;
   ci.tiling = VK_IMAGE_TILING_OPTIMAL;
   ci.usage = desc.usage;
@@ -82,9 +84,9 @@ std::string Gpu::createImage(const ImageDesc& desc, Image& out) {
   SE_VK_TRY(vkBindImageMemory(device_, out.image, out.memory, 0));
   VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   vi.image = out.image;
-  vi.viewType = VK_IMAGE_VIEW_TYPE_2D;
+  vi.viewType = desc.cube ? VK_IMAGE_VIEW_TYPE_CUBE : VK_IMAGE_VIEW_TYPE_2D;
   vi.format = desc.format;
-  vi.subresourceRange = {desc.aspect, 0, desc.mipLevels, 0, 1};
+  vi.subresourceRange = {desc.aspect, 0, desc.mipLevels, 0, out.layers};
   SE_VK_TRY(vkCreateImageView(device_, &vi, nullptr, &out.view));
   if (desc.altViewFormat != VK_FORMAT_UNDEFINED) {
     vi.format = desc.altViewFormat;
@@ -137,7 +139,7 @@ std::string Gpu::endOneShot(VkCommandBuffer cmd) {
 
 void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout oldLayout,
                   VkImageLayout newLayout, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
-                  VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess) {
+                  VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess, uint32_t baseMip, uint32_t mipCount) {
   VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
   b.srcStageMask = srcStage;
   b.srcAccessMask = srcAccess;
@@ -148,7 +150,7 @@ void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect,
   b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = image;
-  b.subresourceRange = {aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
+  b.subresourceRange = {aspect, baseMip, mipCount, 0, VK_REMAINING_ARRAY_LAYERS};
   VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dep.imageMemoryBarrierCount = 1;
   dep.pImageMemoryBarriers = &b;

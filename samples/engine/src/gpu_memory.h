@@ -24,6 +24,7 @@ struct Image {
   VkFormat format = VK_FORMAT_UNDEFINED;
   VkExtent2D extent{};
   uint32_t mipLevels = 1;
+  uint32_t layers = 1;
 };
 
 struct ImageDesc {
@@ -33,6 +34,7 @@ struct ImageDesc {
   VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT;
   uint32_t mipLevels = 1;
   VkFormat altViewFormat = VK_FORMAT_UNDEFINED;  // creates a MUTABLE_FORMAT image with a second view
+  bool cube = false;  // 6 layers, CUBE_COMPATIBLE, `view` is a cube view (per-face views are the caller's)
 };
 
 class Gpu {
@@ -67,10 +69,11 @@ class Gpu {
   VkPhysicalDeviceMemoryProperties memProps_{};
 };
 
-// Synchronization2 image barrier over all mips/layers of `image`.
+// Synchronization2 image barrier over all mips/layers of `image`, or over mips [baseMip, baseMip+mipCount).
 void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout oldLayout,
                   VkImageLayout newLayout, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
-                  VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess);
+                  VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess, uint32_t baseMip = 0,
+                  uint32_t mipCount = VK_REMAINING_MIP_LEVELS);
 void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
                    VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess);
 

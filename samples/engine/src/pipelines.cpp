@@ -145,9 +145,12 @@ std::string Pipelines::create(VkDevice device) {
                       frameSetLayout));
   check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3)},
                       materialSetLayout));
-  check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3)},
+  check(makeSetLayout(device,
+                      {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3), samplerBinding(4)},
                       lightingSetLayout));
   check(makeSetLayout(device, {samplerBinding(0)}, tonemapSetLayout));
+  check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3)},
+                      screenSetLayout));
   if (!e.empty()) return e;
 
   VkPushConstantRange drawRange{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
@@ -164,15 +167,25 @@ std::string Pipelines::create(VkDevice device) {
   lci.pSetLayouts = &tonemapSetLayout;
   lci.pPushConstantRanges = &tonemapRange;
   SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &tonemapLayout));
+  VkPushConstantRange screenRange{VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(SsaoConstants)};
+  VkDescriptorSetLayout screenSets[2] = {frameSetLayout, screenSetLayout};
+  lci.setLayoutCount = 2;
+  lci.pSetLayouts = screenSets;
+  lci.pPushConstantRanges = &screenRange;
+  SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &screenLayout));
 
   VkShaderModule meshVert = VK_NULL_HANDLE, shadowVert = VK_NULL_HANDLE, prepassFrag = VK_NULL_HANDLE,
-                 forwardFrag = VK_NULL_HANDLE, fullscreenVert = VK_NULL_HANDLE, tonemapFrag = VK_NULL_HANDLE;
+                 forwardFrag = VK_NULL_HANDLE, fullscreenVert = VK_NULL_HANDLE, tonemapFrag = VK_NULL_HANDLE,
+                 ssaoFrag = VK_NULL_HANDLE, ssaoBlurFrag = VK_NULL_HANDLE, shadowVisibilityFrag = VK_NULL_HANDLE;
   check(makeModule(device, spirv::mesh_vert, meshVert));
   check(makeModule(device, spirv::shadow_vert, shadowVert));
   check(makeModule(device, spirv::prepass_frag, prepassFrag));
   check(makeModule(device, spirv::forward_frag, forwardFrag));
   check(makeModule(device, spirv::fullscreen_vert, fullscreenVert));
   check(makeModule(device, spirv::tonemap_frag, tonemapFrag));
+  check(makeModule(device, spirv::ssao_frag, ssaoFrag));
+  check(makeModule(device, spirv::ssao_blur_frag, ssaoBlurFrag));
+  check(makeModule(device, spirv::shadow_visibility_frag, shadowVisibilityFrag));
   if (e.empty()) {
     PipelineDesc d;
     d.vert = shadowVert;
@@ -200,6 +213,11 @@ std::string Pipelines::create(VkDevice device) {
     d.depthCompare = VK_COMPARE_OP_EQUAL;  // only the surface the pre-pass kept gets shaded
     check(makePipeline(device, d, forward));
 
+    // Probe faces have no pre-pass: the capture does its own depth test.
+    d.depthWrite = true;
+    d.depthCompare = VK_COMPARE_OP_LESS;
+    check(makePipeline(device, d, probeCapture));
+
     d = {};
     d.vert = fullscreenVert;
     d.frag = tonemapFrag;
@@ -207,8 +225,18 @@ std::string Pipelines::create(VkDevice device) {
     d.colorFormats = {kLdrFormat};
     d.layout = tonemapLayout;
     check(makePipeline(device, d, tonemap));
+
+    d.colorFormats = {kEffectFormat};
+    d.layout = screenLayout;
+    d.frag = ssaoFrag;
+    check(makePipeline(device, d, ssao));
+    d.frag = ssaoBlurFrag;
+    check(makePipeline(device, d, ssaoBlur));
+    d.frag = shadowVisibilityFrag;
+    check(makePipeline(device, d, shadowVisibility));
   }
-  for (VkShaderModule m : {meshVert, shadowVert, prepassFrag, forwardFrag, fullscreenVert, tonemapFrag})
+  for (VkShaderModule m : {meshVert, shadowVert, prepassFrag, forwardFrag, fullscreenVert, tonemapFrag, ssaoFrag,
+                           ssaoBlurFrag, shadowVisibilityFrag})
     if (m) vkDestroyShaderModule(device, m, nullptr);
   if (!e.empty()) return e;
 
@@ -217,17 +245,20 @@ std::string Pipelines::create(VkDevice device) {
   check(makeSampler(device, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, 0.0f, screenSampler));
   check(makeSampler(device, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER, true, 0.0f, shadowSampler));
   check(makeSampler(device, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, 0.0f, nearestSampler));
+  check(makeSampler(device, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, VK_LOD_CLAMP_NONE,
+                    cubeSampler));
   return e;
 }
 
 void Pipelines::destroy(VkDevice device) {
-  for (VkPipeline p : {shadow, prepass, forward, tonemap})
+  for (VkPipeline p : {shadow, prepass, forward, tonemap, probeCapture, ssao, ssaoBlur, shadowVisibility})
     if (p) vkDestroyPipeline(device, p, nullptr);
-  for (VkPipelineLayout l : {sceneLayout, tonemapLayout})
+  for (VkPipelineLayout l : {sceneLayout, tonemapLayout, screenLayout})
     if (l) vkDestroyPipelineLayout(device, l, nullptr);
-  for (VkDescriptorSetLayout l : {frameSetLayout, materialSetLayout, lightingSetLayout, tonemapSetLayout})
+  for (VkDescriptorSetLayout l :
+       {frameSetLayout, materialSetLayout, lightingSetLayout, tonemapSetLayout, screenSetLayout})
     if (l) vkDestroyDescriptorSetLayout(device, l, nullptr);
-  for (VkSampler s : {materialSampler, screenSampler, shadowSampler, nearestSampler})
+  for (VkSampler s : {materialSampler, screenSampler, shadowSampler, nearestSampler, cubeSampler})
     if (s) vkDestroySampler(device, s, nullptr);
   *this = {};
 }

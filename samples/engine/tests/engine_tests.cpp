@@ -279,3 +279,235 @@ TEST_CASE("glTF Box sample loads and renders", "[gltf][render]") {
   REQUIRE(engine->waitIdle().ok());
   CHECK(engine->validationErrorCount() == 0);
 }
+
+// ---------------------------------------------------------------------------------------------------------
+// The engine's own raster effects: SSAO, reflection probe, shadow-visibility output.
+
+namespace {
+
+constexpr uint32_t kFxWidth = 320, kFxHeight = 240;
+
+// A rough dielectric ground with a 2 m matte box at x = -3 and a polished metal sphere at x = +3; the sun
+// comes from +x at 45 degrees, so the box's shadow covers the ground around (-5, 0, 0).
+Scene makeEffectsScene() {
+  Scene s;
+  s.materials.push_back(Material{.name = "rough ground", .baseColorFactor = {0.7f, 0.7f, 0.7f, 1.0f},
+                                 .metallicFactor = 0.0f, .roughnessFactor = 0.8f});
+  s.materials.push_back(Material{.name = "matte box", .baseColorFactor = {0.2f, 0.3f, 0.7f, 1.0f},
+                                 .metallicFactor = 0.0f, .roughnessFactor = 0.8f});
+  s.materials.push_back(Material{.name = "polished metal", .baseColorFactor = {0.95f, 0.95f, 0.95f, 1.0f},
+                                 .metallicFactor = 1.0f, .roughnessFactor = 0.05f});
+  auto add = [&](MeshData mesh, uint32_t material, glm::vec3 at) {
+    mesh.material = material;
+    s.meshes.push_back(std::move(mesh));
+    glm::mat4 m(1.0f);
+    m[3] = glm::vec4(at, 1.0f);
+    s.instances.push_back(Instance{uint32_t(s.meshes.size() - 1), m});
+  };
+  add(makePlane(40.0f, 40.0f, 8, 8), 0, {0, 0, 0});
+  add(makeBox({2.0f, 2.0f, 2.0f}, 2), 1, {-3, 1, 0});
+  add(makeSphere(1.0f, 64, 32), 2, {3, 1, 0});
+  s.camera = Camera{.eye = {0.0f, 5.0f, 10.0f}, .target = {0.0f, 0.5f, 0.0f}, .fovYDegrees = 50.0f,
+                    .zNear = 0.1f, .zFar = 100.0f};
+  s.sun = Sun{.direction = glm::normalize(glm::vec3(1.0f, 1.0f, 0.0f)), .color = {1, 1, 1}, .intensity = 3.0f};
+  return s;
+}
+
+struct EffectsFixture {
+  std::unique_ptr<Engine> engine = makeEngine();
+  FrameParams params;
+
+  EffectsFixture() {
+    REQUIRE(engine->loadScene(makeEffectsScene()).ok());
+    REQUIRE(engine->setRenderSize(kFxWidth, kFxHeight).ok());
+    params = paramsFor(*engine);
+  }
+
+  // Pixel that shows world point `p` (assumes it is visible).
+  glm::ivec2 pixelOf(glm::vec3 p) const {
+    glm::mat4 vp = projectionMatrix(params.camera, float(kFxWidth) / float(kFxHeight)) * viewMatrix(params.camera);
+    glm::vec4 c = vp * glm::vec4(p, 1.0f);
+    glm::vec2 uv = glm::vec2(c) / c.w * 0.5f + 0.5f;
+    glm::ivec2 px(uv * glm::vec2(kFxWidth, kFxHeight));
+    REQUIRE((c.w > 0.0f && px.x >= 3 && px.y >= 3 && px.x + 3 < int(kFxWidth) && px.y + 3 < int(kFxHeight)));
+    return px;
+  }
+
+  void render() {
+    Status s = engine->renderFrame(params);
+    INFO(s.error);
+    REQUIRE(s.ok());
+  }
+
+  std::vector<float> ssao() {
+    auto r = engine->readbackSsao();
+    INFO(r.error);
+    REQUIRE(r.ok());
+    REQUIRE(r.value.size() == size_t(kFxWidth) * kFxHeight);
+    return std::move(r.value);
+  }
+};
+
+float at(const std::vector<float>& img, glm::ivec2 p) { return img[size_t(p.y) * kFxWidth + size_t(p.x)]; }
+
+// Mean over a (2r+1)^2 window.
+float windowMean(const std::vector<float>& img, glm::ivec2 c, int r) {
+  double sum = 0;
+  int n = 0;
+  for (int y = c.y - r; y <= c.y + r; ++y)
+    for (int x = c.x - r; x <= c.x + r; ++x, ++n) sum += at(img, {x, y});
+  return float(sum / n);
+}
+
+float windowLuminance(const ImageRGBA32F& img, glm::ivec2 c, int r) {
+  double sum = 0;
+  int n = 0;
+  for (int y = c.y - r; y <= c.y + r; ++y)
+    for (int x = c.x - r; x <= c.x + r; ++x, ++n) sum += luminance(img.at(uint32_t(x), uint32_t(y)));
+  return float(sum / n);
+}
+
+// High-frequency energy among occluded pixels: mean |a(x) - a(x+1)| where either is below 1.
+float roughness(const std::vector<float>& ao) {
+  double sum = 0;
+  uint32_t n = 0;
+  for (uint32_t y = 0; y < kFxHeight; ++y)
+    for (uint32_t x = 0; x + 1 < kFxWidth; ++x) {
+      float a = ao[y * kFxWidth + x], b = ao[y * kFxWidth + x + 1];
+      if (a > 0.999f && b > 0.999f) continue;
+      sum += std::abs(a - b);
+      ++n;
+    }
+  return n ? float(sum / n) : 0.0f;
+}
+
+}  // namespace
+
+TEST_CASE("engine effects are off by default", "[effects]") {
+  EffectsFixture f;
+  f.render();
+  CHECK_FALSE(f.engine->readbackSsao().ok());
+  CHECK_FALSE(f.engine->readbackShadowVisibility().ok());
+  PassTimings t = f.engine->lastTimings();
+  CHECK_FALSE(t.probeCaptured);
+  REQUIRE(f.engine->waitIdle().ok());
+  CHECK(f.engine->validationErrorCount() == 0);
+}
+
+TEST_CASE("SSAO darkens creases, leaves open ground open and feeds the lighting", "[effects][ssao]") {
+  EffectsFixture f;
+  const glm::ivec2 crease = f.pixelOf({-3.0f, 0.0f, 1.08f});  // ground touching the box's front face
+  const glm::ivec2 open = f.pixelOf({0.0f, 0.0f, 4.0f});      // > 3 m from anything
+  ImageRGBA32F without = renderHdr(*f.engine, f.params);
+
+  f.params.ssao.enabled = true;
+  f.params.ssao.radius = 1.0f;
+  ImageRGBA32F with = renderHdr(*f.engine, f.params);
+  std::vector<float> ao = f.ssao();
+  INFO("AO crease " << windowMean(ao, crease, 1) << ", open " << windowMean(ao, open, 2));
+  CHECK(windowMean(ao, crease, 1) < 0.8f);
+  CHECK(windowMean(ao, open, 2) > 0.98f);
+  CHECK(at(ao, {kFxWidth / 2, 2}) == 1.0f);  // sky
+  for (float v : ao) REQUIRE((v >= 0.0f && v <= 1.0f));
+  CHECK(f.engine->lastTimings().ssaoMs > 0.0);
+
+  // The lighting multiplies the ambient terms by it: the crease darkens, open ground does not change.
+  CHECK(windowLuminance(with, crease, 1) < windowLuminance(without, crease, 1) - 1e-3f);
+  CHECK(std::abs(windowLuminance(with, open, 2) - windowLuminance(without, open, 2)) <
+        0.01f * windowLuminance(without, open, 2));
+
+  SECTION("an external AO input replaces it in the lighting, and it can still be read back") {
+    ExternalMask ones(*f.engine, kFxWidth, kFxHeight);
+    f.engine->setPrepassHook([&](const PrepassHookInfo& info, LightingInputs& inputs) {
+      ones.record(info.commandBuffer, 1.0f);
+      inputs.ambientOcclusion = ones.view;
+    });
+    ImageRGBA32F external = renderHdr(*f.engine, f.params);
+    f.engine->setPrepassHook({});
+    CHECK(std::abs(windowLuminance(external, crease, 1) - windowLuminance(without, crease, 1)) < 1e-3f);
+    CHECK(windowMean(f.ssao(), crease, 1) < 0.8f);
+  }
+
+  SECTION("the kernel size changes the result: fewer samples, more noise") {
+    f.params.ssao.blur = false;
+    f.params.ssao.kernelSize = 8;
+    f.render();
+    std::vector<float> few = f.ssao();
+    f.params.ssao.kernelSize = 64;
+    f.render();
+    std::vector<float> many = f.ssao();
+    float maxDiff = 0.0f;
+    for (size_t i = 0; i < few.size(); ++i) maxDiff = std::max(maxDiff, std::abs(few[i] - many[i]));
+    INFO("noise with 8 samples " << roughness(few) << ", with 64 " << roughness(many) << ", max diff " << maxDiff);
+    CHECK(maxDiff > 0.05f);
+    CHECK(roughness(few) > 1.3f * roughness(many));
+    CHECK(windowMean(many, open, 2) > 0.98f);
+    // The blur removes most of the remaining pattern.
+    f.params.ssao.blur = true;
+    f.render();
+    CHECK(roughness(f.ssao()) < roughness(many));
+  }
+
+  REQUIRE(f.engine->waitIdle().ok());
+  CHECK(f.engine->validationErrorCount() == 0);
+}
+
+TEST_CASE("the reflection probe changes polished metal, not rough ground far from objects", "[effects][probe]") {
+  EffectsFixture f;
+  ImageRGBA32F sky = renderHdr(*f.engine, f.params);
+  f.params.reflectionProbe.enabled = true;
+  ImageRGBA32F probe = renderHdr(*f.engine, f.params);
+  PassTimings t = f.engine->lastTimings();
+  CHECK(t.probeCaptured);
+  CHECK(t.probeMs > 0.0);
+
+  // The lower half of the metal sphere mirrors the lit ground instead of the sky.
+  const glm::ivec2 sphereLow = f.pixelOf({3.0f, 0.45f, 0.8f});
+  const float metalSky = windowLuminance(sky, sphereLow, 1), metalProbe = windowLuminance(probe, sphereLow, 1);
+  INFO("metal: sky-only " << metalSky << ", probe " << metalProbe);
+  CHECK(std::abs(metalProbe - metalSky) > 0.2f * metalSky);
+
+  for (glm::vec3 p : {glm::vec3(0.0f, 0.0f, 5.0f), glm::vec3(-3.0f, 0.0f, 4.0f), glm::vec3(3.0f, 0.0f, 4.0f)}) {
+    const glm::ivec2 px = f.pixelOf(p);
+    const float a = windowLuminance(sky, px, 2), b = windowLuminance(probe, px, 2);
+    INFO("ground at " << p.x << "," << p.z << ": sky-only " << a << ", probe " << b);
+    CHECK(std::abs(a - b) < 0.02f * a);
+  }
+
+  SECTION("static: captured once, again when an input changes") {
+    f.render();
+    REQUIRE(f.engine->waitIdle().ok());
+    CHECK_FALSE(f.engine->lastTimings().probeCaptured);
+    f.params.reflectionProbe.resolution = 32;
+    f.render();
+    REQUIRE(f.engine->waitIdle().ok());
+    CHECK(f.engine->lastTimings().probeCaptured);
+  }
+
+  REQUIRE(f.engine->waitIdle().ok());
+  CHECK(f.engine->validationErrorCount() == 0);
+}
+
+TEST_CASE("shadow-visibility readback matches the shadow map", "[effects][shadow]") {
+  EffectsFixture f;
+  f.params.outputShadowVisibility = true;
+  ImageRGBA32F hdr = renderHdr(*f.engine, f.params);
+  auto vis = f.engine->readbackShadowVisibility();
+  INFO(vis.error);
+  REQUIRE(vis.ok());
+  REQUIRE(vis.value.size() == size_t(kFxWidth) * kFxHeight);
+  const glm::ivec2 shadowed = f.pixelOf({-5.0f, 0.0f, 0.0f});  // inside the box's shadow
+  const glm::ivec2 lit = f.pixelOf({0.0f, 0.0f, 4.0f});
+  INFO("shadowed " << windowMean(vis.value, shadowed, 1) << ", lit " << windowMean(vis.value, lit, 1));
+  CHECK(windowMean(vis.value, shadowed, 1) < 0.05f);
+  CHECK(windowMean(vis.value, lit, 1) > 0.95f);
+  CHECK(at(vis.value, {kFxWidth / 2, 2}) == 1.0f);  // sky
+  CHECK(windowLuminance(hdr, shadowed, 1) < 0.5f * windowLuminance(hdr, lit, 1));
+
+  // Only produced on request.
+  f.params.outputShadowVisibility = false;
+  f.render();
+  CHECK_FALSE(f.engine->readbackShadowVisibility().ok());
+  REQUIRE(f.engine->waitIdle().ok());
+  CHECK(f.engine->validationErrorCount() == 0);
+}

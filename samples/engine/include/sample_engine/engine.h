@@ -1,5 +1,6 @@
 // The sample forward engine: owns a Vulkan 1.3 instance/device/queue, renders a Scene with
-//   shadow map -> depth+normal pre-pass -> [pre-pass hook] -> forward PBR lighting -> tonemap
+//   shadow map -> [probe capture] -> depth+normal pre-pass -> [SSAO] -> [shadow visibility] -> [pre-pass hook]
+//   -> forward PBR lighting -> tonemap
 // into an offscreen image (read back to the CPU) and optionally presents it to a swapchain.
 //
 // Add-ons (e.g. a ray-tracing adapter) plug in through three small things:
@@ -12,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -76,6 +78,32 @@ struct ShadowSettings {
   float normalOffset = 1.5f;    // world offset along the normal, in shadow-map texels
 };
 
+// The engine's own screen-space ambient occlusion (Crytek / LearnOpenGL hemisphere kernel with range check),
+// computed from the pre-pass depth and geometric normals into an R16F image (1 = open). The lighting pass
+// multiplies its ambient terms by it unless LightingInputs::ambientOcclusion is set; it is computed whenever
+// enabled, so readbackSsao() also works next to an external AO input (e.g. to compare the two).
+struct SsaoSettings {
+  bool enabled = false;
+  uint32_t kernelSize = 16;  // samples per pixel, clamped to [1, 64]
+  float radius = 0.5f;       // hemisphere radius, world units
+  float bias = 0.025f;       // depth difference (world units) below which a sample does not occlude
+  float power = 1.0f;        // ao = (1 - occluded fraction)^power
+  bool blur = true;          // 4x4 depth/plane-aware blur that removes the 4x4 kernel-rotation pattern
+};
+
+// A static reflection probe: a small cubemap captured from one point with the engine's forward shading (sun,
+// shadow map, constant-sky ambient; background = skyColor * ambientIntensity, the radiance the constant-sky
+// fallback uses, so a probe that sees only sky changes nothing). When enabled the lighting pass samples it
+// along the reflection vector (mip chosen by roughness) instead of the constant sky, unless
+// LightingInputs::reflection is set. Captured on the first enabled frame and recaptured only when the scene,
+// the probe settings, the sun, the sky or the shadow settings change.
+struct ReflectionProbeSettings {
+  bool enabled = false;
+  uint32_t resolution = 64;           // per face, clamped to [8, 512]
+  std::optional<glm::vec3> position;  // default: scene bounds centre, raised to heightAboveGround
+  float heightAboveGround = 1.5f;     // default position: y >= bounds.min.y + this (world units)
+};
+
 // External images the lighting pass samples instead of its own terms. Each must be a 2D view that stays
 // valid until the frame completes, in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL when the lighting pass
 // runs, and covering the whole viewport (any resolution: sampled bilinearly at the pixel's UV).
@@ -98,6 +126,11 @@ struct FrameParams {
   float exposure = 1.0f;
   ShadowSettings shadow;
   LightingInputs lightingInputs;  // the pre-pass hook may change these for the frame
+  SsaoSettings ssao;
+  ReflectionProbeSettings reflectionProbe;
+  // Also writes the shadow-map sun visibility the lighting uses (PCF, and 0 where the shading normal faces
+  // away from the sun; 1 on background) into an R16F image for readbackShadowVisibility().
+  bool outputShadowVisibility = false;
 };
 
 // One image of the pre-pass, as the hook receives it.
@@ -136,10 +169,14 @@ using PrepassHook = std::function<void(const PrepassHookInfo& info, LightingInpu
 
 struct PassTimings {
   double shadowMs = 0.0;
+  double probeMs = 0.0;  // reflection-probe capture (0 on frames without a capture)
   double prepassMs = 0.0;
+  double ssaoMs = 0.0;   // SSAO + blur (0 when disabled)
+  double shadowVisibilityMs = 0.0;  // shadow-visibility output (0 unless requested)
   double hookMs = 0.0;  // whatever the hook recorded
   double lightingMs = 0.0;
   double tonemapMs = 0.0;
+  bool probeCaptured = false;  // this frame captured the reflection probe
   bool valid = false;   // false until a frame with timestamps has completed
 };
 
@@ -219,6 +256,10 @@ class Engine {
   // Read the last rendered frame back (waits for it): tonemapped sRGB RGBA8, and linear HDR.
   Result<ImageRGBA8> readbackLdr();
   Result<ImageRGBA32F> readbackHdr();
+  // The last frame's effect images (waits for it), row-major renderSize() floats, top row first. Fail when
+  // that frame did not produce them (FrameParams::outputShadowVisibility / SsaoSettings::enabled).
+  Result<std::vector<float>> readbackShadowVisibility();  // 1 = lit, 0 = shadowed
+  Result<std::vector<float>> readbackSsao();              // 1 = open (blurred when SsaoSettings::blur)
 
   struct Impl;
 

@@ -1,0 +1,18 @@
+// Per-frame uniforms, set 0 of every pass (scene passes and fullscreen passes). Keep in sync with
+// FrameUniforms in src/pipelines.h.
+layout(set = 0, binding = 0) uniform FrameUniforms {
+  mat4 view;
+  mat4 proj;
+  mat4 viewProj;
+  mat4 invViewProj;
+  mat4 lightViewProj;
+  vec4 cameraPos;     // xyz
+  vec4 sunDirection;  // xyz: towards the sun, normalized
+  vec4 sunRadiance;   // rgb: color * intensity
+  vec4 sky;           // rgb: sky radiance (background), w: ambient intensity
+  vec4 viewport;      // width, height, 1/width, 1/height
+  vec4 shadow;        // x: 1/map size, y: PCF taps per axis, z: normal offset (world units)
+  uvec4 inputs;       // x: sun visibility image, y: AO image (external or SSAO), z: external reflection (1 = bound)
+  mat4 invProj;
+  vec4 probe;         // x: 1 = sample the reflection probe, y: its last mip level
+} frame;
