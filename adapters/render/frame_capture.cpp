@@ -1,4 +1,4 @@
-// Host copies of the pre-pass and visibility images, recorded in the pre-pass hook (see the header).
+// Host copies of the pre-pass and effect images, recorded in the pre-pass hook (see the header).
 #include "frame_capture.h"
 
 #include <cstring>
@@ -43,9 +43,15 @@ struct FrameCapture::Impl {
   PFN_vkMapMemory map = nullptr;
   PFN_vkCmdPipelineBarrier barrier = nullptr;
   PFN_vkCmdCopyImageToBuffer copy = nullptr;
-  HostBuffer depth, normal, visibility;
+  HostBuffer depth, normal;
+  std::vector<HostBuffer> extra;  // one per distinct captured image
+  struct Named {
+    std::string name;
+    size_t buffer;
+    uint32_t channels;
+  };
+  std::vector<Named> names;
   uint32_t width = 0, height = 0;
-  bool haveVisibility = false;
 
   std::string ensure(HostBuffer& b, VkDeviceSize size);
   void release(HostBuffer& b) {
@@ -54,7 +60,8 @@ struct FrameCapture::Impl {
     b = {};
   }
   ~Impl() {
-    for (HostBuffer* b : {&depth, &normal, &visibility}) release(*b);
+    for (HostBuffer* b : {&depth, &normal}) release(*b);
+    for (HostBuffer& b : extra) release(b);
   }
 };
 
@@ -109,15 +116,26 @@ se::Result<std::unique_ptr<FrameCapture>> FrameCapture::create(se::Engine& engin
   return R::success(std::unique_ptr<FrameCapture>(new FrameCapture(std::move(impl))));
 }
 
-se::Status FrameCapture::record(const se::PrepassHookInfo& info, const se::PassImage& normal, VkImage visibility) {
+se::Status FrameCapture::record(const se::PrepassHookInfo& info, const se::PassImage& normal,
+                                const std::vector<CaptureImage>& images) {
   Impl& c = *impl_;
   c.width = info.extent.width;
   c.height = info.extent.height;
-  c.haveVisibility = visibility != VK_NULL_HANDLE;
   const VkDeviceSize pixels = VkDeviceSize(c.width) * c.height;
   std::string e = c.ensure(c.depth, pixels * 4);
   if (e.empty()) e = c.ensure(c.normal, pixels * 8);
-  if (e.empty() && c.haveVisibility) e = c.ensure(c.visibility, pixels * 2);
+  // Distinct images, each copied once.
+  std::vector<const CaptureImage*> distinct;
+  c.names.clear();
+  for (const CaptureImage& img : images) {
+    if (!img.image) continue;
+    size_t k = 0;
+    while (k < distinct.size() && distinct[k]->image != img.image) ++k;
+    if (k == distinct.size()) distinct.push_back(&img);
+    c.names.push_back({img.name, k, img.channels});
+  }
+  if (c.extra.size() < distinct.size()) c.extra.resize(distinct.size());
+  for (size_t k = 0; k < distinct.size() && e.empty(); ++k) e = c.ensure(c.extra[k], pixels * 2 * distinct[k]->channels);
   if (!e.empty()) return se::Status::failure("frame capture: " + e);
 
   struct Target {
@@ -129,8 +147,8 @@ se::Status FrameCapture::record(const se::PrepassHookInfo& info, const se::PassI
   std::vector<Target> targets = {
       {info.depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, info.depth.layout, c.depth.buffer},
       {normal.image, VK_IMAGE_ASPECT_COLOR_BIT, normal.layout, c.normal.buffer}};
-  if (c.haveVisibility)
-    targets.push_back({visibility, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.visibility.buffer});
+  for (size_t k = 0; k < distinct.size(); ++k)
+    targets.push_back({distinct[k]->image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.extra[k].buffer});
 
   auto transition = [&](bool toTransfer) {
     std::vector<VkImageMemoryBarrier> barriers;
@@ -178,10 +196,11 @@ CapturedFrame FrameCapture::read() const {
   f.normal.resize(pixels * 4);
   const auto* n = static_cast<const uint16_t*>(c.normal.mapped);
   for (size_t i = 0; i < pixels * 4; ++i) f.normal[i] = halfToFloat(n[i]);
-  if (c.haveVisibility) {
-    f.visibility.resize(pixels);
-    const auto* v = static_cast<const uint16_t*>(c.visibility.mapped);
-    for (size_t i = 0; i < pixels; ++i) f.visibility[i] = halfToFloat(v[i]);
+  for (const Impl::Named& n : c.names) {
+    std::vector<float>& out = f.images[n.name];
+    out.resize(pixels * n.channels);
+    const auto* v = static_cast<const uint16_t*>(c.extra[n.buffer].mapped);
+    for (size_t i = 0; i < out.size(); ++i) out[i] = halfToFloat(v[i]);
   }
   return f;
 }

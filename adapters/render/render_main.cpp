@@ -1,5 +1,6 @@
 // raybridge-render: one headless image of a scene with the sample engine, in raster mode (the engine's shadow
-// maps) or hybrid mode (Raybridge's ray-traced shadows through the adapter), plus optional dumps and stats.
+// map, SSAO and reflection probe) or hybrid mode (Raybridge's ray-traced shadows, AO and reflections through
+// the adapter), plus optional dumps and stats.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -118,15 +119,33 @@ int main(int argc, char** argv) {
   else if (engine.scene().sun) params.sun = *engine.scene().sun;
   params.sun.direction = glm::normalize(params.sun.direction);
 
+  const ResolvedEffects fx = resolve(o);
+  const bool wantShadows = fx.effects & rbAdapter::kEffectShadows, wantAo = fx.effects & rbAdapter::kEffectAo,
+             wantReflections = fx.effects & rbAdapter::kEffectReflections;
   std::unique_ptr<rbAdapter::Adapter> adapter;
   if (hybrid) {
     rbAdapter::AdapterConfig ac;
+    ac.effects = fx.effects;
     ac.normals = o.geometricNormals ? rbAdapter::GBufferNormals::Geometric : rbAdapter::GBufferNormals::Shading;
     auto a = rbAdapter::Adapter::create(engine, ac);
     if (!a) return fail("adapter: " + a.error);
     adapter = std::move(a.value);
-    adapter->settings().sunAngularRadiusDegrees = o.sunRadiusDegrees;
-    adapter->settings().shadowRaysPerPixel = o.shadowRays;
+    rbAdapter::FrameSettings& s = adapter->settings();
+    s.denoise = o.denoise;
+    s.sunAngularRadiusDegrees = fx.sunRadiusDegrees;
+    s.shadowRaysPerPixel = fx.shadowRays;
+    s.aoRaysPerPixel = fx.aoRays;
+    s.aoRange = fx.aoRange;
+    s.aoEstimator = o.aoEstimator;
+    s.reflectionRoughnessThreshold = fx.reflectionRoughness;
+    s.reflectionRaysPerPixel = fx.reflectionRays;
+    s.lightingFrom(params);
+  } else {
+    // The engine's own counterparts of the effects (its shadow map is always on).
+    params.ssao.enabled = wantAo;
+    params.ssao.radius = fx.aoRange;
+    params.reflectionProbe.enabled = wantReflections;
+    params.outputShadowVisibility = o.dump;
   }
   std::unique_ptr<FrameCapture> capture;
   if (o.dump) {
@@ -143,8 +162,13 @@ int main(int argc, char** argv) {
     captureNext = false;
     capturedViewProj = info.viewProj;
     const bool geometric = o.geometricNormals;
-    VkImage visibility = adapter && inputs.sunVisibility ? adapter->shadowPass()->outputs().visibility : VK_NULL_HANDLE;
-    if (se::Status s = capture->record(info, geometric ? info.geometricNormal : info.normalRoughness, visibility); !s)
+    std::vector<CaptureImage> images;
+    if (adapter) {
+      const rbAdapter::FrameImages& fi = adapter->lastImages();
+      images = {{"shadow", fi.shadow, 1}, {"ao", fi.ao, 1}, {"ao_raw", fi.aoRaw, 1}, {"reflection", fi.reflection, 4}};
+      if (fi.shadowRaw != fi.shadow) images.push_back({"shadow_raw", fi.shadowRaw, 1});  // denoised soft shadows
+    }
+    if (se::Status s = capture->record(info, geometric ? info.geometricNormal : info.normalRoughness, images); !s)
       captureError = s.error;
   });
 
@@ -175,8 +199,8 @@ int main(int argc, char** argv) {
 
   // Statistics. The SDK resolves a pass's GPU time kFramesInFlight frames after recording it.
   nlohmann::json stats;
-  const double engineTotal =
-      timings.shadowMs + timings.prepassMs + timings.hookMs + timings.lightingMs + timings.tonemapMs;
+  const double engineTotal = timings.shadowMs + timings.probeMs + timings.prepassMs + timings.ssaoMs +
+                             timings.shadowVisibilityMs + timings.hookMs + timings.lightingMs + timings.tonemapMs;
   stats["mode"] = hybrid ? "hybrid" : "raster";
   stats["width"] = o.width;
   stats["height"] = o.height;
@@ -188,9 +212,23 @@ int main(int argc, char** argv) {
                      {"fovy_degrees", params.camera.fovYDegrees}, {"z_near", params.camera.zNear},
                      {"z_far", params.camera.zFar},        {"source", cameraSource}};
   stats["sun"] = {{"direction", vec(params.sun.direction)},
-                  {"angular_radius_degrees", hybrid ? o.sunRadiusDegrees : 0.0f},
-                  {"rays_per_pixel", hybrid ? (o.sunRadiusDegrees > 0.0f ? o.shadowRays : 1u) : 0u}};
+                  {"angular_radius_degrees", hybrid && wantShadows ? fx.sunRadiusDegrees : 0.0f},
+                  {"rays_per_pixel", hybrid && wantShadows ? fx.shadowRays : 0u}};
+  stats["preset"] = rbAdapter::toString(o.preset);
+  stats["effects"] = {{"enabled", rbAdapter::effectsToString(fx.effects)},
+                      {"denoise", o.denoise},
+                      {"ao_rays_per_pixel", wantAo ? fx.aoRays : 0u},
+                      {"ao_range", fx.aoRange},
+                      {"ao_estimator", o.aoEstimator == rb::AoEstimator::Binary ? "binary" : "distance"},
+                      {"reflection_roughness_threshold", fx.reflectionRoughness},
+                      {"reflection_rays_per_pixel", wantReflections ? fx.reflectionRays : 0u}};
+  if (!hybrid)
+    stats["effects"]["raster_counterparts"] = {{"shadows", "shadow map (always on)"},
+                                               {"ao", wantAo ? "SSAO" : "off"},
+                                               {"reflections", wantReflections ? "reflection probe" : "constant sky"}};
   stats["engine_gpu_ms"] = {{"valid", timings.valid},         {"shadow_map", timings.shadowMs},
+                            {"probe", timings.probeMs},       {"ssao", timings.ssaoMs},
+                            {"shadow_visibility_output", timings.shadowVisibilityMs},
                             {"prepass", timings.prepassMs},   {"hook", timings.hookMs},
                             {"lighting", timings.lightingMs}, {"tonemap", timings.tonemapMs},
                             {"frame_total", engineTotal}};
@@ -203,7 +241,7 @@ int main(int argc, char** argv) {
     const rb::DeviceInfo& di = adapter->context().deviceInfo();
     stats["device"]["driver"] = di.driverName;
     stats["device"]["driver_info"] = di.driverInfo;
-    const rb::PassStats shadow = adapter->shadowPass()->stats();
+    const rbAdapter::EffectStats es = adapter->stats();
     const rb::AsStats as = adapter->accelerationStructures().stats();
     double buildMs = 0.0;
     for (const rb::BuildBatchTiming& b : as.batches) buildMs += b.gpuMs;
@@ -212,10 +250,27 @@ int main(int argc, char** argv) {
     for (size_t c = 0; c < size_t(rb::MemoryCategory::Count); ++c)
       memory[rb::toString(rb::MemoryCategory(c))] = mem.bytes[c];
     memory["total"] = mem.total();
-    stats["rays_traced"] = shadow.rays;
+    nlohmann::json passes = nlohmann::json::object();
+    uint64_t rays = 0;
+    const std::pair<const char*, const rb::PassStats*> all[] = {
+        {"shadow", adapter->shadowPass() ? &es.shadow : nullptr},
+        {"shadow_denoise", adapter->shadowDenoiser() ? &es.shadowDenoise : nullptr},
+        {"ao", adapter->aoPass() ? &es.ao : nullptr},
+        {"ao_denoise", adapter->aoDenoiser() ? &es.aoDenoise : nullptr},
+        {"reflection", adapter->reflectionPass() ? &es.reflection : nullptr}};
+    std::printf("Raybridge (%s):", rbAdapter::effectsToString(fx.effects).c_str());
+    for (const auto& [name, p] : all) {
+      if (!p) continue;
+      passes[name] = {{"gpu_ms", p->gpuMs}, {"rays", p->rays}, {"rays_per_second", p->raysPerSecond()}, {"frame", p->frame}};
+      rays += p->rays;
+      std::printf(" %s %.1f ms", name, p->gpuMs);
+      if (p->rays) std::printf(" %.2f Mrays (%.1f Mrays/s)", p->rays * 1e-6, p->raysPerSecond() * 1e-6);
+      std::printf(";");
+    }
+    std::printf(" BLAS build %.2f ms; memory %.1f MiB\n", buildMs, mem.total() / 1048576.0);
+    stats["rays_traced"] = rays;
     stats["raybridge"] = {
-        {"shadow_pass", {{"gpu_ms", shadow.gpuMs}, {"rays", shadow.rays}, {"rays_per_second", shadow.raysPerSecond()},
-                         {"frame", shadow.frame}}},
+        {"passes", passes},
         {"acceleration_structures",
          {{"blas_build_gpu_ms", buildMs}, {"build_batches", as.batches.size()}, {"blas_count", as.blasCount},
           {"blas_triangles", as.triangles}, {"blas_bytes", as.blasBytes}, {"tlas_bytes", as.tlasBytes},
@@ -223,12 +278,11 @@ int main(int argc, char** argv) {
           {"dedup_hits", as.dedupHits}, {"tlas_instances", adapter->lastTlas().instanceCount},
           {"tlas_skipped_instances", adapter->lastTlas().skippedInstances}}},
         {"memory_bytes", memory}};
-    std::printf("Raybridge: shadow pass %.2f ms GPU, %llu rays (%.1f Mrays/s); BLAS build %.2f ms, %llu bytes\n",
-                shadow.gpuMs, static_cast<unsigned long long>(shadow.rays), shadow.raysPerSecond() * 1e-6, buildMs,
-                static_cast<unsigned long long>(as.blasBytes));
   }
-  std::printf("engine GPU ms: shadow map %.2f  prepass %.2f  hook %.2f  lighting %.2f  tonemap %.2f  total %.2f\n",
-              timings.shadowMs, timings.prepassMs, timings.hookMs, timings.lightingMs, timings.tonemapMs, engineTotal);
+  std::printf("engine GPU ms: shadow map %.2f  probe %.2f  prepass %.2f  ssao %.2f  hook %.2f  lighting %.2f  tonemap "
+              "%.2f  total %.2f\n",
+              timings.shadowMs, timings.probeMs, timings.prepassMs, timings.ssaoMs, timings.hookMs, timings.lightingMs,
+              timings.tonemapMs, engineTotal);
   stats["validation"] = {{"enabled", o.validation}, {"errors", engine.validationErrorCount()}};
 
   if (o.dump) {
@@ -239,12 +293,38 @@ int main(int argc, char** argv) {
     };
     std::string e = write("depth.exr", toExr(f, distances(f, capturedViewProj, params.camera.eye), 1));
     if (e.empty()) e = write("normal.exr", toExr(f, f.normal, 4));
-    if (e.empty() && !f.visibility.empty()) e = write("shadow.exr", toExr(f, f.visibility, 1));
+    std::vector<std::string> written = {"depth.exr", "normal.exr"};
+    // Hybrid: Raybridge's images as captured in the hook (raw only where a denoiser ran).
+    auto writeCaptured = [&](const std::string& name, int channels) {
+      auto it = f.images.find(name);
+      if (!e.empty() || it == f.images.end()) return;
+      e = write((name + ".exr").c_str(), toExr(f, it->second, channels));
+      written.push_back(name + ".exr");
+    };
+    writeCaptured("shadow", 1);
+    writeCaptured("shadow_raw", 1);
+    writeCaptured("ao", 1);
+    writeCaptured("ao_raw", 1);
+    writeCaptured("reflection", 4);
+    // Raster: the engine's shadow-map visibility and SSAO.
+    if (e.empty() && !hybrid) {
+      auto visibility = engine.readbackShadowVisibility();
+      if (!visibility) e = visibility.error;
+      else e = write("shadow.exr", toExr(f, visibility.value, 1)), written.push_back("shadow.exr");
+      if (e.empty() && wantAo) {
+        auto ssao = engine.readbackSsao();
+        if (!ssao) e = ssao.error;
+        else e = write("ao.exr", toExr(f, ssao.value, 1)), written.push_back("ao.exr");
+      }
+    }
     if (!e.empty()) return fail(e);
     std::ofstream json(out / "stats.json");
     json << stats.dump(2) << "\n";
     if (!json) return fail("cannot write " + (out / "stats.json").string());
-    std::printf("wrote depth.exr, normal.exr%s, stats.json\n", f.visibility.empty() ? "" : ", shadow.exr");
+    written.push_back("stats.json");
+    std::printf("wrote");
+    for (size_t i = 0; i < written.size(); ++i) std::printf("%s %s", i ? "," : "", written[i].c_str());
+    std::printf("\n");
   }
   if (o.validation) {
     std::printf("validation errors: %u\n", engine.validationErrorCount());

@@ -11,6 +11,8 @@ namespace rbRender {
 namespace {
 
 constexpr uint32_t kMaxSize = 16384;  // the engine's render-target limit
+const float kDefaultReflectionRoughness = rbAdapter::FrameSettings{}.reflectionRoughnessThreshold;
+const uint32_t kDefaultReflectionRays = rbAdapter::FrameSettings{}.reflectionRaysPerPixel;
 
 std::string quoted(const std::string& s) { return "'" + s + "'"; }
 
@@ -55,7 +57,7 @@ std::string parseList(const std::string& option, const std::string& text, size_t
 const char* renderUsage() {
   return "usage: raybridge-render [options]\n"
          "Renders one image headless with the sample engine and Raybridge (default: the procedural demo scene,\n"
-         "1280x720, hybrid mode, into out/final.png and out/final.exr).\n"
+         "1280x720, hybrid mode, preset high, into out/final.png and out/final.exr).\n"
          "  --scene FILE.gltf|.glb       scene to render (default: the engine's procedural demo scene)\n"
          "  --width W --height H         image size, 1..16384 (default 1280x720)\n"
          "  --camera ex,ey,ez,tx,ty,tz,fovy\n"
@@ -63,19 +65,56 @@ const char* renderUsage() {
          "                               top-left, primary rays through pixel centres (default: the scene's camera,\n"
          "                               else framed on the scene bounds)\n"
          "  --sun dx,dy,dz               direction towards the sun (default: the scene's sun)\n"
-         "  --sun-radius DEG             angular radius of the sun, 0 = hard shadows (default 0)\n"
-         "  --shadow-rays N              rays per pixel for soft shadows, 1..4096 (default 8)\n"
-         "  --mode raster|hybrid         engine shadow maps, or Raybridge ray-traced shadows (default hybrid)\n"
+         "  --preset NAME                effects and quality (default high):\n"
+         "                                 low     hard shadows, AO 4 rays\n"
+         "                                 medium  soft shadows 4 rays, AO 4 rays\n"
+         "                                 high    medium + reflections\n"
+         "                                 ultra   soft shadows 8 rays, AO 16 rays, reflections\n"
+         "                                 shadows | ao | reflections   that effect alone (shadows: soft, 4 rays)\n"
+         "                               explicit options below override what the preset sets\n"
+         "  --effects LIST               effects to run, comma-separated from shadows,ao,reflections, or none\n"
+         "                               (overrides the preset's set, keeps its quality settings)\n"
+         "  --sun-radius DEG             angular radius of the sun, 0 = hard shadows (default: 0.5 for presets\n"
+         "                               with soft shadows, else 0)\n"
+         "  --shadow-rays N              rays per pixel for soft shadows, 1..4096 (default: the preset's)\n"
+         "  --ao-rays N                  AO rays per pixel, 1..4096 (default: the preset's, else 4); 0 is an error\n"
+         "  --ao-range R                 AO ray length in world units, > 0 (default 1)\n"
+         "  --ao-estimator binary|distance\n"
+         "                               AO hits count as occluded, or t/range open (default binary)\n"
+         "  --reflection-roughness T     roughness threshold in (0, 1]: rougher surfaces trace no reflection ray\n"
+         "                               (default 0.5)\n"
+         "  --reflection-rays N          reflection rays per glossy pixel, 1..64 (default 4)\n"
+         "  --no-denoise                 use the raw soft-shadow and AO images (default: denoised)\n"
+         "  --mode raster|hybrid         hybrid: Raybridge's effects; raster: the engine's counterparts of the\n"
+         "                               same effects (shadow map, SSAO, reflection probe) (default hybrid)\n"
          "  --gbuffer-normals shading|geometric\n"
          "                               normal the passes use (default shading)\n"
          "  --out DIR                    output folder (default out): final.png, final.exr\n"
          "  --dump                       also depth.exr (distance from the eye, 0 = sky), normal.exr (world normal\n"
-         "                               used by the passes), shadow.exr (sun visibility; hybrid mode only),\n"
-         "                               stats.json\n"
+         "                               used by the passes), shadow.exr (sun visibility the lighting used; plus\n"
+         "                               shadow_raw.exr when denoised), ao.exr (AO the lighting used; plus\n"
+         "                               ao_raw.exr in hybrid mode), reflection.exr (hybrid), stats.json\n"
          "  --frames N                   frames to render, the last is reported (default 3)\n"
          "  --device SUBSTR              pick the Vulkan device whose name contains SUBSTR\n"
          "  --validation                 enable VK_LAYER_KHRONOS_validation (also RAYBRIDGE_VALIDATION=1); exit\n"
          "                               status 3 if it reported errors\n";
+}
+
+ResolvedEffects resolve(const RenderOptions& o) {
+  const rbAdapter::PresetDesc p = rbAdapter::presetDesc(o.preset);
+  ResolvedEffects r;
+  r.effects = o.effects ? *o.effects : p.effects;
+  r.sunRadiusDegrees = o.sunRadiusDegrees ? *o.sunRadiusDegrees
+                       : p.softShadows    ? rbAdapter::kDefaultSoftSunRadiusDegrees
+                                          : 0.0f;
+  // A preset without shadows (--effects adds them): soft shadows get Medium's 4 rays.
+  const uint32_t presetShadowRays = (p.effects & rbAdapter::kEffectShadows) && p.softShadows ? p.shadowRaysPerPixel : 4;
+  r.shadowRays = r.sunRadiusDegrees > 0.0f ? (o.shadowRays ? *o.shadowRays : presetShadowRays) : 1;
+  r.aoRays = o.aoRays ? *o.aoRays : p.aoRaysPerPixel ? p.aoRaysPerPixel : 4;
+  r.aoRange = o.aoRange ? *o.aoRange : 1.0f;
+  r.reflectionRoughness = o.reflectionRoughness ? *o.reflectionRoughness : kDefaultReflectionRoughness;
+  r.reflectionRays = o.reflectionRays ? *o.reflectionRays : kDefaultReflectionRays;
+  return r;
 }
 
 std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
@@ -96,9 +135,13 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
       o.dump = true;
     } else if (a == "--validation") {
       o.validation = true;
+    } else if (a == "--no-denoise") {
+      o.denoise = false;
     } else if (a == "--scene" || a == "--out" || a == "--device" || a == "--width" || a == "--height" ||
                a == "--camera" || a == "--sun" || a == "--sun-radius" || a == "--shadow-rays" || a == "--mode" ||
-               a == "--gbuffer-normals" || a == "--frames") {
+               a == "--gbuffer-normals" || a == "--frames" || a == "--preset" || a == "--effects" ||
+               a == "--ao-rays" || a == "--ao-range" || a == "--ao-estimator" || a == "--reflection-roughness" ||
+               a == "--reflection-rays") {
       if (!takeValue()) return needsValue();
       if (a == "--scene") {
         if (value.empty()) return "--scene: the file name is empty";
@@ -115,7 +158,38 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
       } else if (a == "--frames") {
         e = parseUint(a, value, 1, 100000, o.frames);
       } else if (a == "--shadow-rays") {
-        e = parseUint(a, value, 1, 4096, o.shadowRays);
+        uint32_t n = 0;
+        if ((e = parseUint(a, value, 1, 4096, n)).empty()) o.shadowRays = n;
+      } else if (a == "--ao-rays") {
+        uint32_t n = 0;
+        if ((e = parseUint(a, value, 1, 4096, n)).empty()) o.aoRays = n;
+      } else if (a == "--ao-range") {
+        float r = 0.0f;
+        if (!parseFloat(value, r)) e = "--ao-range: " + quoted(value) + " is not a number";
+        else if (!(r > 0.0f)) e = "--ao-range: " + value + " must be greater than 0 (world units)";
+        else o.aoRange = r;
+      } else if (a == "--ao-estimator") {
+        if (value == "binary") o.aoEstimator = rb::AoEstimator::Binary;
+        else if (value == "distance") o.aoEstimator = rb::AoEstimator::DistanceWeighted;
+        else e = "--ao-estimator: " + quoted(value) + " is not binary or distance";
+      } else if (a == "--reflection-roughness") {
+        float t = 0.0f;
+        if (!parseFloat(value, t)) e = "--reflection-roughness: " + quoted(value) + " is not a number";
+        else if (!(t > 0.0f && t <= 1.0f)) e = "--reflection-roughness: " + value + " is outside (0, 1]";
+        else o.reflectionRoughness = t;
+      } else if (a == "--reflection-rays") {
+        uint32_t n = 0;
+        if ((e = parseUint(a, value, 1, 64, n)).empty()) o.reflectionRays = n;
+      } else if (a == "--preset") {
+        if (auto p = rbAdapter::parsePreset(value)) o.preset = *p;
+        else e = "--preset: " + quoted(value) + " is not low, medium, high, ultra, shadows, ao or reflections";
+      } else if (a == "--effects") {
+        rbAdapter::EffectSet set = 0;
+        if (value != "none") {
+          if (value.empty()) e = "--effects: the list is empty (use none for no effect)";
+          else if (std::string pe = rbAdapter::parseEffects(value, set); !pe.empty()) e = "--effects: " + pe;
+        }
+        if (e.empty()) o.effects = set;
       } else if (a == "--camera") {
         if ((e = parseList(a, value, 7, list)).empty()) {
           o.eye = glm::vec3(list[0], list[1], list[2]);
@@ -131,9 +205,10 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
           if (glm::length(*o.sun) < 1e-6f) e = "--sun: the direction " + value + " has zero length";
         }
       } else if (a == "--sun-radius") {
-        if (!parseFloat(value, o.sunRadiusDegrees)) e = "--sun-radius: " + quoted(value) + " is not a number";
-        else if (!(o.sunRadiusDegrees >= 0.0f && o.sunRadiusDegrees < 45.0f))
-          e = "--sun-radius: " + value + " is outside [0, 45) degrees";
+        float r = 0.0f;
+        if (!parseFloat(value, r)) e = "--sun-radius: " + quoted(value) + " is not a number";
+        else if (!(r >= 0.0f && r < 45.0f)) e = "--sun-radius: " + value + " is outside [0, 45) degrees";
+        else o.sunRadiusDegrees = r;
       } else if (a == "--mode") {
         if (value == "raster") o.mode = Mode::Raster;
         else if (value == "hybrid") o.mode = Mode::Hybrid;

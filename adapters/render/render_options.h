@@ -7,6 +7,8 @@
 
 #include <glm/glm.hpp>
 
+#include "raybridge_sample_engine_adapter.h"
+
 namespace rbRender {
 
 enum class Mode { Raster, Hybrid };
@@ -18,8 +20,17 @@ struct RenderOptions {
   std::optional<glm::vec3> eye, target;
   float fovYDegrees = 0.0f;
   std::optional<glm::vec3> sun;  // towards the sun; empty = the scene's sun, else the engine's default
-  float sunRadiusDegrees = 0.0f;
-  uint32_t shadowRays = 8;
+  // Effects and their quality: the preset gives defaults, explicit options win (see resolve()).
+  rbAdapter::Preset preset = rbAdapter::Preset::High;
+  std::optional<rbAdapter::EffectSet> effects;  // --effects: overrides the preset's set
+  std::optional<float> sunRadiusDegrees;        // --sun-radius; else 0.5 for soft presets, 0 for hard ones
+  std::optional<uint32_t> shadowRays;           // --shadow-rays; else the preset's
+  std::optional<uint32_t> aoRays;               // --ao-rays; else the preset's (4 where it has no AO)
+  std::optional<float> aoRange;                 // --ao-range; else the SDK's 1.0
+  rb::AoEstimator aoEstimator = rb::AoEstimator::Binary;  // --ao-estimator binary|distance
+  std::optional<float> reflectionRoughness;     // --reflection-roughness threshold; else the default below
+  std::optional<uint32_t> reflectionRays;       // --reflection-rays; else the default below
+  bool denoise = true;                          // --no-denoise
   Mode mode = Mode::Hybrid;
   std::string out = "out";
   bool dump = false;
@@ -29,6 +40,18 @@ struct RenderOptions {
   bool validation = false;
   bool help = false;
 };
+
+// What the preset and the explicit options amount to.
+struct ResolvedEffects {
+  rbAdapter::EffectSet effects = 0;
+  float sunRadiusDegrees = 0.0f;  // 0 = hard shadows
+  uint32_t shadowRays = 1;        // effective rays per pixel (1 for hard shadows)
+  uint32_t aoRays = 4;
+  float aoRange = 1.0f;
+  float reflectionRoughness = 0.3f;
+  uint32_t reflectionRays = 1;
+};
+ResolvedEffects resolve(const RenderOptions& options);
 
 // Parses argv; returns an error message naming the problem, or "" on success.
 std::string parseRenderOptions(int argc, char** argv, RenderOptions& options);

@@ -1,6 +1,8 @@
-// Raybridge <-> sample engine: device setup, scene registration and the pre-pass hook (see the header).
+// Raybridge <-> sample engine: device setup, scene registration, effects and the pre-pass hook (see the header).
 #include "raybridge_sample_engine_adapter.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstring>
 
@@ -27,6 +29,66 @@ std::string rbError(const char* what, const rb::Error& e) {
 }
 
 void copyMatrix(const glm::mat4& m, float out[16]) { std::memcpy(out, &m[0][0], 16 * sizeof(float)); }
+
+// FNV-1a over a byte range, chained.
+uint64_t hashBytes(uint64_t h, const void* data, size_t bytes) {
+  const auto* p = static_cast<const uint8_t*>(data);
+  for (size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+  return h;
+}
+
+float srgbToLinear(uint8_t v) {
+  const float c = float(v) / 255.0f;
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+// Average of a texture: .rgb decoded from sRGB (base colour, emissive) and raw .rgb (metallic-roughness).
+struct TextureAverage {
+  glm::vec3 srgbDecoded{1.0f};
+  glm::vec3 linear{1.0f};
+};
+
+TextureAverage averageOf(const se::TextureData& t) {
+  TextureAverage a;
+  const size_t pixels = size_t(t.width) * t.height;
+  if (pixels == 0 || t.rgba8.size() < pixels * 4) return a;
+  glm::dvec3 decoded(0.0), raw(0.0);
+  for (size_t i = 0; i < pixels; ++i) {
+    const uint8_t* p = &t.rgba8[i * 4];
+    for (int c = 0; c < 3; ++c) {
+      decoded[c] += srgbToLinear(p[c]);
+      raw[c] += p[c] / 255.0;
+    }
+  }
+  a.srgbDecoded = glm::vec3(decoded / double(pixels));
+  a.linear = glm::vec3(raw / double(pixels));
+  return a;
+}
+
+// The engine's glTF material as reflection hits shade it. The engine exposes no texture views, so a texture
+// contributes its average (multiplied into the factor, as glTF multiplies texel and factor).
+rb::Material toRbMaterial(const se::Material& m, const std::vector<TextureAverage>& averages) {
+  auto average = [&](int index) -> const TextureAverage* {
+    return index >= 0 && size_t(index) < averages.size() ? &averages[size_t(index)] : nullptr;
+  };
+  rb::Material out;
+  glm::vec4 base = m.baseColorFactor;
+  if (const TextureAverage* a = average(m.baseColorTexture)) base *= glm::vec4(a->srgbDecoded, 1.0f);
+  float metallic = m.metallicFactor, roughness = m.roughnessFactor;
+  if (const TextureAverage* a = average(m.metallicRoughnessTexture)) {
+    roughness *= a->linear.g;  // glTF: G = roughness, B = metallic
+    metallic *= a->linear.b;
+  }
+  glm::vec3 emissive = m.emissiveFactor;
+  if (const TextureAverage* a = average(m.emissiveTexture)) emissive *= a->srgbDecoded;
+  for (int c = 0; c < 4; ++c) out.baseColor[c] = base[c];
+  for (int c = 0; c < 3; ++c) out.emissive[c] = emissive[c];
+  out.metallic = std::clamp(metallic, 0.0f, 1.0f);
+  out.roughness = std::clamp(roughness, 0.0f, 1.0f);
+  return out;
+}
+
+rb::PassStats statsOf(const auto* pass) { return pass ? pass->stats() : rb::PassStats{}; }
 
 }  // namespace
 
@@ -58,23 +120,106 @@ void configureEngine(se::EngineConfig& config, rb::RequiredFeatures& features) {
   config.deviceFeaturesPNext = others.front();
 }
 
+std::string effectsToString(EffectSet effects) {
+  std::vector<std::string_view> names;
+  if (effects & kEffectShadows) names.push_back("shadows");
+  if (effects & kEffectAo) names.push_back("ao");
+  if (effects & kEffectReflections) names.push_back("reflections");
+  std::string out;
+  for (size_t i = 0; i < names.size(); ++i) out.append(i ? "," : "").append(names[i]);
+  return out;
+}
+
+std::string parseEffects(std::string_view text, EffectSet& out) {
+  EffectSet set = 0;
+  size_t start = 0;
+  while (start <= text.size() && !text.empty()) {
+    const size_t comma = text.find(',', start);
+    const std::string_view item = text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+    if (item == "shadows") set |= kEffectShadows;
+    else if (item == "ao") set |= kEffectAo;
+    else if (item == "reflections") set |= kEffectReflections;
+    else
+      return std::string("'").append(item).append("' in '").append(text).append(
+          "' is not an effect (shadows, ao, reflections)");
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  out = set;
+  return {};
+}
+
+PresetDesc presetDesc(Preset preset) {
+  switch (preset) {
+    case Preset::Low: return {kEffectShadows | kEffectAo, false, 1, 4};
+    case Preset::Medium: return {kEffectShadows | kEffectAo, true, 4, 4};
+    case Preset::High: return {kAllEffects, true, 4, 4};
+    case Preset::Ultra: return {kAllEffects, true, 8, 16};
+    case Preset::ShadowsOnly: return {kEffectShadows, true, 4, 0};
+    case Preset::AoOnly: return {kEffectAo, false, 1, 4};
+    case Preset::ReflectionsOnly: return {kEffectReflections, false, 1, 0};
+  }
+  return {};
+}
+
+const char* toString(Preset preset) {
+  switch (preset) {
+    case Preset::Low: return "low";
+    case Preset::Medium: return "medium";
+    case Preset::High: return "high";
+    case Preset::Ultra: return "ultra";
+    case Preset::ShadowsOnly: return "shadows";
+    case Preset::AoOnly: return "ao";
+    case Preset::ReflectionsOnly: return "reflections";
+  }
+  return "?";
+}
+
+std::optional<Preset> parsePreset(std::string_view name) {
+  for (int p = 0; p <= int(Preset::ReflectionsOnly); ++p)
+    if (name == toString(Preset(p))) return Preset(p);
+  return std::nullopt;
+}
+
 struct Adapter::Impl {
   se::Engine& engine;
   AdapterConfig config;
   FrameSettings settings;
   std::unique_ptr<rb::Context> ctx;
   std::unique_ptr<rb::AccelerationStructureService> as;
-  std::unique_ptr<rb::ShadowPass> shadows;  // only with kEffectShadows
-  std::vector<rb::MeshHandle> meshes;       // parallel to engine.meshes(); null for empty meshes
+  std::unique_ptr<rb::ShadowPass> shadows;         // only with kEffectShadows
+  std::unique_ptr<rb::AoPass> ao;                  // only with kEffectAo
+  std::unique_ptr<rb::ReflectionPass> reflection;  // only with kEffectReflections
+  std::unique_ptr<rb::Denoiser> shadowDenoiser;    // only for denoised soft shadows
+  std::unique_ptr<rb::Denoiser> aoDenoiser;        // only for denoised AO
+  // Disabled passes, destroyed once no frame in flight can use them: (frameIndex when retired, object).
+  std::vector<std::pair<uint64_t, std::shared_ptr<void>>> retired;
+  std::vector<rb::MeshHandle> meshes;  // parallel to engine.meshes(); null for empty meshes
   std::vector<rb::Instance> instances;
+  std::vector<rb::Material> materials;  // the engine's materials, converted
+  bool materialsDirty = true;           // not yet given to the reflection pass
+  uint64_t sceneGeneration = 0;
   rb::TlasInfo tlas;
+  FrameImages images;
   std::string error;
 
   explicit Impl(se::Engine& e) : engine(e) {}
+  EffectSet effects() const {  // what exists, so a failed setEffects never leaves flags and passes apart
+    return (shadows ? kEffectShadows : 0u) | (ao ? kEffectAo : 0u) | (reflection ? kEffectReflections : 0u);
+  }
   void fail(std::string message) {
     if (error.empty()) error = std::move(message);
   }
-  rb::GBufferDesc describePrepass(const se::PrepassHookInfo& info) const;
+  template <typename T>
+  void retire(std::unique_ptr<T>& object) {
+    if (object) retired.emplace_back(ctx->frameIndex(), std::shared_ptr<void>(std::move(object)));
+  }
+  void releaseRetired(bool idle) {
+    const uint64_t now = ctx->frameIndex();
+    std::erase_if(retired, [&](const auto& r) { return idle || r.first + ctx->framesInFlight() + 1 <= now; });
+  }
+  se::Status updateDenoisers();
+  rb::GBufferDesc describePrepass(const se::PrepassHookInfo& info, bool shadingNormals) const;
 };
 
 Adapter::Adapter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -82,7 +227,12 @@ Adapter::Adapter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Adapter::~Adapter() {
   // The SDK destroys its objects at once; the engine's frames in flight may still use them.
   (void)impl_->engine.waitIdle();
+  impl_->retired.clear();
+  impl_->shadowDenoiser.reset();
+  impl_->aoDenoiser.reset();
   impl_->shadows.reset();
+  impl_->ao.reset();
+  impl_->reflection.reset();
   impl_->as.reset();
   impl_->ctx.reset();
 }
@@ -107,15 +257,50 @@ se::Result<std::unique_ptr<Adapter>> Adapter::create(se::Engine& engine, const A
   if (!as) return R::failure(rbError("rb::AccelerationStructureService::create", as.error()));
   impl->as = std::move(as.value());
 
-  if (config.effects & kEffectShadows) {
-    auto shadows = rb::ShadowPass::create(*impl->ctx);
-    if (!shadows) return R::failure(rbError("rb::ShadowPass::create", shadows.error()));
-    impl->shadows = std::move(shadows.value());
-  }
-
   std::unique_ptr<Adapter> adapter(new Adapter(std::move(impl)));
   if (se::Status s = adapter->syncScene(); !s) return R::failure(s.error);
+  if (se::Status s = adapter->setEffects(config.effects); !s) return R::failure(s.error);
   return R::success(std::move(adapter));
+}
+
+se::Status Adapter::setEffects(EffectSet effects) {
+  Impl& a = *impl_;
+  if (effects & ~kAllEffects) return se::Status::failure("setEffects: unknown effect bits " + std::to_string(effects & ~kAllEffects));
+  // Disable first (their memory is released after the frames in flight), then create the new ones.
+  if (!(effects & kEffectShadows)) a.retire(a.shadows), a.retire(a.shadowDenoiser);
+  if (!(effects & kEffectAo)) a.retire(a.ao), a.retire(a.aoDenoiser);
+  if (!(effects & kEffectReflections)) a.retire(a.reflection);
+  if ((effects & kEffectShadows) && !a.shadows) {
+    auto p = rb::ShadowPass::create(*a.ctx);
+    if (!p) return se::Status::failure(rbError("rb::ShadowPass::create", p.error()));
+    a.shadows = std::move(p.value());
+  }
+  if ((effects & kEffectAo) && !a.ao) {
+    auto p = rb::AoPass::create(*a.ctx);
+    if (!p) return se::Status::failure(rbError("rb::AoPass::create", p.error()));
+    a.ao = std::move(p.value());
+  }
+  if ((effects & kEffectReflections) && !a.reflection) {
+    auto p = rb::ReflectionPass::create(*a.ctx);
+    if (!p) return se::Status::failure(rbError("rb::ReflectionPass::create", p.error()));
+    a.reflection = std::move(p.value());
+    a.materialsDirty = true;
+  }
+  return se::Status::success();
+}
+
+EffectSet Adapter::effects() const { return impl_->effects(); }
+
+se::Status Adapter::applyPreset(Preset preset, float sunAngularRadiusDegrees) {
+  const PresetDesc d = presetDesc(preset);
+  if (se::Status s = setEffects(d.effects); !s) return s;
+  FrameSettings& f = impl_->settings;
+  if (d.effects & kEffectShadows) {
+    f.sunAngularRadiusDegrees = d.softShadows ? sunAngularRadiusDegrees : 0.0f;
+    f.shadowRaysPerPixel = d.shadowRaysPerPixel;
+  }
+  if (d.effects & kEffectAo) f.aoRaysPerPixel = d.aoRaysPerPixel;
+  return se::Status::success();
 }
 
 se::Status Adapter::syncScene() {
@@ -125,6 +310,8 @@ se::Status Adapter::syncScene() {
   }
   a.meshes.clear();
   a.instances.clear();
+  ++a.sceneGeneration;
+  const se::Scene& scene = a.engine.scene();
   const std::span<const se::GpuMesh> meshes = a.engine.meshes();
   for (size_t i = 0; i < meshes.size(); ++i) {
     const se::GpuMesh& m = meshes[i];
@@ -148,16 +335,31 @@ se::Status Adapter::syncScene() {
     d.indexAddress = m.indexAddress;
     d.indexBufferBytes = VkDeviceSize(m.indexCount) * sizeof(uint32_t);
     d.triangleCount = triangles;
+    if (m.attributeAddress) {  // interleaved {vec3 normal; vec2 uv; vec4 tangent}
+      d.normalAddress = m.attributeAddress;
+      d.normalStride = m.attributeStride;
+      d.texcoordAddress = m.attributeAddress + 12;
+      d.texcoordStride = m.attributeStride;
+    }
     if (m.cpu) {
       d.hostVertices = m.cpu->positions.data();
       d.hostIndices = m.cpu->indices.empty() ? nullptr : m.cpu->indices.data();
       d.debugName = m.cpu->name.c_str();
+      // Dedup key over everything a hit reads, salted with the scene generation. The SDK shades hits from
+      // the buffers of a BLAS's first registration (as_service.cpp registerMesh, dedup hit), so a BLAS must
+      // never be shared with meshes of an earlier loadScene (freed buffers) or with other attributes.
+      uint64_t h = hashBytes(0xcbf29ce484222325ull, &a.sceneGeneration, sizeof a.sceneGeneration);
+      h = hashBytes(h, m.cpu->positions.data(), m.cpu->positions.size() * sizeof(glm::vec3));
+      h = hashBytes(h, m.cpu->indices.data(), m.cpu->indices.size() * sizeof(uint32_t));
+      h = hashBytes(h, m.cpu->normals.data(), m.cpu->normals.size() * sizeof(glm::vec3));
+      h = hashBytes(h, m.cpu->uvs.data(), m.cpu->uvs.size() * sizeof(glm::vec2));
+      d.contentKey = h ? h : 1;
     }
     auto handle = a.as->registerMesh(d);
     if (!handle) return se::Status::failure(rbError("registerMesh", handle.error()));
     a.meshes.push_back(handle.value());
   }
-  for (const se::Instance& inst : a.engine.scene().instances) {
+  for (const se::Instance& inst : scene.instances) {
     if (inst.mesh >= a.meshes.size() || a.meshes[inst.mesh].isNull()) continue;
     rb::Instance out;
     out.mesh = a.meshes[inst.mesh];
@@ -165,12 +367,34 @@ se::Status Adapter::syncScene() {
       for (int c = 0; c < 4; ++c) out.transform[r * 4 + c] = inst.transform[c][r];  // GLM is column-major
     }
     out.customIndex = inst.mesh;
+    out.material = meshes[inst.mesh].material;
     a.instances.push_back(out);
+  }
+  std::vector<TextureAverage> averages;
+  for (const se::TextureData& t : scene.textures) averages.push_back(averageOf(t));
+  a.materials.clear();
+  for (const se::Material& m : scene.materials) a.materials.push_back(toRbMaterial(m, averages));
+  if (a.materials.empty()) a.materials.emplace_back();
+  for (rb::Instance& inst : a.instances) inst.material = std::min<uint32_t>(inst.material, uint32_t(a.materials.size() - 1));
+  a.materialsDirty = true;
+  return se::Status::success();
+}
+
+se::Status Adapter::Impl::updateDenoisers() {
+  const bool wantShadow = shadows && settings.denoise && settings.sunAngularRadiusDegrees > 0.0f;
+  const bool wantAo = ao && settings.denoise;
+  if (!wantShadow) retire(shadowDenoiser);
+  if (!wantAo) retire(aoDenoiser);
+  for (auto [want, denoiser] : {std::pair{wantShadow, &shadowDenoiser}, {wantAo, &aoDenoiser}}) {
+    if (!want || *denoiser) continue;
+    auto d = rb::Denoiser::create(*ctx);
+    if (!d) return se::Status::failure(rbError("rb::Denoiser::create", d.error()));
+    *denoiser = std::move(d.value());
   }
   return se::Status::success();
 }
 
-rb::GBufferDesc Adapter::Impl::describePrepass(const se::PrepassHookInfo& info) const {
+rb::GBufferDesc Adapter::Impl::describePrepass(const se::PrepassHookInfo& info, bool shadingNormals) const {
   rb::GBufferDesc g;
   g.width = info.extent.width;
   g.height = info.extent.height;
@@ -179,9 +403,9 @@ rb::GBufferDesc Adapter::Impl::describePrepass(const se::PrepassHookInfo& info) 
   g.depthConvention = info.reversedZ ? rb::DepthConvention::ReversedZ : rb::DepthConvention::Standard;
   g.normalEncoding = rb::NormalEncoding::WorldFloat;
   g.geometricNormal = {info.geometricNormal.view, info.geometricNormal.layout};  // w = metallic, unused
-  if (config.normals == GBufferNormals::Shading) {
+  if (shadingNormals) {
     g.normal = {info.normalRoughness.view, info.normalRoughness.layout};
-    g.roughnessInNormalW = true;
+    g.roughnessInNormalW = true;  // perceptual roughness in normalRoughness.w
   } else {
     g.normal = g.geometricNormal;
   }
@@ -194,30 +418,89 @@ rb::GBufferDesc Adapter::Impl::describePrepass(const se::PrepassHookInfo& info) 
 void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& inputs) {
   Impl& a = *impl_;
   a.ctx->beginFrame();  // every frame, so deferred releases and statistics keep pace with the engine
-  if (!a.settings.enabled || a.config.effects == 0) return;
+  a.releaseRetired(false);
+  a.images = {};
+  if (!a.settings.enabled || a.effects() == 0) return;
   VkCommandBuffer cmd = info.commandBuffer;
+  if (se::Status s = a.updateDenoisers(); !s) return a.fail(s.error);
+  if (a.reflection && a.materialsDirty) {
+    if (rb::Status s = a.reflection->setMaterials(a.materials, {}); !s) return a.fail(rbError("setMaterials", s.error()));
+    a.materialsDirty = false;
+  }
 
   if (auto pending = a.as->recordPendingWork(cmd); !pending) return a.fail(rbError("recordPendingWork", pending.error()));
   rb::TlasBuildOptions options;
   for (int i = 0; i < 3; ++i) options.originOffset[i] = double(info.cameraPosition[i]);
+  options.writeShadingRecords = a.reflection != nullptr;  // vertex data + material per instance, for hits
   auto tlas = a.as->recordTlasBuild(cmd, a.instances, options);
   if (!tlas) return a.fail(rbError("recordTlasBuild", tlas.error()));
   a.tlas = tlas.value();
 
-  const rb::GBufferDesc gbuffer = a.describePrepass(info);
+  const FrameSettings& f = a.settings;
+  const rb::GBufferDesc gbuffer = a.describePrepass(info, a.config.normals == GBufferNormals::Shading);
   if (a.shadows) {
     rb::Light sun;
     sun.type = rb::LightType::Directional;
     for (int i = 0; i < 3; ++i) sun.direction[i] = info.sunDirection[i];
-    sun.angularRadiusDegrees = a.settings.sunAngularRadiusDegrees;
+    sun.angularRadiusDegrees = f.sunAngularRadiusDegrees;
     rb::ShadowSettings s;
-    s.raysPerPixel = a.settings.shadowRaysPerPixel;
-    if (rb::Status st = a.shadows->record(cmd, gbuffer, a.tlas, sun, s); !st) {
+    s.raysPerPixel = f.shadowRaysPerPixel;
+    if (rb::Status st = a.shadows->record(cmd, gbuffer, a.tlas, sun, s); !st)
       return a.fail(rbError("ShadowPass::record", st.error()));
+    const rb::ShadowOutputs& out = a.shadows->outputs();
+    a.images.shadowRaw = a.images.shadow = out.visibility;
+    inputs.sunVisibility = out.visibilityView;  // SHADER_READ_ONLY_OPTIMAL
+    if (a.shadowDenoiser) {
+      if (rb::Status st = a.shadowDenoiser->record(cmd, gbuffer, out.visibilityView, f.denoiser); !st)
+        return a.fail(rbError("Denoiser::record (shadows)", st.error()));
+      a.images.shadow = a.shadowDenoiser->outputs().denoised;
+      inputs.sunVisibility = a.shadowDenoiser->outputs().denoisedView;
     }
-    inputs.sunVisibility = a.shadows->outputs().visibilityView;  // SHADER_READ_ONLY_OPTIMAL
   }
-  // Next effects: ambient occlusion -> inputs.ambientOcclusion, reflections -> inputs.reflection.
+  if (a.ao) {
+    rb::AoSettings s;
+    s.raysPerPixel = f.aoRaysPerPixel;
+    s.range = f.aoRange;
+    s.estimator = f.aoEstimator;
+    if (rb::Status st = a.ao->record(cmd, gbuffer, a.tlas, s); !st) return a.fail(rbError("AoPass::record", st.error()));
+    const rb::AoOutputs& out = a.ao->outputs();
+    a.images.aoRaw = a.images.ao = out.ao;
+    inputs.ambientOcclusion = out.aoView;
+    if (a.aoDenoiser) {
+      if (rb::Status st = a.aoDenoiser->record(cmd, gbuffer, out.aoView, f.denoiser); !st)
+        return a.fail(rbError("Denoiser::record (AO)", st.error()));
+      a.images.ao = a.aoDenoiser->outputs().denoised;
+      inputs.ambientOcclusion = a.aoDenoiser->outputs().denoisedView;
+    }
+  }
+  if (a.reflection) {
+    // Roughness lives in normalRoughness.w, so reflections always read the shading G-buffer.
+    const rb::GBufferDesc shading =
+        a.config.normals == GBufferNormals::Shading ? gbuffer : a.describePrepass(info, true);
+    rb::ReflectionSettings s;
+    s.roughnessThreshold = f.reflectionRoughnessThreshold;
+    s.raysPerPixel = f.reflectionRaysPerPixel;
+    for (int i = 0; i < 3; ++i) {
+      s.sunDirection[i] = info.sunDirection[i];
+      s.sunRadiance[i] = f.sunRadiance[i];
+      s.skyRadiance[i] = f.skyColor[i];
+    }
+    s.ambientIntensity = f.ambientIntensity > 0.0f ? f.ambientIntensity : 1e-6f;  // 0 would mean the default
+    if (rb::Status st = a.reflection->record(cmd, shading, a.tlas, s); !st)
+      return a.fail(rbError("ReflectionPass::record", st.error()));
+    a.images.reflection = a.reflection->outputs().radiance;
+    inputs.reflection = a.reflection->outputs().radianceView;
+  }
+}
+
+void Adapter::releaseAfterIdle() {
+  impl_->releaseRetired(true);
+  impl_->ctx->releaseAfterIdle();
+}
+
+void Adapter::resetHistory() {
+  if (impl_->shadowDenoiser) impl_->shadowDenoiser->resetHistory();
+  if (impl_->aoDenoiser) impl_->aoDenoiser->resetHistory();
 }
 
 se::PrepassHook Adapter::prepassHook() {
@@ -229,6 +512,16 @@ const std::string& Adapter::lastError() const { return impl_->error; }
 rb::Context& Adapter::context() { return *impl_->ctx; }
 rb::AccelerationStructureService& Adapter::accelerationStructures() { return *impl_->as; }
 const rb::ShadowPass* Adapter::shadowPass() const { return impl_->shadows.get(); }
+const rb::AoPass* Adapter::aoPass() const { return impl_->ao.get(); }
+const rb::ReflectionPass* Adapter::reflectionPass() const { return impl_->reflection.get(); }
+const rb::Denoiser* Adapter::shadowDenoiser() const { return impl_->shadowDenoiser.get(); }
+const rb::Denoiser* Adapter::aoDenoiser() const { return impl_->aoDenoiser.get(); }
+EffectStats Adapter::stats() const {
+  const Impl& a = *impl_;
+  return {statsOf(a.shadows.get()), statsOf(a.shadowDenoiser.get()), statsOf(a.ao.get()), statsOf(a.aoDenoiser.get()),
+          statsOf(a.reflection.get())};
+}
+const FrameImages& Adapter::lastImages() const { return impl_->images; }
 const rb::TlasInfo& Adapter::lastTlas() const { return impl_->tlas; }
 uint32_t Adapter::sceneInstances() const { return uint32_t(impl_->instances.size()); }
 

@@ -1,5 +1,6 @@
-// raybridge-viewer: the sample engine in a GLFW window with the Raybridge adapter, toggling between the engine's
-// shadow maps and ray-traced shadows at run time. Combines exactly one platform side (the engine's GLFW Window)
+// raybridge-viewer: the sample engine in a GLFW window with the Raybridge adapter, toggling at run time between
+// the engine's own terms (shadow map, SSAO, reflection probe) and Raybridge's ray-traced shadows, AO and
+// reflections, and between presets. Combines exactly one platform side (the engine's GLFW Window)
 // with the adapter.
 #include <algorithm>
 #include <chrono>
@@ -24,16 +25,18 @@ struct Options {
   int width = 1280, height = 720;
   int frames = 0;  // 0 = until closed
   std::string screenshot;
+  rbAdapter::Preset preset = rbAdapter::Preset::High;
   bool validation = false;
 };
 
 const char* kUsage =
     "usage: raybridge-viewer [--scene FILE.gltf] [--width W] [--height H] [--frames N] [--screenshot FILE.png]\n"
-    "                        [--validation]\n";
+    "                        [--preset low|medium|high|ultra|shadows|ao|reflections] [--validation]\n";
 
 const char* kKeys =
     "keys: drag = orbit, scroll = zoom, W/A/S/D/Q/E = move (Shift = faster)\n"
-    "      M = mode raster <-> hybrid (Raybridge), H = shadows hard <-> soft (hybrid),\n"
+    "      M = mode raster (shadow map, SSAO, probe) <-> hybrid (Raybridge), P = next preset,\n"
+    "      H = shadows hard <-> soft, O = ambient occlusion on/off, R = reflections on/off, N = denoise on/off,\n"
     "      Left/Right = sun azimuth, Up/Down = sun elevation, Esc = quit\n";
 
 int fail(const std::string& message) {
@@ -51,7 +54,14 @@ bool parse(int argc, char** argv, Options& o) {
     else if (a == "--width" && hasValue) o.width = std::atoi(argv[++i]);
     else if (a == "--height" && hasValue) o.height = std::atoi(argv[++i]);
     else if (a == "--frames" && hasValue) o.frames = std::atoi(argv[++i]);
-    else {
+    else if (a == "--preset" && hasValue) {
+      auto p = rbAdapter::parsePreset(argv[++i]);
+      if (!p) {
+        std::fprintf(stderr, "raybridge-viewer: error: --preset: '%s' is not a preset\n%s", argv[i], kUsage);
+        return false;
+      }
+      o.preset = *p;
+    } else {
       std::fprintf(stderr, "raybridge-viewer: error: unknown option or missing value '%s'\n%s", a.c_str(), kUsage);
       return false;
     }
@@ -127,7 +137,8 @@ int main(int argc, char** argv) {
   auto adapter = rbAdapter::Adapter::create(engine, {});
   if (!adapter) return fail("adapter: " + adapter.error);
   rbAdapter::FrameSettings& rt = adapter.value->settings();
-  rt.shadowRaysPerPixel = 8;
+  rbAdapter::Preset preset = o.preset;
+  if (se::Status s = adapter.value->applyPreset(preset); !s) return fail("adapter: " + s.error);
   engine.setPrepassHook(adapter.value->prepassHook());
 
   se::FrameParams params;
@@ -145,9 +156,18 @@ int main(int argc, char** argv) {
   auto last = std::chrono::steady_clock::now();
   int frames = 0;
   auto printState = [&] {
-    std::printf("mode %s, shadows %s, sun azimuth %.0f elevation %.0f deg\n", rt.enabled ? "hybrid" : "raster",
-                rt.sunAngularRadiusDegrees > 0.0f ? "soft" : "hard", glm::degrees(sunAzimuth),
-                glm::degrees(sunElevation));
+    const rbAdapter::EffectSet fx = adapter.value->effects();
+    std::printf("mode %s, preset %s, effects [%s], shadows %s (%u rays), AO %u rays, denoise %s, sun azimuth %.0f "
+                "elevation %.0f deg\n",
+                rt.enabled ? "hybrid" : "raster", rbAdapter::toString(preset),
+                rbAdapter::effectsToString(fx).c_str(), rt.sunAngularRadiusDegrees > 0.0f ? "soft" : "hard",
+                rt.sunAngularRadiusDegrees > 0.0f ? rt.shadowRaysPerPixel : 1u, rt.aoRaysPerPixel,
+                rt.denoise ? "on" : "off", glm::degrees(sunAzimuth), glm::degrees(sunElevation));
+  };
+  auto toggle = [&](rbAdapter::Effect effect) {
+    if (se::Status s = adapter.value->setEffects(adapter.value->effects() ^ effect); !s)
+      std::fprintf(stderr, "raybridge-viewer: %s\n", s.error.c_str());
+    printState();
   };
   printState();
   while (!window.shouldClose()) {
@@ -158,7 +178,19 @@ int main(int argc, char** argv) {
     last = now;
 
     if (keys.pressed(GLFW_KEY_M)) rt.enabled = !rt.enabled, printState();
-    if (keys.pressed(GLFW_KEY_H)) rt.sunAngularRadiusDegrees = rt.sunAngularRadiusDegrees > 0.0f ? 0.0f : 2.0f, printState();
+    if (keys.pressed(GLFW_KEY_H)) {
+      rt.sunAngularRadiusDegrees = rt.sunAngularRadiusDegrees > 0.0f ? 0.0f : rbAdapter::kDefaultSoftSunRadiusDegrees;
+      if (rt.shadowRaysPerPixel < 2) rt.shadowRaysPerPixel = 4;
+      printState();
+    }
+    if (keys.pressed(GLFW_KEY_O)) toggle(rbAdapter::kEffectAo);
+    if (keys.pressed(GLFW_KEY_R)) toggle(rbAdapter::kEffectReflections);
+    if (keys.pressed(GLFW_KEY_N)) rt.denoise = !rt.denoise, printState();
+    if (keys.pressed(GLFW_KEY_P)) {
+      preset = rbAdapter::Preset((int(preset) + 1) % (int(rbAdapter::Preset::ReflectionsOnly) + 1));
+      if (se::Status s = adapter.value->applyPreset(preset); !s) return fail("adapter: " + s.error);
+      printState();
+    }
     const float sunSpeed = 0.8f * dt;
     if (keys.down(GLFW_KEY_LEFT)) sunAzimuth -= sunSpeed;
     if (keys.down(GLFW_KEY_RIGHT)) sunAzimuth += sunSpeed;
@@ -166,6 +198,10 @@ int main(int argc, char** argv) {
     if (keys.down(GLFW_KEY_DOWN)) sunElevation = std::max(sunElevation - sunSpeed, glm::radians(3.0f));
     params.sun.direction = {std::cos(sunElevation) * std::sin(sunAzimuth), std::sin(sunElevation),
                             std::cos(sunElevation) * std::cos(sunAzimuth)};
+    rt.lightingFrom(params);
+    // Raster mode: the engine's own counterparts of the enabled effects (its shadow map is always on).
+    params.ssao.enabled = !rt.enabled && (adapter.value->effects() & rbAdapter::kEffectAo);
+    params.reflectionProbe.enabled = !rt.enabled && (adapter.value->effects() & rbAdapter::kEffectReflections);
 
     double x, y;
     window.cursorPosition(x, y);
@@ -195,8 +231,11 @@ int main(int argc, char** argv) {
     if (!adapter.value->lastError().empty()) return fail("Raybridge: " + adapter.value->lastError());
     if (++frames % 60 == 0) {
       const se::PassTimings t = engine.lastTimings();
-      std::printf("GPU ms: shadow map %.1f prepass %.1f hook (Raybridge) %.1f lighting %.1f tonemap %.1f\n", t.shadowMs,
-                  t.prepassMs, t.hookMs, t.lightingMs, t.tonemapMs);
+      const rbAdapter::EffectStats es = adapter.value->stats();
+      std::printf("GPU ms: shadow map %.1f probe %.1f prepass %.1f ssao %.1f hook (Raybridge) %.1f [shadows %.1f+%.1f, "
+                  "AO %.1f+%.1f, reflections %.1f] lighting %.1f tonemap %.1f\n",
+                  t.shadowMs, t.probeMs, t.prepassMs, t.ssaoMs, t.hookMs, es.shadow.gpuMs, es.shadowDenoise.gpuMs,
+                  es.ao.gpuMs, es.aoDenoise.gpuMs, es.reflection.gpuMs, t.lightingMs, t.tonemapMs);
     }
     if (o.frames > 0 && frames >= o.frames) window.requestClose();
   }

@@ -1,0 +1,151 @@
+// raybridge-render end to end against an independent tracer: the demo scene rendered headless, its dumped
+// depth (distance along the primary ray through the pixel centre) and hard-shadow visibility compared with
+// Embree tracing the same camera rays and sun over the same geometry, with --gbuffer-normals geometric.
+#include <catch2/catch_test_macros.hpp>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImathBox.h>
+
+#include <sample_engine/procedural.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "embree_reference.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<float> readExrRed(const fs::path& path, int& width, int& height) {
+  Imf::InputFile file(path.string().c_str());
+  Imath::Box2i dw = file.header().dataWindow();
+  width = dw.max.x - dw.min.x + 1;
+  height = dw.max.y - dw.min.y + 1;
+  std::vector<float> red(size_t(width) * height);
+  Imf::FrameBuffer fb;
+  fb.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(red.data() - dw.min.x - dw.min.y * width),
+                            sizeof(float), sizeof(float) * width));
+  file.setFrameBuffer(fb);
+  file.readPixels(dw.min.y, dw.max.y);
+  return red;
+}
+
+int run(const std::string& args) {
+  const char* overridden = std::getenv("RAYBRIDGE_RENDER");
+  std::string command = "\"";
+  command += overridden && *overridden ? overridden : RAYBRIDGE_RENDER_EXE;
+  command += "\" --validation ";
+  command += args;
+  return std::system(command.c_str());
+}
+
+}  // namespace
+
+TEST_CASE("raybridge-render's depth and hard shadows match Embree on the demo scene", "[render][embree]") {
+  const uint32_t W = 192, H = 108;
+  const glm::vec3 eye(-9.0f, 6.0f, 14.0f), target(0.0f, 1.2f, 0.0f);
+  const float fovy = 50.0f;
+  const glm::vec3 toSun = glm::normalize(glm::vec3(0.45f, 0.6f, -0.5f));
+  const fs::path dir = fs::temp_directory_path() / "raybridge_render_conformance";
+  fs::remove_all(dir);
+  char camera[256], sun[128];
+  std::snprintf(camera, sizeof camera, "%g,%g,%g,%g,%g,%g,%g", eye.x, eye.y, eye.z, target.x, target.y, target.z, fovy);
+  std::snprintf(sun, sizeof sun, "%g,%g,%g", toSun.x, toSun.y, toSun.z);
+  REQUIRE(run("--mode hybrid --effects shadows --gbuffer-normals geometric --sun-radius 0 --dump --width " +
+              std::to_string(W) + " --height " + std::to_string(H) + " --camera " + camera + " --sun " + sun +
+              " --out " + dir.string()) == 0);
+  int w = 0, h = 0;
+  std::vector<float> depth = readExrRed(dir / "depth.exr", w, h);
+  REQUIRE((w == int(W) && h == int(H)));
+  std::vector<float> shadow = readExrRed(dir / "shadow.exr", w, h);
+
+  // The same geometry in Embree, flattened to world space.
+  sample_engine::Scene scene = sample_engine::makeDefaultDemoScene();
+  rbtest::EmbreeScene embree;
+  for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+    const sample_engine::MeshData& m = scene.meshes[scene.instances[i].mesh];
+    rbsamples::CpuMesh cpu;
+    for (const glm::vec3& p : m.positions) cpu.positions.insert(cpu.positions.end(), {p.x, p.y, p.z});
+    cpu.indices = m.indices;
+    if (cpu.indices.empty()) {
+      for (uint32_t v = 0; v < m.positions.size(); ++v) cpu.indices.push_back(v);
+    }
+    const glm::mat4& t = scene.instances[i].transform;  // column-major
+    float rowMajor[12];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) rowMajor[r * 4 + c] = t[c][r];
+    }
+    embree.addInstance(cpu, rowMajor, i);
+  }
+  embree.commit();
+
+  // The documented camera convention: up = +Y, right-handed, pixel (x, y) from the top-left, through its centre.
+  const glm::vec3 forward = glm::normalize(target - eye);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, glm::vec3(0, 1, 0)));
+  const glm::vec3 up = glm::cross(right, forward);
+  const float tanHalf = std::tan(glm::radians(fovy) * 0.5f), aspect = float(W) / float(H);
+  auto rayDir = [&](float px, float py) {
+    float nx = px / W * 2 - 1, ny = py / H * 2 - 1;
+    return glm::normalize(forward + nx * tanHalf * aspect * right - ny * tanHalf * up);
+  };
+  struct Ref {
+    rbtest::ReferenceHit hit;
+    int visible = -1;  // -1 sky
+  };
+  std::vector<Ref> ref(size_t(W) * H);
+  for (uint32_t y = 0; y < H; ++y) {
+    for (uint32_t x = 0; x < W; ++x) {
+      glm::vec3 d = rayDir(x + 0.5f, y + 0.5f);
+      Ref& r = ref[size_t(y) * W + x];
+      r.hit = embree.intersect(&eye.x, &d.x, 0.0f, 1e30f);
+      if (!r.hit.hit) continue;
+      glm::vec3 n = glm::normalize(glm::vec3(r.hit.geometricNormal[0], r.hit.geometricNormal[1], r.hit.geometricNormal[2]));
+      if (glm::dot(n, d) > 0) n = -n;
+      if (glm::dot(n, toSun) <= 0.0f) {
+        r.visible = 0;
+        continue;
+      }
+      glm::vec3 o = eye + d * r.hit.t + n * 1e-4f * std::max(1.0f, r.hit.t);
+      r.visible = embree.intersect(&o.x, &toSun.x, 0.0f, 1e30f).hit ? 0 : 1;
+    }
+  }
+  uint32_t compared = 0, depthAgree = 0, shadowAgree = 0, shadowed = 0, skyPixels = 0, skyZero = 0;
+  for (int y = 1; y + 1 < int(H); ++y) {
+    for (int x = 1; x + 1 < int(W); ++x) {
+      size_t i = size_t(y) * W + x;
+      if (!ref[i].hit.hit) {
+        ++skyPixels;
+        skyZero += depth[i] == 0.0f;
+        continue;
+      }
+      bool edge = false;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Ref& n = ref[size_t(y + dy) * W + size_t(x + dx)];
+          edge |= !n.hit.hit || n.hit.instanceId != ref[i].hit.instanceId || n.visible != ref[i].visible ||
+                  std::fabs(n.hit.t - ref[i].hit.t) > 0.1f * ref[i].hit.t;
+        }
+      }
+      if (edge) continue;
+      ++compared;
+      depthAgree += std::fabs(depth[i] - ref[i].hit.t) <= 2e-3f * ref[i].hit.t;
+      shadowAgree += (shadow[i] > 0.5f) == (ref[i].visible == 1);
+      shadowed += ref[i].visible == 0;
+    }
+  }
+  INFO("compared " << compared << " pixels, " << shadowed << " shadowed; depth agrees on " << depthAgree
+                   << ", shadow on " << shadowAgree);
+  REQUIRE(compared > W * H / 3);  // the rest is sky, silhouettes and shadow edges
+  REQUIRE(shadowed > 200);
+  CHECK(skyZero == skyPixels);  // depth.exr is 0 where nothing is hit
+  CHECK(double(depthAgree) / compared >= 0.999);
+  CHECK(double(shadowAgree) / compared >= 0.999);
+}
