@@ -8,6 +8,7 @@
 #include "reflection_common.glsl"
 
 layout(set = 0, binding = 0) uniform accelerationStructureEXT tlas;
+layout(set = 0, binding = 4) buffer RayCounters { uint rayCount[4096]; };
 layout(location = 0) rayPayloadInEXT ReflectionPayload payload;
 layout(location = 1) rayPayloadEXT float shadowHit;
 hitAttributeEXT vec2 barycentrics;
@@ -64,6 +65,9 @@ void main() {
     traceRayEXT(tlas, gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT,
                 0xFF, 0, 0, 1, origin, 0.0, toSun, 1e30, 1);
     sunVisible = shadowHit == 0.0 ? 1.0 : 0.0;
+    // Shadow rays from hits are the pass's rays too.
+    uvec2 pixel = gl_LaunchIDEXT.xy;
+    atomicAdd(rayCount[(pixel.x & 63u) | ((pixel.y & 63u) << 6)], 1u);
   }
   vec3 diffuse = base.rgb * (1.0 - metallic) / RB_PI;
   vec3 specularColour = mix(vec3(0.04), base.rgb, metallic);

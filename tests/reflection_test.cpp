@@ -124,14 +124,30 @@ TEST_CASE("a mirror reflects a coloured box where Embree says it should", "[refl
     CHECK(red == boxInMirror);
     CHECK(sky == skyInMirror);
     CHECK(boxTraced == 0);
-    // Rays are counted: exactly one per pixel that traced (every floor pixel, no box pixel).
-    uint64_t tracedPixels = 0, allFloor = 0;
+    // Rays are counted: one reflection ray per mirror pixel (every floor pixel, no box pixel), plus a shadow
+    // ray where a reflection ray hits a box face that faces the sun.
+    uint64_t tracedPixels = 0, allFloor = 0, shadowRays = 0;
+    const glm::dvec3 toSun = glm::normalize(glm::dvec3(settings.sunDirection[0], settings.sunDirection[1],
+                                                       settings.sunDirection[2]));
     for (size_t i = 0; i < run.radiance.size(); ++i) {
       tracedPixels += run.radiance[i].a != 0.0f;
-      allFloor += cpu.hit[i] && cpu.instance[i] == 0;
+      if (!cpu.hit[i] || cpu.instance[i] != 0) continue;
+      ++allFloor;
+      glm::dvec3 v = glm::normalize(cpu.position[i] - view.eye);
+      glm::dvec3 r = glm::reflect(v, glm::dvec3(0, 1, 0));
+      glm::dvec3 o = cpu.position[i] + glm::dvec3(0, 1e-4, 0);
+      float of[3] = {float(o.x), float(o.y), float(o.z)}, d[3] = {float(r.x), float(r.y), float(r.z)};
+      ReferenceHit h = embree.intersect(of, d, 0.0f, 1e30f);
+      if (!h.hit) continue;
+      glm::dvec3 n = glm::normalize(glm::dvec3(h.geometricNormal[0], h.geometricNormal[1], h.geometricNormal[2]));
+      if (glm::dot(n, r) > 0) n = -n;
+      shadowRays += glm::dot(n, toSun) > 0.0;
     }
     CHECK(tracedPixels == allFloor);
-    CHECK(run.stats.rays == tracedPixels);
+    INFO("rays " << run.stats.rays << ", mirror pixels " << tracedPixels << ", expected shadow rays " << shadowRays);
+    REQUIRE(shadowRays > 20);
+    CHECK(double(run.stats.rays) >= double(tracedPixels + shadowRays) * 0.98);
+    CHECK(double(run.stats.rays) <= double(tracedPixels + shadowRays) * 1.02);
     CHECK(floorPixels > 0);
     CHECK(boxPixels > 0);
   }

@@ -40,7 +40,8 @@ AccelerationStructureService::Impl::Impl(Context& context, const AsServiceDesc& 
   if (desc.scratchBudgetBytes == 0) desc.scratchBudgetBytes = kDefaultScratchBudget;
   if (desc.storageBlockBytes == 0) desc.storageBlockBytes = kDefaultBlockBytes;
   tlasSlots.resize(c.desc.framesInFlight);
-  entries.emplace_back();  // index 0 is never used, so a zero handle is always the null handle
+  entries.emplace_back();        // index 0 is never used, so a zero handle is always the null handle
+  registrations.emplace_back();
 }
 
 AccelerationStructureService::Impl::~Impl() {
@@ -113,23 +114,24 @@ Result<VkAccelerationStructureKHR> AccelerationStructureService::Impl::createAs(
   return as;
 }
 
-Result<BlasEntry*> AccelerationStructureService::Impl::lookup(MeshHandle h, const char* what) {
+Result<Registration*> AccelerationStructureService::Impl::lookup(MeshHandle h, const char* what) {
   if (h.isNull()) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS, std::string(what) + ": the mesh handle is null"};
   }
-  if (h.index >= entries.size() || entries[h.index].generation != h.generation ||
-      entries[h.index].state == BlasState::Free) {
+  if (h.index >= registrations.size() || registrations[h.index].generation != h.generation ||
+      !registrations[h.index].live) {
     return Error{ErrorCode::StaleHandle, VK_SUCCESS,
                  std::string(what) + ": mesh handle {index " + std::to_string(h.index) + ", generation " +
-                     std::to_string(h.generation) + "} refers to a mesh that was destroyed or evicted"};
+                     std::to_string(h.generation) +
+                     "} was released (releaseMesh) or never registered; register the mesh again to use it"};
   }
-  BlasEntry& e = entries[h.index];
-  if (e.refCount == 0) {
-    return Error{ErrorCode::StaleHandle, VK_SUCCESS,
-                 std::string(what) + ": " + meshName(e, h.index) +
-                     " was released (releaseMesh); register it again to use it"};
-  }
-  return &e;
+  return &registrations[h.index];
+}
+
+uint32_t AccelerationStructureService::Impl::liveRegistrations() const {
+  uint32_t n = 0;
+  for (const Registration& r : registrations) n += r.live ? 1u : 0u;
+  return n;
 }
 
 void AccelerationStructureService::Impl::destroyEntry(uint32_t index) {
@@ -202,14 +204,37 @@ Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& de
   Impl& s = *impl_;
   Result<ValidatedMesh> v = validateMesh(desc, s.c.vk, s.c.desc.physicalDevice, s.c.info.maxPrimitiveCount);
   if (!v) return v.error();
+  // The registration itself: its own handle, buffers and lifetime, whatever BLAS it ends up sharing.
+  auto addRegistration = [&](uint32_t blas) {
+    uint32_t r;
+    if (!s.freeRegistrations.empty()) {
+      r = s.freeRegistrations.back();
+      s.freeRegistrations.pop_back();
+    } else {
+      r = static_cast<uint32_t>(s.registrations.size());
+      s.registrations.emplace_back();
+    }
+    Registration& reg = s.registrations[r];
+    reg.generation = reg.generation + 1 == 0 ? 1 : reg.generation + 1;
+    reg.live = true;
+    reg.blas = blas;
+    reg.mesh = v.value();
+    ++s.entries[blas].refCount;
+    ++s.counters.registrations;
+    return MeshHandle{r, reg.generation};
+  };
   bool dedupable = v->desc.role == MeshRole::Static || v->desc.contentKey != 0;
   if (dedupable) {
     if (auto it = s.byKey.find(v->key); it != s.byKey.end()) {
-      BlasEntry& e = s.entries[it->second];
-      ++e.refCount;
       ++s.counters.dedupHits;
-      ++s.counters.registrations;
-      return MeshHandle{it->second, e.generation};
+      BlasEntry& e = s.entries[it->second];
+      MeshHandle h = addRegistration(it->second);
+      // A cached BLAS (all registrations released) reads from the new one's buffers from now on.
+      if (e.refCount == 1) {
+        e.mesh = v.value();
+        e.sourceRegistration = h.index;
+      }
+      return h;
     }
   }
   BlasEntry e;
@@ -241,25 +266,42 @@ Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& de
     e.generation = 1;
   }
   e.state = BlasState::Queued;
-  e.refCount = 1;
+  e.refCount = 0;
   s.entries[index] = e;
   s.queue.push_back(index);
   if (dedupable) s.byKey[e.key] = index;
   s.reservedBytes += need;
-  ++s.counters.registrations;
-  return MeshHandle{index, e.generation};
+  MeshHandle h = addRegistration(index);
+  s.entries[index].sourceRegistration = h.index;
+  return h;
 }
 
 Status AccelerationStructureService::releaseMesh(MeshHandle mesh) {
   Impl& s = *impl_;
-  Result<BlasEntry*> e = s.lookup(mesh, "releaseMesh");
-  if (!e) return e.error();
-  BlasEntry& entry = *e.value();
-  if (--entry.refCount > 0) return {};
-  bool cacheable = s.byKey.count(entry.key) && s.byKey[entry.key] == mesh.index;
+  Result<Registration*> r = s.lookup(mesh, "releaseMesh");
+  if (!r) return r.error();
+  const uint32_t index = r.value()->blas;
+  r.value()->live = false;
+  r.value()->mesh = ValidatedMesh{};
+  s.freeRegistrations.push_back(mesh.index);
+  BlasEntry& entry = s.entries[index];
+  if (--entry.refCount > 0) {
+    if (entry.sourceRegistration == mesh.index) {
+      // Builds and refits must not read the released registration's buffers: take another live one's.
+      for (uint32_t i = 1; i < s.registrations.size(); ++i) {
+        if (s.registrations[i].live && s.registrations[i].blas == index) {
+          entry.mesh = s.registrations[i].mesh;
+          entry.sourceRegistration = i;
+          break;
+        }
+      }
+    }
+    return {};
+  }
+  bool cacheable = s.byKey.count(entry.key) && s.byKey[entry.key] == index;
   if (entry.state == BlasState::Queued || !cacheable) {
     // Nothing to gain from keeping it: never built, or (dynamic) no registration can ever match it again.
-    s.destroyEntry(mesh.index);
+    s.destroyEntry(index);
   } else {
     entry.releasedOrder = ++s.releaseCounter;
   }
@@ -268,14 +310,15 @@ Status AccelerationStructureService::releaseMesh(MeshHandle mesh) {
 
 Status AccelerationStructureService::updateMesh(MeshHandle mesh) {
   Impl& s = *impl_;
-  Result<BlasEntry*> e = s.lookup(mesh, "updateMesh");
-  if (!e) return e.error();
-  if (e.value()->mesh.desc.role != MeshRole::Dynamic) {
+  Result<Registration*> r = s.lookup(mesh, "updateMesh");
+  if (!r) return r.error();
+  BlasEntry& e = s.entries[r.value()->blas];
+  if (e.mesh.desc.role != MeshRole::Dynamic) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
-                 "updateMesh: " + meshName(*e.value(), mesh.index) +
+                 "updateMesh: " + meshName(e, r.value()->blas) +
                      " was registered with MeshRole::Static; register deforming meshes as MeshRole::Dynamic"};
   }
-  if (e.value()->state == BlasState::Built) e.value()->needsRefit = true;
+  if (e.state == BlasState::Built) e.needsRefit = true;
   return {};
 }
 
@@ -551,31 +594,32 @@ Result<uint32_t> AccelerationStructureService::recordPendingWork(VkCommandBuffer
 }
 
 Result<bool> AccelerationStructureService::isBuilt(MeshHandle mesh) const {
-  Result<BlasEntry*> e = impl_->lookup(mesh, "isBuilt");
-  if (!e) return e.error();
-  return e.value()->state == BlasState::Built;
+  Result<Registration*> r = impl_->lookup(mesh, "isBuilt");
+  if (!r) return r.error();
+  return impl_->entries[r.value()->blas].state == BlasState::Built;
 }
 
 Result<VkDeviceAddress> AccelerationStructureService::blasAddress(MeshHandle mesh) const {
-  Result<BlasEntry*> e = impl_->lookup(mesh, "blasAddress");
-  if (!e) return e.error();
-  if (e.value()->state != BlasState::Built) {
+  Result<Registration*> r = impl_->lookup(mesh, "blasAddress");
+  if (!r) return r.error();
+  const BlasEntry& e = impl_->entries[r.value()->blas];
+  if (e.state != BlasState::Built) {
     return Error{ErrorCode::NotReady, VK_SUCCESS, "blasAddress: the mesh's BLAS build has not been recorded yet"};
   }
-  return e.value()->address;
+  return e.address;
 }
 
 AsStats AccelerationStructureService::stats() const {
   Impl& s = *impl_;
   s.resolveBatches();
   AsStats out = s.counters;
-  out.meshHandles = out.blasCount = out.blasQueued = 0;
+  out.meshHandles = s.liveRegistrations();
+  out.blasCount = out.blasQueued = 0;
   out.triangles = out.blasBytes = out.blasBytesBeforeCompaction = 0;
   for (uint32_t i = 1; i < s.entries.size(); ++i) {
     const BlasEntry& e = s.entries[i];
     if (e.state == BlasState::Free) continue;
     ++out.blasCount;
-    if (e.refCount > 0) ++out.meshHandles;
     if (e.state == BlasState::Queued) {
       ++out.blasQueued;
       continue;

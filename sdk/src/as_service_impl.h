@@ -24,9 +24,12 @@ enum class BlasState : uint8_t {
 struct BlasEntry {
   uint32_t generation = 0;
   BlasState state = BlasState::Free;
-  uint32_t refCount = 0;
+  uint32_t refCount = 0;  // live registrations sharing this BLAS
   uint64_t key = 0;
+  // The buffers builds and refits read: those of `sourceRegistration`, a live registration, switched to
+  // another one when it is released, so a BLAS never reads buffers their owner may have freed.
   ValidatedMesh mesh;
+  uint32_t sourceRegistration = 0;
   VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
   VkAccelerationStructureKHR as = VK_NULL_HANDLE;
   StorageAllocation storage;
@@ -40,6 +43,15 @@ struct BlasEntry {
   uint64_t lastUsedFrame = 0;   // frame of the last TLAS that referenced it
   uint64_t lastTlasSerial = 0;  // serial of the last TLAS that referenced it
   uint64_t releasedOrder = 0;   // LRU order among released entries
+};
+
+// One registerMesh call: what a MeshHandle names. Registrations of equal geometry share one BlasEntry but
+// keep their own buffers and attributes (read by shading records) and their own lifetime.
+struct Registration {
+  uint32_t generation = 0;
+  bool live = false;
+  uint32_t blas = 0;  // BlasEntry index
+  ValidatedMesh mesh;
 };
 
 // One recorded build batch whose queries resolve once its frame is done.
@@ -74,6 +86,8 @@ struct AccelerationStructureService::Impl {
   AsStorageAllocator storage;
   std::vector<BlasEntry> entries;
   std::vector<uint32_t> freeSlots;
+  std::vector<Registration> registrations;  // index 0 unused: a zero handle is the null handle
+  std::vector<uint32_t> freeRegistrations;
   std::unordered_map<uint64_t, uint32_t> byKey;
   std::deque<uint32_t> queue;  // entry indices waiting for a build, in registration order
   GpuBuffer scratch;           // persistent build scratch (scratchBudgetBytes)
@@ -90,7 +104,9 @@ struct AccelerationStructureService::Impl {
   Impl(Context& context, const AsServiceDesc& d);
   ~Impl();
 
-  Result<BlasEntry*> lookup(MeshHandle h, const char* what);
+  // The live registration a handle names (errors name the call, `what`).
+  Result<Registration*> lookup(MeshHandle h, const char* what);
+  uint32_t liveRegistrations() const;
   void destroyEntry(uint32_t index);  // retires its AS and storage; frees the slot
   Status makeRoom(VkDeviceSize bytes, const std::string& forWhat);
   void resolveBatches();

@@ -90,6 +90,7 @@ Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context)
   const VkShaderStageFlags hit = VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR;
   p.bindings = PassCore::commonBindings();
   p.bindings[0].stageFlags |= hit;  // shadow rays from hits
+  p.bindings[4].stageFlags |= hit;  // and their count
   p.bindings.push_back({5, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
   p.bindings.push_back({6, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
   p.bindings.push_back({7, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit, nullptr});

@@ -75,8 +75,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   for (uint32_t i = 0; i < count; ++i) {
     const Instance& in = instances[i];
     const MeshHandle h = in.mesh;
-    if (h.isNull() || h.index >= s.entries.size() || s.entries[h.index].generation != h.generation ||
-        s.entries[h.index].state == BlasState::Free || s.entries[h.index].refCount == 0) {
+    if (h.isNull() || h.index >= s.registrations.size() || s.registrations[h.index].generation != h.generation ||
+        !s.registrations[h.index].live) {
       return Error{ErrorCode::StaleHandle, VK_SUCCESS,
                    "recordTlasBuild: instances[" + std::to_string(i) + "] refers to " +
                        (h.isNull() ? std::string("the null mesh handle")
@@ -104,7 +104,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   const bool rebase = options.originOffset[0] != 0.0 || options.originOffset[1] != 0.0 || options.originOffset[2] != 0.0;
   for (uint32_t i = 0; i < count; ++i) {
     const Instance& in = instances[i];
-    BlasEntry& e = s.entries[in.mesh.index];
+    const Registration& reg = s.registrations[in.mesh.index];
+    BlasEntry& e = s.entries[reg.blas];
     if (e.state != BlasState::Built) {
       ++skipped;
       continue;
@@ -123,7 +124,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     inst.flags = in.flags;
     inst.accelerationStructureReference = e.address;
     if (records) {
-      const MeshDesc& m = e.mesh.desc;
+      const MeshDesc& m = reg.mesh.desc;  // this registration's own buffers and attributes
       ShadingRecord r{};
       r.positions = m.vertexAddress;
       r.indices = m.indexAddress;

@@ -35,7 +35,7 @@ struct Material {
 
 struct ReflectionSettings {
   float roughnessThreshold = 0.0f;  // 0 = 0.3: rougher surfaces trace no reflection ray
-  uint32_t raysPerPixel = 0;        // 0 = 1 (glossy surfaces are noisy at 1; denoise or accumulate)
+  uint32_t raysPerPixel = 0;        // glossy pixels; 0 = 1 (noisy: denoise or accumulate). Mirrors trace one.
   float sunDirection[3] = {0.0f, 1.0f, 0.0f};  // towards the sun
   float sunRadiance[3] = {3.0f, 3.0f, 3.0f};   // linear, the sun's colour times intensity
   float skyRadiance[3] = {0.45f, 0.62f, 0.9f}; // linear, returned by rays that escape
