@@ -170,11 +170,14 @@ class AccelerationStructureService {
                                                                       const AsServiceDesc& desc = {});
   ~AccelerationStructureService();
 
-  // Validates the description and queues a build (or returns the existing BLAS's handle on a dedup hit, with
-  // its reference count raised). Cheap: no GPU work happens until recordPendingWork().
+  // Validates the description and queues a build, or, on a dedup hit, shares the existing BLAS. Every call
+  // returns a handle of its own: registrations that share a BLAS keep their own buffers, attributes and
+  // lifetime. Cheap: no GPU work happens until recordPendingWork().
   Result<MeshHandle> registerMesh(const MeshDesc& desc);
-  // Drops one reference. At zero the BLAS stays cached (a later identical registration revives it) until the
-  // memory budget evicts it or the service is destroyed. Further use of the handle is an error.
+  // Ends this registration; its buffers may be freed once the frames in flight are done (a queued build then
+  // reads another live registration's buffers). When no registration of a BLAS is left, the BLAS stays
+  // cached (a later identical registration revives it) until the memory budget evicts it or the service is
+  // destroyed. Further use of the handle is an error.
   Status releaseMesh(MeshHandle mesh);
   // A dynamic mesh's vertices changed: refit its BLAS in the next recordPendingWork().
   Status updateMesh(MeshHandle mesh);
