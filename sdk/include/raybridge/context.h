@@ -26,12 +26,9 @@ struct ContextDesc {
   PFN_vkGetInstanceProcAddr getInstanceProcAddr = nullptr;   // required; every Vulkan function is loaded from it
   uint32_t framesInFlight = 0;                               // 0 = 2; at most 8
   const VkAllocationCallbacks* allocationCallbacks = nullptr;  // nullptr = the driver's allocator
-  // Optional second queue for asynchronous BLAS rebuilds of deforming meshes. VK_NULL_HANDLE = none: such
-  // rebuilds are recorded into the engine's frame command buffer instead (always the case on lavapipe, which
-  // has one queue family).
-  VkQueue asyncComputeQueue = VK_NULL_HANDLE;
-  uint32_t asyncComputeQueueFamily = 0;  // family of asyncComputeQueue; ignored when it is VK_NULL_HANDLE
-  uint32_t mainQueueFamily = 0;          // family of the engine's queue that executes Raybridge's recordings
+  // Family of the engine's queue that executes Raybridge's recordings (for its timestamp bits). Refits of
+  // deforming meshes are recorded into the same command buffers as everything else.
+  uint32_t mainQueueFamily = 0;
 };
 
 // Device extensions the engine must enable on its VkDevice for Raybridge (Vulkan 1.2 or newer).
