@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <span>
 
 namespace rbAdapter {
 
@@ -30,62 +31,55 @@ std::string rbError(const char* what, const rb::Error& e) {
 
 void copyMatrix(const glm::mat4& m, float out[16]) { std::memcpy(out, &m[0][0], 16 * sizeof(float)); }
 
-// FNV-1a over a byte range, chained.
-uint64_t hashBytes(uint64_t h, const void* data, size_t bytes) {
-  const auto* p = static_cast<const uint8_t*>(data);
-  for (size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-  return h;
-}
-
 float srgbToLinear(uint8_t v) {
   const float c = float(v) / 255.0f;
   return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
-// Average of a texture: .rgb decoded from sRGB (base colour, emissive) and raw .rgb (metallic-roughness).
-struct TextureAverage {
-  glm::vec3 srgbDecoded{1.0f};
-  glm::vec3 linear{1.0f};
-};
-
-TextureAverage averageOf(const se::TextureData& t) {
-  TextureAverage a;
+// rb::Material has no emissive texture: an emissive texture is folded into the factor as its average texel
+// (decoded from sRGB), so e.g. a mostly black emissive mask does not make the whole surface glow in reflections.
+glm::vec3 averageSrgbDecoded(const se::TextureData& t) {
   const size_t pixels = size_t(t.width) * t.height;
-  if (pixels == 0 || t.rgba8.size() < pixels * 4) return a;
-  glm::dvec3 decoded(0.0), raw(0.0);
-  for (size_t i = 0; i < pixels; ++i) {
-    const uint8_t* p = &t.rgba8[i * 4];
-    for (int c = 0; c < 3; ++c) {
-      decoded[c] += srgbToLinear(p[c]);
-      raw[c] += p[c] / 255.0;
-    }
-  }
-  a.srgbDecoded = glm::vec3(decoded / double(pixels));
-  a.linear = glm::vec3(raw / double(pixels));
-  return a;
+  if (pixels == 0 || t.rgba8.size() < pixels * 4) return glm::vec3(1.0f);
+  glm::dvec3 sum(0.0);
+  for (size_t i = 0; i < pixels; ++i)
+    for (int c = 0; c < 3; ++c) sum[c] += srgbToLinear(t.rgba8[i * 4 + size_t(c)]);
+  return glm::vec3(sum / double(pixels));
 }
 
-// The engine's glTF material as reflection hits shade it. The engine exposes no texture views, so a texture
-// contributes its average (multiplied into the factor, as glTF multiplies texel and factor).
-rb::Material toRbMaterial(const se::Material& m, const std::vector<TextureAverage>& averages) {
-  auto average = [&](int index) -> const TextureAverage* {
-    return index >= 0 && size_t(index) < averages.size() ? &averages[size_t(index)] : nullptr;
+// The engine's materials as reflection hits shade them, and the texture table they index: base-colour textures
+// as the engine's sRGB views (sampling decodes to linear), metallic-roughness textures as its UNORM views
+// (G = roughness, B = metallic), each (texture, view) once. All in SHADER_READ_ONLY_OPTIMAL until the next
+// loadScene (Engine::textures()).
+void convertMaterials(const se::Scene& scene, std::span<const se::GpuTexture> gpuTextures,
+                      std::vector<rb::Material>& materials, std::vector<VkImageView>& views) {
+  materials.clear();
+  views.clear();
+  std::vector<uint32_t> slot(gpuTextures.size() * 2, rb::kNoTexture);  // [2 * texture + (srgb ? 0 : 1)]
+  auto textureSlot = [&](int index, bool srgb) -> uint32_t {
+    if (index < 0 || size_t(index) >= gpuTextures.size()) return rb::kNoTexture;
+    const VkImageView view = srgb ? gpuTextures[size_t(index)].srgbView : gpuTextures[size_t(index)].unormView;
+    if (!view) return rb::kNoTexture;  // no texels: the engine samples white, as the factor alone does
+    uint32_t& s = slot[size_t(index) * 2 + (srgb ? 0 : 1)];
+    if (s == rb::kNoTexture) {
+      s = uint32_t(views.size());
+      views.push_back(view);
+    }
+    return s;
   };
-  rb::Material out;
-  glm::vec4 base = m.baseColorFactor;
-  if (const TextureAverage* a = average(m.baseColorTexture)) base *= glm::vec4(a->srgbDecoded, 1.0f);
-  float metallic = m.metallicFactor, roughness = m.roughnessFactor;
-  if (const TextureAverage* a = average(m.metallicRoughnessTexture)) {
-    roughness *= a->linear.g;  // glTF: G = roughness, B = metallic
-    metallic *= a->linear.b;
+  for (const se::Material& m : scene.materials) {
+    rb::Material out;
+    for (int c = 0; c < 4; ++c) out.baseColor[c] = m.baseColorFactor[c];
+    out.metallic = std::clamp(m.metallicFactor, 0.0f, 1.0f);
+    out.roughness = std::clamp(m.roughnessFactor, 0.0f, 1.0f);
+    out.baseColorTexture = textureSlot(m.baseColorTexture, true);
+    out.metallicRoughnessTexture = textureSlot(m.metallicRoughnessTexture, false);
+    glm::vec3 emissive = m.emissiveFactor;
+    if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < scene.textures.size())
+      emissive *= averageSrgbDecoded(scene.textures[size_t(m.emissiveTexture)]);
+    for (int c = 0; c < 3; ++c) out.emissive[c] = emissive[c];
+    materials.push_back(out);
   }
-  glm::vec3 emissive = m.emissiveFactor;
-  if (const TextureAverage* a = average(m.emissiveTexture)) emissive *= a->srgbDecoded;
-  for (int c = 0; c < 4; ++c) out.baseColor[c] = base[c];
-  for (int c = 0; c < 3; ++c) out.emissive[c] = emissive[c];
-  out.metallic = std::clamp(metallic, 0.0f, 1.0f);
-  out.roughness = std::clamp(roughness, 0.0f, 1.0f);
-  return out;
 }
 
 rb::PassStats statsOf(const auto* pass) { return pass ? pass->stats() : rb::PassStats{}; }
@@ -197,8 +191,8 @@ struct Adapter::Impl {
   std::vector<rb::MeshHandle> meshes;  // parallel to engine.meshes(); null for empty meshes
   std::vector<rb::Instance> instances;
   std::vector<rb::Material> materials;  // the engine's materials, converted
+  std::vector<VkImageView> textureViews;  // what rb::Material texture indices index (engine-owned views)
   bool materialsDirty = true;           // not yet given to the reflection pass
-  uint64_t sceneGeneration = 0;
   rb::TlasInfo tlas;
   FrameImages images;
   std::string error;
@@ -310,7 +304,6 @@ se::Status Adapter::syncScene() {
   }
   a.meshes.clear();
   a.instances.clear();
-  ++a.sceneGeneration;
   const se::Scene& scene = a.engine.scene();
   const std::span<const se::GpuMesh> meshes = a.engine.meshes();
   for (size_t i = 0; i < meshes.size(); ++i) {
@@ -345,15 +338,6 @@ se::Status Adapter::syncScene() {
       d.hostVertices = m.cpu->positions.data();
       d.hostIndices = m.cpu->indices.empty() ? nullptr : m.cpu->indices.data();
       d.debugName = m.cpu->name.c_str();
-      // Dedup key over everything a hit reads, salted with the scene generation. The SDK shades hits from
-      // the buffers of a BLAS's first registration (as_service.cpp registerMesh, dedup hit), so a BLAS must
-      // never be shared with meshes of an earlier loadScene (freed buffers) or with other attributes.
-      uint64_t h = hashBytes(0xcbf29ce484222325ull, &a.sceneGeneration, sizeof a.sceneGeneration);
-      h = hashBytes(h, m.cpu->positions.data(), m.cpu->positions.size() * sizeof(glm::vec3));
-      h = hashBytes(h, m.cpu->indices.data(), m.cpu->indices.size() * sizeof(uint32_t));
-      h = hashBytes(h, m.cpu->normals.data(), m.cpu->normals.size() * sizeof(glm::vec3));
-      h = hashBytes(h, m.cpu->uvs.data(), m.cpu->uvs.size() * sizeof(glm::vec2));
-      d.contentKey = h ? h : 1;
     }
     auto handle = a.as->registerMesh(d);
     if (!handle) return se::Status::failure(rbError("registerMesh", handle.error()));
@@ -370,10 +354,7 @@ se::Status Adapter::syncScene() {
     out.material = meshes[inst.mesh].material;
     a.instances.push_back(out);
   }
-  std::vector<TextureAverage> averages;
-  for (const se::TextureData& t : scene.textures) averages.push_back(averageOf(t));
-  a.materials.clear();
-  for (const se::Material& m : scene.materials) a.materials.push_back(toRbMaterial(m, averages));
+  convertMaterials(scene, a.engine.textures(), a.materials, a.textureViews);
   if (a.materials.empty()) a.materials.emplace_back();
   for (rb::Instance& inst : a.instances) inst.material = std::min<uint32_t>(inst.material, uint32_t(a.materials.size() - 1));
   a.materialsDirty = true;
@@ -424,7 +405,7 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   VkCommandBuffer cmd = info.commandBuffer;
   if (se::Status s = a.updateDenoisers(); !s) return a.fail(s.error);
   if (a.reflection && a.materialsDirty) {
-    if (rb::Status s = a.reflection->setMaterials(a.materials, {}); !s) return a.fail(rbError("setMaterials", s.error()));
+    if (rb::Status s = a.reflection->setMaterials(a.materials, a.textureViews); !s) return a.fail(rbError("setMaterials", s.error()));
     a.materialsDirty = false;
   }
 

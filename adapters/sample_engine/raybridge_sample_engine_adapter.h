@@ -14,8 +14,9 @@
 //      AO          -> rb::AoPass [-> rb::Denoiser]                -> LightingInputs::ambientOcclusion
 //      reflections -> rb::ReflectionPass (engine materials)       -> LightingInputs::reflection
 //  [x] Quality presets (Low / Medium / High / Ultra and single-effect presets), see presetDesc().
-//  [ ] Material textures in reflection hits: the engine exposes no texture views, so each texture is folded
-//      into its material's factors as its average (base colour, metallic-roughness, emissive).
+//  [x] Material textures in reflection hits: base colour (the engine's sRGB views) and metallic-roughness
+//      (its UNORM views) from Engine::textures(). rb::Material has no emissive texture: an emissive texture
+//      is folded into the emissive factor as its average texel.
 //
 // Where it sits in the engine's frame (everything is recorded into the engine's command buffer; the adapter
 // never submits and never waits, except in its destructor and in releaseAfterIdle's caller):
@@ -93,8 +94,8 @@ struct FrameSettings {
   float aoRange = 0.0f;                  // world units; 0 = 1.0
   rb::AoEstimator aoEstimator = rb::AoEstimator::Binary;
   // Reflections.
-  // Default 0.5 (the SDK's is 0.3): the engine's lighting treats untraced pixels as receiving no reflected
-  // light, so metals rougher than the threshold would lose their environment term entirely.
+  // Default 0.5 (the SDK's is 0.3), so the demo's brushed copper (0.45) gets traced reflections. Untraced
+  // pixels (alpha 0 in the reflection image) keep the engine's own environment term (sky or probe).
   float reflectionRoughnessThreshold = 0.5f;
   uint32_t reflectionRaysPerPixel = 4;  // glossy pixels; the reflection is not denoised (0 = 1)
   // Light that reflection hits are shaded with. The hook does not receive it from the engine: set it from

@@ -1,7 +1,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Forward PBR lighting: GGX specular + Lambert diffuse for the sun, constant-sky ambient, with optional
-// external sun visibility / AO / reflection images replacing the engine's own terms. Also used (depth LESS)
+// external sun visibility / AO / reflection images replacing the engine's own terms (the reflection only
+// where its alpha says it covers the pixel). Also used (depth LESS)
 // to capture the reflection probe, with frame.probe.x = 0 and no screen-space inputs.
 #include "common.glsl"
 #include "surface.glsl"
@@ -56,14 +57,19 @@ void main() {
   vec3 ambient = frame.sky.rgb * frame.sky.w;
   color += ambient * s.baseColor * (1.0 - s.metallic) * ao;  // Lambert under a uniform sky
   vec3 specularWeight = environmentBrdf(f0, s.roughness, nDotV);
-  // External reflection > reflection probe > constant sky. The probe is sharp at mip 0 and blurrier with
-  // roughness (box-filtered mips: an approximation of the GGX lobe, good enough for a fallback).
+  // The engine's own environment term: the reflection probe when in use, else the constant sky. The probe
+  // is sharp at mip 0 and blurrier with roughness (box-filtered mips: an approximation of the GGX lobe, good
+  // enough for a fallback).
   vec3 reflected = ambient * ao;
-  if (frame.inputs.z != 0u) {
-    reflected = texture(externalReflection, screenUv).rgb;
-  } else if (frame.probe.x > 0.5) {
+  if (frame.probe.x > 0.5) {
     vec3 r = reflect(-s.v, s.n);
     reflected = textureLod(probeCube, r, s.roughness * frame.probe.y).rgb * ao;
+  }
+  // An external reflection replaces it where it covers the pixel: alpha = coverage (1 = its radiance,
+  // 0 = keep the engine's term, e.g. pixels a ray-traced pass did not trace).
+  if (frame.inputs.z != 0u) {
+    vec4 ext = texture(externalReflection, screenUv);
+    reflected = mix(reflected, ext.rgb, clamp(ext.a, 0.0, 1.0));
   }
   color += reflected * specularWeight;
   color += s.emissive;

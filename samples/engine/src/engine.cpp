@@ -135,6 +135,7 @@ uint32_t Engine::validationErrorCount() const { return impl_->ctx.counters->erro
 uint32_t Engine::validationWarningCount() const { return impl_->ctx.counters->warnings.load(); }
 const Scene& Engine::scene() const { return impl_->scene.cpu; }
 std::span<const GpuMesh> Engine::meshes() const { return impl_->scene.meshes; }
+std::span<const GpuTexture> Engine::textures() const { return impl_->scene.textureViews; }
 Bounds Engine::sceneBounds() const { return impl_->scene.bounds; }
 VkExtent2D Engine::renderSize() const { return impl_->targets.extent; }
 void Engine::setPrepassHook(PrepassHook hook) { impl_->hook = std::move(hook); }

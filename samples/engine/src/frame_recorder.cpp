@@ -263,11 +263,12 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
   }
   timestamp(kTsHookEnd);
 
-  // External inputs win over the engine's own SSAO / probe.
+  // External inputs win over the engine's own SSAO; the probe stays bound under an external reflection, as
+  // the environment term where the reflection's alpha (coverage) is below 1.
   const VkImageView ao = inputs.ambientOcclusion ? inputs.ambientOcclusion
                           : params.ssao.enabled  ? targets.ssao.view
                                                  : VK_NULL_HANDLE;
-  const bool useProbe = params.reflectionProbe.enabled && probe.captured() && !inputs.reflection;
+  const bool useProbe = params.reflectionProbe.enabled && probe.captured();
   FrameUniforms u = uniformsIn;
   u.inputs = glm::uvec4(inputs.sunVisibility != VK_NULL_HANDLE, ao != VK_NULL_HANDLE,
                         inputs.reflection != VK_NULL_HANDLE, 0u);

@@ -228,6 +228,12 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     if (!s.textures[t].rgba8.empty()) textures.push_back({&out.textures[t], &s.textures[t]});
   if (!textures.empty())
     if (e = uploadTextures(gpu, canBlitMips(ctx.physicalDevice), textures); !e.empty()) return e;
+  out.textureViews.resize(out.textures.size());
+  for (size_t t = 0; t < out.textures.size(); ++t) {
+    const Image& img = out.textures[t];
+    if (img.image)
+      out.textureViews[t] = {img.image, img.altView, img.view, img.extent.width, img.extent.height, img.mipLevels};
+  }
 
   // --- Materials ---
   const uint32_t materialCount = uint32_t(s.materials.size());

@@ -29,6 +29,7 @@ struct GpuScene {
   std::vector<MeshBuffers> buffers;
   std::vector<GpuMesh> meshes;
   std::vector<Image> textures;
+  std::vector<GpuTexture> textureViews;  // public view of `textures`
   VkDescriptorPool materialPool = VK_NULL_HANDLE;
   std::vector<VkDescriptorSet> materialSets;
   std::vector<DrawConstants> materialConstants;  // model matrix filled per draw

@@ -1,6 +1,8 @@
 // Sample engine tests: headless rendering on whatever device exists (lavapipe in CI) with validation on.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <span>
 
 #include <catch2/catch_test_macros.hpp>
 
@@ -52,17 +54,19 @@ float groundLuminance(const ImageRGBA32F& img) {
   return float(sum / n);
 }
 
-// A screen-sized R8 image the test owns and fills from inside the pre-pass hook, the way an add-on would.
+// A screen-sized image (R8 by default) the test owns and fills from inside the pre-pass hook, the way an
+// add-on would.
 struct ExternalMask {
   VkDevice device = VK_NULL_HANDLE;
   VkImage image = VK_NULL_HANDLE;
   VkDeviceMemory memory = VK_NULL_HANDLE;
   VkImageView view = VK_NULL_HANDLE;
 
-  ExternalMask(Engine& engine, uint32_t w, uint32_t h) : device(engine.device()) {
+  ExternalMask(Engine& engine, uint32_t w, uint32_t h, VkFormat format = VK_FORMAT_R8_UNORM)
+      : device(engine.device()) {
     VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     ci.imageType = VK_IMAGE_TYPE_2D;
-    ci.format = VK_FORMAT_R8_UNORM;
+    ci.format = format;
     ci.extent = {w, h, 1};
     ci.mipLevels = ci.arrayLayers = 1;
     ci.samples = VK_SAMPLE_COUNT_1_BIT;
@@ -85,7 +89,7 @@ struct ExternalMask {
     VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
     vi.image = image;
     vi.viewType = VK_IMAGE_VIEW_TYPE_2D;
-    vi.format = VK_FORMAT_R8_UNORM;
+    vi.format = format;
     vi.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
     REQUIRE(vkCreateImageView(device, &vi, nullptr, &view) == VK_SUCCESS);
   }
@@ -96,8 +100,9 @@ struct ExternalMask {
     vkFreeMemory(device, memory, nullptr);
   }
 
-  // Records a clear to `value` and leaves the image in SHADER_READ_ONLY_OPTIMAL.
-  void record(VkCommandBuffer cmd, float value) const {
+  // Records a clear to `value` (all channels) and leaves the image in SHADER_READ_ONLY_OPTIMAL.
+  void record(VkCommandBuffer cmd, float value) const { record(cmd, glm::vec4(value)); }
+  void record(VkCommandBuffer cmd, glm::vec4 value) const {
     VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
     b.srcStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;  // previous frame's lighting pass read it
     b.dstStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT;
@@ -111,7 +116,7 @@ struct ExternalMask {
     dep.imageMemoryBarrierCount = 1;
     dep.pImageMemoryBarriers = &b;
     vkCmdPipelineBarrier2(cmd, &dep);
-    VkClearColorValue color{{value, value, value, value}};
+    VkClearColorValue color{{value.r, value.g, value.b, value.a}};
     vkCmdClearColorImage(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &color, 1, &b.subresourceRange);
     b.srcStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT;
     b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
@@ -276,6 +281,42 @@ TEST_CASE("glTF Box sample loads and renders", "[gltf][render]") {
   ImageRGBA32F img = renderHdr(*engine, params);
   glm::vec4 center = img.at(kWidth / 2, kHeight / 2);
   CHECK(glm::length(glm::vec3(center) - params.skyColor) > 0.05f);  // the box covers the centre
+  REQUIRE(engine->waitIdle().ok());
+  CHECK(engine->validationErrorCount() == 0);
+}
+
+TEST_CASE("scene textures are exposed as read-only views, parallel to Scene::textures", "[gltf][textures]") {
+  const std::filesystem::path path =
+      std::filesystem::path(RAYBRIDGE_SOURCE_DIR) / ".." / "shared" / "scenes" / "BoxTextured" / "BoxTextured.gltf";
+  if (!std::filesystem::exists(path)) SKIP("glTF sample not present: " + path.string());
+  SceneLoadResult r = loadGltf(path.string());
+  INFO(r.error);
+  REQUIRE(r.ok());
+  REQUIRE_FALSE(r.scene.textures.empty());
+
+  auto engine = makeEngine();
+  CHECK(engine->textures().empty());  // no scene yet
+  REQUIRE(engine->loadScene(r.scene).ok());
+  const std::span<const GpuTexture> textures = engine->textures();
+  REQUIRE(textures.size() == engine->scene().textures.size());
+  for (size_t i = 0; i < textures.size(); ++i) {
+    const GpuTexture& t = textures[i];
+    INFO("texture " << i);
+    CHECK(t.image != VK_NULL_HANDLE);
+    CHECK(t.srgbView != VK_NULL_HANDLE);
+    CHECK(t.unormView != VK_NULL_HANDLE);
+    CHECK(t.srgbView != t.unormView);
+    CHECK(t.width == engine->scene().textures[i].width);
+    CHECK(t.height == engine->scene().textures[i].height);
+    CHECK(t.mipLevels >= 1);
+  }
+  // The base-colour texture of the material is one of them.
+  const Material& m = engine->scene().materials.at(engine->scene().meshes.at(0).material);
+  REQUIRE(m.baseColorTexture >= 0);
+  CHECK(size_t(m.baseColorTexture) < textures.size());
+
+  REQUIRE(engine->setRenderSize(kWidth, kHeight).ok());
+  renderHdr(*engine, paramsFor(*engine));
   REQUIRE(engine->waitIdle().ok());
   CHECK(engine->validationErrorCount() == 0);
 }
@@ -508,6 +549,64 @@ TEST_CASE("shadow-visibility readback matches the shadow map", "[effects][shadow
   f.params.outputShadowVisibility = false;
   f.render();
   CHECK_FALSE(f.engine->readbackShadowVisibility().ok());
+  REQUIRE(f.engine->waitIdle().ok());
+  CHECK(f.engine->validationErrorCount() == 0);
+}
+
+TEST_CASE("an external reflection replaces the environment term by its alpha (coverage)", "[effects][reflection]") {
+  EffectsFixture f;
+  const glm::ivec2 sphere = f.pixelOf({3.0f, 1.3f, 0.95f});  // polished metal, upper front of the sphere
+  ExternalMask reflection(*f.engine, kFxWidth, kFxHeight, VK_FORMAT_R16G16B16A16_SFLOAT);
+  glm::vec4 value(0.0f);
+  auto useExternal = [&] {
+    f.engine->setPrepassHook([&](const PrepassHookInfo& info, LightingInputs& inputs) {
+      reflection.record(info.commandBuffer, value);
+      inputs.reflection = reflection.view;
+    });
+  };
+  auto ldr = [&] {
+    auto img = f.engine->readbackLdr();
+    INFO(img.error);
+    REQUIRE(img.ok());
+    return std::move(img.value);
+  };
+  auto maxDifference = [](const ImageRGBA8& a, const ImageRGBA8& b) {
+    int diff = 0;
+    for (uint32_t y = 0; y < a.height; ++y)
+      for (uint32_t x = 0; x < a.width; ++x)
+        for (int c = 0; c < 3; ++c) diff = std::max(diff, std::abs(int(a.at(x, y)[c]) - int(b.at(x, y)[c])));
+    return diff;
+  };
+
+  SECTION("alpha 0 keeps the engine's own term (constant sky), whatever the colour") {
+    ImageRGBA32F ownHdr = renderHdr(*f.engine, f.params);
+    ImageRGBA8 own = ldr();
+    useExternal();
+    value = glm::vec4(20.0f, 0.0f, 20.0f, 0.0f);  // must not leak anywhere
+    ImageRGBA32F externalHdr = renderHdr(*f.engine, f.params);
+    INFO("max LDR difference " << maxDifference(own, ldr()));
+    CHECK(maxDifference(own, ldr()) <= 1);
+    CHECK(std::abs(windowLuminance(externalHdr, sphere, 1) - windowLuminance(ownHdr, sphere, 1)) <
+          1e-3f * windowLuminance(ownHdr, sphere, 1) + 1e-4f);
+
+    value = glm::vec4(8.0f, 8.0f, 8.0f, 1.0f);  // alpha 1: a bright environment brightens the metal
+    ImageRGBA32F bright = renderHdr(*f.engine, f.params);
+    INFO("metal: own " << windowLuminance(ownHdr, sphere, 1) << ", external bright " << windowLuminance(bright, sphere, 1));
+    CHECK(windowLuminance(bright, sphere, 1) > 2.0f * windowLuminance(ownHdr, sphere, 1));
+  }
+
+  SECTION("alpha 0 keeps the reflection probe when it is enabled") {
+    f.params.reflectionProbe.enabled = true;
+    renderHdr(*f.engine, f.params);
+    ImageRGBA8 own = ldr();
+    useExternal();
+    value = glm::vec4(20.0f, 0.0f, 20.0f, 0.0f);
+    renderHdr(*f.engine, f.params);
+    INFO("max LDR difference " << maxDifference(own, ldr()));
+    CHECK(maxDifference(own, ldr()) <= 1);
+  }
+
+  f.engine->setPrepassHook({});
   REQUIRE(f.engine->waitIdle().ok());
   CHECK(f.engine->validationErrorCount() == 0);
 }

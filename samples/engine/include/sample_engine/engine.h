@@ -94,9 +94,9 @@ struct SsaoSettings {
 // A static reflection probe: a small cubemap captured from one point with the engine's forward shading (sun,
 // shadow map, constant-sky ambient; background = skyColor * ambientIntensity, the radiance the constant-sky
 // fallback uses, so a probe that sees only sky changes nothing). When enabled the lighting pass samples it
-// along the reflection vector (mip chosen by roughness) instead of the constant sky, unless
-// LightingInputs::reflection is set. Captured on the first enabled frame and recaptured only when the scene,
-// the probe settings, the sun, the sky or the shadow settings change.
+// along the reflection vector (mip chosen by roughness) instead of the constant sky; an external
+// LightingInputs::reflection replaces it where its alpha (coverage) is 1. Captured on the first enabled frame
+// and recaptured only when the scene, the probe settings, the sun, the sky or the shadow settings change.
 struct ReflectionProbeSettings {
   bool enabled = false;
   uint32_t resolution = 64;           // per face, clamped to [8, 512]
@@ -112,8 +112,10 @@ struct LightingInputs {
   VkImageView sunVisibility = VK_NULL_HANDLE;
   // R channel, 1 = unoccluded. Multiplies the ambient (sky) terms.
   VkImageView ambientOcclusion = VK_NULL_HANDLE;
-  // RGB = linear radiance arriving along the mirror direction (RGBA16F). Replaces the constant-sky specular
-  // ambient term; the engine weights it by its Fresnel/roughness environment BRDF and AO.
+  // RGB = linear radiance arriving along the mirror direction, A = coverage (RGBA16F). The specular ambient
+  // term becomes mix(engine's own, rgb, a): 1 = use the external radiance, 0 = keep the engine's own term
+  // (constant sky * AO, or the reflection probe when enabled), e.g. where a ray-traced pass traced nothing.
+  // The engine weights the result by its Fresnel/roughness environment BRDF.
   VkImageView reflection = VK_NULL_HANDLE;
 };
 
@@ -201,6 +203,21 @@ struct GpuMesh {
   const MeshData* cpu = nullptr;  // CPU copy (finalized), owned by the engine
 };
 
+// A scene texture as uploaded, at its Scene::textures index: an RGBA8 image with a mip chain (one level when
+// the device cannot blit RGBA8), in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL from loadScene() until the next
+// loadScene() or the engine's destruction. Read-only for add-ons: sample it, never write or transition it.
+// Two 2D views over all mips; pick by the texture's use:
+//   srgbView  (R8G8B8A8_SRGB):  sampling decodes sRGB to linear. Base colour and emissive textures.
+//   unormView (R8G8B8A8_UNORM): raw values. Metallic-roughness (G = roughness, B = metallic), normal maps.
+// All handles are VK_NULL_HANDLE for a texture without texels (empty TextureData::rgba8); materials using
+// it sample the engine's 1x1 defaults instead.
+struct GpuTexture {
+  VkImage image = VK_NULL_HANDLE;
+  VkImageView srgbView = VK_NULL_HANDLE;
+  VkImageView unormView = VK_NULL_HANDLE;
+  uint32_t width = 0, height = 0, mipLevels = 0;
+};
+
 struct DeviceInfo {
   std::string name;
   uint32_t apiVersion = 0;
@@ -233,6 +250,7 @@ class Engine {
   Status loadScene(const Scene& scene);
   const Scene& scene() const;              // finalized CPU copy
   std::span<const GpuMesh> meshes() const;  // parallel to scene().meshes
+  std::span<const GpuTexture> textures() const;  // parallel to scene().textures, see GpuTexture
   Bounds sceneBounds() const;
 
   // --- Targets ---
