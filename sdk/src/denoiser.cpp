@@ -7,6 +7,7 @@
 #include "compute_pipeline.h"
 #include "context_impl.h"
 #include "gbuffer_sampler.h"
+#include "image_barriers.h"
 #include "pass_constants.h"
 #include "pass_images.h"
 #include "pass_metrics.h"
@@ -156,15 +157,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   // The images written this frame start undefined; last frame's history and distance are read as they are.
   std::vector<VkImageMemoryBarrier> barriers;
   auto barrier = [&](const GpuImage& img, VkImageLayout from, VkImageLayout to, VkAccessFlags src, VkAccessFlags dst) {
-    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-    b.srcAccessMask = src;
-    b.dstAccessMask = dst;
-    b.oldLayout = from;
-    b.newLayout = to;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = img.image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    barriers.push_back(b);
+    barriers.push_back(colorImageBarrier(img.image, from, to, src, dst));
   };
   auto flush = [&](VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) {
     vk.vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, static_cast<uint32_t>(barriers.size()),

@@ -1,6 +1,7 @@
 #include "pass_images.h"
 
 #include "context_impl.h"
+#include "image_barriers.h"
 
 namespace rb {
 
@@ -31,17 +32,7 @@ void transition(Context& ctx, VkCommandBuffer cmd, const std::vector<GpuImage>& 
                 VkImageLayout to, VkAccessFlags srcAccess, VkAccessFlags dstAccess, VkPipelineStageFlags srcStage,
                 VkPipelineStageFlags dstStage) {
   std::vector<VkImageMemoryBarrier> barriers;
-  for (const GpuImage& img : images) {
-    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-    b.srcAccessMask = srcAccess;
-    b.dstAccessMask = dstAccess;
-    b.oldLayout = from;
-    b.newLayout = to;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = img.image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    barriers.push_back(b);
-  }
+  for (const GpuImage& img : images) barriers.push_back(colorImageBarrier(img.image, from, to, srcAccess, dstAccess));
   if (barriers.empty()) return;
   ctx.vk().vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr,
                                 static_cast<uint32_t>(barriers.size()), barriers.data());
