@@ -12,7 +12,7 @@ layout(push_constant) uniform DenoiseConstants {
   vec4 cameraDelta;         // xyz: current camera position - previous camera position; w: depth sigma
   uvec4 size;               // x, y: size; z: flags (bit 0 reversed-Z, bit 1 octahedral, bit 2 history valid,
                             // bit 3 motion vectors); w: step (a-trous) or max history (temporal)
-  vec4 params;              // x: normal power
+  vec4 params;              // x: normal power, y: rays per pixel of the signal (0 = unknown)
 } pc;
 
 const uint RB_DN_REVERSED_Z = 1u;

@@ -432,7 +432,9 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
     a.images.shadowRaw = a.images.shadow = out.visibility;
     inputs.sunVisibility = out.visibilityView;  // SHADER_READ_ONLY_OPTIMAL
     if (a.shadowDenoiser) {
-      if (rb::Status st = a.shadowDenoiser->record(cmd, gbuffer, out.visibilityView, f.denoiser); !st)
+      rb::DenoiseSettings d = f.denoiser;  // the visibility is a fraction of this many binary rays
+      d.raysPerPixel = s.raysPerPixel ? s.raysPerPixel : 4u;
+      if (rb::Status st = a.shadowDenoiser->record(cmd, gbuffer, out.visibilityView, d); !st)
         return a.fail(rbError("Denoiser::record (shadows)", st.error()));
       a.images.shadow = a.shadowDenoiser->outputs().denoised;
       inputs.sunVisibility = a.shadowDenoiser->outputs().denoisedView;
@@ -448,7 +450,10 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
     a.images.aoRaw = a.images.ao = out.ao;
     inputs.ambientOcclusion = out.aoView;
     if (a.aoDenoiser) {
-      if (rb::Status st = a.aoDenoiser->record(cmd, gbuffer, out.aoView, f.denoiser); !st)
+      rb::DenoiseSettings d = f.denoiser;
+      // Binary AO is a fraction of binary rays; distance-weighted AO is not, so its noise is estimated.
+      if (s.estimator == rb::AoEstimator::Binary) d.raysPerPixel = s.raysPerPixel ? s.raysPerPixel : 4u;
+      if (rb::Status st = a.aoDenoiser->record(cmd, gbuffer, out.aoView, d); !st)
         return a.fail(rbError("Denoiser::record (AO)", st.error()));
       a.images.ao = a.aoDenoiser->outputs().denoised;
       inputs.ambientOcclusion = a.aoDenoiser->outputs().denoisedView;

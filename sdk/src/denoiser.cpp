@@ -127,6 +127,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   pc.size[1] = g.height;
   pc.cameraDelta[3] = settings.depthSigma > 0.0f ? settings.depthSigma : 0.005f;
   pc.params[0] = settings.normalPower > 0.0f ? settings.normalPower : 32.0f;
+  pc.params[1] = float(settings.raysPerPixel);
 
   // This frame's camera: projection * rotation-only view, kept for next frame's reprojection.
   double camera[3];

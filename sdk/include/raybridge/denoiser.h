@@ -22,6 +22,10 @@ struct DenoiseSettings {
   uint32_t maxHistoryFrames = 0;  // 0 = 32: the running mean forgets more slowly than this
   float depthSigma = 0.0f;        // 0 = 0.005: plane-distance tolerance relative to view distance, per step
   float normalPower = 0.0f;       // 0 = 32: exponent of the normal similarity weight
+  // Rays per pixel behind the signal, when it is a fraction of binary rays (shadow visibility, binary AO):
+  // the spatial filter then knows the noise exactly and keeps every edge that is not noise. 0 = unknown:
+  // the noise is estimated from the 3x3 neighbourhood, which also blurs thin noise-free features.
+  uint32_t raysPerPixel = 0;
 };
 
 // Owned by the denoiser, left in SHADER_READ_ONLY_OPTIMAL after record().

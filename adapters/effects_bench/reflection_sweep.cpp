@@ -1,0 +1,143 @@
+// Reflections: compared on the final HDR image, because the raster counterparts (constant sky, reflection probe)
+// only exist inside the lighting pass. Shadows come from the engine's shadow map in every row (the same map),
+// AO is off, so the reflected term is the only difference between rows.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "effect_sweeps.h"
+
+namespace rbEffects {
+
+namespace se = sample_engine;
+
+namespace {
+
+se::Result<std::vector<float>> hdrRgb(se::Engine& engine) {
+  auto hdr = engine.readbackHdr();
+  if (!hdr) return se::Result<std::vector<float>>::failure(hdr.error);
+  return se::Result<std::vector<float>>::success(rgbOf(hdr.value.pixels));
+}
+
+}  // namespace
+
+se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan& plan) {
+  using R = se::Result<EffectResult>;
+  const auto start = std::chrono::steady_clock::now();
+  EffectResult result;
+  result.effect = "reflections";
+  result.compared = "final HDR image (linear RGB), surface pixels";
+  result.effectMsNote =
+      "traced: ReflectionPass GPU ms; raster: the probe capture (a one-time cost, recaptured only when the scene, "
+      "sun or sky change; 0 per frame otherwise), constant sky: no pass (0 ms)";
+  rbAdapter::Adapter& adapter = driver.adapter();
+  rbAdapter::FrameSettings& s = adapter.settings();
+  const se::FrameParams base = driver.baseParams();
+  const uint32_t w = plan.width, h = plan.height;
+  auto png = [&](const std::vector<float>& rgb) {
+    return [&rgb, w, h, exposure = base.exposure](const std::string& p) {
+      return writeTonemappedPng(p, rgb, w, h, exposure);
+    };
+  };
+
+  if (se::Status st = adapter.setEffects(rbAdapter::kEffectReflections); !st) return R::failure(st.error);
+  s.enabled = true;
+  s.lightingFrom(base);
+  // Every surface traces (threshold 1 by default): the engine treats untraced pixels as reflecting nothing, so a
+  // lower threshold would make the reference itself wrong on rough surfaces.
+  s.reflectionRoughnessThreshold = plan.reflectionRoughness;
+  const uint32_t perFrame = std::min(plan.referenceReflections, kReferenceRaysPerFrame);
+  s.reflectionRaysPerPixel = perFrame;
+  const uint32_t frames = (plan.referenceReflections + perFrame - 1) / perFrame;
+  result.reference.raysPerFrame = perFrame;
+  progress("reflections: reference, %u rays per pixel (%u frames of %u)", plan.referenceReflections, frames, perFrame);
+  auto ref = traceReference(
+      driver, base, frames, 3, [&](const rbRender::CapturedFrame&) { return hdrRgb(driver.engine()); },
+      &rbAdapter::EffectStats::reflection, result.reference);
+  if (!ref) return R::failure("reflections reference: " + ref.error);
+  const std::vector<uint8_t>& mask = ref.value.mask;
+  result.surfacePixels = countSet(mask);
+  auto refImage = writeImage(plan, "reflections", "reference", png(ref.value.values));
+  if (!refImage) return R::failure(refImage.error);
+  result.reference.image = refImage.value;
+  if (auto m = writeImage(plan, "reflections", "mask", [&](const std::string& p) { return writeMaskPng(p, mask, w, h); }); !m)
+    return R::failure(m.error);
+  progress("reflections: reference done in %.1f s (halves RMSE %.5f)", result.reference.seconds,
+           result.reference.halvesRmse);
+
+  auto finish = [&](Row row, const std::vector<FrameSample>& samples, const std::vector<float>& rgb) -> se::Status {
+    row.engineMs = engineMedians(samples);
+    row.frameMs = row.engineMs["frame"];
+    const ErrorStats e = compare(rgb, ref.value.values, mask, 3);
+    row.rmse = e.rmse;
+    row.bias = e.bias;
+    auto img = writeImage(plan, "reflections", row.id, png(rgb));
+    if (!img) return se::Status::failure(img.error);
+    row.image = img.value;
+    progress("reflections: %-16s %-22s effect %8.3f ms  frame %8.3f ms  RMSE %.5f", row.method.c_str(),
+             row.setting.c_str(), row.effectMs, row.frameMs, row.rmse);
+    result.rows.push_back(std::move(row));
+    return se::Status::success();
+  };
+
+  // Traced rows (the reflection is not denoised: raw only).
+  for (uint32_t n : plan.reflectionRays) {
+    s.reflectionRaysPerPixel = n;
+    auto samples = driver.run(base, plan.warmupFrames, plan.timedFrames);
+    if (!samples) return R::failure(samples.error);
+    if (auto cap = driver.capture(base); !cap) return R::failure(cap.error);
+    auto rgb = hdrRgb(driver.engine());
+    if (!rgb) return R::failure(rgb.error);
+    Row row;
+    row.method = "traced_raw";
+    row.setting = std::to_string(n) + (n == 1 ? " ray" : " rays");
+    row.id = "traced_raw_r" + std::to_string(n);
+    row.params = {{"rays_per_pixel", n}, {"roughness_threshold", plan.reflectionRoughness}};
+    const PassResult pass = passMedian(samples.value, "reflection", &rbAdapter::EffectStats::reflection);
+    row.passes = {pass};
+    row.effectMs = pass.gpuMs;
+    row.effectMsOf = "reflection";
+    if (se::Status st = finish(std::move(row), samples.value, rgb.value); !st) return R::failure(st.error);
+  }
+
+  // Raster rows: constant sky (probe off) and the probe at each resolution.
+  s.enabled = false;
+  for (uint32_t size : plan.probeSizes) {
+    se::FrameParams p = base;
+    p.reflectionProbe.enabled = size > 0;
+    p.reflectionProbe.resolution = size ? size : 64;
+    // Each timed frame moves the probe up by a hair so that every one of them recaptures it: its capture cost
+    // is measured over several frames, and the steady-state frame (without it) separately.
+    // (The engine's default position, the bounds centre raised to heightAboveGround, moved by 0.1 mm steps.)
+    const se::Bounds bounds = driver.engine().sceneBounds();
+    glm::vec3 position = bounds.center();
+    position.y = std::max(position.y, bounds.min.y + p.reflectionProbe.heightAboveGround);
+    auto samples = driver.run(p, plan.warmupFrames, plan.timedFrames, [position](uint32_t i, se::FrameParams& q) {
+      q.reflectionProbe.position = position + glm::vec3(0.0f, 1e-4f * float(i + 1), 0.0f);
+    });
+    if (!samples) return R::failure(samples.error);
+    if (auto cap = driver.capture(p); !cap) return R::failure(cap.error);
+    auto rgb = hdrRgb(driver.engine());
+    if (!rgb) return R::failure(rgb.error);
+    Row row;
+    row.method = "raster";
+    row.setting = size ? "probe " + std::to_string(size) : "constant sky";
+    row.id = size ? "raster_probe" + std::to_string(size) : "raster_sky";
+    row.params = {{"probe_resolution", size}};
+    if (size) {
+      std::vector<double> capture;
+      for (const FrameSample& f : samples.value)
+        if (f.engine.probeCaptured) capture.push_back(f.engine.probeMs);
+      if (capture.empty()) return R::failure("reflections: no timed frame captured the probe");
+      row.effectMs = median(capture);
+    }
+    row.effectMsOf = size ? "probe capture (one-time)" : "none";
+    if (se::Status st = finish(std::move(row), samples.value, rgb.value); !st) return R::failure(st.error);
+  }
+  s.enabled = true;
+  selfCheck(result);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return R::success(std::move(result));
+}
+
+}  // namespace rbEffects
