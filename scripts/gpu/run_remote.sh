@@ -2,10 +2,11 @@
 # Runs the benchmark and the tests on the GPU machine (NVIDIA, no Vulkan loader, no network) from the folder
 # .devcarry/ that scripts/gpu/prepare.sh assembled and the device tool carried. Run from the repository root:
 #
-#   bash scripts/gpu/run_remote.sh [all|bench|tests]      (default all)
+#   bash scripts/gpu/run_remote.sh [all|bench|tests|render|effects]      (default all)
 #
 # Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
-# tests_gpu.log, render_gpu.log, render_gpu.tar.gz (stats.json and final.png of each render), summary.txt, env.txt. Every step's exit code is recorded; the script exits non-zero if any step failed.
+# tests_gpu.log, effects_gpu.json, effects_gpu.log, render_gpu.tar.gz (render logs, stats.json and final.png
+# of each render, env.txt), summary.txt. Every step's exit code is recorded; the script exits non-zero if any step failed.
 # The whole run stays under RB_TIME_BUDGET seconds (default 500, inside the tool's 10-minute command limit):
 # a step that would start after the budget is skipped and counted as failed.
 #
@@ -19,7 +20,7 @@
 set -u
 
 MODE="${1:-all}"
-case "$MODE" in all|bench|tests|render) ;; *) echo "usage: $0 [all|bench|tests|render]" >&2; exit 2 ;; esac
+case "$MODE" in all|bench|tests|render|effects) ;; *) echo "usage: $0 [all|bench|tests|render|effects]" >&2; exit 2 ;; esac
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 cd "$ROOT"
 CARRY="$ROOT/.devcarry"
@@ -171,9 +172,28 @@ if [ "$MODE" = all ] || [ "$MODE" = render ]; then
     RAYBRIDGE_VALIDATION=0 step "render $name" 60 "$OUT/render_gpu.log" \
       "$RENDER" --width 1920 --height 1080 --frames 12 --dump "${vargs[@]}" --out "$RDIR/$name"
   done
-  # One archive: the tool brings back at most 8 files.
-  tar -C "$RDIR" -czf "$OUT/render_gpu.tar.gz" --exclude='*.exr' . 2>/dev/null
   grep -E 'engine GPU ms|Raybridge:' "$OUT/render_gpu.log"
+  # One archive with the render outputs, its log and the environment: the tool brings back at most 8 files.
+  cp "$OUT/render_gpu.log" "$OUT/env.txt" "$RDIR/" && rm -f "$OUT/render_gpu.log" "$OUT/env.txt"
+  tar -C "$RDIR" -czf "$OUT/render_gpu.tar.gz" --exclude='*.exr' . 2>/dev/null
+fi
+
+# ---- effects: speed against error at 1920x1080 (validation off), FLIP computed here ------------------------
+if [ "$MODE" = all ] || [ "$MODE" = effects ]; then
+  : >"$OUT/effects_gpu.log"
+  EIMG="$(mktemp -d)"
+  RAW=()
+  [ -f "$OUT/bench_gpu.json" ] && RAW=(--raw-rate-json "$OUT/bench_gpu.json")
+  RAYBRIDGE_VALIDATION=0 step effects 240 "$OUT/effects_gpu.log" "$RT/bin/raybridge-effects-bench" \
+    --width 1920 --height 1080 "${RAW[@]}" --images "$EIMG" --out "$OUT/effects_gpu.json"
+  # FLIP needs the 1080p images, too large to bring back: computed on the machine from the carried wheel.
+  if ls "$ROOT"/.whl/flip_evaluator-*.whl >/dev/null 2>&1; then
+    python3 -m pip install -q --no-index --no-deps --no-compile --target /tmp/flipsite "$ROOT"/.whl/flip_evaluator-*.whl \
+      >>"$OUT/effects_gpu.log" 2>&1
+    PYTHONPATH=/tmp/flipsite step flip 150 "$OUT/effects_gpu.log" python3 "$ROOT/scripts/plot_speed_vs_error.py" \
+      "$OUT/effects_gpu.json" --images "$EIMG" --flip-into "$OUT/effects_gpu.json" --no-plots
+  fi
+  grep -E '^(shadows|ao|reflections):' "$OUT/effects_gpu.log" | grep -v reference | head -n 60
 fi
 
 # ---- tests (validation on) ---------------------------------------------------------------------------------

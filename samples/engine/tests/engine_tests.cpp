@@ -293,6 +293,10 @@ TEST_CASE("scene textures are exposed as read-only views, parallel to Scene::tex
   INFO(r.error);
   REQUIRE(r.ok());
   REQUIRE_FALSE(r.scene.textures.empty());
+  for (const TextureData& t : r.scene.textures) {
+    // A copy of the models without their image files (the GPU machine gets geometry only) has nothing to test.
+    if (t.rgba8.empty()) SKIP("texture image files not present next to " + path.string());
+  }
 
   auto engine = makeEngine();
   CHECK(engine->textures().empty());  // no scene yet
