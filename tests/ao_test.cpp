@@ -53,18 +53,23 @@ std::vector<double> referenceAo(const EmbreeScene& embree, const CpuGBuffer& g, 
 
 }  // namespace
 
-TEST_CASE("AO at 256 rays matches Embree's AO at 1024 rays", "[ao][embree]") {
-  GpuFixture fx;
-  TestScene scene = makeConformanceScene();
-  EmbreeScene embree;
-  addToEmbree(embree, scene);
+// The conformance scene seen from the side, at 64x48.
+SyntheticView aoView() {
   SyntheticView view;
   view.eye = {-6.0, 3.5, 7.0};
   view.target = {0.0, 0.8, 0.0};
   view.fovYDegrees = 45.0;
   view.width = 64;
   view.height = 48;
-  CpuGBuffer cpu = traceGBuffer(embree, view);
+  return view;
+}
+
+TEST_CASE("AO at 256 rays matches Embree's AO at 1024 rays", "[ao][embree]") {
+  GpuFixture fx;
+  TestScene scene = makeConformanceScene();
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  CpuGBuffer cpu = traceGBuffer(embree, aoView());
   rb::AoSettings settings;
   settings.raysPerPixel = 256;
   settings.range = 2.0f;
@@ -155,12 +160,7 @@ TEST_CASE("distance-weighted AO never occludes more than binary AO with the same
   TestScene scene = makeConformanceScene();
   EmbreeScene embree;
   addToEmbree(embree, scene);
-  SyntheticView view;
-  view.eye = {-6.0, 3.5, 7.0};
-  view.target = {0.0, 0.8, 0.0};
-  view.width = 64;
-  view.height = 48;
-  CpuGBuffer cpu = traceGBuffer(embree, view);
+  CpuGBuffer cpu = traceGBuffer(embree, aoView());
   rb::AoSettings settings;
   settings.raysPerPixel = 16;
   settings.range = 1.5f;

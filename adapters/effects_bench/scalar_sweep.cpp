@@ -81,6 +81,23 @@ se::Result<EffectResult> runScalarSweep(FrameDriver& driver, const SweepPlan& pl
   progress("%s: reference done in %.1f s (halves RMSE %.5f)", fx.name.c_str(), result.reference.seconds,
            result.reference.halvesRmse);
 
+  // Every row, traced or raster, ends the same way: frame times, error against the reference, its image, a
+  // progress line. Returns an error message, empty on success.
+  auto finishRow = [&](Row& row, const nlohmann::json& engineMs, const std::vector<float>& values) -> std::string {
+    row.frameMs = engineMs["frame"];
+    row.engineMs = engineMs;
+    const ErrorStats e = compare(values, ref.value.values, mask, 1);
+    row.rmse = e.rmse;
+    row.bias = e.bias;
+    auto img = writeImage(plan, fx.name, row.id, grey(values));
+    if (!img) return img.error;
+    row.image = img.value;
+    progress("%s: %-16s %-22s effect %8.3f ms  frame %8.3f ms  RMSE %.5f", fx.name.c_str(), row.method.c_str(),
+             row.setting.c_str(), row.effectMs, row.frameMs, row.rmse);
+    result.rows.push_back(std::move(row));
+    return {};
+  };
+
   // Traced rows: one run per ray count gives both the raw and the denoised row (the raw image stays available).
   for (uint32_t n : fx.rays) {
     s.denoise = true;
@@ -107,17 +124,7 @@ se::Result<EffectResult> runScalarSweep(FrameDriver& driver, const SweepPlan& pl
       if (denoised) row.passes.push_back(denoise);
       row.effectMs = pass.gpuMs + (denoised ? denoise.gpuMs : 0.0);
       row.effectMsOf = denoised ? std::string(fx.passName) + " + " + fx.denoiseName : fx.passName;
-      row.frameMs = engineMs["frame"];
-      row.engineMs = engineMs;
-      const ErrorStats e = compare(values.value, ref.value.values, mask, 1);
-      row.rmse = e.rmse;
-      row.bias = e.bias;
-      auto img = writeImage(plan, fx.name, row.id, grey(values.value));
-      if (!img) return R::failure(img.error);
-      row.image = img.value;
-      progress("%s: %-16s %-22s effect %8.3f ms  frame %8.3f ms  RMSE %.5f", fx.name.c_str(), row.method.c_str(),
-               row.setting.c_str(), row.effectMs, row.frameMs, row.rmse);
-      result.rows.push_back(std::move(row));
+      if (std::string err = finishRow(row, engineMs, values.value); !err.empty()) return R::failure(err);
     }
   }
 
@@ -139,17 +146,7 @@ se::Result<EffectResult> runScalarSweep(FrameDriver& driver, const SweepPlan& pl
     const nlohmann::json engineMs = engineMedians(samples.value);
     row.effectMs = medianOf(samples.value, [&](const FrameSample& f) { return f.engine.*fx.rasterMs; });
     row.effectMsOf = fx.rasterMsOf;
-    row.frameMs = engineMs["frame"];
-    row.engineMs = engineMs;
-    const ErrorStats e = compare(values.value, ref.value.values, mask, 1);
-    row.rmse = e.rmse;
-    row.bias = e.bias;
-    auto img = writeImage(plan, fx.name, row.id, grey(values.value));
-    if (!img) return R::failure(img.error);
-    row.image = img.value;
-    progress("%s: %-16s %-22s effect %8.3f ms  frame %8.3f ms  RMSE %.5f", fx.name.c_str(), row.method.c_str(),
-             row.setting.c_str(), row.effectMs, row.frameMs, row.rmse);
-    result.rows.push_back(std::move(row));
+    if (std::string err = finishRow(row, engineMs, values.value); !err.empty()) return R::failure(err);
   }
   s.enabled = true;
   selfCheck(result);
