@@ -1,7 +1,6 @@
 // The first trace agrees with an independent tracer (Embree) on hit/miss, hit distance and what was hit.
 #include <catch2/catch_test_macros.hpp>
 
-#include <cstring>
 
 #include "test_scene.h"
 
@@ -14,11 +13,7 @@ TEST_CASE("first trace matches Embree on a procedural scene", "[trace][embree]")
   TestScene scene = makeConformanceScene();
   BuiltScene built = buildScene(fx, *service.value(), scene);
 
-  rb::PrimaryRayCamera cam;
-  float eye[3] = {-9.0f, 4.5f, 11.0f}, target[3] = {0.5f, 0.8f, -0.5f};
-  std::memcpy(cam.eye, eye, sizeof eye);
-  std::memcpy(cam.target, target, sizeof target);
-  cam.verticalFovDegrees = 50.0f;
+  const rb::PrimaryRayCamera cam = conformanceCamera(50.0f);
   const uint32_t W = 192, H = 128;
   TraceComparison c = compareFirstTrace(fx, scene, built.tlas.tlas, cam, W, H);
   INFO("compared " << c.compared << " pixels (" << c.silhouettes << " near silhouettes excluded), " << c.hits

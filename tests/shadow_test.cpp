@@ -88,12 +88,7 @@ TEST_CASE("hard shadows match Embree away from shadow edges", "[shadow][embree]"
   TestScene scene = makeConformanceScene();
   EmbreeScene embree;
   addToEmbree(embree, scene);
-  SyntheticView view;
-  view.eye = {-9.0, 4.5, 11.0};
-  view.target = {0.5, 0.8, -0.5};
-  view.fovYDegrees = 50.0;
-  view.width = 192;
-  view.height = 128;
+  const SyntheticView view = conformanceView(192, 128, 50.0);
   CpuGBuffer cpu = traceGBuffer(embree, view);
   glm::dvec3 toSun(0.4, 0.8, 0.3);
   ShadowRun run = runShadowPass(fx, scene, cpu, sun(toSun));
@@ -216,11 +211,7 @@ TEST_CASE("a scene 10 km from the origin shadows like the same scene at the orig
   TestScene scene = makeConformanceScene();
   EmbreeScene embree;
   addToEmbree(embree, scene);
-  SyntheticView view;
-  view.eye = {-9.0, 4.5, 11.0};
-  view.target = {0.5, 0.8, -0.5};
-  view.width = 160;
-  view.height = 120;
+  const SyntheticView view = conformanceView(160, 120);
   CpuGBuffer cpu = traceGBuffer(embree, view);
   glm::dvec3 toSun(0.3, 0.5, 0.2);  // low sun: long shadows, grazing on the bumps
   ShadowRun atOrigin = runShadowPass(fx, scene, cpu, sun(toSun));

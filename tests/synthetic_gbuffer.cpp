@@ -7,6 +7,17 @@
 
 namespace rbtest {
 
+SyntheticView conformanceView(uint32_t width, uint32_t height, double fovYDegrees) {
+  const rb::PrimaryRayCamera cam = conformanceCamera();
+  SyntheticView v;
+  v.eye = {cam.eye[0], cam.eye[1], cam.eye[2]};
+  v.target = {cam.target[0], cam.target[1], cam.target[2]};
+  v.fovYDegrees = fovYDegrees;
+  v.width = width;
+  v.height = height;
+  return v;
+}
+
 CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& v, const std::vector<float>& roughness) {
   CpuGBuffer g;
   g.view = v;

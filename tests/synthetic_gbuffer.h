@@ -26,6 +26,9 @@ struct SyntheticView {
   float farPlane = 500.0f;
 };
 
+// The conformance scene's camera (conformanceCamera()) as a synthetic view of the given size.
+SyntheticView conformanceView(uint32_t width, uint32_t height, double fovYDegrees = 60.0);
+
 // CPU-side G-buffer: per pixel the exact hit (world position in double, geometric normal facing the eye).
 struct CpuGBuffer {
   SyntheticView view;

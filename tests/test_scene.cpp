@@ -23,6 +23,15 @@ TestScene makeConformanceScene() {
   return s;
 }
 
+rb::PrimaryRayCamera conformanceCamera(float verticalFovDegrees) {
+  rb::PrimaryRayCamera cam;
+  const float eye[3] = {-9.0f, 4.5f, 11.0f}, target[3] = {0.5f, 0.8f, -0.5f};
+  std::memcpy(cam.eye, eye, sizeof eye);
+  std::memcpy(cam.target, target, sizeof target);
+  cam.verticalFovDegrees = verticalFovDegrees;
+  return cam;
+}
+
 BuiltScene buildScene(GpuFixture& fx, rb::AccelerationStructureService& service, const TestScene& scene) {
   BuiltScene b;
   for (const rbsamples::CpuMesh& m : scene.meshes) {

@@ -26,6 +26,8 @@ struct TestScene {
 // A bumpy ground, spheres, boxes and a rotated, scaled box: smooth and flat surfaces, grazing angles,
 // shared meshes between instances.
 TestScene makeConformanceScene();
+// The camera the conformance tests look at that scene with (vertical field of view: 0 = the pass default).
+rb::PrimaryRayCamera conformanceCamera(float verticalFovDegrees = 0.0f);
 std::array<float, 12> translation(float x, float y, float z);
 
 // The scene registered with a service and its TLAS built (in one submitted frame).

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstddef>
 #include <cstring>
 #include <span>
 
@@ -12,18 +11,6 @@ namespace rbAdapter {
 namespace se = sample_engine;
 
 namespace {
-
-// ORs the VkBool32 members of a core feature struct (they follow the sType/pNext header) into `dst`.
-template <typename T>
-void mergeBools(T& dst, const void* src, size_t firstOffset) {
-  for (size_t o = firstOffset; o + sizeof(VkBool32) <= sizeof(T); o += sizeof(VkBool32)) {
-    VkBool32 a, b;
-    std::memcpy(&a, reinterpret_cast<const char*>(&dst) + o, sizeof a);
-    std::memcpy(&b, static_cast<const char*>(src) + o, sizeof b);
-    a = a || b;
-    std::memcpy(reinterpret_cast<char*>(&dst) + o, &a, sizeof a);
-  }
-}
 
 std::string rbError(const char* what, const rb::Error& e) {
   return std::string(what) + ": " + rb::toString(e.code) + ": " + e.message;
@@ -92,26 +79,10 @@ void configureEngine(se::EngineConfig& config, rb::RequiredFeatures& features) {
     for (const std::string& e : config.deviceExtensions) present = present || e == name;
     if (!present) config.deviceExtensions.emplace_back(name);
   }
-  // The engine builds the core feature structs itself and takes the others as a chain: split Raybridge's.
-  std::vector<VkBaseOutStructure*> others;
-  for (auto* s = static_cast<VkBaseOutStructure*>(features.chainHead()); s; s = s->pNext) {
-    switch (s->sType) {
-      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES:
-        mergeBools(config.extraFeatures11, s, offsetof(VkPhysicalDeviceVulkan11Features, storageBuffer16BitAccess));
-        break;
-      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES:
-        mergeBools(config.extraFeatures12, s, offsetof(VkPhysicalDeviceVulkan12Features, samplerMirrorClampToEdge));
-        break;
-      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES:
-        mergeBools(config.extraFeatures13, s, offsetof(VkPhysicalDeviceVulkan13Features, robustImageAccess));
-        break;
-      default: others.push_back(s);
-    }
-  }
-  if (others.empty()) return;
-  for (size_t i = 0; i + 1 < others.size(); ++i) others[i]->pNext = others[i + 1];
-  others.back()->pNext = static_cast<VkBaseOutStructure*>(const_cast<void*>(config.deviceFeaturesPNext));
-  config.deviceFeaturesPNext = others.front();
+  // The engine builds the core feature structs itself and takes the others as a chain: the SDK's helpers
+  // split its requirements exactly that way.
+  features.mergeVulkan12Into(config.extraFeatures12);
+  config.deviceFeaturesPNext = features.extensionChain(const_cast<void*>(config.deviceFeaturesPNext));
 }
 
 std::string effectsToString(EffectSet effects) {

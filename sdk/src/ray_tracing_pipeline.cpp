@@ -74,20 +74,9 @@ Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTra
   auto cleanupModules = [&] {
     for (VkShaderModule m : modules) c.vk.vkDestroyShaderModule(c.desc.device, m, c.allocator());
   };
-  std::vector<VkSpecializationMapEntry> specEntries;
-  for (uint32_t i = 0; i < desc.raygenSpecialization.size(); ++i) {
-    specEntries.push_back({i, i * uint32_t(sizeof(uint32_t)), sizeof(uint32_t)});
-  }
-  VkSpecializationInfo spec{static_cast<uint32_t>(specEntries.size()), specEntries.data(),
-                            desc.raygenSpecialization.size() * sizeof(uint32_t), desc.raygenSpecialization.data()};
   {
     Result<uint32_t> s = addStage(desc.raygen, VK_SHADER_STAGE_RAYGEN_BIT_KHR);
-    if (!s) {
-      status = s.error();
-    } else {
-      if (!specEntries.empty()) stages[s.value()].pSpecializationInfo = &spec;
-      groups.push_back(general(s.value()));
-    }
+    if (!s) status = s.error(); else groups.push_back(general(s.value()));
   }
   for (const SpirvModule& miss : desc.misses) {
     if (!status) break;
@@ -238,13 +227,6 @@ void DescriptorWrites::sampledImage(uint32_t binding, VkImageView view, VkSample
 void DescriptorWrites::storageBuffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset, VkDeviceSize range) {
   buffers.push_back({buffer, offset, range});
   VkWriteDescriptorSet w = write(binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
-  w.pBufferInfo = &buffers.back();
-  writes.push_back(w);
-}
-
-void DescriptorWrites::uniformBuffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset, VkDeviceSize range) {
-  buffers.push_back({buffer, offset, range});
-  VkWriteDescriptorSet w = write(binding, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER);
   w.pBufferInfo = &buffers.back();
   writes.push_back(w);
 }

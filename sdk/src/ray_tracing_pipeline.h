@@ -29,7 +29,6 @@ struct RayTracingPipelineDesc {
   std::vector<HitGroupDesc> hitGroups;
   std::vector<VkDescriptorSetLayoutBinding> bindings;  // set 0, pushed with vkCmdPushDescriptorSetKHR
   std::vector<VkDescriptorSetLayout> extraSetLayouts;   // sets 1.. (owned by the caller), bound by the caller
-  std::vector<uint32_t> raygenSpecialization;  // value of constant_id i in the raygen shader
   uint32_t pushConstantBytes = 0;
   uint32_t maxRecursionDepth = 1;
   const char* name = "ray tracing pipeline";
@@ -65,7 +64,6 @@ struct DescriptorWrites {
   void storageImage(uint32_t binding, VkImageView view, VkImageLayout layout = VK_IMAGE_LAYOUT_GENERAL);
   void sampledImage(uint32_t binding, VkImageView view, VkSampler sampler, VkImageLayout layout);
   void storageBuffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE);
-  void uniformBuffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE);
 };
 
 }  // namespace rb
