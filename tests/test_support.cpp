@@ -4,11 +4,12 @@
 
 namespace rbtest {
 
-GpuFixture::GpuFixture(uint32_t framesInFlight) {
+GpuFixture::GpuFixture(uint32_t framesInFlight, bool requestAsyncComputeQueue) {
   rb::HeadlessDeviceDesc desc;
   desc.enableValidation = true;
   desc.requireValidation = true;
   desc.framesInFlight = framesInFlight;
+  desc.requestAsyncComputeQueue = requestAsyncComputeQueue;
   auto device = rb::HeadlessDevice::create(desc);
   INFO((device.ok() ? std::string() : device.error().message));
   REQUIRE(device.ok());

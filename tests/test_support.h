@@ -27,7 +27,8 @@ struct UploadedMesh {
 
 class GpuFixture {
  public:
-  explicit GpuFixture(uint32_t framesInFlight = 2);
+  // requestAsyncComputeQueue: see HeadlessDeviceDesc (a second, compute-only queue when the device has one).
+  explicit GpuFixture(uint32_t framesInFlight = 2, bool requestAsyncComputeQueue = false);
   // Fails the running test if the validation layer reported any error.
   ~GpuFixture();
 

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "animated_scene.h"
 #include "frame_capture.h"
 #include "raybridge_sample_engine_adapter.h"
 #include "render_options.h"
@@ -24,8 +25,17 @@ int fail(const std::string& message, int code = 1) {
   return code;
 }
 
-se::Result<se::Scene> loadScene(const RenderOptions& o) {
+se::Result<se::Scene> loadScene(const RenderOptions& o, std::vector<se::AnimationPlayback>& playbacks) {
   using R = se::Result<se::Scene>;
+  if (o.characters) {
+    const std::string dir = o.charactersFrom.empty() ? std::string(RAYBRIDGE_SOURCE_DIR) + "/../shared/scenes"
+                                                     : o.charactersFrom;
+    // In front of the demo's objects, facing its camera's view (the benchmark centres them on the scene).
+    auto animated = rbAnimated::makeAnimatedScene(dir, o.characters, glm::vec2(0.0f, 5.5f));
+    if (!animated) return R::failure("--characters: " + animated.error);
+    playbacks = animated.value.playbacks;
+    return R::success(std::move(animated.value.scene));
+  }
   if (o.scene.empty()) return R::success(se::makeDefaultDemoScene());
   std::error_code ec;
   if (!std::filesystem::is_regular_file(o.scene, ec))
@@ -97,7 +107,8 @@ int main(int argc, char** argv) {
   if (const char* v = std::getenv("RAYBRIDGE_VALIDATION"); v && std::string(v) == "1") o.validation = true;
   const bool hybrid = o.mode == Mode::Hybrid;
 
-  auto scene = loadScene(o);  // before any Vulkan work, so bad input fails fast
+  std::vector<se::AnimationPlayback> characterPlaybacks;  // --characters: one animation per character
+  auto scene = loadScene(o, characterPlaybacks);  // before any Vulkan work, so bad input fails fast
   if (!scene) return fail(scene.error);
 
   // The same device in both modes (Raybridge's extensions enabled), so raster and hybrid compare like for like.
@@ -113,6 +124,25 @@ int main(int argc, char** argv) {
   if (se::Status s = engine.setRenderSize(o.width, o.height); !s) return fail(s.error);
 
   se::FrameParams params;
+  int animation = -1;  // the animation that plays (index into Scene::animations), -1 = the scene has none
+  if (!characterPlaybacks.empty()) {
+    if (!o.animation.empty()) return fail("--animation: with --characters every character plays its own animation");
+    params.animations = characterPlaybacks;
+    animation = int(characterPlaybacks[0].animation);
+  } else if (!engine.scene().animations.empty()) {
+    std::optional<uint32_t> index = o.animation.empty() ? std::optional<uint32_t>(0)
+                                                        : engine.scene().animationIndex(o.animation);
+    if (!index) {
+      std::string names;
+      for (size_t i = 0; i < engine.scene().animations.size(); ++i)
+        names += (i ? ", " : "") + std::to_string(i) + " '" + engine.scene().animations[i].name + "'";
+      return fail("--animation: the scene has no animation " + o.animation + "; its animations are " + names);
+    }
+    animation = int(*index);
+    params.animations = {{*index, 0.0}};
+  } else if (!o.animation.empty()) {
+    return fail("--animation " + o.animation + ": the scene has no animations");
+  }
   std::string cameraSource;
   params.camera = chooseCamera(o, engine.scene(), engine.sceneBounds(), cameraSource);
   if (o.sun) params.sun.direction = glm::normalize(*o.sun);
@@ -127,6 +157,7 @@ int main(int argc, char** argv) {
     rbAdapter::AdapterConfig ac;
     ac.effects = fx.effects;
     ac.normals = o.geometricNormals ? rbAdapter::GBufferNormals::Geometric : rbAdapter::GBufferNormals::Shading;
+    ac.accelerationStructures.dynamicMode = o.dynamicMode;
     auto a = rbAdapter::Adapter::create(engine, ac);
     if (!a) return fail("adapter: " + a.error);
     adapter = std::move(a.value);
@@ -172,13 +203,23 @@ int main(int argc, char** argv) {
       captureError = s.error;
   });
 
-  for (uint32_t f = 0; f < o.frames; ++f) {
+  // Frame k of N shows time - (N-1-k)/fps (every frame at `time` without --fps), so the last, captured frame is
+  // always at `time`; a time before 0 is clamped to 0.
+  auto frameTime = [&](uint32_t k) {
+    return o.fps ? std::max(0.0, o.time - double(o.frames - 1 - k) / *o.fps) : o.time;
+  };
+  // With --dump the last frame also copies its pre-pass and effect images; the timings reported are those of
+  // the frame before it, which has no capture copies.
+  const uint32_t plain = capture && o.frames > 1 ? o.frames - 1 : o.frames;
+  for (uint32_t f = 0; f < plain; ++f) {
+    params.time = frameTime(f);
     if (se::Status s = engine.renderFrame(params); !s) return fail(s.error);
   }
   if (se::Status s = engine.waitIdle(); !s) return fail(s.error);
-  const se::PassTimings timings = engine.lastTimings();  // the last frame, without capture copies
-  if (capture) {  // one more identical frame that also copies its pre-pass and visibility images
+  const se::PassTimings timings = engine.lastTimings();  // without capture copies
+  if (capture) {
     captureNext = true;
+    params.time = frameTime(o.frames - 1);
     if (se::Status s = engine.renderFrame(params); !s) return fail(s.error);
   }
   auto ldr = engine.readbackLdr();  // waits for the GPU
@@ -205,8 +246,14 @@ int main(int argc, char** argv) {
   stats["width"] = o.width;
   stats["height"] = o.height;
   stats["frames"] = o.frames;
+  stats["animation"] = {{"time", o.time},
+                        {"fps", o.fps ? nlohmann::json(*o.fps) : nlohmann::json(nullptr)},
+                        {"index", animation},
+                        {"name", animation >= 0 ? engine.scene().animations[size_t(animation)].name : ""},
+                        {"deformed_instances", engine.deformedInstances().size()}};
   stats["gbuffer_normals"] = o.geometricNormals ? "geometric" : "shading";
-  stats["scene"] = o.scene.empty() ? "procedural demo scene" : o.scene;
+  stats["scene"] = o.characters ? "procedural demo scene with " + std::to_string(o.characters) + " characters"
+                  : o.scene.empty() ? "procedural demo scene" : o.scene;
   stats["device"] = {{"name", engine.deviceInfo().name}};
   stats["camera"] = {{"eye", vec(params.camera.eye)},     {"target", vec(params.camera.target)},
                      {"fovy_degrees", params.camera.fovYDegrees}, {"z_near", params.camera.zNear},
@@ -276,7 +323,14 @@ int main(int argc, char** argv) {
           {"blas_triangles", as.triangles}, {"blas_bytes", as.blasBytes}, {"tlas_bytes", as.tlasBytes},
           {"scratch_bytes", as.scratchBytes}, {"storage_block_bytes", as.storageBlockBytes},
           {"dedup_hits", as.dedupHits}, {"tlas_instances", adapter->lastTlas().instanceCount},
-          {"tlas_skipped_instances", adapter->lastTlas().skippedInstances}}},
+          {"tlas_skipped_instances", adapter->lastTlas().skippedInstances},
+          {"dynamic_builds", o.dynamicMode == rb::DynamicBuildMode::InFrame          ? "in-frame"
+                             : o.dynamicMode == rb::DynamicBuildMode::AsyncSameFrame ? "async"
+                                                                                     : "async-late"},
+          {"refits", as.refits}, {"rebuilds", as.rebuilds}, {"async", as.async},
+          {"async_queue_family", as.async ? nlohmann::json(as.asyncQueueFamily) : nlohmann::json(nullptr)},
+          {"async_fallback_reason", as.asyncFallbackReason}, {"stale_blas", as.staleBlas},
+          {"async_gpu_ms", as.lastAsyncGpuMs}, {"dynamic_blas_bytes", as.dynamicBlasBytes}}},
         {"memory_bytes", memory}};
   }
   std::printf("engine GPU ms: shadow map %.2f  probe %.2f  prepass %.2f  ssao %.2f  hook %.2f  lighting %.2f  tonemap "

@@ -24,6 +24,20 @@ bool parseFloat(const std::string& text, float& out) {
   return errno == 0 && end == text.c_str() + text.size() && std::isfinite(out);
 }
 
+// Seconds for --time / --fps: finite and not negative (or positive), the error names the value.
+std::string parseSeconds(const std::string& option, const std::string& text, bool allowZero, double& out) {
+  errno = 0;
+  char* end = nullptr;
+  const double v = text.empty() ? 0.0 : std::strtod(text.c_str(), &end);
+  if (text.empty() || errno != 0 || end != text.c_str() + text.size())
+    return option + ": " + quoted(text) + " is not a number";
+  if (!std::isfinite(v)) return option + ": " + quoted(text) + " is not finite; give a finite number";
+  if (v < 0.0 || (!allowZero && v == 0.0))
+    return option + ": " + text + (allowZero ? " is negative; give 0 or more" : " must be greater than 0");
+  out = v;
+  return {};
+}
+
 std::string parseUint(const std::string& option, const std::string& text, uint32_t min, uint32_t max, uint32_t& out) {
   if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos || text.size() > 9)
     return option + ": " + quoted(text) + " is not a whole number in " + std::to_string(min) + ".." + std::to_string(max);
@@ -95,6 +109,19 @@ const char* renderUsage() {
          "                               shadow_raw.exr when denoised), ao.exr (AO the lighting used; plus\n"
          "                               ao_raw.exr in hybrid mode), reflection.exr (hybrid), stats.json\n"
          "  --frames N                   frames to render, the last is reported (default 3)\n"
+         "  --time T                     seconds into the animation the (last) frame shows, >= 0 (default 0)\n"
+         "  --fps F                      frame k of --frames N shows T - (N-1-k)/F, so the frames animate into\n"
+         "                               the last one (default: every frame at T)\n"
+         "  --animation N|NAME           the animation that plays, by index or name (default: the first)\n"
+         "  --characters N               the demo scene with N skinned characters (CesiumMan, Fox, BrainStem in\n"
+         "                               turn, 1..1000), each playing its first animation at its own offset\n"
+         "  --characters-from DIR        where their glTF folders are (default ../shared/scenes)\n"
+         "  --dynamic-builds in-frame|async|async-late\n"
+         "                               where deforming meshes' BLAS refits and rebuilds run: in the frame's\n"
+         "                               command buffer, on the engine's async compute queue with this frame's\n"
+         "                               TLAS waiting for them, or one frame late (the TLAS uses the previous\n"
+         "                               pose; the graphics queue never waits). Without a second queue the async\n"
+         "                               modes run in the frame, with the same result (default in-frame)\n"
          "  --device SUBSTR              pick the Vulkan device whose name contains SUBSTR\n"
          "  --validation                 enable VK_LAYER_KHRONOS_validation (also RAYBRIDGE_VALIDATION=1); exit\n"
          "                               status 3 if it reported errors\n";
@@ -141,7 +168,8 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
                a == "--camera" || a == "--sun" || a == "--sun-radius" || a == "--shadow-rays" || a == "--mode" ||
                a == "--gbuffer-normals" || a == "--frames" || a == "--preset" || a == "--effects" ||
                a == "--ao-rays" || a == "--ao-range" || a == "--ao-estimator" || a == "--reflection-roughness" ||
-               a == "--reflection-rays") {
+               a == "--reflection-rays" || a == "--time" || a == "--fps" || a == "--animation" ||
+               a == "--dynamic-builds" || a == "--characters" || a == "--characters-from") {
       if (!takeValue()) return needsValue();
       if (a == "--scene") {
         if (value.empty()) return "--scene: the file name is empty";
@@ -157,6 +185,24 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
         e = parseUint(a, value, 1, kMaxSize, o.height);
       } else if (a == "--frames") {
         e = parseUint(a, value, 1, 100000, o.frames);
+      } else if (a == "--time") {
+        e = parseSeconds(a, value, true, o.time);
+      } else if (a == "--fps") {
+        double f = 0.0;
+        if ((e = parseSeconds(a, value, false, f)).empty()) o.fps = f;
+      } else if (a == "--animation") {
+        if (value.empty()) e = "--animation: the index or name is empty";
+        o.animation = value;
+      } else if (a == "--characters") {
+        e = parseUint(a, value, 1, 1000, o.characters);
+      } else if (a == "--characters-from") {
+        if (value.empty()) e = "--characters-from: the folder name is empty";
+        o.charactersFrom = value;
+      } else if (a == "--dynamic-builds") {
+        if (value == "in-frame") o.dynamicMode = rb::DynamicBuildMode::InFrame;
+        else if (value == "async") o.dynamicMode = rb::DynamicBuildMode::AsyncSameFrame;
+        else if (value == "async-late") o.dynamicMode = rb::DynamicBuildMode::AsyncOneFrameLate;
+        else e = "--dynamic-builds: " + quoted(value) + " is not in-frame, async or async-late";
       } else if (a == "--shadow-rays") {
         uint32_t n = 0;
         if ((e = parseUint(a, value, 1, 4096, n)).empty()) o.shadowRays = n;
@@ -223,6 +269,9 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
     }
     if (!e.empty()) return e;
   }
+  if (o.characters && !o.scene.empty())
+    return "--characters: adds characters to the demo scene; it cannot be combined with --scene";
+  if (!o.charactersFrom.empty() && !o.characters) return "--characters-from needs --characters N";
   if (uint64_t(o.width) * o.height > uint64_t(8192) * 8192)
     return "--width/--height: " + std::to_string(o.width) + "x" + std::to_string(o.height) +
            " exceeds 67 megapixels";

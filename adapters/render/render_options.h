@@ -36,6 +36,15 @@ struct RenderOptions {
   bool dump = false;
   bool geometricNormals = false;
   uint32_t frames = 3;  // enough for the SDK's deferred statistics (resolved kFramesInFlight frames later)
+  // Animation: the last frame shows the scene at `time` seconds; with `fps`, frame k of `frames` is at
+  // time - (frames - 1 - k) / fps, so the earlier frames animate into the captured one.
+  double time = 0.0;
+  std::optional<double> fps;
+  std::string animation;  // --animation N|NAME; empty = the scene's first animation
+  // --characters N: N skinned characters from `charactersFrom` on the demo scene, each playing its animation.
+  uint32_t characters = 0;
+  std::string charactersFrom;  // --characters-from DIR; empty = ../shared/scenes beside the source tree
+  rb::DynamicBuildMode dynamicMode = rb::DynamicBuildMode::InFrame;  // --dynamic-builds
   std::string device;
   bool validation = false;
   bool help = false;

@@ -83,6 +83,8 @@ void configureEngine(se::EngineConfig& config, rb::RequiredFeatures& features) {
   // split its requirements exactly that way.
   features.mergeVulkan12Into(config.extraFeatures12);
   config.deviceFeaturesPNext = features.extensionChain(const_cast<void*>(config.deviceFeaturesPNext));
+  // A compute-only queue (where the device has one) for asynchronous BLAS work of deforming meshes.
+  config.requestAsyncComputeQueue = true;
 }
 
 std::string effectsToString(EffectSet effects) {
@@ -159,8 +161,10 @@ struct Adapter::Impl {
   std::unique_ptr<rb::Denoiser> aoDenoiser;        // only for denoised AO
   // Disabled passes, destroyed once no frame in flight can use them: (frameIndex when retired, object).
   std::vector<std::pair<uint64_t, std::shared_ptr<void>>> retired;
-  std::vector<rb::MeshHandle> meshes;  // parallel to engine.meshes(); null for empty meshes
+  std::vector<rb::MeshHandle> meshes;    // parallel to engine.meshes(); null for empty meshes
+  std::vector<rb::MeshHandle> deformed;  // parallel to engine.deformedInstances(): dynamic BLASes
   std::vector<rb::Instance> instances;
+  std::vector<uint32_t> instanceSource;  // Scene::instances index of each entry of `instances`
   std::vector<rb::Material> materials;  // the engine's materials, converted
   std::vector<VkImageView> textureViews;  // what rb::Material texture indices index (engine-owned views)
   bool materialsDirty = true;           // not yet given to the reflection pass
@@ -184,6 +188,7 @@ struct Adapter::Impl {
     std::erase_if(retired, [&](const auto& r) { return idle || r.first + ctx->framesInFlight() + 1 <= now; });
   }
   se::Status updateDenoisers();
+  se::Status updateDynamicMeshes(const se::PrepassHookInfo& info);
   rb::GBufferDesc describePrepass(const se::PrepassHookInfo& info, bool shadingNormals) const;
 };
 
@@ -218,7 +223,12 @@ se::Result<std::unique_ptr<Adapter>> Adapter::create(se::Engine& engine, const A
   if (!ctx) return R::failure(rbError("rb::Context::create", ctx.error()));
   impl->ctx = std::move(ctx.value());
 
-  auto as = rb::AccelerationStructureService::create(*impl->ctx, config.accelerationStructures);
+  rb::AsServiceDesc asDesc = config.accelerationStructures;
+  if (asDesc.dynamicMode != rb::DynamicBuildMode::InFrame && !asDesc.asyncQueue) {
+    asDesc.asyncQueue = engine.asyncComputeQueue();  // VK_NULL_HANDLE on one-queue devices: the SDK falls back
+    asDesc.asyncQueueFamily = engine.asyncComputeQueueFamily();
+  }
+  auto as = rb::AccelerationStructureService::create(*impl->ctx, asDesc);
   if (!as) return R::failure(rbError("rb::AccelerationStructureService::create", as.error()));
   impl->as = std::move(as.value());
 
@@ -268,19 +278,54 @@ se::Status Adapter::applyPreset(Preset preset, float sunAngularRadiusDegrees) {
   return se::Status::success();
 }
 
+namespace {
+
+// The engine's buffers as a Raybridge mesh: positions R32G32B32_SFLOAT, uint32 indices (or none), attributes
+// interleaved {vec3 normal; vec2 uv; vec4 tangent}.
+rb::MeshDesc describeMesh(VkDeviceAddress positions, uint32_t positionStride, uint32_t vertexCount,
+                          const se::GpuMesh& topology, VkDeviceAddress attributes, uint32_t attributeStride) {
+  rb::MeshDesc d;
+  d.vertexAddress = positions;
+  d.vertexBufferBytes = VkDeviceSize(vertexCount) * positionStride;
+  d.vertexCount = vertexCount;
+  d.vertexFormat = topology.positionFormat;
+  d.vertexStride = positionStride;
+  d.indexType = topology.indexCount ? rb::IndexType::Uint32 : rb::IndexType::None;
+  d.indexAddress = topology.indexAddress;
+  d.indexBufferBytes = VkDeviceSize(topology.indexCount) * sizeof(uint32_t);
+  d.triangleCount = (topology.indexCount ? topology.indexCount : vertexCount) / 3;
+  if (attributes) {
+    d.normalAddress = attributes;
+    d.normalStride = attributeStride;
+    d.texcoordAddress = attributes + 12;
+    d.texcoordStride = attributeStride;
+  }
+  if (topology.cpu) d.debugName = topology.cpu->name.c_str();
+  return d;
+}
+
+void toRowMajor3x4(const glm::mat4& m, float out[12]) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) out[r * 4 + c] = m[c][r];  // GLM is column-major
+}
+
+}  // namespace
+
 se::Status Adapter::syncScene() {
   Impl& a = *impl_;
   for (rb::MeshHandle h : a.meshes) {
     if (!h.isNull()) (void)a.as->releaseMesh(h);
   }
+  for (rb::MeshHandle h : a.deformed) (void)a.as->releaseMesh(h);
   a.meshes.clear();
+  a.deformed.clear();
   a.instances.clear();
+  a.instanceSource.clear();
   const se::Scene& scene = a.engine.scene();
   const std::span<const se::GpuMesh> meshes = a.engine.meshes();
   for (size_t i = 0; i < meshes.size(); ++i) {
     const se::GpuMesh& m = meshes[i];
-    const uint32_t triangles = (m.indexCount ? m.indexCount : m.vertexCount) / 3;
-    if (triangles == 0) {
+    if ((m.indexCount ? m.indexCount : m.vertexCount) / 3 == 0) {
       a.meshes.push_back({});
       continue;
     }
@@ -289,46 +334,56 @@ se::Status Adapter::syncScene() {
                                  " has no device address: create the engine with "
                                  "EngineConfig::enableRayTracingInputs and rbAdapter::configureEngine()");
     }
-    rb::MeshDesc d;
-    d.vertexAddress = m.positionAddress;
-    d.vertexBufferBytes = VkDeviceSize(m.vertexCount) * m.positionStride;
-    d.vertexCount = m.vertexCount;
-    d.vertexFormat = m.positionFormat;
-    d.vertexStride = m.positionStride;
-    d.indexType = m.indexCount ? rb::IndexType::Uint32 : rb::IndexType::None;
-    d.indexAddress = m.indexAddress;
-    d.indexBufferBytes = VkDeviceSize(m.indexCount) * sizeof(uint32_t);
-    d.triangleCount = triangles;
-    if (m.attributeAddress) {  // interleaved {vec3 normal; vec2 uv; vec4 tangent}
-      d.normalAddress = m.attributeAddress;
-      d.normalStride = m.attributeStride;
-      d.texcoordAddress = m.attributeAddress + 12;
-      d.texcoordStride = m.attributeStride;
-    }
-    if (m.cpu) {
+    rb::MeshDesc d = describeMesh(m.positionAddress, m.positionStride, m.vertexCount, m, m.attributeAddress,
+                                  m.attributeStride);
+    if (m.cpu) {  // content-hash dedup of identical static meshes
       d.hostVertices = m.cpu->positions.data();
       d.hostIndices = m.cpu->indices.empty() ? nullptr : m.cpu->indices.data();
-      d.debugName = m.cpu->name.c_str();
     }
     auto handle = a.as->registerMesh(d);
     if (!handle) return se::Status::failure(rbError("registerMesh", handle.error()));
     a.meshes.push_back(handle.value());
   }
-  for (const se::Instance& inst : scene.instances) {
-    if (inst.mesh >= a.meshes.size() || a.meshes[inst.mesh].isNull()) continue;
+  // Deforming instances (skinned, morphed) trace their own deformed buffers, one dynamic BLAS each.
+  std::vector<rb::MeshHandle> byInstance(scene.instances.size());
+  for (const se::DeformedInstance& di : a.engine.deformedInstances()) {
+    rb::MeshDesc d = describeMesh(di.positionAddress, 12, di.vertexCount, meshes[di.mesh], di.attributeAddress, 36);
+    d.role = rb::MeshRole::Dynamic;
+    auto handle = a.as->registerMesh(d);
+    if (!handle) return se::Status::failure(rbError("registerMesh (deformed instance)", handle.error()));
+    a.deformed.push_back(handle.value());
+    byInstance[di.instance] = handle.value();
+  }
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const se::Instance& inst = scene.instances[i];
     rb::Instance out;
-    out.mesh = a.meshes[inst.mesh];
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c) out.transform[r * 4 + c] = inst.transform[c][r];  // GLM is column-major
-    }
+    out.mesh = byInstance[i].isNull() && inst.mesh < a.meshes.size() ? a.meshes[inst.mesh] : byInstance[i];
+    if (out.mesh.isNull()) continue;
+    toRowMajor3x4(inst.transform, out.transform);
     out.customIndex = inst.mesh;
     out.material = meshes[inst.mesh].material;
     a.instances.push_back(out);
+    a.instanceSource.push_back(uint32_t(i));
   }
   convertMaterials(scene, a.engine.textures(), a.materials, a.textureViews);
   if (a.materials.empty()) a.materials.emplace_back();
   for (rb::Instance& inst : a.instances) inst.material = std::min<uint32_t>(inst.material, uint32_t(a.materials.size() - 1));
   a.materialsDirty = true;
+  return se::Status::success();
+}
+
+se::Status Adapter::Impl::updateDynamicMeshes(const se::PrepassHookInfo& info) {
+  // This frame's node animation moves instances; deformation rewrote the deformed buffers.
+  if (info.instanceTransforms.size() == engine.scene().instances.size())
+    for (size_t k = 0; k < instances.size(); ++k) toRowMajor3x4(info.instanceTransforms[instanceSource[k]], instances[k].transform);
+  if (deformed.empty() || !settings.updateDeformedMeshes) return se::Status::success();
+  for (rb::MeshHandle h : deformed)
+    if (rb::Status s = as->updateMesh(h); !s) return se::Status::failure(rbError("updateMesh", s.error()));
+  if (rb::Status s = as->submitDynamicWork({info.deformSemaphore, info.deformValue}); !s)
+    return se::Status::failure(rbError("submitDynamicWork", s.error()));
+  VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  if (as->fillTlasWait(wait) && info.submitWaits) info.submitWaits->push_back(wait);
+  if (as->fillVertexReuseWait(wait) && info.deformWaits) info.deformWaits->push_back(wait);
   return se::Status::success();
 }
 
@@ -380,6 +435,7 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
     a.materialsDirty = false;
   }
 
+  if (se::Status st = a.updateDynamicMeshes(info); !st) return a.fail(st.error);
   if (auto pending = a.as->recordPendingWork(cmd); !pending) return a.fail(rbError("recordPendingWork", pending.error()));
   rb::TlasBuildOptions options;
   for (int i = 0; i < 3; ++i) options.originOffset[i] = double(info.cameraPosition[i]);

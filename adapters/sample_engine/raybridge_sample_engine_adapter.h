@@ -5,6 +5,11 @@
 //  [x] rb::Context on the engine's device, instance, queue family and kFramesInFlight.
 //  [x] Engine meshes registered with the acceleration-structure service from the engine's own buffers (device
 //      addresses, no copies), with their normals and UVs (interleaved attribute buffer) for reflection hits.
+//  [x] Animation: every deforming instance (skinned, morphed) is a dynamic BLAS over the engine's deformed
+//      buffers, updated every frame; node animation moves TLAS instances. With an async DynamicBuildMode the
+//      refits and rebuilds run on the engine's async compute queue (EngineConfig::requestAsyncComputeQueue),
+//      waiting on the engine's deform timeline; the frame's submission waits for what the TLAS needs
+//      (PrepassHookInfo::submitWaits) and the next deformation for the SDK's reads (deformWaits).
 //  [x] One TLAS per frame over the scene instances, camera-relative (originOffset = camera position), with
 //      shading records (vertex data + material per instance) only while reflections are on.
 //  [x] The engine's pre-pass described as an rb::GBufferDesc (shading or geometric normals; roughness in
@@ -79,13 +84,17 @@ enum class GBufferNormals : uint8_t {
 struct AdapterConfig {
   EffectSet effects = kEffectShadows;  // default: shadows; 0 = no pass, no BLAS, no TLAS (only frame pacing)
   GBufferNormals normals = GBufferNormals::Shading;  // default Shading
-  rb::AsServiceDesc accelerationStructures;          // zero = the SDK's defaults (64 MiB scratch, no budget)
+  // Zero = the SDK's defaults (64 MiB scratch, no budget, dynamic BLAS work in the frame). With an async
+  // dynamicMode and no asyncQueue, the engine's async compute queue is handed over.
+  rb::AsServiceDesc accelerationStructures;
 };
 
 // Per-frame knobs; change them between frames through Adapter::settings(). Zeros mean the SDK's defaults.
 struct FrameSettings {
   bool enabled = true;                   // false = record nothing: the engine uses its own lighting terms
   bool denoise = true;                   // denoise soft shadows and AO (the raw images stay available)
+  // false = the BLASes of deforming instances keep their last pose (a paused animation costs no BLAS work).
+  bool updateDeformedMeshes = true;
   // Shadows.
   float sunAngularRadiusDegrees = 0.0f;  // 0 = hard shadows (one ray per pixel, never denoised)
   uint32_t shadowRaysPerPixel = 0;       // soft shadows only; 0 = the SDK's default (4)

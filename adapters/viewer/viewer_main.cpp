@@ -37,7 +37,7 @@ const char* kKeys =
     "keys: drag = orbit, scroll = zoom, W/A/S/D/Q/E = move (Shift = faster)\n"
     "      M = mode raster (shadow map, SSAO, probe) <-> hybrid (Raybridge), P = next preset,\n"
     "      H = shadows hard <-> soft, O = ambient occlusion on/off, R = reflections on/off, N = denoise on/off,\n"
-    "      Left/Right = sun azimuth, Up/Down = sun elevation, Esc = quit\n";
+    "      Left/Right = sun azimuth, Up/Down = sun elevation, Space = pause/resume the animation, Esc = quit\n";
 
 int fail(const std::string& message) {
   std::fprintf(stderr, "raybridge-viewer: error: %s\n", message.c_str());
@@ -155,6 +155,7 @@ int main(int argc, char** argv) {
   window.cursorPosition(lastX, lastY);
   auto last = std::chrono::steady_clock::now();
   int frames = 0;
+  bool paused = false;  // the animation clock (real time) stops while paused
   auto printState = [&] {
     const rbAdapter::EffectSet fx = adapter.value->effects();
     std::printf("mode %s, preset %s, effects [%s], shadows %s (%u rays), AO %u rays, denoise %s, sun azimuth %.0f "
@@ -177,6 +178,8 @@ int main(int argc, char** argv) {
     const float dt = std::min(std::chrono::duration<float>(now - last).count(), 0.1f);
     last = now;
 
+    if (keys.pressed(GLFW_KEY_SPACE)) paused = !paused, std::printf("animation %s at %.2f s\n", paused ? "paused" : "playing", params.time);
+    if (!paused) params.time += dt;
     if (keys.pressed(GLFW_KEY_M)) rt.enabled = !rt.enabled, printState();
     if (keys.pressed(GLFW_KEY_H)) {
       rt.sunAngularRadiusDegrees = rt.sunAngularRadiusDegrees > 0.0f ? 0.0f : rbAdapter::kDefaultSoftSunRadiusDegrees;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 
 #include "sample_engine/engine.h"
@@ -30,6 +31,9 @@ struct Options {
   bool window = false;
   bool validation = false;
   int frames = 0;  // --window: close after this many frames (0 = run until closed); headless: frames to render
+  double time = 0.0;       // animation time of the (last) headless frame; the viewer starts there
+  std::string animation;   // index or name; empty = the scene's first
+  bool restPose = false;
 };
 
 void usage() {
@@ -37,8 +41,11 @@ void usage() {
       "usage: raybridge-engine-demo [--out FILE.png] [--exr FILE.exr] [--width W] [--height H]\n"
       "                             [--scene FILE.gltf|.glb] [--shadow-map-size N] [--pcf N]\n"
       "                             [--ssao KERNEL] [--probe RES] [--effects PREFIX]\n"
+      "                             [--time T] [--animation N|NAME] [--rest-pose]\n"
       "                             [--validation] [--frames N] [--window]\n"
       "  Headless by default: renders one frame and writes the PNG (and EXR of the HDR image).\n"
+      "  --time T poses the scene's animation at T seconds (>= 0; headless frames end there, 1/30 s apart;\n"
+      "  the viewer plays from T), --animation picks it by index or name, --rest-pose plays none.\n"
       "  --ssao enables the engine's SSAO with KERNEL samples, --probe a RES^2-per-face reflection probe;\n"
       "  --effects writes the shadow-map visibility (and SSAO) images as PREFIX_shadow.png / PREFIX_ssao.png.\n"
       "  --window opens a viewer: drag = orbit, scroll = zoom, WASD/QE = move, Shift = faster, Esc = quit.\n");
@@ -66,6 +73,17 @@ bool parse(int argc, char** argv, Options& o) {
     else if (a == "--probe") { if (!(v = next("--probe"))) return false; o.probeResolution = uint32_t(std::atoi(v)); }
     else if (a == "--effects") { if (!(v = next("--effects"))) return false; o.effectsPrefix = v; }
     else if (a == "--frames") { if (!(v = next("--frames"))) return false; o.frames = std::atoi(v); }
+    else if (a == "--time") {
+      if (!(v = next("--time"))) return false;
+      char* end = nullptr;
+      o.time = std::strtod(v, &end);
+      if (end == v || *end != '\0' || !std::isfinite(o.time) || o.time < 0.0) {
+        std::fprintf(stderr, "--time %s: expected seconds, finite and >= 0\n", v);
+        return false;
+      }
+    }
+    else if (a == "--animation") { if (!(v = next("--animation"))) return false; o.animation = v; }
+    else if (a == "--rest-pose") o.restPose = true;
     else if (a == "--window") o.window = true;
     else if (a == "--validation") o.validation = true;
     else if (a == "--help" || a == "-h") { usage(); std::exit(0); }
@@ -93,6 +111,21 @@ bool loadScene(const Options& o, Scene& scene) {
     return false;
   }
   scene = std::move(r.scene);
+  return true;
+}
+
+// The animation to play (FrameParams::animations), or an error naming the scene's animations.
+bool pickAnimation(const Options& o, const Scene& scene, FrameParams& p) {
+  p.restPose = o.restPose;
+  p.time = o.time;
+  if (o.animation.empty()) return true;
+  std::optional<uint32_t> index = scene.animationIndex(o.animation);
+  if (!index) {
+    std::fprintf(stderr, "error: --animation %s: no such animation; the scene's animations are %s\n",
+                 o.animation.c_str(), scene.describeAnimations().c_str());
+    return false;
+  }
+  p.animations = {{*index, 0.0}};
   return true;
 }
 
@@ -143,9 +176,9 @@ int writeEffects(const Options& o, Engine& engine) {
 
 void printTimings(const PassTimings& t) {
   if (!t.valid) return;
-  std::printf("GPU ms: shadow %.2f  probe %.2f%s  prepass %.2f  ssao %.2f  shadow-vis %.2f  hook %.2f  lighting %.2f"
-              "  tonemap %.2f\n",
-              t.shadowMs, t.probeMs, t.probeCaptured ? " (captured)" : "", t.prepassMs, t.ssaoMs,
+  std::printf("GPU ms: deform %.2f  shadow %.2f  probe %.2f%s  prepass %.2f  ssao %.2f  shadow-vis %.2f  hook %.2f"
+              "  lighting %.2f  tonemap %.2f\n",
+              t.deformMs, t.shadowMs, t.probeMs, t.probeCaptured ? " (captured)" : "", t.prepassMs, t.ssaoMs,
               t.shadowVisibilityMs, t.hookMs, t.lightingMs, t.tonemapMs);
 }
 
@@ -164,8 +197,15 @@ int runHeadless(const Options& o) {
   if (Status s = engine.loadScene(scene); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
   if (Status s = engine.setRenderSize(o.width, o.height); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
   FrameParams params = initialParams(o, engine);
+  if (!pickAnimation(o, engine.scene(), params)) return 1;
+  if (!engine.deformedInstances().empty())
+    std::printf("animated: %zu deforming instances, %zu animations (%s)\n", engine.deformedInstances().size(),
+                engine.scene().animations.size(), engine.scene().describeAnimations().c_str());
   // Extra frames (--frames N) give steady-state timings; the first one's are printed too (probe capture).
+  // They lead up to --time at 30 frames per second, so the written frame shows --time.
+  const double lastTime = o.time;
   for (int i = 1; i < o.frames; ++i) {
+    params.time = std::max(0.0, lastTime - double(o.frames - i) / 30.0);
     if (Status s = engine.renderFrame(params); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
     if (i == 1) {
       if (Status s = engine.waitIdle(); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
@@ -174,6 +214,7 @@ int runHeadless(const Options& o) {
     }
   }
   auto t0 = std::chrono::steady_clock::now();
+  params.time = lastTime;
   if (Status s = engine.renderFrame(params); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
   auto ldr = engine.readbackLdr();
   auto t1 = std::chrono::steady_clock::now();
@@ -233,6 +274,8 @@ int runWindow(const Options& o) {
     return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
 
   FrameParams params = initialParams(o, engine);
+  if (!pickAnimation(o, engine.scene(), params)) return 1;
+  const auto start = std::chrono::steady_clock::now();
   Orbit orbit = Orbit::from(params.camera);
   const float sceneSize = std::max(engine.sceneBounds().radius(), 1.0f);
   double lastX = 0, lastY = 0;
@@ -269,6 +312,7 @@ int runWindow(const Options& o) {
     if (w == 0 || h == 0) continue;  // minimized
     VkExtent2D size = engine.renderSize();
     if (uint32_t(w) != size.width || uint32_t(h) != size.height) engine.resizeSwapchain(uint32_t(w), uint32_t(h));
+    params.time = o.time + std::chrono::duration<double>(now - start).count();
     if (Status s = engine.renderFrame(params); !s) {
       std::fprintf(stderr, "error: %s\n", s.error.c_str());
       break;

@@ -103,6 +103,14 @@ for f in "$CARRY"/bin/*; do
   case "$name" in *test*) echo "$name|$name|" >>"$CARRY/tests.txt" ;; esac
 done
 echo "bench_smoke|raybridge-bench|--quick --scenario all" >>"$CARRY/tests.txt"
+
+# The independent raw-rate probe (../shared/tools/rt-probe), run in the same GPU run as the benchmarks.
+PROBE_SRC="$ROOT/../shared/tools/rt-probe"
+if [ -f "$PROBE_SRC/build.sh" ]; then
+  sh "$PROBE_SRC/build.sh" "$CARRY/probe" >/dev/null && log "probe: built into .devcarry/probe"
+else
+  log "no rt-probe at $PROBE_SRC: the GPU run has no raw-rate baseline"
+fi
 echo "$ROOT" >"$CARRY/source_dir.txt"
 
 # ---- 3. validation layer -----------------------------------------------------------------------------------

@@ -2,7 +2,7 @@
 # Runs the benchmark and the tests on the GPU machine (NVIDIA, no Vulkan loader, no network) from the folder
 # .devcarry/ that scripts/gpu/prepare.sh assembled and the device tool carried. Run from the repository root:
 #
-#   bash scripts/gpu/run_remote.sh [all|bench|tests|render|effects]      (default all)
+#   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, render, effects, animated (default all)
 #
 # Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
 # tests_gpu.log, effects_gpu.json, effects_gpu.log, render_gpu.tar.gz (render logs, stats.json and final.png
@@ -20,7 +20,10 @@
 set -u
 
 MODE="${1:-all}"
-case "$MODE" in all|bench|tests|render|effects) ;; *) echo "usage: $0 [all|bench|tests|render|effects]" >&2; exit 2 ;; esac
+for m in ${MODE//,/ }; do
+  case "$m" in all|bench|tests|render|effects|animated) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, render, effects or animated" >&2; exit 2 ;; esac
+done
+want() { [ "$MODE" = all ] || [[ ",$MODE," == *",$1,"* ]]; }
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 cd "$ROOT"
 CARRY="$ROOT/.devcarry"
@@ -153,7 +156,7 @@ fi
 } >"$OUT/env.txt" 2>&1
 
 # ---- benchmark (full sizes, validation off) ----------------------------------------------------------------
-if [ "$MODE" = all ] || [ "$MODE" = bench ]; then
+if want bench; then
   read -r -a BENCH_ARGS <<<"${RB_BENCH_ARGS:---scenario all --full}"
   : >"$OUT/bench_gpu.log"
   RAYBRIDGE_VALIDATION=0 step bench 300 "$OUT/bench_gpu.log" \
@@ -162,7 +165,7 @@ if [ "$MODE" = all ] || [ "$MODE" = bench ]; then
 fi
 
 # ---- render command: frame times raster vs hybrid at 1920x1080 (validation off) -------------------------------
-if [ "$MODE" = all ] || [ "$MODE" = render ]; then
+if want render; then
   : >"$OUT/render_gpu.log"
   RENDER="$RT/bin/raybridge-render"
   RDIR="$(mktemp -d)"
@@ -179,7 +182,7 @@ if [ "$MODE" = all ] || [ "$MODE" = render ]; then
 fi
 
 # ---- effects: speed against error at 1920x1080 (validation off), FLIP computed here ------------------------
-if [ "$MODE" = all ] || [ "$MODE" = effects ]; then
+if want effects; then
   : >"$OUT/effects_gpu.log"
   EIMG="$(mktemp -d)"
   RAW=()
@@ -196,8 +199,24 @@ if [ "$MODE" = all ] || [ "$MODE" = effects ]; then
   grep -E '^(shadows|ao|reflections):' "$OUT/effects_gpu.log" | grep -v reference | head -n 60
 fi
 
+# ---- animated: K skinned characters, sync vs async BLAS work, 2560x1440 (validation off); the raw-rate probe in
+# the same run; then the two-queue SDK tests and the animated smoke run with validation (sync validation) on.
+if want animated; then
+  : >"$OUT/animated_gpu.log"
+  if [ -x "$RT/probe/probe" ]; then
+    RAYBRIDGE_VALIDATION=0 step probe 60 "$OUT/animated_gpu.log" "$RT/probe/probe" --width 2560 --height 1440 \
+      --rays 64 --k 10 --ground-tiles 64 --reps 7
+  fi
+  RAYBRIDGE_VALIDATION=0 step animated 330 "$OUT/animated_gpu.log" "$RT/bin/raybridge-animated-bench" \
+    ${RB_ANIMATED_ARGS:-} --scenes "$SCENES" --out "$OUT/animated_gpu.json"
+  RAYBRIDGE_VALIDATION=1 step "async tests" 120 "$OUT/animated_gpu.log" "$RT/bin/raybridge_tests" "[async],[dynamic]"
+  RAYBRIDGE_VALIDATION=1 step "animated smoke" 120 "$OUT/animated_gpu.log" "$RT/bin/raybridge-animated-bench" \
+    --quick --validation --scenes "$SCENES" --out "$(mktemp -d)/animated_smoke.json"
+  grep -E '^\| |^device|stress|All tests passed|test cases|FAILED|SKIPPED|validation' "$OUT/animated_gpu.log" | head -n 80
+fi
+
 # ---- tests (validation on) ---------------------------------------------------------------------------------
-if [ "$MODE" = all ] || [ "$MODE" = tests ]; then
+if want tests; then
   : >"$OUT/tests_gpu.log"
   while IFS='|' read -r name exe args; do
     [ -n "$name" ] || continue

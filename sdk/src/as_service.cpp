@@ -13,14 +13,8 @@ namespace {
 
 constexpr VkDeviceSize kDefaultScratchBudget = 64ull << 20;
 constexpr VkDeviceSize kDefaultBlockBytes = 32ull << 20;
-constexpr size_t kMaxTimings = 64;
 
 VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
-
-std::string meshName(const BlasEntry& e, uint32_t index) {
-  return e.mesh.desc.debugName ? std::string("mesh '") + e.mesh.desc.debugName + "'"
-                               : "mesh #" + std::to_string(index);
-}
 
 }  // namespace
 
@@ -45,8 +39,10 @@ AccelerationStructureService::Impl::Impl(Context& context, const AsServiceDesc& 
 }
 
 AccelerationStructureService::Impl::~Impl() {
-  // Contract: the GPU is done with everything this service recorded. Retired objects reference the storage
-  // allocator, so they are released before it goes.
+  // Contract: the GPU is done with everything this service recorded on the engine's queues; the async queue's
+  // work is waited for on the SDK's own timeline first. Retired objects reference the storage allocators, so
+  // they are released before those go.
+  submitter.destroy();
   for (uint32_t i = 1; i < entries.size(); ++i) {
     if (entries[i].state != BlasState::Free) destroyEntry(i);
   }
@@ -63,11 +59,17 @@ AccelerationStructureService::Impl::~Impl() {
   }
   for (VkQueryPool p : freeTimestampPools) c.vk.vkDestroyQueryPool(c.desc.device, p, c.allocator());
   destroyBuffer(ctx, scratch);
+  destroyDynamic();
   c.releaseRetired(true);
 }
 
 VkDeviceSize AccelerationStructureService::Impl::scratchAlignment() const {
   return std::max<VkDeviceSize>(c.info.minAccelerationStructureScratchOffsetAlignment, 1);
+}
+
+VkDeviceSize AccelerationStructureService::Impl::storageNeed(const BlasEntry& e) const {
+  const VkDeviceSize one = alignUp(e.sizes.accelerationStructureSize, AsStorageAllocator::kAlignment);
+  return e.mesh.desc.role == MeshRole::Dynamic ? one * dynamicCopies : one;
 }
 
 VkBuildAccelerationStructureFlagsKHR AccelerationStructureService::Impl::blasFlags(const BlasEntry& e) const {
@@ -141,7 +143,9 @@ void AccelerationStructureService::Impl::destroyEntry(uint32_t index) {
   if (e.state == BlasState::Queued) {
     queue.erase(std::remove(queue.begin(), queue.end(), index), queue.end());
   }
-  if (e.as) {
+  if (e.mesh.desc.role == MeshRole::Dynamic) {
+    retireCopies(e.dyn.copies);  // `as` only mirrors the newest copy
+  } else if (e.as) {
     VkAccelerationStructureKHR as = e.as;
     StorageAllocation alloc = e.storage;
     c.retire([this, as, alloc] {
@@ -149,8 +153,7 @@ void AccelerationStructureService::Impl::destroyEntry(uint32_t index) {
       storage.free(alloc);
     });
   }
-  reservedBytes -= alignUp(e.currentSize ? e.currentSize : e.sizes.accelerationStructureSize,
-                           AsStorageAllocator::kAlignment);
+  reservedBytes -= e.reserved;
   uint32_t generation = e.generation + 1;
   e = BlasEntry{};
   e.generation = generation == 0 ? 1 : generation;
@@ -196,8 +199,9 @@ Result<std::unique_ptr<AccelerationStructureService>> AccelerationStructureServi
                  "AsServiceDesc::storageBlockBytes is " + std::to_string(desc.storageBlockBytes) +
                      "; use 0 (32 MiB) or at least 64 KiB"};
   }
-  return std::unique_ptr<AccelerationStructureService>(
-      new AccelerationStructureService(std::make_unique<Impl>(context, desc)));
+  auto impl = std::make_unique<Impl>(context, desc);
+  if (Status st = impl->initDynamic(desc); !st) return st.error();
+  return std::unique_ptr<AccelerationStructureService>(new AccelerationStructureService(std::move(impl)));
 }
 
 Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& desc) {
@@ -251,7 +255,7 @@ Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& de
   info.pGeometries = &geometry;
   s.c.vk.vkGetAccelerationStructureBuildSizesKHR(s.c.desc.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR,
                                                  &info, &range.primitiveCount, &e.sizes);
-  VkDeviceSize need = alignUp(e.sizes.accelerationStructureSize, AsStorageAllocator::kAlignment);
+  VkDeviceSize need = s.storageNeed(e);
   std::string name = desc.debugName ? std::string("mesh '") + desc.debugName + "'" : "a mesh";
   if (Status st = s.makeRoom(need, "registering " + name); !st) return st.error();
 
@@ -267,8 +271,10 @@ Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& de
   }
   e.state = BlasState::Queued;
   e.refCount = 0;
+  e.reserved = need;
   s.entries[index] = e;
-  s.queue.push_back(index);
+  // Dynamic meshes are built by the dynamic work (their copies, their queue); the queue holds static builds.
+  if (e.mesh.desc.role == MeshRole::Static) s.queue.push_back(index);
   if (dedupable) s.byKey[e.key] = index;
   s.reservedBytes += need;
   MeshHandle h = addRegistration(index);
@@ -308,18 +314,12 @@ Status AccelerationStructureService::releaseMesh(MeshHandle mesh) {
   return {};
 }
 
-Status AccelerationStructureService::updateMesh(MeshHandle mesh) {
-  Impl& s = *impl_;
-  Result<Registration*> r = s.lookup(mesh, "updateMesh");
-  if (!r) return r.error();
-  BlasEntry& e = s.entries[r.value()->blas];
-  if (e.mesh.desc.role != MeshRole::Dynamic) {
-    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
-                 "updateMesh: " + meshName(e, r.value()->blas) +
-                     " was registered with MeshRole::Static; register deforming meshes as MeshRole::Dynamic"};
+void AccelerationStructureService::Impl::addTiming(const BuildBatchTiming& timing) {
+  timings.push_back(timing);
+  if (timings.size() > kMaxBatchTimings) {
+    timings.erase(timings.begin());
+    ++counters.batchTimingsDropped;
   }
-  if (e.state == BlasState::Built) e.needsRefit = true;
-  return {};
 }
 
 void AccelerationStructureService::Impl::resolveBatches() {
@@ -338,13 +338,8 @@ void AccelerationStructureService::Impl::resolveBatches() {
         continue;
       }
       if (r == VK_SUCCESS) {
-        BuildBatchTiming t{b.frame, b.builds, b.triangles,
-                           double(c.info.timestampTicks(ticks[0], ticks[1])) * c.info.timestampPeriodNs * 1e-6};
-        timings.push_back(t);
-        if (timings.size() > kMaxTimings) {
-          timings.erase(timings.begin());
-          ++counters.batchTimingsDropped;
-        }
+        addTiming({b.frame, b.builds, b.triangles,
+                   double(c.info.timestampTicks(ticks[0], ticks[1])) * c.info.timestampPeriodNs * 1e-6});
       }
       freeTimestampPools.push_back(b.timestamps);
     }
@@ -396,8 +391,9 @@ Status AccelerationStructureService::Impl::recordCompactions(VkCommandBuffer cmd
       c.vk.vkDestroyAccelerationStructureKHR(c.desc.device, old, c.allocator());
       storage.free(oldAlloc);
     });
-    reservedBytes -= alignUp(e.currentSize, AsStorageAllocator::kAlignment);
-    reservedBytes += alloc->size;
+    reservedBytes -= e.reserved;
+    e.reserved = alloc->size;
+    reservedBytes += e.reserved;
     e.as = as.value();
     e.storage = alloc.value();
     e.currentSize = e.compactedSize;
@@ -416,8 +412,7 @@ Status AccelerationStructureService::Impl::recordCompactions(VkCommandBuffer cmd
 }
 
 Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd, std::vector<uint32_t>& batch,
-                                                           bool refit, VkDeviceSize scratchBytes,
-                                                           bool& recordedAny) {
+                                                           VkDeviceSize scratchBytes, bool& recordedAny) {
   if (batch.empty()) return {};
   const VkDeviceSize align = scratchAlignment();
   // Scratch: the persistent buffer when the batch fits the budget, else transient scratch for this batch.
@@ -451,40 +446,37 @@ Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd,
   VkDeviceSize offset = 0;
   for (size_t i = 0; i < batch.size(); ++i) {
     BlasEntry& e = entries[batch[i]];
-    if (!refit) {
-      Result<StorageAllocation> alloc = storage.allocate(e.sizes.accelerationStructureSize);
-      if (!alloc) return alloc.error();
-      Result<VkAccelerationStructureKHR> as =
-          createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, storage.buffer(alloc->block), alloc->offset,
-                   e.sizes.accelerationStructureSize);
-      if (!as) {
-        storage.free(alloc.value());
-        return as.error();
-      }
-      e.as = as.value();
-      e.storage = alloc.value();
-      VkAccelerationStructureDeviceAddressInfoKHR ai{
-          VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
-      ai.accelerationStructure = e.as;
-      e.address = c.vk.vkGetAccelerationStructureDeviceAddressKHR(c.desc.device, &ai);
-      e.builtSize = e.sizes.accelerationStructureSize;
-      e.currentSize = e.builtSize;
+    Result<StorageAllocation> alloc = storage.allocate(e.sizes.accelerationStructureSize);
+    if (!alloc) return alloc.error();
+    Result<VkAccelerationStructureKHR> as =
+        createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, storage.buffer(alloc->block), alloc->offset,
+                 e.sizes.accelerationStructureSize);
+    if (!as) {
+      storage.free(alloc.value());
+      return as.error();
     }
+    e.as = as.value();
+    e.storage = alloc.value();
+    VkAccelerationStructureDeviceAddressInfoKHR ai{
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
+    ai.accelerationStructure = e.as;
+    e.address = c.vk.vkGetAccelerationStructureDeviceAddressKHR(c.desc.device, &ai);
+    e.builtSize = e.sizes.accelerationStructureSize;
+    e.currentSize = e.builtSize;
     buildGeometry(e, geometries[i], ranges[i]);
     rangePtrs[i] = &ranges[i];
     VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
     info = VkAccelerationStructureBuildGeometryInfoKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
     info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
     info.flags = blasFlags(e);
-    info.mode = refit ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-    info.srcAccelerationStructure = refit ? e.as : VK_NULL_HANDLE;
+    info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
     info.dstAccelerationStructure = e.as;
     info.geometryCount = 1;
     info.pGeometries = &geometries[i];
     info.scratchData.deviceAddress = scratchBase + offset;
-    offset += alignUp(refit ? e.sizes.updateScratchSize : e.sizes.buildScratchSize, align);
+    offset += alignUp(e.sizes.buildScratchSize, align);
     record.triangles += e.mesh.desc.triangleCount;
-    if (!refit && (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR)) {
+    if (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR) {
       record.compactEntries.push_back(batch[i]);
       record.compactGenerations.push_back(e.generation);
       e.compactionPending = true;
@@ -534,10 +526,7 @@ Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd,
                                                       VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR,
                                                       record.compactedSizes, 0);
   }
-  for (uint32_t idx : batch) {
-    entries[idx].state = BlasState::Built;
-    entries[idx].needsRefit = false;
-  }
+  for (uint32_t idx : batch) entries[idx].state = BlasState::Built;
   if (transient.valid()) retireBuffer(ctx, transient);
   inFlightBatches.push_back(std::move(record));
   recordedAny = true;
@@ -552,34 +541,23 @@ Result<uint32_t> AccelerationStructureService::recordPendingWork(VkCommandBuffer
   if (Status st = s.recordCompactions(cmd, recordedAny); !st) return st.error();
 
   const VkDeviceSize align = s.scratchAlignment();
-  // Refits of deforming meshes first: they are cheap and their TLAS instances are already live.
+  uint64_t trianglesThisCall = 0;
+  // Deforming meshes first (in-frame modes; the async modes submit them in submitDynamicWork): refits are
+  // cheap and their TLAS instances are already live.
+  if (!s.async) {
+    if (Status st = s.recordDynamicWork(cmd, trianglesThisCall, recordedAny); !st) return st.error();
+  }
+
+  const uint64_t triangleCap = s.desc.maxBuildTrianglesPerCall;
   std::vector<uint32_t> batch;
   VkDeviceSize batchScratch = 0;
-  for (uint32_t i = 1; i < s.entries.size(); ++i) {
-    BlasEntry& e = s.entries[i];
-    if (e.state != BlasState::Built || !e.needsRefit) continue;
-    VkDeviceSize need = alignUp(e.sizes.updateScratchSize, align);
-    if (!batch.empty() && batchScratch + need > s.desc.scratchBudgetBytes) {
-      if (Status st = s.recordBuildBatch(cmd, batch, true, batchScratch, recordedAny); !st) return st.error();
-      batch.clear();
-      batchScratch = 0;
-    }
-    batch.push_back(i);
-    batchScratch += need;
-  }
-  if (Status st = s.recordBuildBatch(cmd, batch, true, batchScratch, recordedAny); !st) return st.error();
-
-  uint64_t trianglesThisCall = 0;
-  const uint64_t triangleCap = s.desc.maxBuildTrianglesPerCall;
-  batch.clear();
-  batchScratch = 0;
   while (!s.queue.empty()) {
     uint32_t index = s.queue.front();
     BlasEntry& e = s.entries[index];
     VkDeviceSize need = alignUp(e.sizes.buildScratchSize, align);
     if (triangleCap && trianglesThisCall > 0 && trianglesThisCall + e.mesh.desc.triangleCount > triangleCap) break;
     if (!batch.empty() && batchScratch + need > s.desc.scratchBudgetBytes) {
-      if (Status st = s.recordBuildBatch(cmd, batch, false, batchScratch, recordedAny); !st) return st.error();
+      if (Status st = s.recordBuildBatch(cmd, batch, batchScratch, recordedAny); !st) return st.error();
       batch.clear();
       batchScratch = 0;
     }
@@ -588,9 +566,14 @@ Result<uint32_t> AccelerationStructureService::recordPendingWork(VkCommandBuffer
     batchScratch += need;
     trianglesThisCall += e.mesh.desc.triangleCount;
   }
-  if (Status st = s.recordBuildBatch(cmd, batch, false, batchScratch, recordedAny); !st) return st.error();
+  if (Status st = s.recordBuildBatch(cmd, batch, batchScratch, recordedAny); !st) return st.error();
   (void)recordedAny;
-  return static_cast<uint32_t>(s.queue.size());
+  uint32_t queued = static_cast<uint32_t>(s.queue.size());
+  for (uint32_t i = 1; i < s.entries.size(); ++i) {
+    const BlasEntry& e = s.entries[i];
+    queued += e.state == BlasState::Queued && e.mesh.desc.role == MeshRole::Dynamic ? 1u : 0u;
+  }
+  return queued;
 }
 
 Result<bool> AccelerationStructureService::isBuilt(MeshHandle mesh) const {
@@ -612,10 +595,11 @@ Result<VkDeviceAddress> AccelerationStructureService::blasAddress(MeshHandle mes
 AsStats AccelerationStructureService::stats() const {
   Impl& s = *impl_;
   s.resolveBatches();
+  s.resolveDynamicSubmissions();
   AsStats out = s.counters;
   out.meshHandles = s.liveRegistrations();
   out.blasCount = out.blasQueued = 0;
-  out.triangles = out.blasBytes = out.blasBytesBeforeCompaction = 0;
+  out.triangles = out.blasBytes = out.blasBytesBeforeCompaction = out.dynamicBlasBytes = 0;
   for (uint32_t i = 1; i < s.entries.size(); ++i) {
     const BlasEntry& e = s.entries[i];
     if (e.state == BlasState::Free) continue;
@@ -625,14 +609,21 @@ AsStats AccelerationStructureService::stats() const {
       continue;
     }
     out.triangles += e.mesh.desc.triangleCount;
-    out.blasBytesBeforeCompaction += e.builtSize;
-    out.blasBytes += e.currentSize;
+    const VkDeviceSize copies = e.mesh.desc.role == MeshRole::Dynamic ? e.dyn.copies.size() : 1;
+    out.blasBytesBeforeCompaction += e.builtSize * copies;
+    out.blasBytes += e.currentSize * copies;
+    if (e.mesh.desc.role == MeshRole::Dynamic) out.dynamicBlasBytes += e.currentSize * copies;
   }
   out.bytesPerTriangle = out.triangles ? double(out.blasBytes) / double(out.triangles) : 0.0;
   out.storageBlocks = s.storage.blockCount();
   out.storageBlockBytes = s.storage.blockBytes();
   out.storageUsedBytes = s.storage.usedBytes();
-  out.scratchBytes = s.scratch.allocatedBytes;
+  if (s.dynamicStorage) {
+    out.storageBlocks += s.dynamicStorage->blockCount();
+    out.storageBlockBytes += s.dynamicStorage->blockBytes();
+    out.storageUsedBytes += s.dynamicStorage->usedBytes();
+  }
+  out.scratchBytes = s.scratch.allocatedBytes + s.asyncScratch.allocatedBytes;
   out.tlasBytes = 0;
   for (const TlasSlot& t : s.tlasSlots) {
     out.tlasBytes += t.storage.allocatedBytes + t.scratch.allocatedBytes + t.instances.allocatedBytes +

@@ -5,20 +5,58 @@
 #include <raybridge/acceleration_structures.h>
 
 #include <deque>
+#include <functional>
+#include <memory>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "as_storage_allocator.h"
+#include "async_submitter.h"
+#include "cluster_bounds.h"
 #include "context_impl.h"
 #include "gpu_memory.h"
 #include "mesh_validation.h"
 
 namespace rb {
 
+constexpr size_t kMaxBatchTimings = 64;  // AsStats::batches keeps the most recent ones
+
 enum class BlasState : uint8_t {
   Free,     // slot unused (its generation is bumped on reuse)
   Queued,   // registered, build not yet recorded
   Built,    // build recorded; usable by TLAS builds recorded after it
+};
+
+// One copy of a dynamic BLAS; the copies of a mesh form a ring (see DynamicBuildMode).
+struct BlasCopy {
+  VkAccelerationStructureKHR as = VK_NULL_HANDLE;
+  StorageAllocation storage;
+  VkDeviceAddress address = 0;
+  bool written = false;
+  uint64_t writeSerial = 0;    // order of the writes over the mesh's copies (the newest has the largest)
+  uint64_t writtenFrame = 0;   // Context frame of the work that wrote it last
+  uint64_t pose = 0;           // DynamicBlas::pose it was built or refit from
+  uint64_t signalValue = 0;    // async timeline value of that work; 0 = recorded on the main queue
+  bool used = false;           // referenced by a TLAS since it was created
+  uint64_t lastUsedFrame = 0;  // frame of the last TLAS that referenced it
+};
+
+// Refit/rebuild state of a dynamic BLAS.
+struct DynamicBlas {
+  std::vector<BlasCopy> copies;  // empty until the first build is planned
+  uint32_t newest = 0;           // copy written last
+  uint64_t writes = 0;           // writes so far (BlasCopy::writeSerial)
+  bool updatePending = false;    // updateMesh since the last refit or build
+  bool forceRebuild = false;
+  bool resize = false;           // forceRebuild with new counts: the copies are re-created at the rebuild
+  uint64_t pose = 0;             // updateMesh calls so far: the pose the engine's buffers hold
+  uint32_t refitsSinceBuild = 0;
+  uint32_t buildGeneration = 0;  // full builds so far; measure samples carry it, so late ones are ignored
+  double baselineArea = 0.0;     // refit-quality measure at the last full build (0 = not read back yet)
+  double ratio = 0.0;            // latest measure / baseline
+  bool overThreshold = false;    // ratio > RefitPolicy::maxAreaGrowth
+  uint64_t waitingSince = 0;     // frame since which it waits for a rebuild (staggering order)
 };
 
 struct BlasEntry {
@@ -34,9 +72,10 @@ struct BlasEntry {
   VkAccelerationStructureKHR as = VK_NULL_HANDLE;
   StorageAllocation storage;
   VkDeviceAddress address = 0;
-  VkDeviceSize builtSize = 0;    // size of the original build
+  VkDeviceSize builtSize = 0;    // size of the original build (of one copy, for a dynamic BLAS)
   VkDeviceSize currentSize = 0;  // size now (smaller once compacted)
-  bool needsRefit = false;
+  VkDeviceSize reserved = 0;     // storage it holds against the budget (aligned, all copies)
+  DynamicBlas dyn;               // MeshRole::Dynamic only; `as` and `address` then mirror the newest copy
   bool compactionPending = false;       // waiting for its compacted-size query
   VkDeviceSize compactedSize = 0;       // known and worth a copy: copy queued
   bool compacted = false;
@@ -63,6 +102,37 @@ struct BuildBatch {
   std::vector<uint32_t> compactGenerations;
   uint32_t builds = 0;
   uint64_t triangles = 0;
+};
+
+// A measure read back for one dynamic BLAS: the cluster areas at [firstCluster, firstCluster + clusterCount).
+struct ClusterSample {
+  uint32_t entry = 0;
+  uint32_t entryGeneration = 0;
+  uint32_t buildGeneration = 0;  // DynamicBlas::buildGeneration after this work
+  bool build = false;            // measured for a full build: the new baseline
+  uint32_t firstCluster = 0;
+  uint32_t clusterCount = 0;
+};
+
+// One frame's dynamic work, waiting for its GPU results (measures, async timings).
+struct DynamicSubmission {
+  uint64_t frame = 0;
+  uint64_t timelineValue = 0;  // async: the value it signals; 0 = recorded on the main queue (frameDone)
+  GpuBuffer readback;          // host-visible cluster areas; invalid when nothing was measured
+  std::vector<ClusterSample> samples;
+  VkQueryPool timestamps = VK_NULL_HANDLE;  // async submissions (main-queue work is a BuildBatch)
+  uint32_t builds = 0;
+  uint64_t triangles = 0;
+};
+
+// What a frame's dynamic work does to one BLAS.
+struct DynamicOp {
+  enum Kind : uint8_t { FirstBuild, Refit, Rebuild } kind = Refit;
+  uint32_t entry = 0;
+  uint32_t src = 0;  // copy read (refit)
+  uint32_t dst = 0;  // copy written
+  bool measure = false;
+  std::vector<BlasCopy> replacement;  // resize: the new copies (dst indexes them)
 };
 
 struct TlasSlot {
@@ -101,6 +171,27 @@ struct AccelerationStructureService::Impl {
   VkDeviceSize reservedBytes = 0;  // storage of all live BLASes (aligned), for the budget
   AsStats counters;                // the cumulative counters (registrations, dedupHits, evictions, ...)
 
+  // Dynamic meshes (dynamic_blas.cpp).
+  RefitPolicy policy;          // defaults resolved
+  uint32_t dynamicCopies = 1;  // copies per dynamic BLAS
+  bool async = false;          // dynamic work on the async queue
+  AsyncSubmitter submitter;
+  std::unique_ptr<AsStorageAllocator> dynamicStorage;  // async: concurrent over both families
+  ClusterBoundsPass clusterBounds;
+  bool clusterBoundsCreated = false;
+  GpuBuffer asyncScratch;
+  uint64_t asyncTimestampMask = 0;  // 0 = no timestamps on the async queue
+  std::vector<DynamicSubmission> dynamicSubmissions;  // in order
+  std::vector<GpuBuffer> freeReadbacks;
+  std::vector<VkQueryPool> freeAsyncTimestampPools;
+  struct AsyncRelease {
+    uint64_t value;  // the async timeline reaches it once the GPU no longer uses the object
+    std::function<void()> release;
+  };
+  std::vector<AsyncRelease> asyncReleases;
+  uint64_t lastDynamicWriteFrame = UINT64_MAX;  // frame whose dynamic work wrote copies
+  uint64_t lastVertexReadValue = 0;             // async value of the latest submission that read vertex buffers
+
   Impl(Context& context, const AsServiceDesc& d);
   ~Impl();
 
@@ -110,8 +201,9 @@ struct AccelerationStructureService::Impl {
   void destroyEntry(uint32_t index);  // retires its AS and storage; frees the slot
   Status makeRoom(VkDeviceSize bytes, const std::string& forWhat);
   void resolveBatches();
+  void addTiming(const BuildBatchTiming& timing);
   Status recordCompactions(VkCommandBuffer cmd, bool& recordedAny);
-  Status recordBuildBatch(VkCommandBuffer cmd, std::vector<uint32_t>& batch, bool refit, VkDeviceSize scratchBytes,
+  Status recordBuildBatch(VkCommandBuffer cmd, std::vector<uint32_t>& batch, VkDeviceSize scratchBytes,
                           bool& recordedAny);
   Result<VkAccelerationStructureKHR> createAs(VkAccelerationStructureTypeKHR type, VkBuffer buffer,
                                               VkDeviceSize offset, VkDeviceSize size);
@@ -119,6 +211,28 @@ struct AccelerationStructureService::Impl {
                      VkAccelerationStructureBuildRangeInfoKHR& range) const;
   VkBuildAccelerationStructureFlagsKHR blasFlags(const BlasEntry& e) const;
   VkDeviceSize scratchAlignment() const;
+  VkDeviceSize storageNeed(const BlasEntry& e) const;  // aligned storage of all its copies
+
+  // Dynamic meshes (dynamic_blas.cpp).
+  Status initDynamic(const AsServiceDesc& d);
+  void destroyDynamic();
+  bool lateMode() const { return desc.dynamicMode == DynamicBuildMode::AsyncOneFrameLate; }
+  AsStorageAllocator& copyStorage() { return dynamicStorage ? *dynamicStorage : storage; }
+  // The copy this frame's TLAS references (-1: none written yet).
+  int32_t tlasCopy(const BlasEntry& e) const;
+  Result<std::vector<BlasCopy>> createCopies(const BlasEntry& e);
+  void retireCopies(std::vector<BlasCopy>& copies);
+  // Retires through the Context once the async timeline shows the GPU past every submission so far.
+  void retireAfterAsync(std::function<void()> release);
+  void releaseAsyncRetired();
+  void resolveDynamicSubmissions();
+  // Plans, records and commits one frame's dynamic work into `cmd` (the engine's command buffer in the
+  // in-frame modes); `trianglesUsed` counts first builds against maxBuildTrianglesPerCall.
+  Status recordDynamicWork(VkCommandBuffer cmd, uint64_t& trianglesUsed, bool& recordedAny);
+  Result<std::vector<DynamicOp>> planDynamicWork(uint64_t& trianglesUsed);
+  Status recordDynamicOps(VkCommandBuffer cmd, std::vector<DynamicOp>& ops, bool onAsyncQueue,
+                          DynamicSubmission& sub, std::vector<GpuBuffer>& transientScratch);
+  void commitDynamicOps(std::vector<DynamicOp>& ops, uint64_t signalValue);
 };
 
 // Where a TLAS instance's surface data is, for hit shading (mirrors ShadingRecord in

@@ -34,7 +34,7 @@ Result<StorageAllocation> AsStorageAllocator::allocate(VkDeviceSize size) {
   Result<GpuBuffer> buffer =
       createBuffer(ctx_, bytes,
                    VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                   MemoryLocation::DeviceLocal, MemoryCategory::BlasStorage, "BLAS storage block");
+                   MemoryLocation::DeviceLocal, MemoryCategory::BlasStorage, "BLAS storage block", sharedWith_);
   if (!buffer) return buffer.error();
   Block block;
   block.buffer = buffer.value();

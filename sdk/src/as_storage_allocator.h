@@ -19,7 +19,10 @@ class AsStorageAllocator {
  public:
   static constexpr VkDeviceSize kAlignment = 256;  // VkAccelerationStructureCreateInfoKHR::offset rule
 
-  AsStorageAllocator(Context& ctx, VkDeviceSize blockBytes) : ctx_(ctx), blockBytes_(blockBytes) {}
+  // `sharedWith`: the queue families whose queues build or read these BLASes when there are two (the blocks are
+  // then VK_SHARING_MODE_CONCURRENT over them); empty = the main queue only.
+  AsStorageAllocator(Context& ctx, VkDeviceSize blockBytes, std::vector<uint32_t> sharedWith = {})
+      : ctx_(ctx), blockBytes_(blockBytes), sharedWith_(std::move(sharedWith)) {}
   ~AsStorageAllocator();
 
   Result<StorageAllocation> allocate(VkDeviceSize size);
@@ -42,6 +45,7 @@ class AsStorageAllocator {
   };
   Context& ctx_;
   VkDeviceSize blockBytes_;
+  std::vector<uint32_t> sharedWith_;
   std::vector<Block> blocks_;  // a destroyed block keeps its slot (invalid buffer) so indices stay stable
 };
 

@@ -1,5 +1,5 @@
-// Compute pipeline plumbing for the image-space passes (the denoiser): one push-descriptor set and push
-// constants, like RayTracingPipeline.
+// Compute pipeline plumbing for the image-space passes (the denoiser) and the BLAS cluster measure: one
+// push-descriptor set (possibly empty) and push constants, like RayTracingPipeline.
 #pragma once
 
 #include <span>

@@ -55,6 +55,7 @@ Status checkFeatures(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
   need(v12.scalarBlockLayout, "scalarBlockLayout");
   need(v12.descriptorBindingPartiallyBound, "descriptorBindingPartiallyBound");
   need(v12.descriptorBindingVariableDescriptorCount, "descriptorBindingVariableDescriptorCount");
+  need(v12.timelineSemaphore, "timelineSemaphore");
   need(as.accelerationStructure, "accelerationStructure");
   need(rt.rayTracingPipeline, "rayTracingPipeline");
   if (!missing.empty()) {
@@ -78,6 +79,7 @@ RequiredFeatures::RequiredFeatures() {
   vulkan12.scalarBlockLayout = VK_TRUE;
   vulkan12.descriptorBindingPartiallyBound = VK_TRUE;
   vulkan12.descriptorBindingVariableDescriptorCount = VK_TRUE;
+  vulkan12.timelineSemaphore = VK_TRUE;  // the async dynamic BLAS builds signal one the engine waits on
   accelerationStructure.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
   accelerationStructure.pNext = &rayTracingPipeline;
   accelerationStructure.accelerationStructure = VK_TRUE;
@@ -99,6 +101,7 @@ void RequiredFeatures::mergeVulkan12Into(VkPhysicalDeviceVulkan12Features& f) co
   f.scalarBlockLayout |= vulkan12.scalarBlockLayout;
   f.descriptorBindingPartiallyBound |= vulkan12.descriptorBindingPartiallyBound;
   f.descriptorBindingVariableDescriptorCount |= vulkan12.descriptorBindingVariableDescriptorCount;
+  f.timelineSemaphore |= vulkan12.timelineSemaphore;
 }
 
 const char* toString(ErrorCode code) {

@@ -71,7 +71,19 @@ namespace rb {
   X(vkCreateRayTracingPipelinesKHR)                 \
   X(vkGetRayTracingShaderGroupHandlesKHR)           \
   X(vkCmdTraceRaysKHR)                              \
-  X(vkCmdPushDescriptorSetKHR)
+  X(vkCmdPushDescriptorSetKHR)                     \
+  X(vkCreateCommandPool)                            \
+  X(vkDestroyCommandPool)                           \
+  X(vkAllocateCommandBuffers)                       \
+  X(vkFreeCommandBuffers)                           \
+  X(vkBeginCommandBuffer)                           \
+  X(vkEndCommandBuffer)                             \
+  X(vkResetCommandBuffer)                           \
+  X(vkQueueSubmit)                                  \
+  X(vkCreateSemaphore)                              \
+  X(vkDestroySemaphore)                             \
+  X(vkGetSemaphoreCounterValue)                     \
+  X(vkWaitSemaphores)
 
 struct DeviceFunctions {
 #define RB_DECLARE(name) PFN_##name name = nullptr;

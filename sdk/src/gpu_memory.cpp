@@ -46,7 +46,7 @@ Result<VkDeviceMemory> allocate(Context::Impl& c, const VkMemoryRequirements& re
 }  // namespace
 
 Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryLocation location,
-                               MemoryCategory category, const char* what) {
+                               MemoryCategory category, const char* what, std::span<const uint32_t> sharedWith) {
   Context::Impl& c = ctx.impl();
   GpuBuffer out;
   out.size = size;
@@ -54,7 +54,11 @@ Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFla
   VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   info.size = size;
   info.usage = usage;
-  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  info.sharingMode = sharedWith.size() >= 2 ? VK_SHARING_MODE_CONCURRENT : VK_SHARING_MODE_EXCLUSIVE;
+  if (sharedWith.size() >= 2) {
+    info.queueFamilyIndexCount = static_cast<uint32_t>(sharedWith.size());
+    info.pQueueFamilyIndices = sharedWith.data();
+  }
   VkResult r = c.vk.vkCreateBuffer(c.desc.device, &info, c.allocator(), &out.buffer);
   if (r != VK_SUCCESS) return vulkanError(r, std::string("vkCreateBuffer for ") + what);
   VkMemoryRequirements req;

@@ -3,6 +3,8 @@
 
 #include <raybridge/context.h>
 
+#include <span>
+
 namespace rb {
 
 enum class MemoryLocation : uint8_t {
@@ -32,8 +34,11 @@ struct GpuImage {
   bool valid() const { return image != VK_NULL_HANDLE; }
 };
 
+// `sharedWith`: two or more queue families make the buffer VK_SHARING_MODE_CONCURRENT over them (a buffer both
+// the main and the async queue touch needs no ownership transfers); empty = exclusive.
 Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryLocation location,
-                               MemoryCategory category, const char* what);
+                               MemoryCategory category, const char* what,
+                               std::span<const uint32_t> sharedWith = {});
 // Destroys now. Use retireBuffer() when the GPU may still read it.
 void destroyBuffer(Context& ctx, GpuBuffer& buffer);
 // Destroys once the frames in flight that may use it are done (Context::beginFrame contract).

@@ -35,6 +35,9 @@ struct HeadlessDevice::Impl {
   VkDevice device = VK_NULL_HANDLE;
   VkQueue queue = VK_NULL_HANDLE;
   uint32_t queueFamily = 0;
+  VkQueue asyncQueue = VK_NULL_HANDLE;
+  uint32_t asyncFamily = UINT32_MAX;
+  std::vector<uint32_t> bufferFamilies;  // both families when there is an async queue: concurrent buffers
   VkCommandPool pool = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
   bool validation = false;
@@ -204,6 +207,17 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
   if (!foundFamily) {
     return Error{ErrorCode::NoSuitableDevice, VK_SUCCESS, "device '" + impl->name + "' has no graphics+compute queue"};
   }
+  if (desc.requestAsyncComputeQueue) {
+    // A compute-only family; among several, one that can write timestamps.
+    for (uint32_t i = 0; i < familyCount; ++i) {
+      const VkQueueFlags f = families[i].queueFlags;
+      if (!(f & VK_QUEUE_COMPUTE_BIT) || (f & VK_QUEUE_GRAPHICS_BIT) || families[i].queueCount == 0) continue;
+      if (impl->asyncFamily == UINT32_MAX || (families[impl->asyncFamily].timestampValidBits == 0 &&
+                                              families[i].timestampValidBits != 0)) {
+        impl->asyncFamily = i;
+      }
+    }
+  }
 
   RequiredFeatures required;
   VkPhysicalDeviceVulkan13Features v13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
@@ -213,20 +227,28 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
   features.pNext = required.link(&v13);
   features.features.shaderInt64 = VK_TRUE;
   float priority = 1.0f;
-  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  qci.queueFamilyIndex = impl->queueFamily;
-  qci.queueCount = 1;
-  qci.pQueuePriorities = &priority;
+  VkDeviceQueueCreateInfo qci[2] = {{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO},
+                                    {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO}};
+  qci[0].queueFamilyIndex = impl->queueFamily;
+  qci[0].queueCount = 1;
+  qci[0].pQueuePriorities = &priority;
+  qci[1].queueFamilyIndex = impl->asyncFamily;
+  qci[1].queueCount = 1;
+  qci[1].pQueuePriorities = &priority;
   auto ext = requiredDeviceExtensions();
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features};
-  dci.queueCreateInfoCount = 1;
-  dci.pQueueCreateInfos = &qci;
+  dci.queueCreateInfoCount = impl->asyncFamily == UINT32_MAX ? 1 : 2;
+  dci.pQueueCreateInfos = qci;
   dci.enabledExtensionCount = static_cast<uint32_t>(ext.size());
   dci.ppEnabledExtensionNames = ext.data();
   r = impl->ip<PFN_vkCreateDevice>("vkCreateDevice")(impl->physicalDevice, &dci, nullptr, &impl->device);
   if (r != VK_SUCCESS) return vulkanError(r, "vkCreateDevice on '" + impl->name + "'");
   impl->gdpa = impl->ip<PFN_vkGetDeviceProcAddr>("vkGetDeviceProcAddr");
   impl->dp<PFN_vkGetDeviceQueue>("vkGetDeviceQueue")(impl->device, impl->queueFamily, 0, &impl->queue);
+  if (impl->asyncFamily != UINT32_MAX) {
+    impl->dp<PFN_vkGetDeviceQueue>("vkGetDeviceQueue")(impl->device, impl->asyncFamily, 0, &impl->asyncQueue);
+    impl->bufferFamilies = {impl->queueFamily, impl->asyncFamily};
+  }
   impl->ip<PFN_vkGetPhysicalDeviceMemoryProperties>("vkGetPhysicalDeviceMemoryProperties")(impl->physicalDevice,
                                                                                           &impl->memoryProperties);
 
@@ -246,6 +268,8 @@ VkPhysicalDevice HeadlessDevice::physicalDevice() const { return impl_->physical
 VkDevice HeadlessDevice::device() const { return impl_->device; }
 VkQueue HeadlessDevice::queue() const { return impl_->queue; }
 uint32_t HeadlessDevice::queueFamily() const { return impl_->queueFamily; }
+VkQueue HeadlessDevice::asyncComputeQueue() const { return impl_->asyncQueue; }
+uint32_t HeadlessDevice::asyncComputeQueueFamily() const { return impl_->asyncFamily; }
 PFN_vkGetInstanceProcAddr HeadlessDevice::getInstanceProcAddr() const { return impl_->gipa; }
 PFN_vkVoidFunction HeadlessDevice::instanceProc(const char* name) const {
   return impl_->gipa(impl_->instance, name);
@@ -282,7 +306,10 @@ Result<VkCommandBuffer> HeadlessDevice::beginCommands() {
   return cmd;
 }
 
-Status HeadlessDevice::submitAndWait(VkCommandBuffer cmd) {
+Status HeadlessDevice::submitAndWait(VkCommandBuffer cmd) { return submitAndWait(cmd, {}, {}); }
+
+Status HeadlessDevice::submitAndWait(VkCommandBuffer cmd, std::span<const VkSemaphoreSubmitInfo> waits,
+                                     std::span<const VkSemaphoreSubmitInfo> signals) {
   Impl& d = *impl_;
   VkResult r = d.dp<PFN_vkEndCommandBuffer>("vkEndCommandBuffer")(cmd);
   auto freeCmd = [&] { d.dp<PFN_vkFreeCommandBuffers>("vkFreeCommandBuffers")(d.device, d.pool, 1, &cmd); };
@@ -293,15 +320,35 @@ Status HeadlessDevice::submitAndWait(VkCommandBuffer cmd) {
   VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VkFence fence = VK_NULL_HANDLE;
   d.dp<PFN_vkCreateFence>("vkCreateFence")(d.device, &fci, nullptr, &fence);
-  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd;
-  r = d.dp<PFN_vkQueueSubmit>("vkQueueSubmit")(d.queue, 1, &si, fence);
+  VkCommandBufferSubmitInfo ci{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+  ci.commandBuffer = cmd;
+  VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  si.waitSemaphoreInfoCount = static_cast<uint32_t>(waits.size());
+  si.pWaitSemaphoreInfos = waits.data();
+  si.commandBufferInfoCount = 1;
+  si.pCommandBufferInfos = &ci;
+  si.signalSemaphoreInfoCount = static_cast<uint32_t>(signals.size());
+  si.pSignalSemaphoreInfos = signals.data();
+  r = d.dp<PFN_vkQueueSubmit2>("vkQueueSubmit2")(d.queue, 1, &si, fence);
   if (r == VK_SUCCESS) r = d.dp<PFN_vkWaitForFences>("vkWaitForFences")(d.device, 1, &fence, VK_TRUE, UINT64_MAX);
   d.dp<PFN_vkDestroyFence>("vkDestroyFence")(d.device, fence, nullptr);
   freeCmd();
   if (r != VK_SUCCESS) return vulkanError(r, "vkQueueSubmit/vkWaitForFences");
   return {};
+}
+
+Result<VkSemaphore> HeadlessDevice::createTimelineSemaphore() {
+  VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
+  type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
+  VkSemaphoreCreateInfo si{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
+  VkSemaphore semaphore = VK_NULL_HANDLE;
+  VkResult r = impl_->dp<PFN_vkCreateSemaphore>("vkCreateSemaphore")(impl_->device, &si, nullptr, &semaphore);
+  if (r != VK_SUCCESS) return vulkanError(r, "vkCreateSemaphore (timeline)");
+  return semaphore;
+}
+
+void HeadlessDevice::destroySemaphore(VkSemaphore semaphore) {
+  if (semaphore) impl_->dp<PFN_vkDestroySemaphore>("vkDestroySemaphore")(impl_->device, semaphore, nullptr);
 }
 
 Status HeadlessDevice::waitIdle() {
@@ -318,6 +365,12 @@ Result<HeadlessBuffer> HeadlessDevice::createBuffer(VkDeviceSize size, VkBufferU
   VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bci.size = size;
   bci.usage = usage | (hostVisible ? 0 : VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  if (!d.bufferFamilies.empty()) {
+    // The async queue reads them too (dynamic BLAS builds): no ownership transfers needed.
+    bci.sharingMode = VK_SHARING_MODE_CONCURRENT;
+    bci.queueFamilyIndexCount = static_cast<uint32_t>(d.bufferFamilies.size());
+    bci.pQueueFamilyIndices = d.bufferFamilies.data();
+  }
   VkResult r = d.dp<PFN_vkCreateBuffer>("vkCreateBuffer")(d.device, &bci, nullptr, &out.buffer);
   if (r != VK_SUCCESS) return vulkanError(r, "vkCreateBuffer");
   VkMemoryRequirements req;

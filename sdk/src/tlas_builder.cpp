@@ -99,7 +99,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   const uint64_t serial = s.tlasSerial + 1;
   auto* out = static_cast<VkAccelerationStructureInstanceKHR*>(slot.instances.mapped);
   auto* records = options.writeShadingRecords ? static_cast<ShadingRecord*>(slot.shading.mapped) : nullptr;
-  uint32_t written = 0, skipped = 0;
+  uint32_t written = 0, skipped = 0, stale = 0;
   uint64_t signature = 0;
   const bool rebase = options.originOffset[0] != 0.0 || options.originOffset[1] != 0.0 || options.originOffset[2] != 0.0;
   for (uint32_t i = 0; i < count; ++i) {
@@ -109,6 +109,20 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     if (e.state != BlasState::Built) {
       ++skipped;
       continue;
+    }
+    VkDeviceAddress blas = e.address;
+    if (e.mesh.desc.role == MeshRole::Dynamic) {
+      // The copy this mode traces (the previous frame's pose when one frame late).
+      const int32_t k = s.tlasCopy(e);
+      if (k < 0) {
+        ++skipped;
+        continue;
+      }
+      BlasCopy& copy = e.dyn.copies[k];
+      copy.used = true;
+      copy.lastUsedFrame = c.frame;
+      blas = copy.address;
+      if (copy.pose < e.dyn.pose) ++stale;
     }
     VkAccelerationStructureInstanceKHR inst;
     std::memcpy(&inst.transform, in.transform, sizeof(inst.transform));
@@ -122,7 +136,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     inst.mask = in.mask;
     inst.instanceShaderBindingTableRecordOffset = in.sbtRecordOffset;
     inst.flags = in.flags;
-    inst.accelerationStructureReference = e.address;
+    inst.accelerationStructureReference = blas;
     if (records) {
       const MeshDesc& m = reg.mesh.desc;  // this registration's own buffers and attributes
       ShadingRecord r{};
@@ -141,7 +155,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     out[written++] = inst;
     e.lastUsedFrame = c.frame;
     e.lastTlasSerial = serial;
-    signature = hashCombine(signature, e.address);
+    signature = hashCombine(signature, blas);
   }
   s.tlasSerial = serial;
 
@@ -225,6 +239,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   slot.blasSignature = signature;
   s.lastTlasSlot = slotIndex;
   s.counters.lastTlasInstances = written;
+  s.counters.staleBlas = stale;
 
   TlasInfo result;
   result.tlas = slot.tlas;

@@ -16,6 +16,7 @@ std::string Engine::Impl::init(const EngineConfig& config) {
   if (std::string e = ctx.create(config); !e.empty()) return e;
   gpu.init(ctx.physicalDevice, ctx.device, ctx.queue, ctx.queueFamily);
   if (std::string e = pipelines.create(ctx.device); !e.empty()) return e;
+  if (std::string e = deformer.create(gpu, ctx); !e.empty()) return e;
   if (std::string e = defaults.create(gpu); !e.empty()) return e;
   if (std::string e = probe.create(gpu, ctx, pipelines); !e.empty()) return e;
 
@@ -90,6 +91,7 @@ Engine::Impl::~Impl() {
     destroyTargets();
     gpu.destroy(targets.shadowMap);
     if (sceneLoaded) destroyScene(gpu, scene);
+    deformer.destroy();
     for (FrameResources& f : frames) {
       if (f.timestamps) vkDestroyQueryPool(ctx.device, f.timestamps, nullptr);
       gpu.destroy(f.uniforms);
@@ -127,6 +129,12 @@ VkPhysicalDevice Engine::physicalDevice() const { return impl_->ctx.physicalDevi
 VkDevice Engine::device() const { return impl_->ctx.device; }
 VkQueue Engine::queue() const { return impl_->ctx.queue; }
 uint32_t Engine::queueFamily() const { return impl_->ctx.queueFamily; }
+VkQueue Engine::asyncComputeQueue() const { return impl_->ctx.asyncComputeQueue; }
+uint32_t Engine::asyncComputeQueueFamily() const { return impl_->ctx.asyncComputeFamily; }
+std::span<const DeformedInstance> Engine::deformedInstances() const { return impl_->deformer.instances(); }
+std::span<const glm::mat4> Engine::instanceTransforms() const {
+  return impl_->sceneLoaded ? impl_->pose.instanceTransforms() : std::span<const glm::mat4>();
+}
 PFN_vkGetInstanceProcAddr Engine::getInstanceProcAddr() const { return &vkGetInstanceProcAddr; }
 uint32_t Engine::apiVersion() const { return VK_API_VERSION_1_3; }
 const DeviceInfo& Engine::deviceInfo() const { return impl_->ctx.info; }
@@ -149,13 +157,19 @@ Status Engine::loadScene(const Scene& scene) {
   try {
     vkDeviceWaitIdle(impl_->ctx.device);
     ++impl_->sceneVersion;
+    impl_->deformer.unload();
     if (impl_->sceneLoaded) destroyScene(impl_->gpu, impl_->scene);
     impl_->sceneLoaded = true;  // partially uploaded resources are destroyed like a full scene
-    std::string e = uploadScene(impl_->gpu, impl_->ctx, impl_->pipelines, impl_->defaults, scene, impl_->scene);
+    std::string e = uploadScene(impl_->gpu, impl_->ctx, impl_->pipelines, impl_->defaults, scene, impl_->pose,
+                                impl_->scene);
+    // The rest pose until the first frame; the deformed buffers start as the bind pose.
+    if (e.empty()) e = impl_->pose.evaluate(impl_->scene.cpu, 0.0, {}, true).error;
+    if (e.empty()) e = impl_->deformer.load(impl_->scene, impl_->pose);
     if (!e.empty()) {
+      impl_->deformer.unload();
       destroyScene(impl_->gpu, impl_->scene);
       impl_->sceneLoaded = false;
-      return Status::failure("scene upload failed: " + e);
+      return Status::failure("loadScene: " + e);
     }
     return Status::success();
   } catch (const std::exception& e) {
@@ -220,6 +234,7 @@ std::string Engine::Impl::waitFrame(FrameResources& frame) {
 }
 
 void Engine::Impl::collectTimings(FrameResources& frame) {
+  const double deformMs = deformer.collectTimings(uint32_t(&frame - frames.data()));
   if (!frame.timingsPending || !frame.timestamps) return;
   frame.timingsPending = false;
   uint64_t ts[kTsCount];
@@ -238,7 +253,9 @@ void Engine::Impl::collectTimings(FrameResources& frame) {
   timings.hookMs = ms(kTsShadowVisibilityEnd, kTsHookEnd);
   timings.lightingMs = ms(kTsHookEnd, kTsLightingEnd);
   timings.tonemapMs = ms(kTsLightingEnd, kTsTonemapEnd);
+  timings.deformMs = deformMs;
   timings.probeCaptured = frame.probeCaptured;
+  timings.frameNumber = frame.frameNumber;
   timings.valid = true;
 }
 
@@ -250,7 +267,11 @@ Status Engine::waitIdle() {
   for (FrameResources* f : order)
     if (std::string e = impl_->waitFrame(*f); !e.empty()) return Status::failure(e);
   VkResult r = vkDeviceWaitIdle(impl_->ctx.device);
-  return r == VK_SUCCESS ? Status::success() : Status::failure(vkFailure("vkDeviceWaitIdle", r));
+  if (r != VK_SUCCESS) return Status::failure(vkFailure("vkDeviceWaitIdle", r));
+  // Every submission is done, so every wait a hook left for the next deformation is met: dropping them lets
+  // the add-on that owns their semaphores (e.g. an adapter being destroyed) release them.
+  impl_->deformer.pendingWaits().clear();
+  return Status::success();
 }
 
 Status Engine::renderFrame(const FrameParams& params) {
@@ -384,6 +405,19 @@ Result<std::vector<float>> Engine::readbackShadowVisibility() {
 
 Result<std::vector<float>> Engine::readbackSsao() {
   return readEffectImage(*this, *impl_, impl_->targets.ssao, impl_->ssaoRendered, "readbackSsao");
+}
+
+Result<std::vector<glm::vec3>> Engine::readbackDeformedPositions(uint32_t deformedIndex) {
+  using R = Result<std::vector<glm::vec3>>;
+  const size_t count = impl_->deformer.instances().size();
+  if (deformedIndex >= count)
+    return R::failure("readbackDeformedPositions: deformed instance " + std::to_string(deformedIndex) +
+                      " is out of range (the scene has " + std::to_string(count) + ")");
+  if (Status s = waitIdle(); !s) return R::failure(s.error);
+  std::vector<glm::vec3> out;
+  if (std::string e = impl_->deformer.readbackPositions(deformedIndex, out); !e.empty())
+    return R::failure("readbackDeformedPositions: " + e);
+  return R::success(std::move(out));
 }
 
 }  // namespace sample_engine

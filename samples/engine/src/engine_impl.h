@@ -5,6 +5,7 @@
 #include <array>
 #include <optional>
 
+#include "deformer.h"
 #include "gpu_memory.h"
 #include "gpu_scene.h"
 #include "pipelines.h"
@@ -72,6 +73,10 @@ struct Engine::Impl {
   detail::Pipelines pipelines;
   detail::DefaultImages defaults;
   detail::GpuScene scene;
+  ScenePose pose;             // the loaded scene's, evaluated every frame
+  detail::Deformer deformer;  // skinning / morphing of the loaded scene's deforming instances
+  std::vector<VkSemaphoreSubmitInfo> submitWaits;  // the hook's additions to this frame's main submission
+  std::vector<VkSemaphoreSubmitInfo> mainWaits;    // reused: all waits of the main submission
   bool sceneLoaded = false;
   uint64_t sceneVersion = 0;  // bumped by loadScene (the reflection probe recaptures)
   detail::ReflectionProbe probe;

@@ -33,6 +33,9 @@ glm::mat4 lightViewProjection(const Bounds& bounds, const glm::vec3& towardsSun,
 
 std::string Engine::Impl::renderFrame(const FrameParams& params) {
   if (targets.extent.width == 0) return "renderFrame: no render size (call setRenderSize or attachSurface)";
+  static const Scene kNoScene;
+  if (Status s = checkPlayback(sceneLoaded ? scene.cpu : kNoScene, params.time, params.animations); !s)
+    return "renderFrame: " + s.error;
   const uint32_t shadowSize = std::clamp(params.shadow.mapSize, 1024u, 8192u);
   if (shadowSize != targets.shadowMapSize) {
     vkDeviceWaitIdle(ctx.device);
@@ -54,6 +57,17 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
     if (r == VK_ERROR_OUT_OF_DATE_KHR) return createSwapchain(swapchain.extent.width, swapchain.extent.height);
     if (r != VK_SUCCESS && r != VK_SUBOPTIMAL_KHR) return vkFailure("vkAcquireNextImageKHR", r);
     imageIndex = index;
+  }
+
+  // --- Animation: this frame's pose on the CPU, then the deformed vertex buffers in their own submission ---
+  const uint64_t frameNumber = frameCounter + 1;
+  if (sceneLoaded) {
+    if (Status s = pose.evaluate(scene.cpu, params.time, params.animations, params.restPose); !s)
+      return "renderFrame: " + s.error;
+    const std::span<const glm::mat4> transforms = pose.instanceTransforms();
+    std::copy(transforms.begin(), transforms.end(), scene.instanceTransforms.begin());
+    if (deformer.active())
+      if (std::string e = deformer.submit(slot, frameNumber, pose); !e.empty()) return "renderFrame: " + e;
   }
 
   // --- Uniforms ---
@@ -99,24 +113,38 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   SE_VK_TRY(vkBeginCommandBuffer(frame.cmd, &bi));
   frame.frameNumber = ++frameCounter;
+  submitWaits.clear();
   recordFrame(frame, params, u, imageIndex, captureProbe, probeKey);
   SE_VK_TRY(vkEndCommandBuffer(frame.cmd));
 
   // --- Submit (and present) ---
   VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
   cbi.commandBuffer = frame.cmd;
-  VkSemaphoreSubmitInfo waitInfo{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-  waitInfo.semaphore = frame.imageAcquired;
-  waitInfo.stageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;  // only the final blit touches the image
+  mainWaits.clear();
+  if (imageIndex) {
+    VkSemaphoreSubmitInfo w{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    w.semaphore = frame.imageAcquired;
+    w.stageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;  // only the final blit touches the image
+    mainWaits.push_back(w);
+  }
+  if (sceneLoaded && deformer.active()) {
+    // Same queue: makes this frame's deformed buffers visible to every pass (and AS build) of the frame.
+    VkSemaphoreSubmitInfo w{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    w.semaphore = deformer.semaphore();
+    w.value = frame.frameNumber;
+    w.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    mainWaits.push_back(w);
+  }
+  mainWaits.insert(mainWaits.end(), submitWaits.begin(), submitWaits.end());
   VkSemaphoreSubmitInfo signalInfo{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
   signalInfo.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
   VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
   si.commandBufferInfoCount = 1;
   si.pCommandBufferInfos = &cbi;
+  si.waitSemaphoreInfoCount = uint32_t(mainWaits.size());
+  si.pWaitSemaphoreInfos = mainWaits.data();
   if (imageIndex) {
     signalInfo.semaphore = swapchain.renderFinished[*imageIndex];
-    si.waitSemaphoreInfoCount = 1;
-    si.pWaitSemaphoreInfos = &waitInfo;
     si.signalSemaphoreInfoCount = 1;
     si.pSignalSemaphoreInfos = &signalInfo;
   }
@@ -255,6 +283,12 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     info.invViewProj = uniformsIn.invViewProj;
     info.cameraPosition = params.camera.eye;
     info.sunDirection = glm::vec3(uniformsIn.sunDirection);
+    if (haveScene) info.instanceTransforms = scene.instanceTransforms;
+    info.deformedInstances = deformer.instances();
+    info.deformSemaphore = deformer.semaphore();
+    info.deformValue = deformer.active() ? frame.frameNumber : 0;
+    info.submitWaits = &submitWaits;
+    info.deformWaits = deformer.active() ? &deformer.pendingWaits() : nullptr;
     hook(info, inputs);
     // Whatever the hook wrote becomes visible to the lighting pass (layouts are the hook's business).
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,

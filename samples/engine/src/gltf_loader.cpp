@@ -1,110 +1,23 @@
-// glTF 2.0 loader on top of tinygltf: flattens the node hierarchy into Scene instances, converts each
-// triangle primitive into a MeshData and each image into an RGBA8 TextureData.
+// glTF 2.0 loader on top of tinygltf: flattens the node hierarchy into Scene instances (keeping the nodes,
+// skins and animations for animation), converts each triangle primitive into a MeshData and each image into
+// an RGBA8 TextureData.
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <set>
 
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/gtc/quaternion.hpp>
-#include <glm/gtc/type_ptr.hpp>
 #include <tiny_gltf.h>
 
+#include "gltf_accessors.h"
+#include "gltf_animation.h"
+#include "sample_engine/animation.h"
 #include "sample_engine/gltf_loader.h"
 
 namespace sample_engine {
 namespace {
 
-// Reads accessor element `i`, component `c` as float, honouring normalized integer types.
-float readComponent(const uint8_t* p, int componentType, bool normalized) {
-  switch (componentType) {
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-      float f;
-      std::memcpy(&f, p, 4);
-      return f;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0f : p[0];
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-      float v = static_cast<int8_t>(p[0]);
-      return normalized ? std::max(v / 127.0f, -1.0f) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      uint16_t v;
-      std::memcpy(&v, p, 2);
-      return normalized ? v / 65535.0f : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-      int16_t v;
-      std::memcpy(&v, p, 2);
-      return normalized ? std::max(v / 32767.0f, -1.0f) : v;
-    }
-    default: return 0.0f;
-  }
-}
-
-// Returns the accessor as `components` floats per element, or an error message.
-std::string readFloats(const tinygltf::Model& model, int accessorIndex, int components, std::vector<float>& out) {
-  if (accessorIndex < 0 || accessorIndex >= int(model.accessors.size())) return "accessor index out of range";
-  const tinygltf::Accessor& acc = model.accessors[accessorIndex];
-  if (acc.sparse.isSparse) return "sparse accessors are not supported";
-  int have = tinygltf::GetNumComponentsInType(static_cast<uint32_t>(acc.type));
-  if (have < components) return "accessor has " + std::to_string(have) + " components, need " + std::to_string(components);
-  out.assign(acc.count * components, 0.0f);
-  if (acc.bufferView < 0) return {};  // all zeros per spec
-  const tinygltf::BufferView& view = model.bufferViews.at(acc.bufferView);
-  const tinygltf::Buffer& buffer = model.buffers.at(view.buffer);
-  int compSize = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(acc.componentType));
-  if (compSize <= 0) return "bad component type";
-  size_t stride = view.byteStride ? view.byteStride : size_t(compSize) * have;
-  size_t base = view.byteOffset + acc.byteOffset;
-  if (acc.count > 0 && base + stride * (acc.count - 1) + size_t(compSize) * have > buffer.data.size())
-    return "accessor reads past the end of its buffer";
-  for (size_t i = 0; i < acc.count; ++i)
-    for (int c = 0; c < components; ++c)
-      out[i * components + c] =
-          readComponent(&buffer.data[base + i * stride + size_t(c) * compSize], acc.componentType, acc.normalized);
-  return {};
-}
-
-std::string readIndices(const tinygltf::Model& model, int accessorIndex, std::vector<uint32_t>& out) {
-  if (accessorIndex < 0 || accessorIndex >= int(model.accessors.size())) return "index accessor out of range";
-  const tinygltf::Accessor& acc = model.accessors[accessorIndex];
-  if (acc.bufferView < 0) return "index accessor has no buffer view";
-  const tinygltf::BufferView& view = model.bufferViews.at(acc.bufferView);
-  const tinygltf::Buffer& buffer = model.buffers.at(view.buffer);
-  int size = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(acc.componentType));
-  if (size != 1 && size != 2 && size != 4) return "unsupported index component type";
-  size_t stride = view.byteStride ? view.byteStride : size_t(size);
-  size_t base = view.byteOffset + acc.byteOffset;
-  if (acc.count > 0 && base + stride * (acc.count - 1) + size > buffer.data.size())
-    return "index accessor reads past the end of its buffer";
-  out.resize(acc.count);
-  for (size_t i = 0; i < acc.count; ++i) {
-    const uint8_t* p = &buffer.data[base + i * stride];
-    if (size == 1) out[i] = p[0];
-    else if (size == 2) {
-      uint16_t v;
-      std::memcpy(&v, p, 2);
-      out[i] = v;
-    } else std::memcpy(&out[i], p, 4);
-  }
-  return {};
-}
-
-glm::mat4 localTransform(const tinygltf::Node& node) {
-  if (node.matrix.size() == 16) {
-    glm::mat4 m;
-    for (int i = 0; i < 16; ++i) glm::value_ptr(m)[i] = static_cast<float>(node.matrix[i]);  // column-major
-    return m;
-  }
-  glm::mat4 m(1.0f);
-  if (node.translation.size() == 3)
-    m = glm::translate(m, glm::vec3(node.translation[0], node.translation[1], node.translation[2]));
-  if (node.rotation.size() == 4)  // glTF stores x, y, z, w; glm::quat takes w first
-    m *= glm::mat4_cast(glm::quat(float(node.rotation[3]), float(node.rotation[0]), float(node.rotation[1]),
-                                  float(node.rotation[2])));
-  if (node.scale.size() == 3) m = glm::scale(m, glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
-  return m;
-}
+using detail::readFloats;
+using detail::readIndices;
 
 TextureData convertImage(const tinygltf::Image& img) {
   TextureData t;
@@ -135,6 +48,13 @@ struct Loader {
   const tinygltf::Model& model;
   SceneLoadResult& result;
   std::map<int, std::vector<uint32_t>> meshPrimitives;  // glTF mesh -> Scene mesh indices
+  std::vector<std::pair<int, int>> meshOrigin;          // Scene mesh -> glTF (mesh, primitive)
+  std::set<std::pair<int, uint32_t>> checkedSkins;       // (skin, Scene mesh) pairs already validated
+  std::string error;                                     // the first fatal problem
+
+  void fail(std::string message) {
+    if (error.empty()) error = std::move(message);
+  }
 
   int textureImage(int textureIndex) {
     if (textureIndex < 0 || textureIndex >= int(model.textures.size())) return -1;
@@ -204,6 +124,8 @@ struct Loader {
     optional("NORMAL", 3, out.normals);
     optional("TEXCOORD_0", 2, out.uvs);
     optional("TANGENT", 4, out.tangents);
+    if (!readDeformation(prim, where, out)) return false;
+    for (double w : mesh.weights) out.morphWeights.push_back(float(w));
     if (prim.indices >= 0) {
       if (std::string e = readIndices(model, prim.indices, out.indices); !e.empty()) {
         result.warnings.push_back(where + ": skipped, indices: " + e);
@@ -223,6 +145,89 @@ struct Loader {
     return true;
   }
 
+  // Reads a required per-vertex attribute of `comps` floats; a problem is fatal (the mesh could not animate).
+  bool readVertexAttribute(int accessor, const std::string& what, int comps, size_t vertexCount, std::vector<float>& f) {
+    if (std::string e = readFloats(model, accessor, comps, f); !e.empty()) {
+      fail(what + ": " + e);
+      return false;
+    }
+    if (f.size() / size_t(comps) != vertexCount) {
+      fail(what + ": " + std::to_string(f.size() / size_t(comps)) + " elements for " + std::to_string(vertexCount) +
+           " vertices");
+      return false;
+    }
+    return true;
+  }
+
+  // JOINTS_n / WEIGHTS_n and morph targets. Returns false on a fatal problem (see `error`).
+  bool readDeformation(const tinygltf::Primitive& prim, const std::string& where, MeshData& out) {
+    const size_t n = out.positions.size();
+    std::vector<float> f;
+    for (int set = 0; set < 2; ++set) {
+      const std::string jointsName = "JOINTS_" + std::to_string(set), weightsName = "WEIGHTS_" + std::to_string(set);
+      auto joints = prim.attributes.find(jointsName), weights = prim.attributes.find(weightsName);
+      if (joints == prim.attributes.end() && weights == prim.attributes.end()) break;
+      if (joints == prim.attributes.end() || weights == prim.attributes.end()) {
+        result.warnings.push_back(where + ": " + jointsName + " and " + weightsName +
+                                  " come in pairs; ignoring the one present");
+        break;
+      }
+      auto& dstJoints = set ? out.joints1 : out.joints0;
+      auto& dstWeights = set ? out.weights1 : out.weights0;
+      if (!readVertexAttribute(joints->second, where + ", " + jointsName, 4, n, f)) return false;
+      dstJoints.resize(n);
+      for (size_t v = 0; v < n; ++v)
+        for (int k = 0; k < 4; ++k) dstJoints[v][k] = uint16_t(std::min(f[v * 4 + size_t(k)], 65535.0f));
+      if (!readVertexAttribute(weights->second, where + ", " + weightsName, 4, n, f)) return false;
+      dstWeights.resize(n);
+      std::memcpy(dstWeights.data(), f.data(), n * sizeof(glm::vec4));
+    }
+    for (size_t t = 0; t < prim.targets.size(); ++t) {
+      MorphTarget target;
+      const std::string at = where + ", morph target " + std::to_string(t);
+      for (const auto& [name, accessor] : prim.targets[t]) {
+        std::vector<glm::vec3>* dst = name == "POSITION" ? &target.positionDeltas
+                                      : name == "NORMAL" ? &target.normalDeltas
+                                                         : nullptr;
+        if (!dst) continue;  // TANGENT deltas: tangents are only skinned
+        if (!readVertexAttribute(accessor, at + " " + name, 3, n, f)) return false;
+        dst->resize(n);
+        std::memcpy(dst->data(), f.data(), n * sizeof(glm::vec3));
+      }
+      out.morphTargets.push_back(std::move(target));
+    }
+    return true;
+  }
+
+  // The skin must cover every joint index of the mesh, and every vertex needs some weight.
+  void checkSkin(int skinIndex, uint32_t m) {
+    if (!checkedSkins.insert({skinIndex, m}).second) return;
+    const Skin& skin = result.scene.skins[size_t(skinIndex)];
+    const MeshData& mesh = result.scene.meshes[m];
+    const std::string skinName = "skin " + std::to_string(skinIndex) + " '" + skin.name + "'";
+    const auto [gltfMesh, primitive] = meshOrigin[m];
+    const std::string where =
+        "mesh " + std::to_string(gltfMesh) + " '" + model.meshes[size_t(gltfMesh)].name + "' primitive " + std::to_string(primitive);
+    const size_t jointCount = skin.joints.size();
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+      float sum = 0.0f;
+      for (int set = 0; set < (mesh.joints1.empty() ? 1 : 2); ++set) {
+        const glm::u16vec4 j = set ? mesh.joints1[v] : mesh.joints0[v];
+        const glm::vec4 w = set ? mesh.weights1[v] : mesh.weights0[v];
+        for (int k = 0; k < 4; ++k)
+          if (j[k] >= jointCount)
+            return fail(skinName + ": " + where + ", vertex " + std::to_string(v) + ": JOINTS_" + std::to_string(set) +
+                        " index " + std::to_string(j[k]) + " is out of range (the skin has " +
+                        std::to_string(jointCount) + " joints)");
+        sum += w.x + w.y + w.z + w.w;
+      }
+      if (!(sum > 1e-6f))
+        return fail(where + ", vertex " + std::to_string(v) + " (" + skinName + "): its WEIGHTS_0" +
+                    (mesh.weights1.empty() ? "" : " and WEIGHTS_1") + " sum to " + std::to_string(sum) +
+                    "; skin weights must sum to 1");
+    }
+  }
+
   const std::vector<uint32_t>& meshesFor(int meshIndex) {
     auto it = meshPrimitives.find(meshIndex);
     if (it != meshPrimitives.end()) return it->second;
@@ -232,18 +237,40 @@ struct Loader {
       MeshData data;
       if (!convertPrimitive(mesh, p, data)) continue;
       result.scene.meshes.push_back(std::move(data));
+      meshOrigin.push_back({meshIndex, int(p)});
       list.push_back(uint32_t(result.scene.meshes.size() - 1));
     }
     return list;
   }
 
   void visit(int nodeIndex, const glm::mat4& parent, int depth) {
-    if (nodeIndex < 0 || nodeIndex >= int(model.nodes.size()) || depth > 256) return;  // bad index or cycle
-    const tinygltf::Node& node = model.nodes[nodeIndex];
-    glm::mat4 world = parent * localTransform(node);
-    if (node.mesh >= 0 && node.mesh < int(model.meshes.size())) {
-      if (node.skin >= 0) result.warnings.push_back("node '" + node.name + "': skinning ignored (bind pose)");
-      for (uint32_t m : meshesFor(node.mesh)) result.scene.instances.push_back(Instance{m, world});
+    if (!error.empty()) return;
+    if (nodeIndex < 0 || nodeIndex >= int(model.nodes.size()))
+      return fail("scene node " + std::to_string(nodeIndex) + " is out of range (the file has " +
+                  std::to_string(model.nodes.size()) + " nodes)");
+    if (depth > 1024) return fail("node " + std::to_string(nodeIndex) + ": the hierarchy is deeper than 1024 (a cycle?)");
+    const tinygltf::Node& node = model.nodes[size_t(nodeIndex)];
+    glm::mat4 world = parent * result.scene.nodes[size_t(nodeIndex)].localTransform();
+    const std::string name = "node " + std::to_string(nodeIndex) + " '" + node.name + "'";
+    if (node.mesh >= int(model.meshes.size()))
+      return fail(name + ": mesh " + std::to_string(node.mesh) + " is out of range (the file has " +
+                  std::to_string(model.meshes.size()) + " meshes)");
+    if (node.skin >= int(model.skins.size()))
+      return fail(name + ": skin " + std::to_string(node.skin) + " is out of range (the file has " +
+                  std::to_string(model.skins.size()) + " skins)");
+    if (node.mesh >= 0) {
+      for (uint32_t m : meshesFor(node.mesh)) {
+        int skin = -1;
+        if (node.skin >= 0 && result.scene.meshes[m].skinned()) {
+          checkSkin(node.skin, m);
+          skin = node.skin;
+        } else if (node.skin >= 0) {
+          result.warnings.push_back(name + ": mesh '" + result.scene.meshes[m].name +
+                                    "' has a primitive without JOINTS_0/WEIGHTS_0; drawn unskinned");
+        }
+        result.scene.instances.push_back(Instance{m, world, nodeIndex, skin});
+      }
+      if (!error.empty()) return;
     }
     if (node.camera >= 0 && node.camera < int(model.cameras.size()) && !result.scene.camera &&
         model.cameras[node.camera].type == "perspective") {
@@ -283,7 +310,14 @@ SceneLoadResult loadGltf(const std::string& path) {
       result.error = "failed to parse glTF '" + path + "': " + (err.empty() ? "unknown error" : err);
       return result;
     }
-    Loader loader{model, result, {}};
+    Loader loader{model, result, {}, {}, {}, {}};
+    if (std::string e = detail::convertNodes(model, result.scene); !e.empty()) loader.fail(e);
+    if (std::string e = detail::convertSkins(model, result.scene); !e.empty()) loader.fail(e);
+    if (std::string e = detail::convertAnimations(model, result.scene, result.warnings); !e.empty()) loader.fail(e);
+    if (!loader.error.empty()) {
+      result.error = "glTF '" + path + "': " + loader.error;
+      return result;
+    }
     for (const tinygltf::Image& img : model.images) {
       result.scene.textures.push_back(convertImage(img));
       if (result.scene.textures.back().rgba8.empty())
@@ -308,6 +342,10 @@ SceneLoadResult loadGltf(const std::string& path) {
         if (!isChild[i]) roots.push_back(int(i));
     }
     for (int r : roots) loader.visit(r, glm::mat4(1.0f), 0);
+    if (!loader.error.empty()) {
+      result.error = "glTF '" + path + "': " + loader.error;
+      return result;
+    }
     // Primitives without a material use a default one appended at the end.
     bool needsDefault = false;
     for (const MeshData& m : result.scene.meshes) needsDefault |= m.material >= result.scene.materials.size();
@@ -318,6 +356,8 @@ SceneLoadResult loadGltf(const std::string& path) {
         if (m.material > index) m.material = index;
     }
     if (result.scene.instances.empty()) result.error = "glTF '" + path + "' contains no renderable triangles";
+    // Whatever the checks above did not name in glTF terms (e.g. a cycle among unvisited nodes).
+    else if (Status s = ScenePose().reset(result.scene); !s) result.error = "glTF '" + path + "': " + s.error;
   } catch (const std::exception& e) {
     result.error = std::string("glTF loading failed: ") + e.what();
   }

@@ -55,6 +55,83 @@ std::string Gpu::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMem
   return {};
 }
 
+std::string Gpu::createBuffers(std::span<const BufferRequest> requests, std::vector<VkDeviceMemory>& blocks) {
+  // Blocks of up to 256 MiB; a larger buffer gets a block of its own.
+  constexpr VkDeviceSize kBlockSize = VkDeviceSize(256) << 20;
+  struct Placement {
+    uint32_t type;
+    VkDeviceSize offset;
+    size_t block;  // index into `pending`
+  };
+  struct PendingBlock {
+    uint32_t type;
+    VkDeviceSize size;
+    bool deviceAddress;
+  };
+  std::vector<Placement> placements(requests.size());
+  std::vector<PendingBlock> pending;
+  std::vector<size_t> openBlock(memProps_.memoryTypeCount, SIZE_MAX);
+  for (size_t i = 0; i < requests.size(); ++i) {
+    const BufferRequest& r = requests[i];
+    Buffer& out = *r.out;
+    out = {};
+    out.size = r.size;
+    VkBufferCreateInfo ci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    ci.size = r.size ? r.size : 4;
+    ci.usage = r.usage;
+    ci.sharingMode = r.queueFamilies.size() > 1 ? VK_SHARING_MODE_CONCURRENT : VK_SHARING_MODE_EXCLUSIVE;
+    ci.queueFamilyIndexCount = r.queueFamilies.size() > 1 ? uint32_t(r.queueFamilies.size()) : 0;
+    ci.pQueueFamilyIndices = r.queueFamilies.size() > 1 ? r.queueFamilies.data() : nullptr;
+    SE_VK_TRY(vkCreateBuffer(device_, &ci, nullptr, &out.buffer));
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(device_, out.buffer, &req);
+    const uint32_t type = memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    if (type == UINT32_MAX) return "no device-local memory type for a buffer";
+    size_t b = openBlock[type];
+    VkDeviceSize offset = 0;
+    if (b != SIZE_MAX) {
+      offset = (pending[b].size + req.alignment - 1) / req.alignment * req.alignment;
+      if (offset + req.size > kBlockSize) b = SIZE_MAX;
+    }
+    if (b == SIZE_MAX) {
+      b = pending.size();
+      pending.push_back({type, 0, false});
+      openBlock[type] = b;
+      offset = 0;
+    }
+    pending[b].size = offset + req.size;
+    pending[b].deviceAddress |= (r.usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0;
+    placements[i] = {type, offset, b};
+  }
+  const size_t firstBlock = blocks.size();
+  for (const PendingBlock& p : pending) {
+    VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+    flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.pNext = p.deviceAddress ? &flags : nullptr;
+    ai.allocationSize = p.size;
+    ai.memoryTypeIndex = p.type;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    SE_VK_TRY(vkAllocateMemory(device_, &ai, nullptr, &memory));
+    blocks.push_back(memory);
+  }
+  for (size_t i = 0; i < requests.size(); ++i) {
+    Buffer& out = *requests[i].out;
+    SE_VK_TRY(vkBindBufferMemory(device_, out.buffer, blocks[firstBlock + placements[i].block], placements[i].offset));
+    if (requests[i].usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) {
+      VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+      info.buffer = out.buffer;
+      out.address = vkGetBufferDeviceAddress(device_, &info);
+    }
+  }
+  return {};
+}
+
+void Gpu::freeBlocks(std::vector<VkDeviceMemory>& blocks) {
+  for (VkDeviceMemory m : blocks) vkFreeMemory(device_, m, nullptr);
+  blocks.clear();
+}
+
 std::string Gpu::createImage(const ImageDesc& desc, Image& out) {
   out = {};
   out.format = desc.format;

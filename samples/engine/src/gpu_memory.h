@@ -1,8 +1,11 @@
-// Buffers, images and one-shot command submission. One VkDeviceMemory per resource: the sample scenes
-// hold a few hundred resources at most, far below maxMemoryAllocationCount.
+// Buffers, images and one-shot command submission. Targets and small buffers get one VkDeviceMemory each;
+// scene buffers (thousands with K animated characters) are bound into a few shared blocks by createBuffers(),
+// staying far below maxMemoryAllocationCount.
 #pragma once
 
+#include <span>
 #include <string>
+#include <vector>
 
 #include <vulkan/vulkan.h>
 
@@ -37,6 +40,14 @@ struct ImageDesc {
   bool cube = false;  // 6 layers, CUBE_COMPATIBLE, `view` is a cube view (per-face views are the caller's)
 };
 
+// One device-local buffer of a Gpu::createBuffers() batch.
+struct BufferRequest {
+  VkDeviceSize size = 0;
+  VkBufferUsageFlags usage = 0;
+  Buffer* out = nullptr;
+  std::span<const uint32_t> queueFamilies;  // two or more: VK_SHARING_MODE_CONCURRENT over them
+};
+
 class Gpu {
  public:
   void init(VkPhysicalDevice pd, VkDevice device, VkQueue queue, uint32_t family);
@@ -44,6 +55,10 @@ class Gpu {
   VkDevice device() const { return device_; }
 
   std::string createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags props, Buffer& out);
+  // Device-local buffers bound into shared memory blocks, appended to `blocks` (freed with freeBlocks() after
+  // the buffers are destroyed; the buffers' own `memory` stays VK_NULL_HANDLE).
+  std::string createBuffers(std::span<const BufferRequest> requests, std::vector<VkDeviceMemory>& blocks);
+  void freeBlocks(std::vector<VkDeviceMemory>& blocks);
   std::string createImage(const ImageDesc& desc, Image& out);
   void destroy(Buffer& b);
   void destroy(Image& i);

@@ -148,11 +148,16 @@ void DefaultImages::destroy(Gpu& gpu) {
   gpu.destroy(flatNormal);
 }
 
+bool deforms(const Scene& scene, const Instance& instance) {
+  return instance.skin >= 0 || scene.meshes[instance.mesh].morphed();
+}
+
 std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pipelines,
-                        const DefaultImages& defaults, const Scene& scene, GpuScene& out) {
+                        const DefaultImages& defaults, const Scene& scene, ScenePose& pose, GpuScene& out) {
   out.cpu = scene;
   finalizeScene(out.cpu);
   const Scene& s = out.cpu;
+  if (Status st = pose.reset(s); !st) return st.error;
   out.bounds = s.bounds();
 
   // --- Buffers ---
@@ -161,7 +166,13 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     rtUsage |= VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
     if (ctx.accelerationStructureEnabled) rtUsage |= VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
   }
+  // The deformation pass reads the bind pose of deforming meshes by device address, and the deformed buffers
+  // start as copies of it.
+  std::vector<bool> deformedMesh(s.meshes.size(), false);
+  for (const Instance& inst : s.instances) deformedMesh[inst.mesh] = deformedMesh[inst.mesh] || deforms(s, inst);
   std::vector<std::vector<VertexAttributes>> attributes(s.meshes.size());
+  std::vector<BufferRequest> requests;
+  out.buffers.resize(s.meshes.size());
   VkDeviceSize stagingSize = 0;
   for (size_t m = 0; m < s.meshes.size(); ++m) {
     const MeshData& mesh = s.meshes[m];
@@ -169,7 +180,19 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     for (size_t v = 0; v < mesh.positions.size(); ++v)
       attributes[m][v] = {mesh.normals[v], mesh.uvs[v], mesh.tangents[v]};
     stagingSize += mesh.positions.size() * 12 + attributes[m].size() * 36 + mesh.indices.size() * 4;
+    const VkBufferUsageFlags vertexUsage =
+        VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | rtUsage |
+        (deformedMesh[m] ? VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT : 0);
+    MeshBuffers& b = out.buffers[m];
+    if (!mesh.positions.empty()) {
+      requests.push_back({mesh.positions.size() * 12, vertexUsage, &b.positions, {}});
+      requests.push_back({mesh.positions.size() * 36, vertexUsage, &b.attributes, {}});
+    }
+    if (!mesh.indices.empty())
+      requests.push_back({mesh.indices.size() * 4,
+                          VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | rtUsage, &b.indices, {}});
   }
+  if (std::string e = gpu.createBuffers(requests, out.memoryBlocks); !e.empty()) return e;
   Buffer staging;
   if (std::string e = gpu.createBuffer(stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
@@ -178,28 +201,24 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     return e;
   std::vector<Upload> uploads;
   VkDeviceSize offset = 0;
-  std::string e;
-  auto stage = [&](const void* data, VkDeviceSize size, VkBufferUsageFlags usage, Buffer& dst) {
-    if (!e.empty() || size == 0) return;
-    e = gpu.createBuffer(size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, dst);
-    if (!e.empty()) return;
+  auto stage = [&](const void* data, VkDeviceSize size, const Buffer& dst) {
+    if (size == 0) return;
     std::memcpy(static_cast<char*>(staging.mapped) + offset, data, size);
     uploads.push_back({dst.buffer, offset, size});
     offset += size;
   };
-  out.buffers.resize(s.meshes.size());
   out.meshes.resize(s.meshes.size());
   for (size_t m = 0; m < s.meshes.size(); ++m) {
     const MeshData& mesh = s.meshes[m];
     MeshBuffers& b = out.buffers[m];
-    stage(mesh.positions.data(), mesh.positions.size() * 12, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | rtUsage, b.positions);
-    stage(attributes[m].data(), attributes[m].size() * 36, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | rtUsage, b.attributes);
-    stage(mesh.indices.data(), mesh.indices.size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT | rtUsage, b.indices);
+    stage(mesh.positions.data(), mesh.positions.size() * 12, b.positions);
+    stage(attributes[m].data(), attributes[m].size() * 36, b.attributes);
+    stage(mesh.indices.data(), mesh.indices.size() * 4, b.indices);
     GpuMesh& g = out.meshes[m];
     g.positionBuffer = b.positions.buffer;
-    g.positionAddress = b.positions.address;
+    g.positionAddress = ctx.info.bufferDeviceAddress ? b.positions.address : 0;
     g.attributeBuffer = b.attributes.buffer;
-    g.attributeAddress = b.attributes.address;
+    g.attributeAddress = ctx.info.bufferDeviceAddress ? b.attributes.address : 0;
     g.indexBuffer = b.indices.buffer;
     g.indexAddress = b.indices.address;
     g.indexType = mesh.indices.empty() ? VK_INDEX_TYPE_NONE_KHR : VK_INDEX_TYPE_UINT32;
@@ -208,7 +227,8 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     g.material = mesh.material;
     g.cpu = &mesh;
   }
-  if (e.empty() && !uploads.empty())
+  std::string e;
+  if (!uploads.empty())
     e = gpu.submitNow([&](VkCommandBuffer cmd) {
       for (const Upload& u : uploads) {
         VkBufferCopy c{u.srcOffset, 0, u.size};
@@ -220,6 +240,15 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     });
   gpu.destroy(staging);
   if (!e.empty()) return e;
+
+  // --- Per-instance draw data: rest transforms and the mesh's own buffers until deformation takes over ---
+  out.instanceTransforms.resize(s.instances.size());
+  out.instanceVertices.resize(s.instances.size());
+  for (size_t i = 0; i < s.instances.size(); ++i) {
+    out.instanceTransforms[i] = s.instances[i].transform;
+    const MeshBuffers& b = out.buffers[s.instances[i].mesh];
+    out.instanceVertices[i] = {b.positions.buffer, b.attributes.buffer};
+  }
 
   // --- Textures ---
   out.textures.resize(s.textures.size());
@@ -287,6 +316,7 @@ void destroyScene(Gpu& gpu, GpuScene& scene) {
     gpu.destroy(b.attributes);
     gpu.destroy(b.indices);
   }
+  gpu.freeBlocks(scene.memoryBlocks);
   for (Image& i : scene.textures) gpu.destroy(i);
   if (scene.materialPool) vkDestroyDescriptorPool(gpu.device(), scene.materialPool, nullptr);
   scene = GpuScene{};

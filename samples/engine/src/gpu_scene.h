@@ -1,11 +1,13 @@
 // GPU copy of a Scene: vertex/index buffers per mesh, textures, one descriptor set per material.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
 #include "gpu_memory.h"
 #include "pipelines.h"
+#include "sample_engine/animation.h"
 #include "sample_engine/engine.h"
 #include "vk_context.h"
 
@@ -26,7 +28,8 @@ struct MeshBuffers {
 
 struct GpuScene {
   Scene cpu;  // finalized copy; GpuMesh::cpu points into it
-  std::vector<MeshBuffers> buffers;
+  std::vector<MeshBuffers> buffers;  // bound into memoryBlocks
+  std::vector<VkDeviceMemory> memoryBlocks;
   std::vector<GpuMesh> meshes;
   std::vector<Image> textures;
   std::vector<GpuTexture> textureViews;  // public view of `textures`
@@ -34,10 +37,19 @@ struct GpuScene {
   std::vector<VkDescriptorSet> materialSets;
   std::vector<DrawConstants> materialConstants;  // model matrix filled per draw
   Bounds bounds;
+  // Per Scene instance, what the raster passes draw: this frame's world transform, and the position /
+  // attribute buffers (the mesh's, or the instance's deformed buffers).
+  std::vector<glm::mat4> instanceTransforms;
+  std::vector<std::array<VkBuffer, 2>> instanceVertices;
 };
 
+// True for an instance the deformation pass writes own vertex buffers for: skinned and/or morphed.
+bool deforms(const Scene& scene, const Instance& instance);
+
+// Copies and finalizes `scene`, checks its animation data with pose.reset() (nothing is uploaded when that
+// fails), then uploads it.
 std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pipelines,
-                        const DefaultImages& defaults, const Scene& scene, GpuScene& out);
+                        const DefaultImages& defaults, const Scene& scene, ScenePose& pose, GpuScene& out);
 void destroyScene(Gpu& gpu, GpuScene& scene);
 
 }  // namespace sample_engine::detail

@@ -29,10 +29,12 @@ void beginRendering(VkCommandBuffer cmd, VkExtent2D extent, const std::vector<Vk
 
 void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass) {
   uint32_t boundMaterial = UINT32_MAX;
-  for (const Instance& inst : scene.cpu.instances) {
+  for (size_t i = 0; i < scene.cpu.instances.size(); ++i) {
+    const Instance& inst = scene.cpu.instances[i];
     const GpuMesh& mesh = scene.meshes[inst.mesh];
     if (mesh.vertexCount == 0) continue;
-    VkBuffer buffers[2] = {mesh.positionBuffer, mesh.attributeBuffer};
+    // The instance's own deformed buffers when it deforms, else the mesh's.
+    const VkBuffer* buffers = scene.instanceVertices[i].data();
     VkDeviceSize offsets[2] = {0, 0};
     vkCmdBindVertexBuffers(cmd, 0, pass == DrawPass::Shadow ? 1 : 2, buffers, offsets);
     if (pass != DrawPass::Shadow && boundMaterial != mesh.material) {
@@ -41,7 +43,7 @@ void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, D
       boundMaterial = mesh.material;
     }
     DrawConstants c = scene.materialConstants[mesh.material];
-    c.model = inst.transform;
+    c.model = scene.instanceTransforms[i];
     vkCmdPushConstants(cmd, p.sceneLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(c), &c);
     if (mesh.indexCount > 0) {
       vkCmdBindIndexBuffer(cmd, mesh.indexBuffer, 0, VK_INDEX_TYPE_UINT32);

@@ -19,7 +19,9 @@ void beginRendering(VkCommandBuffer cmd, VkExtent2D extent, const std::vector<Vk
 
 enum class DrawPass { Shadow, Prepass, Lighting };
 
-// One draw per instance; binds vertex buffers, material sets (set 1, except for Shadow) and push constants.
+// One draw per instance with its GpuScene::instanceTransforms / instanceVertices entry (this frame's world
+// transform, deformed buffers); binds vertex buffers, material sets (set 1, except for Shadow) and push
+// constants.
 // Set 0 (and set 2 for Lighting) must already be bound.
 void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass);
 

@@ -94,6 +94,14 @@ void finalizeMesh(MeshData& m) {
       m.normals.resize(n);
       m.uvs.resize(n);
       m.tangents.resize(n);
+      // Per-vertex skin and morph arrays follow (empty ones stay empty).
+      for (auto* j : {&m.joints0, &m.joints1})
+        if (!j->empty()) j->resize(n);
+      for (auto* w : {&m.weights0, &m.weights1})
+        if (!w->empty()) w->resize(n);
+      for (MorphTarget& t : m.morphTargets)
+        for (auto* d : {&t.positionDeltas, &t.normalDeltas})
+          if (!d->empty()) d->resize(n);
     }
   } else {
     m.indices.resize(m.indices.size() / 3 * 3);

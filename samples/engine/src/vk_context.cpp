@@ -175,8 +175,8 @@ std::string VulkanContext::create(const EngineConfig& config) {
     f12.pNext = &f13;
     VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12, {}};
     vkGetPhysicalDeviceFeatures2(pd, &f2);
-    if (!f13.dynamicRendering || !f13.synchronization2 || !f12.separateDepthStencilLayouts) {
-      reject("dynamicRendering / synchronization2 / separateDepthStencilLayouts unsupported");
+    if (!f13.dynamicRendering || !f13.synchronization2 || !f12.separateDepthStencilLayouts || !f12.timelineSemaphore) {
+      reject("dynamicRendering / synchronization2 / separateDepthStencilLayouts / timelineSemaphore unsupported");
       continue;
     }
     candidates.push_back(c);
@@ -213,7 +213,10 @@ std::string VulkanContext::create(const EngineConfig& config) {
   f13.dynamicRendering = VK_TRUE;
   f13.synchronization2 = VK_TRUE;
   f12.separateDepthStencilLayouts = VK_TRUE;  // lets the pre-pass depth sit in DEPTH_READ_ONLY_OPTIMAL
-  f12.bufferDeviceAddress = config.enableRayTracingInputs && supported12.bufferDeviceAddress;
+  f12.timelineSemaphore = VK_TRUE;  // the deformation submission signals a timeline semaphore per frame
+  // Required by Vulkan 1.3, so always on: the deformation pass reads and writes vertex buffers through
+  // device addresses. Scene buffers expose addresses only with enableRayTracingInputs (info.bufferDeviceAddress).
+  f12.bufferDeviceAddress = supported12.bufferDeviceAddress;
   mergeBools(f2.features, config.extraFeatures10, 0);
   mergeBools(f11, config.extraFeatures11, offsetof(VkPhysicalDeviceVulkan11Features, storageBuffer16BitAccess));
   mergeBools(f12, config.extraFeatures12, offsetof(VkPhysicalDeviceVulkan12Features, samplerMirrorClampToEdge));
@@ -222,7 +225,8 @@ std::string VulkanContext::create(const EngineConfig& config) {
   f11.pNext = &f12;
   f12.pNext = &f13;
   f13.pNext = const_cast<void*>(config.deviceFeaturesPNext);
-  info.bufferDeviceAddress = f12.bufferDeviceAddress;
+  bufferDeviceAddressFeature = f12.bufferDeviceAddress;
+  info.bufferDeviceAddress = config.enableRayTracingInputs && f12.bufferDeviceAddress;
 
   // --- Device ---
   deviceExtensions = requiredExts;
@@ -231,24 +235,33 @@ std::string VulkanContext::create(const EngineConfig& config) {
                                            VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) != deviceExtensions.end();
   std::vector<const char*> extPtrs;
   for (const auto& e : deviceExtensions) extPtrs.push_back(e.c_str());
-  const float priority = 1.0f;
-  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  qci.queueFamilyIndex = queueFamily;
-  qci.queueCount = 1;
-  qci.pQueuePriorities = &priority;
-  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-  dci.pNext = &f2;
-  dci.queueCreateInfoCount = 1;
-  dci.pQueueCreateInfos = &qci;
-  dci.enabledExtensionCount = uint32_t(extPtrs.size());
-  dci.ppEnabledExtensionNames = extPtrs.data();
-  SE_VK_TRY(vkCreateDevice(physicalDevice, &dci, nullptr, &device));
-  vkGetDeviceQueue(device, queueFamily, 0, &queue);
-
   uint32_t nf = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(physicalDevice, &nf, nullptr);
   std::vector<VkQueueFamilyProperties> families(nf);
   vkGetPhysicalDeviceQueueFamilyProperties(physicalDevice, &nf, families.data());
+  if (config.requestAsyncComputeQueue)
+    for (uint32_t f = 0; f < nf && asyncComputeFamily == UINT32_MAX; ++f)
+      if ((families[f].queueFlags & VK_QUEUE_COMPUTE_BIT) && !(families[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) &&
+          families[f].queueCount > 0)
+        asyncComputeFamily = f;
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo qci[2] = {{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO},
+                                    {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO}};
+  qci[0].queueFamilyIndex = queueFamily;
+  qci[0].queueCount = 1;
+  qci[0].pQueuePriorities = &priority;
+  qci[1].queueFamilyIndex = asyncComputeFamily;
+  qci[1].queueCount = 1;
+  qci[1].pQueuePriorities = &priority;
+  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  dci.pNext = &f2;
+  dci.queueCreateInfoCount = asyncComputeFamily != UINT32_MAX ? 2 : 1;
+  dci.pQueueCreateInfos = qci;
+  dci.enabledExtensionCount = uint32_t(extPtrs.size());
+  dci.ppEnabledExtensionNames = extPtrs.data();
+  SE_VK_TRY(vkCreateDevice(physicalDevice, &dci, nullptr, &device));
+  vkGetDeviceQueue(device, queueFamily, 0, &queue);
+  if (asyncComputeFamily != UINT32_MAX) vkGetDeviceQueue(device, asyncComputeFamily, 0, &asyncComputeQueue);
   timestampsSupported = families[queueFamily].timestampValidBits > 0 && properties.limits.timestampPeriod > 0;
   timestampPeriodNs = properties.limits.timestampPeriod;
   return {};

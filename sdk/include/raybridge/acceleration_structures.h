@@ -5,15 +5,24 @@
 // Frame flow, all recorded into the engine's command buffers:
 //   ctx.beginFrame();                       // after waiting for the frame slot's fence
 //   service.registerMesh(...)               // any time; returns at once, the build is only queued
+//   service.updateMesh(dynamicMesh)         // the deforming meshes whose vertices this frame rewrites
+//   service.submitDynamicWork(ready)        // async modes: dynamic refits/rebuilds on AsServiceDesc::asyncQueue
+//   service.fillTlasWait(wait)              // async modes: a wait for the engine's submission of the TLAS build
 //   service.recordPendingWork(cmd);         // compaction copies, queued builds and refits, within budgets
 //   service.recordTlasBuild(cmd, instances) // TLAS over the meshes built so far; ready for ray tracing
+//
+// Dynamic meshes (MeshRole::Dynamic) are refit or rebuilt after updateMesh() as AsServiceDesc::refitPolicy
+// decides, either in the frame's command buffer (DynamicBuildMode::InFrame) or on a compute queue the engine hands
+// over (the async modes), synchronised by a timeline semaphore the SDK owns and the engine waits on.
 //
 // Engine buffers are read in place, never copied. Vertex and index buffers must be created with
 //   VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR
 // (and memory allocated with VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT). They must stay alive and unchanged
 // while their mesh is registered (a dynamic mesh may change between updateMesh() calls).
 //
-// Thread safety: externally synchronised, like the Context it was created from.
+// Thread safety: externally synchronised, like the Context it was created from. That includes the async queue:
+// the SDK submits to AsServiceDesc::asyncQueue only inside submitDynamicWork(), and the engine must not use that
+// VkQueue from another thread during the call (Vulkan's external synchronisation of queues).
 #pragma once
 
 #include <raybridge/context.h>
@@ -21,6 +30,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace rb {
@@ -43,7 +53,62 @@ enum class IndexType : uint8_t {
 // The role picks the build flags.
 enum class MeshRole : uint8_t {
   Static = 0,  // default: PREFER_FAST_TRACE + ALLOW_COMPACTION, compacted after its build
-  Dynamic,     // deforming: PREFER_FAST_BUILD + ALLOW_UPDATE, refit by updateMesh(); never compacted
+  Dynamic,     // deforming: PREFER_FAST_BUILD + ALLOW_UPDATE, refit or rebuilt after updateMesh(); never compacted
+};
+
+// Where the builds and refits of dynamic meshes run, and which pose a frame's TLAS traces.
+enum class DynamicBuildMode : uint8_t {
+  InFrame = 0,        // default: dynamic BLAS work is recorded by recordPendingWork(cmd), in the frame
+  AsyncSameFrame,     // on AsServiceDesc::asyncQueue; this frame's TLAS waits for this frame's builds
+  AsyncOneFrameLate,  // the TLAS uses the BLAS built from the previous frame's pose; the graphics queue never
+                      // waits for this frame's builds (except a mesh's first, which has no earlier pose)
+};
+// With no async queue (or one of the engine's own family, e.g. lavapipe's single queue, or one without compute)
+// the async modes fall back to recording in recordPendingWork(cmd): the same API and the same semantics
+// (one-frame-late still traces the previous pose), reported by AsStats::async == false and
+// AsStats::asyncFallbackReason.
+//
+// Dynamic BLASes are multi-buffered so that a build never writes a BLAS that a frame in flight (or this frame's
+// TLAS) reads, with F = Context::framesInFlight(): InFrame and the same-frame fallback keep 1 copy (refit in
+// place), AsyncSameFrame F copies, AsyncOneFrameLate F + 1, its fallback 2. Refits form one chain: a refit reads
+// the newest copy and writes the next one. A TLAS refit (TlasBuildMode::UpdateIfPossible) is valid only over the
+// same BLAS addresses, so with several copies the TLAS is rebuilt in every frame that updated a dynamic mesh.
+
+// How an updated dynamic BLAS is brought up to date.
+enum class RefitPolicyKind : uint8_t {
+  Adaptive = 0,   // default: refit; rebuild when the refit-quality measure or the refit count says so
+  AlwaysRefit,    // refit every update; rebuild only when MeshUpdate::forceRebuild asks
+  AlwaysRebuild,  // full build every update, never staggered (the "rebuild every frame" baseline)
+};
+
+// Rebuild when the summed AABB surface area of fixed clusters of kRefitClusterTriangles consecutive triangles
+// (measured on the GPU by every update of an Adaptive mesh, read back once its work is known done: framesInFlight
+// frames later in-frame, usually the next frame async) exceeds this multiple of its value at the last build.
+// Refits keep the tree's topology, so triangles that drift apart grow its boxes; by the time the leaves cover half
+// as much again, rays pay more than a fast rebuild, which costs about six refits (H200: 0.69 ms against 0.11 ms
+// for 523k triangles). Uniform growth of the mesh (an inflating morph) counts as well; scale that belongs to the
+// whole mesh should stay in the instance transform. The clusters follow the index order, which meshes optimised
+// for the vertex cache keep spatially coherent; a mesh whose buffers the measure cannot read (not 4-byte
+// aligned) rebuilds by refit count only.
+constexpr float kDefaultMaxAreaGrowth = 1.5f;
+// Rebuild after this many refits in a row even when the measure stays low (two seconds at 60 frames per second):
+// clusters of consecutive triangles only approximate the tree's leaves, so drift they do not see is bounded too.
+constexpr uint32_t kDefaultMaxRefitsBeforeRebuild = 120;
+// Triangles of dynamic BLAS rebuilds per frame (staggered, highest measure first): about 0.7 ms of
+// PREFER_FAST_BUILD work on an H200 (measured: 0.69 ms for 523k triangles, 2.3 ms for 2.1M), so rebuilds cost a
+// 60 Hz frame a small, bounded share.
+constexpr uint64_t kDefaultRebuildTrianglesPerFrame = 512ull * 1024;
+// Triangles per cluster of the refit-quality measure (and threads per workgroup of its shader).
+constexpr uint32_t kRefitClusterTriangles = 64;
+
+// A zero-initialised RefitPolicy is the documented default. Plain value; thread-safe to copy.
+struct RefitPolicy {
+  RefitPolicyKind kind = RefitPolicyKind::Adaptive;
+  float maxAreaGrowth = 0;                // 0 = kDefaultMaxAreaGrowth; otherwise > 1 (Adaptive only)
+  uint32_t maxRefitsBeforeRebuild = 0;    // 0 = kDefaultMaxRefitsBeforeRebuild (Adaptive only)
+  // 0 = kDefaultRebuildTrianglesPerFrame (Adaptive only). Meshes over the measure wait, still refitting, until
+  // their turn; a single mesh larger than the budget is rebuilt alone in a frame of its own.
+  uint64_t rebuildTrianglesPerFrame = 0;
 };
 
 // Describes one mesh from the engine's own buffers.
@@ -92,6 +157,7 @@ struct Instance {
 enum class TlasBuildMode : uint8_t {
   Rebuild = 0,       // default: a full build every frame (best trace speed after large motion)
   UpdateIfPossible,  // refit the previous frame's TLAS when the instance list has the same meshes and count
+                     // (and BLAS copies: see DynamicBuildMode)
 };
 
 struct TlasBuildOptions {
@@ -123,7 +189,8 @@ struct AsServiceDesc {
   // with transient scratch released after the frame.
   VkDeviceSize scratchBudgetBytes = 0;
   // Triangles one recordPendingWork() call builds at most, to spread a large load over frames; 0 = unlimited.
-  // At least one queued build is recorded per call.
+  // At least one queued build is recorded per call. First builds of dynamic meshes count too (in the async modes
+  // against a cap of their own per submitDynamicWork() call); their rebuilds follow RefitPolicy instead.
   uint64_t maxBuildTrianglesPerCall = 0;
   // Device memory for BLAS storage; 0 = unlimited. When a registration would exceed it, BLASes of released
   // meshes are evicted, least recently used first; never one that a TLAS still in flight references.
@@ -131,6 +198,33 @@ struct AsServiceDesc {
   VkDeviceSize storageBlockBytes = 0;  // 0 = 32 MiB: size of the blocks BLAS storage is suballocated from
   bool disableCompaction = false;      // false = compact static meshes (skipped where it saves < 2%)
   bool disableTimestamps = false;      // false = time each build batch with timestamp queries
+
+  // A compute queue the engine hands over for the async dynamic modes; VK_NULL_HANDLE = none (the async modes
+  // fall back to InFrame recording, see DynamicBuildMode). Used only inside submitDynamicWork(); the engine
+  // must not use it concurrently with that call. Ignored by DynamicBuildMode::InFrame.
+  VkQueue asyncQueue = VK_NULL_HANDLE;
+  // asyncQueue's family (ignored without asyncQueue). The engine's buffers that dynamic meshes read (vertices,
+  // indices) must be VK_SHARING_MODE_CONCURRENT over it and ContextDesc::mainQueueFamily; equal to the main
+  // family, or a family without VK_QUEUE_COMPUTE_BIT, means the fallback.
+  uint32_t asyncQueueFamily = 0;
+  DynamicBuildMode dynamicMode = DynamicBuildMode::InFrame;  // default InFrame
+  RefitPolicy refitPolicy;                                   // zero = the defaults above
+};
+
+// What changed about a dynamic mesh (updateMesh). Plain value; thread-safe to copy.
+struct MeshUpdate {
+  // nullptr = same buffers and counts, new vertex contents (refit, or rebuild as the policy decides).
+  // Non-null = the mesh's new description (buffers may move); a changed vertexCount or triangleCount (or vertex
+  // format, index type, opacity) needs forceRebuild, else updateMesh fails naming the old and new values.
+  const MeshDesc* desc = nullptr;
+  bool forceRebuild = false;  // rebuild in the next dynamic work, outside the staggering budget
+};
+
+// What made this frame's deformed vertex buffers ready: a value of the engine's timeline semaphore, signalled
+// by a submission on the main queue made after the previous frame's main submission. Plain value.
+struct AsyncBuildWait {
+  VkSemaphore semaphore = VK_NULL_HANDLE;  // timeline semaphore; VK_NULL_HANDLE = nothing to wait for
+  uint64_t value = 0;
 };
 
 // GPU time of one recorded build batch, available frames after it was recorded.
@@ -152,7 +246,8 @@ struct AsStats {
   uint32_t evictions = 0;
   uint64_t triangles = 0;          // triangles over all BLASes
   VkDeviceSize blasBytesBeforeCompaction = 0;  // sum of built sizes of all BLASes
-  VkDeviceSize blasBytes = 0;                   // sum of current sizes (after compaction where it happened)
+  VkDeviceSize blasBytes = 0;                   // sum of current sizes (after compaction where it happened;
+                                                // every copy of a dynamic BLAS)
   double bytesPerTriangle = 0.0;                // blasBytes / triangles
   uint32_t storageBlocks = 0;
   VkDeviceSize storageBlockBytes = 0;  // device memory held by the blocks
@@ -160,14 +255,31 @@ struct AsStats {
   VkDeviceSize scratchBytes = 0;       // persistent scratch memory
   VkDeviceSize tlasBytes = 0;          // TLAS storage, scratch and instance buffers over all frame slots
   uint32_t lastTlasInstances = 0;
-  std::vector<BuildBatchTiming> batches;  // the most recent batches with resolved timings (at most 64)
+  std::vector<BuildBatchTiming> batches;  // the most recent batches with resolved timings (at most 64); an
+                                          // async submission is one batch
   uint64_t batchTimingsDropped = 0;       // older resolved timings no longer in `batches`
+
+  // Dynamic meshes (cumulative unless said).
+  uint64_t refits = 0;                          // dynamic BLAS refits recorded
+  uint64_t rebuilds = 0;                        // full rebuilds of already built dynamic BLASes recorded
+  uint64_t lastFrameRefitTriangles = 0;         // of the latest frame's dynamic work
+  uint64_t lastFrameRebuildTriangles = 0;       // of the latest frame's dynamic work (rebuilds, not first builds)
+  bool async = false;                           // dynamic work runs on the async queue
+  uint32_t asyncQueueFamily = UINT32_MAX;       // its family, when async
+  std::string asyncFallbackReason;              // why not async, when an async mode was asked for; else empty
+  uint32_t staleBlas = 0;                       // instances of the last TLAS traced with a pose older than the
+                                                // mesh's newest update (one-frame-late mode)
+  double lastAsyncGpuMs = 0.0;                  // GPU time of the latest resolved async submission
+  VkDeviceSize dynamicBlasBytes = 0;            // storage of dynamic BLASes, all copies
 };
 
 class AccelerationStructureService {
  public:
   static Result<std::unique_ptr<AccelerationStructureService>> create(Context& context,
                                                                       const AsServiceDesc& desc = {});
+  // Waits (on the host) for the SDK's own timeline semaphore to reach its last submission's value, never on
+  // the engine's queues; contract otherwise as for the Context: the GPU is done with the engine's frames that
+  // used this service. The engine must have submitted the signals of the `ready` values it passed.
   ~AccelerationStructureService();
 
   // Validates the description and queues a build, or, on a dedup hit, shares the existing BLAS. Every call
@@ -179,11 +291,33 @@ class AccelerationStructureService {
   // cached (a later identical registration revives it) until the memory budget evicts it or the service is
   // destroyed. Further use of the handle is an error.
   Status releaseMesh(MeshHandle mesh);
-  // A dynamic mesh's vertices changed: refit its BLAS in the next recordPendingWork().
-  Status updateMesh(MeshHandle mesh);
+  // A dynamic mesh's vertices changed (or, with update.desc, its buffers): refit or rebuild its BLAS, as the
+  // policy decides, in the frame's dynamic work (submitDynamicWork() in the async modes, else the next
+  // recordPendingWork()). Call it after the frame's beginFrame and before that work. A BLAS shared by several
+  // registrations (one contentKey) is updated for all of them.
+  Status updateMesh(MeshHandle mesh, const MeshUpdate& update = {});
 
-  // Records compaction copies, queued builds and refits into `cmd` within the scratch budget, followed by a
-  // barrier that makes them visible to TLAS builds. Returns how many builds are still queued.
+  // Once per frame, after the updateMesh calls of the frame and before recordPendingWork/recordTlasBuild.
+  // Async modes: records the dynamic BLAS builds, refits and rebuilds into the SDK's own command buffer and
+  // submits it on the async queue, waiting on `ready` (stages ACCELERATION_STRUCTURE_BUILD | COMPUTE_SHADER)
+  // and signalling the SDK's timeline semaphore; nothing is submitted when there is no dynamic work. InFrame mode
+  // and the fallback: does nothing (recordPendingWork records the work). A second call in a frame that already
+  // submitted work is refused (a second write could hit the copy this frame's TLAS reads).
+  Status submitDynamicWork(const AsyncBuildWait& ready = {});
+  // The wait the engine's submission of the TLAS build and the passes needs: the SDK's timeline semaphore at the
+  // value of the submission that wrote the BLAS copies this frame's TLAS will use (same-frame: this frame's;
+  // one-frame-late: the newest of an earlier frame, or this frame's for a mesh's first build), stage
+  // ACCELERATION_STRUCTURE_BUILD | RAY_TRACING_SHADER | COMPUTE_SHADER. Returns false and leaves `out` alone
+  // when none is needed (InFrame, the fallback, or no dynamic BLAS written on the async queue).
+  bool fillTlasWait(VkSemaphoreSubmitInfo& out) const;
+  // The wait the engine's next write to the vertex buffers of dynamic meshes needs: the value of the latest
+  // submission that read them, stage ALL_COMMANDS. Returns false and leaves `out` alone when none is needed.
+  bool fillVertexReuseWait(VkSemaphoreSubmitInfo& out) const;
+
+  // Records compaction copies and queued builds into `cmd` within the scratch budget, followed by a barrier that
+  // makes them visible to TLAS builds; in DynamicBuildMode::InFrame and the async fallback also the frame's
+  // dynamic work (first builds, refits, rebuilds and their measure, once per frame), which binds a compute
+  // pipeline and push constants in `cmd`. Returns how many builds are still queued.
   Result<uint32_t> recordPendingWork(VkCommandBuffer cmd);
   // Writes this frame slot's instance buffer and records the TLAS build, followed by a barrier that makes the
   // TLAS readable by ray tracing shaders. Instances of meshes not built yet are skipped (counted). Once per
@@ -193,6 +327,7 @@ class AccelerationStructureService {
 
   // State of a mesh's BLAS: true once its build has been recorded (it may then appear in a TLAS).
   Result<bool> isBuilt(MeshHandle mesh) const;
+  // For a dynamic mesh: the newest copy (see DynamicBuildMode), which changes with every update.
   Result<VkDeviceAddress> blasAddress(MeshHandle mesh) const;
   AsStats stats() const;
 

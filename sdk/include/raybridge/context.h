@@ -27,14 +27,16 @@ struct ContextDesc {
   uint32_t framesInFlight = 0;                               // 0 = 2; at most 8
   const VkAllocationCallbacks* allocationCallbacks = nullptr;  // nullptr = the driver's allocator
   // Family of the engine's queue that executes Raybridge's recordings (for its timestamp bits). Refits of
-  // deforming meshes are recorded into the same command buffers as everything else.
+  // deforming meshes are recorded into the same command buffers as everything else, unless the engine hands
+  // an AccelerationStructureService a compute queue of another family (AsServiceDesc::asyncQueue).
   uint32_t mainQueueFamily = 0;
 };
 
 // Device extensions the engine must enable on its VkDevice for Raybridge (Vulkan 1.2 or newer).
 std::span<const char* const> requiredDeviceExtensions();
 
-// Feature structures the engine must chain into VkDeviceCreateInfo::pNext with every listed feature enabled.
+// Feature structures the engine must chain into VkDeviceCreateInfo::pNext with every listed feature enabled
+// (Vulkan 1.2 features including timelineSemaphore; Raybridge needs no synchronization2).
 // Fill one with enableRequiredFeatures() and link `chainHead()` into the engine's own chain, e.g.
 //   rb::RequiredFeatures f; f.link(&engineFeatures2); createInfo.pNext = f.chainHead();
 struct RequiredFeatures {

@@ -1,5 +1,6 @@
 // A headless Vulkan device for Raybridge's samples, tests and benchmarks: it plays the engine's part
-// (instance, device, queue, one-shot submissions). Engines that have their own device do not need it.
+// (instance, device, queue, an optional async compute queue, one-shot submissions). Engines that have their own
+// device do not need it.
 //
 // Device choice: a GPU with ray tracing pipelines if there is one, otherwise a CPU implementation (lavapipe).
 // `HeadlessDeviceDesc::deviceNameFilter` or the environment variable RAYBRIDGE_DEVICE (a case-insensitive
@@ -12,6 +13,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,10 @@ struct HeadlessDeviceDesc {
   bool enableValidation = false;  // VK_LAYER_KHRONOS_validation + debug messenger; also on when $RAYBRIDGE_VALIDATION=1
   bool requireValidation = false;  // fail creation when validation was asked for but the layer is missing
   uint32_t framesInFlight = 0;     // 0 = 2; copied into contextDesc()
+  // Also create one queue of a family with VK_QUEUE_COMPUTE_BIT and no VK_QUEUE_GRAPHICS_BIT, when the device
+  // has one (GPUs usually do; lavapipe does not), for AsServiceDesc::asyncQueue. Then every buffer the device
+  // creates is VK_SHARING_MODE_CONCURRENT over both families. false = one queue.
+  bool requestAsyncComputeQueue = false;
 };
 
 // A buffer made by the headless device for samples and tests (the engine's buffers in a real integration).
@@ -45,6 +51,10 @@ class HeadlessDevice {
   VkDevice device() const;
   VkQueue queue() const;
   uint32_t queueFamily() const;
+  // The compute queue of HeadlessDeviceDesc::requestAsyncComputeQueue; VK_NULL_HANDLE / UINT32_MAX when it was
+  // not requested or the device has no compute-only family.
+  VkQueue asyncComputeQueue() const;
+  uint32_t asyncComputeQueueFamily() const;
   PFN_vkGetInstanceProcAddr getInstanceProcAddr() const;
   // Instance-level function loaded from the headless instance (handy for tests that call Vulkan directly).
   PFN_vkVoidFunction instanceProc(const char* name) const;
@@ -62,6 +72,13 @@ class HeadlessDevice {
   // submits and waits for it, then frees it.
   Result<VkCommandBuffer> beginCommands();
   Status submitAndWait(VkCommandBuffer cmd);
+  // The same on queue(), with semaphore waits and signals (vkQueueSubmit2; timeline values in the infos).
+  Status submitAndWait(VkCommandBuffer cmd, std::span<const VkSemaphoreSubmitInfo> waits,
+                       std::span<const VkSemaphoreSubmitInfo> signals);
+
+  // A timeline semaphore starting at 0 (the engine's side of AsyncBuildWait), and its destruction.
+  Result<VkSemaphore> createTimelineSemaphore();
+  void destroySemaphore(VkSemaphore semaphore);
 
   // Creates a buffer. Device-local unless hostVisible; `data` (size bytes) is uploaded through a staging copy
   // for device-local buffers and memcpy'd otherwise.

@@ -3,10 +3,18 @@
 //   -> forward PBR lighting -> tonemap
 // into an offscreen image (read back to the CPU) and optionally presents it to a swapchain.
 //
+// Animated scenes (glTF node animation, skins, morph targets): each frame first evaluates the animation on
+// the CPU (FrameParams::time / animations / restPose), then, when the scene has deforming (skinned and/or
+// morphed) instances, a compute submission writes each one's deformed vertex buffers and signals a timeline
+// semaphore to the frame number; the main submission waits on it. Static scenes skip both.
+//
 // Add-ons (e.g. a ray-tracing adapter) plug in through three small things:
 //   * EngineConfig: extra device extensions / feature chain, so they can share the engine's device;
 //   * setPrepassHook(): called with the frame's command buffer between the pre-pass and the lighting pass;
 //   * LightingInputs: external sun-visibility / AO / reflection images the lighting pass samples.
+//
+// Thread safety: Engine is not thread-safe; call it from one thread at a time (the hook runs on the thread
+// that called renderFrame()). The spans it returns stay valid until the next loadScene() / destruction.
 #pragma once
 
 #include <array>
@@ -22,6 +30,7 @@
 
 #include <glm/glm.hpp>
 
+#include "sample_engine/animation.h"
 #include "sample_engine/image_io.h"
 #include "sample_engine/result.h"
 #include "sample_engine/scene.h"
@@ -41,9 +50,10 @@ T vkStruct(VkStructureType type) {
 struct EngineConfig {
   // Enables VK_LAYER_KHRONOS_validation plus a debug messenger that counts (and prints) errors.
   bool enableValidation = false;
-  // Requests bufferDeviceAddress and gives vertex/index buffers SHADER_DEVICE_ADDRESS + STORAGE usage
-  // (plus ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY when VK_KHR_acceleration_structure is among the
-  // enabled device extensions). Silently off when the device lacks bufferDeviceAddress.
+  // Gives vertex/index buffers SHADER_DEVICE_ADDRESS + STORAGE usage (plus
+  // ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY when VK_KHR_acceleration_structure is among the enabled device
+  // extensions) and reports their addresses in GpuMesh. The bufferDeviceAddress feature itself is always
+  // enabled (Vulkan 1.3 requires it; the deformation pass reads and writes vertex buffers through it).
   bool enableRayTracingInputs = true;
   // Adds VK_KHR_swapchain to the device; needed by attachSurface().
   bool enableSwapchain = false;
@@ -63,6 +73,10 @@ struct EngineConfig {
       vkStruct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
   VkPhysicalDeviceVulkan13Features extraFeatures13 =
       vkStruct<VkPhysicalDeviceVulkan13Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
+  // Also create one queue of a compute-capable family without graphics (when the device has one; lavapipe
+  // does not) for add-ons, e.g. asynchronous BLAS builds: see Engine::asyncComputeQueue(). The engine never
+  // submits to it; deformed vertex buffers are then shared (CONCURRENT) between both families.
+  bool requestAsyncComputeQueue = false;
   // Substring of the device name to pick. Empty: environment variable SAMPLE_ENGINE_DEVICE, else the
   // first discrete GPU, else the first device that works.
   std::string deviceNameFilter;
@@ -133,6 +147,32 @@ struct FrameParams {
   // Also writes the shadow-map sun visibility the lighting uses (PCF, and 0 where the shading normal faces
   // away from the sun; 1 on background) into an R16F image for readbackShadowVisibility().
   bool outputShadowVisibility = false;
+  // Animation time in seconds; must be finite and >= 0 (renderFrame fails naming the value otherwise).
+  double time = 0.0;
+  // The animations that play this frame, each at time + timeOffset, looping over its own duration, applied in
+  // order (later channels override earlier ones). Empty (default) = the scene's first animation, if any, at
+  // `time`. An index beyond Scene::animations fails renderFrame (the message lists the scene's animations).
+  std::vector<AnimationPlayback> animations;
+  bool restPose = false;  // true = no animation plays: nodes keep their rest transforms and weights
+};
+
+// A deforming (skinned and/or morphed) instance of the loaded scene and its own deformed vertex buffers,
+// rewritten by every frame's deformation submission. Fixed from loadScene() on. Read-only for add-ons.
+struct DeformedInstance {
+  uint32_t instance = 0;  // index into Scene::instances
+  uint32_t mesh = 0;      // index into Scene::meshes / Engine::meshes(): the bind pose, topology (indices) and material
+  // Deformed positions: R32G32B32_SFLOAT, stride 12, vertexCount entries, in the instance's local space
+  // (skinning matrices are inverse(node world) * joint world * inverse bind matrix), so the instance's world
+  // transform (Engine::instanceTransforms()) still places it. Usage STORAGE | VERTEX | SHADER_DEVICE_ADDRESS
+  // | TRANSFER_SRC | TRANSFER_DST (+ ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY when
+  // VK_KHR_acceleration_structure is enabled); VK_SHARING_MODE_CONCURRENT over queueFamily() and
+  // asyncComputeQueueFamily() when an async compute queue exists, else EXCLUSIVE.
+  VkBuffer positionBuffer = VK_NULL_HANDLE;
+  VkDeviceAddress positionAddress = 0;
+  // Deformed attributes, interleaved {vec3 normal; vec2 uv; vec4 tangent}, stride 36, like GpuMesh.
+  VkBuffer attributeBuffer = VK_NULL_HANDLE;
+  VkDeviceAddress attributeAddress = 0;
+  uint32_t vertexCount = 0;
 };
 
 // One image of the pre-pass, as the hook receives it.
@@ -161,6 +201,22 @@ struct PrepassHookInfo {
   glm::mat4 invView{1.0f}, invProj{1.0f}, invViewProj{1.0f};
   glm::vec3 cameraPosition{0.0f};
   glm::vec3 sunDirection{0.0f, 1.0f, 0.0f};  // towards the sun, normalized
+  // This frame's world transform per Scene::instances entry (node animation applied).
+  std::span<const glm::mat4> instanceTransforms;
+  // The deforming instances; this frame's deformation submission rewrites their buffers. Empty for a
+  // scene without skinned or morphed instances.
+  std::span<const DeformedInstance> deformedInstances;
+  // Timeline semaphore the deformation submission signals; VK_NULL_HANDLE when the scene has no deforming
+  // instance. It reaches deformValue (= frameNumber) once this frame's deformed buffers are written. The
+  // main submission already waits for it (ALL_COMMANDS), so commands recorded in commandBuffer see them.
+  VkSemaphore deformSemaphore = VK_NULL_HANDLE;
+  uint64_t deformValue = 0;
+  // Waits to add to this frame's main submission (e.g. an async BLAS build on another queue). Never null.
+  std::vector<VkSemaphoreSubmitInfo>* submitWaits = nullptr;
+  // Waits the engine's NEXT deformation submission performs before it overwrites the deformed buffers (e.g.
+  // another queue still reads them). nullptr when the scene has no deforming instance. Dropped by loadScene()
+  // and waitIdle() (all of them are met then), so an add-on may destroy their semaphores after waitIdle().
+  std::vector<VkSemaphoreSubmitInfo>* deformWaits = nullptr;
 };
 
 // Called once per frame after the pre-pass, before the lighting pass. May record commands into
@@ -178,8 +234,10 @@ struct PassTimings {
   double hookMs = 0.0;  // whatever the hook recorded
   double lightingMs = 0.0;
   double tonemapMs = 0.0;
+  double deformMs = 0.0;  // the deformation submission (skinning / morphing); 0 when nothing deforms
   bool probeCaptured = false;  // this frame captured the reflection probe
   bool valid = false;   // false until a frame with timestamps has completed
+  uint64_t frameNumber = 0;  // Engine::frameNumber() of the frame these timings belong to
 };
 
 // A mesh as uploaded. Positions are R32G32B32_SFLOAT, tightly packed (stride 12) in their own buffer.
@@ -222,7 +280,7 @@ struct DeviceInfo {
   std::string name;
   uint32_t apiVersion = 0;
   VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
-  bool bufferDeviceAddress = false;  // enabled on the device and used for scene buffers
+  bool bufferDeviceAddress = false;  // scene buffers expose device addresses (EngineConfig::enableRayTracingInputs)
 };
 
 class Engine {
@@ -238,6 +296,10 @@ class Engine {
   VkDevice device() const;
   VkQueue queue() const;  // the single graphics+compute queue the engine submits to
   uint32_t queueFamily() const;
+  // The async compute queue (EngineConfig::requestAsyncComputeQueue): VK_NULL_HANDLE when not requested or
+  // the device has no compute family without graphics. The engine never uses it; its owner synchronises it.
+  VkQueue asyncComputeQueue() const;
+  uint32_t asyncComputeQueueFamily() const;  // UINT32_MAX when there is none
   PFN_vkGetInstanceProcAddr getInstanceProcAddr() const;
   uint32_t apiVersion() const;  // the instance/device API version the engine targets (1.3)
   const DeviceInfo& deviceInfo() const;
@@ -251,7 +313,15 @@ class Engine {
   const Scene& scene() const;              // finalized CPU copy
   std::span<const GpuMesh> meshes() const;  // parallel to scene().meshes
   std::span<const GpuTexture> textures() const;  // parallel to scene().textures, see GpuTexture
-  Bounds sceneBounds() const;
+  Bounds sceneBounds() const;  // rest pose
+  // The deforming (skinned and/or morphed) instances of the loaded scene, in instance order, fixed from
+  // loadScene() on (empty for a static scene).
+  std::span<const DeformedInstance> deformedInstances() const;
+  // World transform of every Scene::instances entry for the last rendered frame (rest pose before the first).
+  std::span<const glm::mat4> instanceTransforms() const;
+  // Deformed positions of deformedInstances()[deformedIndex] as the last rendered frame wrote them (waits for
+  // it); before the first frame, the bind pose. Fails naming the index when it is out of range.
+  Result<std::vector<glm::vec3>> readbackDeformedPositions(uint32_t deformedIndex);
 
   // --- Targets ---
   // Size of the offscreen render targets (headless). With a swapchain the size follows the swapchain.

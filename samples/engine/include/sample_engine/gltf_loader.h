@@ -17,8 +17,15 @@ struct SceneLoadResult {
 };
 
 // Loads the default scene of the file (or scene 0, or every root node when none is declared): the node
-// hierarchy is flattened into instances, each glTF primitive becomes one MeshData, the first perspective
-// camera found in the hierarchy becomes Scene::camera. Never throws.
+// hierarchy is flattened into instances (scene roots in order, depth-first pre-order, a node's primitives in
+// order; Instance::node / skin name the glTF node and skin), each glTF primitive becomes one MeshData, the
+// first perspective camera found in the hierarchy becomes Scene::camera. Animation data is kept: every glTF
+// node (same indices, TRS or matrix, parent), skins (joints, inverse bind matrices), animations (translation,
+// rotation, scale and weights channels; LINEAR, STEP, CUBICSPLINE; duration = the largest key time), per
+// primitive JOINTS_0/WEIGHTS_0 (+ JOINTS_1/WEIGHTS_1) and morph targets (POSITION / NORMAL deltas, sparse
+// accessors included) with the mesh's default weights. Bad input (an out-of-range node, mesh, skin or
+// accessor index, a joint index beyond its skin's joint count, a skinned vertex whose weights sum to 0, ...)
+// fails with an error naming the value. Never throws.
 SceneLoadResult loadGltf(const std::string& path);
 
 }  // namespace sample_engine

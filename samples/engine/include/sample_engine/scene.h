@@ -1,15 +1,25 @@
 // The in-memory scene description. Procedural builders and the glTF loader both produce this struct; the
-// engine uploads it as-is (one GPU mesh per MeshData, one draw per Instance).
+// engine uploads it as-is (one GPU mesh per MeshData, one draw per Instance). Animated scenes add a node
+// hierarchy, skins and animations (glTF 2.0 semantics); animation.h evaluates them.
+// Plain data: not thread-safe; distinct Scene objects are independent.
 #pragma once
 
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 namespace sample_engine {
+
+// A morph target (glTF): per-vertex deltas the target adds to the bind pose, scaled by its weight.
+struct MorphTarget {
+  std::vector<glm::vec3> positionDeltas;  // empty (no position change) or one per vertex
+  std::vector<glm::vec3> normalDeltas;    // empty (no normal change) or one per vertex
+};
 
 // One triangle list. Arrays other than `positions` may be empty: missing normals are computed flat-ish
 // (area-weighted), missing UVs become zero, missing tangents are derived from UVs (see finalizeMesh()).
@@ -22,6 +32,19 @@ struct MeshData {
   std::vector<uint32_t> indices;    // empty: non-indexed, every 3 consecutive vertices form a triangle
   uint32_t material = 0;            // index into Scene::materials
 
+  // Linear-blend skinning (glTF JOINTS_0/WEIGHTS_0, JOINTS_1/WEIGHTS_1): per vertex, indices into the
+  // Skin::joints of the instance that draws the mesh and their weights, which sum to 1. All empty = rigid;
+  // joints0/weights0 one per vertex = 4 influences; joints1/weights1 too = 8 influences.
+  std::vector<glm::u16vec4> joints0, joints1;
+  std::vector<glm::vec4> weights0, weights1;
+  // Morph targets (POSITION and NORMAL deltas), blended before skinning. Empty = none.
+  std::vector<MorphTarget> morphTargets;
+  // Default morph weights (glTF mesh.weights), used when the instance has no node; missing entries are 0.
+  std::vector<float> morphWeights;
+
+  bool skinned() const { return !joints0.empty(); }
+  bool morphed() const { return !morphTargets.empty(); }
+  uint32_t influences() const { return joints0.empty() ? 0u : joints1.empty() ? 4u : 8u; }
   uint32_t triangleCount() const {
     return static_cast<uint32_t>((indices.empty() ? positions.size() : indices.size()) / 3);
   }
@@ -53,7 +76,67 @@ struct Material {
 // A placement of a mesh in the world.
 struct Instance {
   uint32_t mesh = 0;
+  // World transform. For an instance with a node: that node's world transform in the rest pose (what
+  // Scene::bounds() uses); the engine places it with the node's animated world transform every frame.
   glm::mat4 transform{1.0f};
+  int node = -1;  // Scene::nodes index that places the instance (e.g. the glTF node); -1 = `transform`, fixed
+  int skin = -1;  // Scene::skins index that deforms the mesh (the mesh must have joints0/weights0); -1 = none
+};
+
+// A node of the transform hierarchy (glTF node). Its local transform is `matrix` when set, else T * R * S;
+// its world transform is parent's world * local.
+struct Node {
+  std::string name;
+  int parent = -1;  // Scene::nodes index; -1 = a root
+  glm::vec3 translation{0.0f};
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // glm order: w, x, y, z
+  glm::vec3 scale{1.0f};
+  std::optional<glm::mat4> matrix;  // replaces T * R * S; such a node is not animated (glTF)
+  // Morph weights of the meshes this node places (glTF node.weights, else mesh.weights); missing entries are 0.
+  std::vector<float> weights;
+
+  glm::mat4 localTransform() const;
+};
+
+// A skeleton (glTF skin): the joint nodes and their inverse bind matrices. A skinned vertex at time t is
+// sum_k weight_k * jointWorld[joint_k](t) * inverseBindMatrices[joint_k] * bindPosition.
+struct Skin {
+  std::string name;
+  std::vector<uint32_t> joints;                // Scene::nodes indices
+  std::vector<glm::mat4> inverseBindMatrices;  // one per joint, or empty = all identity
+};
+
+enum class AnimationPath : uint8_t { Translation, Rotation, Scale, Weights };
+enum class AnimationInterpolation : uint8_t { Linear, Step, CubicSpline };
+
+// Keyframes of one animated property (glTF animation sampler). LINEAR rotations are slerped (shortest arc),
+// CUBICSPLINE ones normalized after the spline; before the first key the first value holds, after the last
+// the last.
+struct AnimationSampler {
+  AnimationInterpolation interpolation = AnimationInterpolation::Linear;
+  std::vector<float> times;   // seconds, non-decreasing
+  // Per key `width` floats (3 for translation / scale, 4 for rotation as x, y, z, w, the morph target count
+  // for weights); CUBICSPLINE keys hold in-tangent, value, out-tangent (3 * width floats).
+  std::vector<float> values;
+};
+
+struct AnimationChannel {
+  uint32_t sampler = 0;  // index into Animation::samplers
+  uint32_t node = 0;     // Scene::nodes index whose property it drives
+  AnimationPath path = AnimationPath::Translation;
+};
+
+struct Animation {
+  std::string name;  // may be empty
+  std::vector<AnimationSampler> samplers;
+  std::vector<AnimationChannel> channels;  // applied in order
+  float duration = 0.0f;  // seconds: the largest key time of its samplers; playback loops over it
+};
+
+// Which animation plays, and where in it (FrameParams::animations).
+struct AnimationPlayback {
+  uint32_t animation = 0;   // index into Scene::animations
+  double timeOffset = 0.0;  // seconds added to FrameParams::time (finite; the sum loops over the duration)
 };
 
 // Right-handed, up = +Y. fovY in degrees. Pixel (0,0) is the top-left corner of the image.
@@ -92,10 +175,25 @@ struct Scene {
   std::vector<Instance> instances;
   std::optional<Camera> camera;     // e.g. the first perspective camera of a glTF file
   std::optional<Sun> sun;
+  std::vector<Node> nodes;          // empty for a static scene
+  std::vector<Skin> skins;
+  std::vector<Animation> animations;
 
-  // World-space bounds over all instances (transformed mesh AABBs).
+  // World-space bounds over all instances (transformed mesh AABBs, rest pose).
   Bounds bounds() const;
+  // The animation called `nameOrNumber`, else the one at that decimal index; nullopt when neither exists.
+  std::optional<uint32_t> animationIndex(std::string_view nameOrNumber) const;
+  std::vector<std::string> animationNames() const;
+  // "0 'Survey', 1 'Walk', 2 'Run'" (or "none"), for error messages.
+  std::string describeAnimations() const;
 };
+
+// Appends src's meshes, materials, textures, nodes, skins, animations and instances to dst, under a new
+// root node (named "placement") whose matrix is `placement`; instances without a node get placement *
+// transform. Every append is an independent copy (its own nodes, skins and animations, so the engine gives
+// its deforming instances their own buffers): this is how a scene holds K animated characters. dst keeps its
+// own camera and sun. Returns the index in dst.animations of src's first animation.
+uint32_t appendScene(Scene& dst, const Scene& src, const glm::mat4& placement);
 
 // Fills missing normals/UVs/tangents, clamps material indices and adds a default material if needed.
 // The engine calls this on its own copy during upload; call it yourself to inspect the final arrays.

@@ -1,0 +1,120 @@
+#include "async_submitter.h"
+
+namespace rb {
+
+Status AsyncSubmitter::create(Context::Impl& c, VkQueue queue, uint32_t family) {
+  c_ = &c;
+  queue_ = queue;
+  family_ = family;
+  VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pi.queueFamilyIndex = family;
+  VkResult r = c.vk.vkCreateCommandPool(c.desc.device, &pi, c.allocator(), &pool_);
+  if (r != VK_SUCCESS) return vulkanError(r, "vkCreateCommandPool (async BLAS builds)");
+  VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
+  type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
+  type.initialValue = 0;
+  VkSemaphoreCreateInfo si{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
+  r = c.vk.vkCreateSemaphore(c.desc.device, &si, c.allocator(), &semaphore_);
+  if (r != VK_SUCCESS) {
+    destroy();
+    return vulkanError(r, "vkCreateSemaphore (async BLAS timeline; is the timelineSemaphore feature enabled?)");
+  }
+  return {};
+}
+
+void AsyncSubmitter::destroy() {
+  if (!c_) return;
+  Context::Impl& c = *c_;
+  if (semaphore_ && lastValue_ > 0) {
+    VkSemaphoreWaitInfo wi{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+    wi.semaphoreCount = 1;
+    wi.pSemaphores = &semaphore_;
+    wi.pValues = &lastValue_;
+    (void)c.vk.vkWaitSemaphores(c.desc.device, &wi, UINT64_MAX);
+  }
+  if (pool_) c.vk.vkDestroyCommandPool(c.desc.device, pool_, c.allocator());  // frees the command buffers
+  if (semaphore_) c.vk.vkDestroySemaphore(c.desc.device, semaphore_, c.allocator());
+  pool_ = VK_NULL_HANDLE;
+  semaphore_ = VK_NULL_HANDLE;
+  slots_.clear();
+}
+
+uint64_t AsyncSubmitter::completedValue() const {
+  uint64_t value = 0;
+  if (semaphore_) c_->vk.vkGetSemaphoreCounterValue(c_->desc.device, semaphore_, &value);
+  return value;
+}
+
+Result<VkCommandBuffer> AsyncSubmitter::begin() {
+  Context::Impl& c = *c_;
+  const uint64_t done = completedValue();
+  Slot* slot = nullptr;
+  for (Slot& s : slots_) {
+    if (!s.recording && s.value <= done) {
+      slot = &s;
+      break;
+    }
+  }
+  if (!slot) {
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = pool_;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    Slot s;
+    VkResult r = c.vk.vkAllocateCommandBuffers(c.desc.device, &ai, &s.cmd);
+    if (r != VK_SUCCESS) return vulkanError(r, "vkAllocateCommandBuffers (async BLAS builds)");
+    slots_.push_back(s);
+    slot = &slots_.back();
+  } else {
+    VkResult r = c.vk.vkResetCommandBuffer(slot->cmd, 0);
+    if (r != VK_SUCCESS) return vulkanError(r, "vkResetCommandBuffer (async BLAS builds)");
+  }
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VkResult r = c.vk.vkBeginCommandBuffer(slot->cmd, &bi);
+  if (r != VK_SUCCESS) return vulkanError(r, "vkBeginCommandBuffer (async BLAS builds)");
+  slot->recording = true;
+  return slot->cmd;
+}
+
+void AsyncSubmitter::abandon(VkCommandBuffer cmd) {
+  for (Slot& s : slots_) {
+    if (s.cmd != cmd) continue;
+    (void)c_->vk.vkEndCommandBuffer(cmd);
+    s.recording = false;
+  }
+}
+
+Result<uint64_t> AsyncSubmitter::submit(VkCommandBuffer cmd, const AsyncBuildWait& ready,
+                                        VkPipelineStageFlags readyStages) {
+  Context::Impl& c = *c_;
+  Slot* slot = nullptr;
+  for (Slot& s : slots_) slot = s.cmd == cmd ? &s : slot;
+  if (!slot) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "internal: unknown async command buffer"};
+  slot->recording = false;
+  VkResult r = c.vk.vkEndCommandBuffer(cmd);
+  if (r != VK_SUCCESS) return vulkanError(r, "vkEndCommandBuffer (async BLAS builds)");
+  const uint64_t signal = lastValue_ + 1;
+  const bool wait = ready.semaphore != VK_NULL_HANDLE;
+  VkTimelineSemaphoreSubmitInfo timeline{VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
+  timeline.waitSemaphoreValueCount = wait ? 1 : 0;
+  timeline.pWaitSemaphoreValues = &ready.value;
+  timeline.signalSemaphoreValueCount = 1;
+  timeline.pSignalSemaphoreValues = &signal;
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO, &timeline};
+  si.waitSemaphoreCount = wait ? 1 : 0;
+  si.pWaitSemaphores = &ready.semaphore;
+  si.pWaitDstStageMask = &readyStages;
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  si.signalSemaphoreCount = 1;
+  si.pSignalSemaphores = &semaphore_;
+  r = c.vk.vkQueueSubmit(queue_, 1, &si, VK_NULL_HANDLE);
+  if (r != VK_SUCCESS) return vulkanError(r, "vkQueueSubmit (async BLAS builds)");
+  lastValue_ = signal;
+  slot->value = signal;
+  return signal;
+}
+
+}  // namespace rb

@@ -1,0 +1,444 @@
+// One frame's dynamic BLAS work: the refit/rebuild policy with its staggering, the recording (cluster measure,
+// builds and refits into the copies), the commit of the new state, and reading the measures back.
+#include <raybridge/acceleration_structures.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "as_service_impl.h"
+
+namespace rb {
+
+namespace {
+
+VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
+
+struct RebuildCandidate {
+  uint32_t entry;
+  double ratio;
+  uint64_t waitingSince;
+};
+
+// Orders the frame's dynamic work after everything on this queue that used the copies, the scratch and the
+// readback buffers before: earlier builds and measures, and (main queue) earlier frames' rays through a copy
+// that is now rewritten.
+void recordDynamicStartBarrier(const DeviceFunctions& vk, VkCommandBuffer cmd, bool onAsyncQueue) {
+  VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  b.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR | VK_ACCESS_SHADER_WRITE_BIT;
+  b.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR |
+                    VK_ACCESS_SHADER_WRITE_BIT;
+  VkPipelineStageFlags src =
+      VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  if (!onAsyncQueue) src |= VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
+  vk.vkCmdPipelineBarrier(cmd, src,
+                          VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                          0, 1, &b, 0, nullptr, 0, nullptr);
+}
+
+}  // namespace
+
+Result<std::vector<DynamicOp>> AccelerationStructureService::Impl::planDynamicWork(uint64_t& trianglesUsed) {
+  std::vector<DynamicOp> ops;
+  const bool adaptive = policy.kind == RefitPolicyKind::Adaptive;
+  const uint64_t cap = desc.maxBuildTrianglesPerCall;
+
+  // First builds, in slot order, under maxBuildTrianglesPerCall.
+  for (uint32_t i = 1; i < entries.size(); ++i) {
+    BlasEntry& e = entries[i];
+    if (e.state != BlasState::Queued || e.mesh.desc.role != MeshRole::Dynamic) continue;
+    const uint64_t tri = e.mesh.desc.triangleCount;
+    if (cap && trianglesUsed > 0 && trianglesUsed + tri > cap) break;
+    if (e.dyn.copies.empty()) {
+      Result<std::vector<BlasCopy>> copies = createCopies(e);
+      if (!copies) return copies.error();
+      e.dyn.copies = std::move(copies.value());
+    }
+    DynamicOp op;
+    op.kind = DynamicOp::FirstBuild;
+    op.entry = i;
+    op.dst = 0;
+    op.measure = adaptive && ClusterBoundsPass::canMeasure(e.mesh.desc);
+    ops.push_back(std::move(op));
+    trianglesUsed += tri;
+  }
+
+  // Updates: refit unless the policy (or the engine) asks for a rebuild.
+  std::vector<DynamicOp> updates;
+  std::vector<RebuildCandidate> candidates;
+  for (uint32_t i = 1; i < entries.size(); ++i) {
+    BlasEntry& e = entries[i];
+    if (e.state != BlasState::Built || e.mesh.desc.role != MeshRole::Dynamic || !e.dyn.updatePending) continue;
+    const DynamicBlas& d = e.dyn;
+    const bool rebuild = d.forceRebuild || d.resize || policy.kind == RefitPolicyKind::AlwaysRebuild;
+    if (!rebuild && adaptive && (d.overThreshold || d.refitsSinceBuild >= policy.maxRefitsBeforeRebuild)) {
+      if (d.waitingSince == 0) e.dyn.waitingSince = c.frame + 1;  // + 1: 0 means "not waiting"
+      candidates.push_back({i, d.ratio, e.dyn.waitingSince});
+      continue;
+    }
+    DynamicOp op;
+    op.kind = rebuild ? DynamicOp::Rebuild : DynamicOp::Refit;
+    op.entry = i;
+    updates.push_back(std::move(op));
+  }
+  // Staggering: the highest measure first, then the longest waiting; a mesh that does not fit keeps refitting.
+  // The first candidate is always taken, so a mesh larger than the whole budget is rebuilt alone.
+  std::sort(candidates.begin(), candidates.end(), [](const RebuildCandidate& a, const RebuildCandidate& b) {
+    if (a.ratio != b.ratio) return a.ratio > b.ratio;
+    if (a.waitingSince != b.waitingSince) return a.waitingSince < b.waitingSince;
+    return a.entry < b.entry;
+  });
+  uint64_t budgetUsed = 0;
+  for (const RebuildCandidate& cand : candidates) {
+    const uint64_t tri = entries[cand.entry].mesh.desc.triangleCount;
+    DynamicOp op;
+    op.entry = cand.entry;
+    if (budgetUsed == 0 || budgetUsed + tri <= policy.rebuildTrianglesPerFrame) {
+      op.kind = DynamicOp::Rebuild;
+      budgetUsed += tri;
+    } else {
+      op.kind = DynamicOp::Refit;
+    }
+    updates.push_back(std::move(op));
+  }
+
+  for (DynamicOp& op : updates) {
+    BlasEntry& e = entries[op.entry];
+    DynamicBlas& d = e.dyn;
+    op.measure = adaptive && ClusterBoundsPass::canMeasure(e.mesh.desc);
+    if (d.resize) {
+      Result<std::vector<BlasCopy>> copies = createCopies(e);  // e.sizes holds the new sizes
+      if (!copies) {
+        for (DynamicOp& planned : ops) retireCopies(planned.replacement);
+        return copies.error();
+      }
+      op.replacement = std::move(copies.value());
+      op.dst = 0;
+      ops.push_back(std::move(op));
+      continue;
+    }
+    op.src = d.newest;
+    const uint32_t count = static_cast<uint32_t>(d.copies.size());
+    if (count == 1) {
+      op.dst = d.newest;  // in place: one queue, ordered by the start barrier
+      ops.push_back(std::move(op));
+      continue;
+    }
+    // The next copy of the ring, unless a TLAS that may still be read references it. On the async queue that is
+    // any TLAS of a frame in flight (the copy counts make that impossible under the beginFrame contract); on the
+    // main queue, earlier frames' rays are ordered before this work by the start barrier, so only a TLAS already
+    // recorded in this frame counts. A misuse then delays the update (its instances count as stale) instead of
+    // corrupting a frame in flight.
+    bool found = false;
+    for (uint32_t step = 1; step < count && !found; ++step) {
+      const uint32_t k = (d.newest + step) % count;
+      const BlasCopy& cp = d.copies[k];
+      const bool free = !cp.used || (async ? c.frameDone(cp.lastUsedFrame) : cp.lastUsedFrame != c.frame);
+      if (free) {
+        op.dst = k;
+        found = true;
+      }
+    }
+    if (found) ops.push_back(std::move(op));
+  }
+  return ops;
+}
+
+Status AccelerationStructureService::Impl::recordDynamicOps(VkCommandBuffer cmd, std::vector<DynamicOp>& ops,
+                                                            bool onAsyncQueue, DynamicSubmission& sub,
+                                                            std::vector<GpuBuffer>& transientScratch) {
+  const VkDeviceSize align = scratchAlignment();
+
+  // Everything that can fail comes first, so that a failure leaves nothing recorded: the readback of the
+  // cluster measure (one float per cluster of every measured mesh), scratch, the timestamp queries.
+  uint32_t clusters = 0;
+  for (const DynamicOp& op : ops) {
+    if (op.measure) clusters += ClusterBoundsPass::clusterCount(entries[op.entry].mesh.desc.triangleCount);
+  }
+  if (clusters > 0) {
+    if (!clusterBoundsCreated) {
+      if (Status st = clusterBounds.create(ctx); !st) return st;
+      clusterBoundsCreated = true;
+    }
+    const VkDeviceSize bytes = VkDeviceSize(clusters) * sizeof(float);
+    auto fit = std::find_if(freeReadbacks.begin(), freeReadbacks.end(),
+                            [&](const GpuBuffer& b) { return b.size >= bytes; });
+    if (fit != freeReadbacks.end()) {
+      sub.readback = *fit;
+      freeReadbacks.erase(fit);
+    } else {
+      Result<GpuBuffer> b = createBuffer(ctx, std::max<VkDeviceSize>(bytes, 4096),
+                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                                         MemoryLocation::HostVisible, MemoryCategory::Scratch,
+                                         "dynamic BLAS cluster measure readback");
+      if (!b) return b.error();
+      sub.readback = b.value();
+    }
+  }
+
+  std::vector<VkAccelerationStructureGeometryKHR> geometries(ops.size());
+  std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges(ops.size());
+  std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> rangePtrs(ops.size());
+  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos(ops.size());
+  std::vector<VkDeviceSize> scratchNeed(ops.size());
+  for (size_t i = 0; i < ops.size(); ++i) {
+    const DynamicOp& op = ops[i];
+    const BlasEntry& e = entries[op.entry];
+    const std::vector<BlasCopy>& copies = op.replacement.empty() ? e.dyn.copies : op.replacement;
+    const bool refit = op.kind == DynamicOp::Refit;
+    buildGeometry(e, geometries[i], ranges[i]);
+    rangePtrs[i] = &ranges[i];
+    VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
+    info = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+    info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+    info.flags = blasFlags(e);
+    info.mode = refit ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR
+                      : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+    info.srcAccelerationStructure = refit ? copies[op.src].as : VK_NULL_HANDLE;
+    info.dstAccelerationStructure = copies[op.dst].as;
+    info.geometryCount = 1;
+    info.pGeometries = &geometries[i];
+    scratchNeed[i] = alignUp(refit ? e.sizes.updateScratchSize : e.sizes.buildScratchSize, align);
+    sub.triangles += e.mesh.desc.triangleCount;
+  }
+  sub.builds = static_cast<uint32_t>(ops.size());
+
+  // Batches whose scratch fits the budget; one BLAS that alone needs more gets transient scratch.
+  struct Batch {
+    size_t end;
+    VkDeviceSize bytes;
+    VkDeviceAddress transientBase;  // 0 = the shared scratch
+  };
+  const VkBufferUsageFlags scratchUsage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+  std::vector<Batch> batches;
+  VkDeviceSize largestShared = 0;
+  for (size_t begin = 0; begin < ops.size();) {
+    Batch batch{begin, 0, 0};
+    while (batch.end < ops.size() &&
+           (batch.end == begin || batch.bytes + scratchNeed[batch.end] <= desc.scratchBudgetBytes)) {
+      batch.bytes += scratchNeed[batch.end++];
+    }
+    if (batch.bytes > desc.scratchBudgetBytes) {
+      Result<GpuBuffer> t = createBuffer(ctx, batch.bytes + align, scratchUsage, MemoryLocation::DeviceLocal,
+                                         MemoryCategory::Scratch, "oversized dynamic BLAS scratch");
+      if (!t) return t.error();
+      transientScratch.push_back(t.value());
+      batch.transientBase = alignUp(t->address, align);
+    } else {
+      largestShared = std::max(largestShared, batch.bytes);
+    }
+    begin = batch.end;
+    batches.push_back(batch);
+  }
+  VkDeviceAddress sharedBase = 0;
+  if (largestShared > 0) {
+    // The async queue has scratch of its own (exclusive to its family), grown to what its batches need.
+    GpuBuffer& buffer = onAsyncQueue ? asyncScratch : scratch;
+    if (!buffer.valid() || buffer.size < largestShared + align) {
+      if (buffer.valid()) {
+        GpuBuffer old = buffer;
+        Context* context = &ctx;
+        retireAfterAsync([context, old]() mutable { destroyBuffer(*context, old); });
+        buffer = GpuBuffer{};
+      }
+      Result<GpuBuffer> t = createBuffer(ctx, (onAsyncQueue ? largestShared : desc.scratchBudgetBytes) + align,
+                                         scratchUsage, MemoryLocation::DeviceLocal, MemoryCategory::Scratch,
+                                         onAsyncQueue ? "async BLAS build scratch" : "BLAS build scratch");
+      if (!t) return t.error();
+      buffer = t.value();
+    }
+    sharedBase = alignUp(buffer.address, align);
+  }
+  for (size_t b = 0, begin = 0; b < batches.size(); begin = batches[b++].end) {
+    VkDeviceAddress address = batches[b].transientBase ? batches[b].transientBase : sharedBase;
+    for (size_t i = begin; i < batches[b].end; ++i) {
+      infos[i].scratchData.deviceAddress = address;
+      address += scratchNeed[i];
+    }
+  }
+
+  // Timestamps: main-queue work is a BuildBatch (resolved with the others); async work times its submission.
+  BuildBatch batchRecord;
+  batchRecord.frame = c.frame;
+  VkQueryPool timestamps = VK_NULL_HANDLE;
+  if (!desc.disableTimestamps && (onAsyncQueue ? asyncTimestampMask != 0 : c.info.timestampsSupported)) {
+    std::vector<VkQueryPool>& pools = onAsyncQueue ? freeAsyncTimestampPools : freeTimestampPools;
+    if (pools.empty()) {
+      VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+      qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+      qi.queryCount = 2;
+      VkQueryPool pool;
+      VkResult r = c.vk.vkCreateQueryPool(c.desc.device, &qi, c.allocator(), &pool);
+      if (r != VK_SUCCESS) return vulkanError(r, "vkCreateQueryPool (dynamic BLAS timestamps)");
+      pools.push_back(pool);
+    }
+    timestamps = pools.back();
+    pools.pop_back();
+    (onAsyncQueue ? sub.timestamps : batchRecord.timestamps) = timestamps;
+  }
+
+  // Recording.
+  if (timestamps) c.vk.vkCmdResetQueryPool(cmd, timestamps, 0, 2);
+  recordDynamicStartBarrier(c.vk, cmd, onAsyncQueue);
+  if (timestamps) c.vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps, 0);
+  // The measure reads the same vertices as the builds, before them.
+  uint32_t firstCluster = 0;
+  for (const DynamicOp& op : ops) {
+    if (!op.measure) continue;
+    const BlasEntry& e = entries[op.entry];
+    ClusterSample sample;
+    sample.entry = op.entry;
+    sample.entryGeneration = e.generation;
+    sample.buildGeneration = e.dyn.buildGeneration + (op.kind == DynamicOp::Refit ? 0u : 1u);
+    sample.build = op.kind != DynamicOp::Refit;
+    sample.firstCluster = firstCluster;
+    sample.clusterCount = ClusterBoundsPass::clusterCount(e.mesh.desc.triangleCount);
+    clusterBounds.record(ctx, cmd, e.mesh.desc, sub.readback.address + VkDeviceAddress(firstCluster) * sizeof(float));
+    firstCluster += sample.clusterCount;
+    sub.samples.push_back(sample);
+  }
+  if (clusters > 0) {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    c.vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0,
+                              nullptr, 0, nullptr);
+  }
+  for (size_t b = 0, begin = 0; b < batches.size(); begin = batches[b++].end) {
+    // Consecutive batches share the scratch memory.
+    if (b > 0) recordAsBarrier(c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
+    c.vk.vkCmdBuildAccelerationStructuresKHR(cmd, static_cast<uint32_t>(batches[b].end - begin), infos.data() + begin,
+                                             rangePtrs.data() + begin);
+  }
+  if (timestamps) c.vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps, 1);
+  if (!onAsyncQueue) {
+    // Visible to this frame's TLAS build and to the rays (the async queue hands over through the semaphore).
+    recordAsBarrier(c.vk, cmd,
+                    VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR |
+                        VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+    if (batchRecord.timestamps) {
+      batchRecord.builds = sub.builds;
+      batchRecord.triangles = sub.triangles;
+      inFlightBatches.push_back(std::move(batchRecord));
+    }
+  }
+  return {};
+}
+
+void AccelerationStructureService::Impl::commitDynamicOps(std::vector<DynamicOp>& ops, uint64_t signalValue) {
+  for (DynamicOp& op : ops) {
+    BlasEntry& e = entries[op.entry];
+    DynamicBlas& d = e.dyn;
+    const uint64_t tri = e.mesh.desc.triangleCount;
+    if (!op.replacement.empty()) {
+      retireCopies(d.copies);
+      d.copies = std::move(op.replacement);
+      d.resize = false;
+    }
+    BlasCopy& cp = d.copies[op.dst];
+    cp.written = true;
+    cp.writeSerial = ++d.writes;
+    cp.writtenFrame = c.frame;
+    cp.pose = d.pose;
+    cp.signalValue = signalValue;
+    d.newest = op.dst;
+    e.as = cp.as;
+    e.address = cp.address;
+    d.updatePending = false;
+    if (op.kind == DynamicOp::Refit) {
+      ++d.refitsSinceBuild;
+      ++counters.refits;
+      counters.lastFrameRefitTriangles += tri;
+      continue;
+    }
+    ++d.buildGeneration;
+    d.refitsSinceBuild = 0;
+    d.baselineArea = 0.0;
+    d.ratio = 0.0;
+    d.overThreshold = false;
+    d.waitingSince = 0;
+    d.forceRebuild = false;
+    e.builtSize = e.currentSize = e.sizes.accelerationStructureSize;
+    if (op.kind == DynamicOp::FirstBuild) {
+      e.state = BlasState::Built;
+    } else {
+      ++counters.rebuilds;
+      counters.lastFrameRebuildTriangles += tri;
+    }
+  }
+}
+
+Status AccelerationStructureService::Impl::recordDynamicWork(VkCommandBuffer cmd, uint64_t& trianglesUsed,
+                                                             bool& recordedAny) {
+  // At most one write per copy ring and frame: a second one could overwrite what this frame's TLAS reads.
+  if (lastDynamicWriteFrame == c.frame) return {};
+  counters.lastFrameRefitTriangles = counters.lastFrameRebuildTriangles = 0;
+  resolveDynamicSubmissions();
+  Result<std::vector<DynamicOp>> ops = planDynamicWork(trianglesUsed);
+  if (!ops) return ops.error();
+  if (ops->empty()) return {};
+  DynamicSubmission sub;
+  std::vector<GpuBuffer> transientScratch;
+  Status st = recordDynamicOps(cmd, ops.value(), false, sub, transientScratch);
+  for (GpuBuffer& b : transientScratch) retireBuffer(ctx, b);
+  if (!st) {
+    for (DynamicOp& op : ops.value()) retireCopies(op.replacement);
+    if (sub.readback.valid()) retireBuffer(ctx, sub.readback);
+    return st;
+  }
+  commitDynamicOps(ops.value(), 0);
+  sub.frame = c.frame;
+  if (sub.readback.valid()) dynamicSubmissions.push_back(std::move(sub));
+  lastDynamicWriteFrame = c.frame;
+  recordedAny = true;
+  return {};
+}
+
+void AccelerationStructureService::Impl::resolveDynamicSubmissions() {
+  releaseAsyncRetired();
+  const uint64_t done = async ? submitter.completedValue() : 0;
+  size_t resolved = 0;
+  // In order: a build's baseline is read before the refits measured against it.
+  for (; resolved < dynamicSubmissions.size(); ++resolved) {
+    DynamicSubmission& sub = dynamicSubmissions[resolved];
+    const bool finished = sub.timelineValue ? sub.timelineValue <= done : c.frameDone(sub.frame);
+    if (!finished) break;
+    if (sub.timestamps) {
+      uint64_t ticks[2] = {0, 0};
+      VkResult r = c.vk.vkGetQueryPoolResults(c.desc.device, sub.timestamps, 0, 2, sizeof(ticks), ticks,
+                                              sizeof(uint64_t), VK_QUERY_RESULT_64_BIT);
+      if (r == VK_NOT_READY) break;
+      if (r == VK_SUCCESS) {
+        const double ms = double((ticks[1] - ticks[0]) & asyncTimestampMask) * c.info.timestampPeriodNs * 1e-6;
+        counters.lastAsyncGpuMs = ms;
+        addTiming({sub.frame, sub.builds, sub.triangles, ms});
+      }
+      freeAsyncTimestampPools.push_back(sub.timestamps);
+      sub.timestamps = VK_NULL_HANDLE;
+    }
+    if (!sub.readback.valid()) continue;
+    const float* areas = static_cast<const float*>(sub.readback.mapped);
+    for (const ClusterSample& sample : sub.samples) {
+      BlasEntry& e = entries[sample.entry];
+      if (e.generation != sample.entryGeneration || e.state != BlasState::Built ||
+          e.mesh.desc.role != MeshRole::Dynamic || e.dyn.buildGeneration != sample.buildGeneration) {
+        continue;  // released, or rebuilt since: measured against a baseline that no longer holds
+      }
+      double area = 0.0;
+      for (uint32_t k = 0; k < sample.clusterCount; ++k) area += areas[sample.firstCluster + k];
+      if (!(area > 0.0) || !std::isfinite(area)) continue;  // degenerate (collapsed) pose: no verdict
+      DynamicBlas& d = e.dyn;
+      if (sample.build) {
+        d.baselineArea = area;
+      } else if (d.baselineArea > 0.0) {
+        d.ratio = area / d.baselineArea;
+        d.overThreshold = d.ratio > double(policy.maxAreaGrowth);
+      }
+    }
+    freeReadbacks.push_back(sub.readback);
+    sub.readback = GpuBuffer{};
+  }
+  dynamicSubmissions.erase(dynamicSubmissions.begin(), dynamicSubmissions.begin() + static_cast<ptrdiff_t>(resolved));
+}
+
+}  // namespace rb
