@@ -11,6 +11,7 @@
 #include <catch2/catch_test_macros.hpp>
 #include <nlohmann/json.hpp>
 
+#include "render_command_support.h"
 #include "raybridge_sample_engine_adapter.h"
 #include "sample_engine/procedural.h"
 
@@ -106,18 +107,7 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
 }
 
 // Reads the R channel of an EXR written by raybridge-render.
-static std::vector<float> readExrRed(const fs::path& path, int& width, int& height) {
-  Imf::RgbaInputFile file(path.c_str());
-  const Imath::Box2i window = file.dataWindow();
-  width = window.max.x - window.min.x + 1;
-  height = window.max.y - window.min.y + 1;
-  std::vector<Imf::Rgba> pixels(size_t(width) * height);
-  file.setFrameBuffer(pixels.data() - window.min.x - window.min.y * width, 1, width);
-  file.readPixels(window.min.y, window.max.y);
-  std::vector<float> red(pixels.size());
-  for (size_t i = 0; i < pixels.size(); ++i) red[i] = pixels[i].r;
-  return red;
-}
+using rbRenderTest::readExrRed;
 
 TEST_CASE("raybridge-render: --preset high --dump writes every effect image and counts rays per pass", "[render]") {
   const fs::path dir = tempDir("dump");

@@ -5,49 +5,28 @@
 // pixel-centre ray) and sun visibility must agree.
 #include <catch2/catch_test_macros.hpp>
 
-#include <ImfFrameBuffer.h>
-#include <ImfHeader.h>
-#include <ImfInputFile.h>
-#include <ImathBox.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include "embree_reference.h"
+#include "render_command_support.h"
 #include "gltf_fixtures.h"
 #include "gltf_pose_reference.h"
 
 namespace fs = std::filesystem;
+using rbRenderTest::readExrRed;
 
 namespace {
 
-std::vector<float> readExrRed(const fs::path& path, int& width, int& height) {
-  Imf::InputFile file(path.string().c_str());
-  Imath::Box2i dw = file.header().dataWindow();
-  width = dw.max.x - dw.min.x + 1;
-  height = dw.max.y - dw.min.y + 1;
-  std::vector<float> red(size_t(width) * height);
-  Imf::FrameBuffer fb;
-  fb.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(red.data() - dw.min.x - dw.min.y * width),
-                            sizeof(float), sizeof(float) * width));
-  file.setFrameBuffer(fb);
-  file.readPixels(dw.min.y, dw.max.y);
-  return red;
-}
-
-int runRender(const std::string& args) {
-  const char* overridden = std::getenv("RAYBRIDGE_RENDER");
-  std::string command = "\"";
-  command += overridden && *overridden ? overridden : RAYBRIDGE_RENDER_EXE;
-  command += "\" --validation " + args;
-  return std::system(command.c_str());
-}
 
 struct Agreement {
   uint32_t pixels = 0, hitMissAgree = 0, depthAgree = 0, bothHit = 0;
@@ -89,7 +68,7 @@ Agreement compareAt(const std::string& model, double time, const std::string& ex
   std::snprintf(sun, sizeof sun, "%g,%g,%g", toSun.x, toSun.y, toSun.z);
   std::snprintf(timeText, sizeof timeText, "%.9g", time);
   fs::remove_all(dir);
-  REQUIRE(runRender("--scene \"" + model + "\" --time " + timeText + " --mode hybrid --effects shadows " +
+  REQUIRE(rbRenderTest::runRender("--scene \"" + model + "\" --time " + timeText + " --mode hybrid --effects shadows " +
                     "--gbuffer-normals geometric --sun-radius 0 --dump --width " + std::to_string(W) + " --height " +
                     std::to_string(H) + " --camera " + camera + " --sun " + sun + " --out \"" + dir.string() + "\" " +
                     extraArgs) == 0);
@@ -190,10 +169,7 @@ TEST_CASE("raybridge-render rejects bad animation options, naming the value", "[
   const std::string scene = " --scene \"" + model.string() + "\" --width 16 --height 16 --out \"" +
                             tempDir("bad").string() + "\" 2>&1";
   auto output = [&](const std::string& args, int& status) {
-    const char* overridden = std::getenv("RAYBRIDGE_RENDER");
-    std::string command = "\"";
-    command += overridden && *overridden ? overridden : RAYBRIDGE_RENDER_EXE;
-    command += "\" " + args + scene;
+    const std::string command = rbRenderTest::renderCommand() + " " + args + scene;
     std::string text;
     if (FILE* p = popen(command.c_str(), "r")) {
       char buf[512];
@@ -234,5 +210,36 @@ TEST_CASE("raybridge-render rejects bad animation options, naming the value", "[
     INFO(out);
     CHECK(status != 0);
     CHECK(out.find("--fps") != std::string::npos);
+  }
+}
+
+TEST_CASE("raybridge-render's stats.json reports the dynamic BLAS work of an animated scene", "[render][animation][stats]") {
+  const fs::path model = tempDir("strip_model") / "strip.gltf";
+  fs::create_directories(model.parent_path());
+  REQUIRE(pose_reference::writeSkinnedStrip(model.string()).empty());
+  auto statsOf = [&](const std::string& mode) {
+    const fs::path dir = tempDir("stats_" + mode);
+    fs::remove_all(dir);
+    REQUIRE(rbRenderTest::runRender("--scene \"" + model.string() + "\" --time 0.6 --fps 30 --frames 4 --effects shadows " +
+                                    "--width 48 --height 48 --dump --dynamic-builds " + mode + " --out \"" +
+                                    dir.string() + "\"") == 0);
+    std::ifstream in(dir / "stats.json");
+    return nlohmann::json::parse(in);
+  };
+  for (const std::string mode : {"in-frame", "async-late"}) {
+    INFO(mode);
+    const nlohmann::json s = statsOf(mode);
+    const nlohmann::json& as = s["raybridge"]["acceleration_structures"];
+    CHECK(s["animation"]["name"] == "bend");
+    CHECK(s["animation"]["deformed_instances"] == 1);
+    CHECK(as["dynamic_builds"] == mode);
+    // Every frame after the first build updates the strip: refit or rebuilt by the policy.
+    CHECK(as["refits"].get<uint64_t>() + as["rebuilds"].get<uint64_t>() >= 3);
+    // One frame late traces the previous frame's pose (also without a second queue, as on lavapipe).
+    CHECK(as["stale_blas"] == (mode == "async-late" ? 1 : 0));
+    if (!as["async"].get<bool>()) {
+      CHECK(as["async_queue_family"].is_null());
+      if (mode != "in-frame") CHECK(!as["async_fallback_reason"].get<std::string>().empty());
+    }
   }
 }

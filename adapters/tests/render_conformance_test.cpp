@@ -3,11 +3,6 @@
 // Embree tracing the same camera rays and sun over the same geometry, with --gbuffer-normals geometric.
 #include <catch2/catch_test_macros.hpp>
 
-#include <ImfChannelList.h>
-#include <ImfFrameBuffer.h>
-#include <ImfHeader.h>
-#include <ImfInputFile.h>
-#include <ImathBox.h>
 
 #include <sample_engine/procedural.h>
 
@@ -19,35 +14,11 @@
 #include <vector>
 
 #include "embree_reference.h"
+#include "render_command_support.h"
 
 namespace fs = std::filesystem;
+using rbRenderTest::readExrRed;
 
-namespace {
-
-std::vector<float> readExrRed(const fs::path& path, int& width, int& height) {
-  Imf::InputFile file(path.string().c_str());
-  Imath::Box2i dw = file.header().dataWindow();
-  width = dw.max.x - dw.min.x + 1;
-  height = dw.max.y - dw.min.y + 1;
-  std::vector<float> red(size_t(width) * height);
-  Imf::FrameBuffer fb;
-  fb.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(red.data() - dw.min.x - dw.min.y * width),
-                            sizeof(float), sizeof(float) * width));
-  file.setFrameBuffer(fb);
-  file.readPixels(dw.min.y, dw.max.y);
-  return red;
-}
-
-int run(const std::string& args) {
-  const char* overridden = std::getenv("RAYBRIDGE_RENDER");
-  std::string command = "\"";
-  command += overridden && *overridden ? overridden : RAYBRIDGE_RENDER_EXE;
-  command += "\" --validation ";
-  command += args;
-  return std::system(command.c_str());
-}
-
-}  // namespace
 
 TEST_CASE("raybridge-render's depth and hard shadows match Embree on the demo scene", "[render][embree]") {
   const uint32_t W = 192, H = 108;
@@ -59,7 +30,7 @@ TEST_CASE("raybridge-render's depth and hard shadows match Embree on the demo sc
   char camera[256], sun[128];
   std::snprintf(camera, sizeof camera, "%g,%g,%g,%g,%g,%g,%g", eye.x, eye.y, eye.z, target.x, target.y, target.z, fovy);
   std::snprintf(sun, sizeof sun, "%g,%g,%g", toSun.x, toSun.y, toSun.z);
-  REQUIRE(run("--mode hybrid --effects shadows --gbuffer-normals geometric --sun-radius 0 --dump --width " +
+  REQUIRE(rbRenderTest::runRender("--mode hybrid --effects shadows --gbuffer-normals geometric --sun-radius 0 --dump --width " +
               std::to_string(W) + " --height " + std::to_string(H) + " --camera " + camera + " --sun " + sun +
               " --out " + dir.string()) == 0);
   int w = 0, h = 0;
