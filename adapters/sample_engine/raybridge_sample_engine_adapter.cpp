@@ -152,6 +152,8 @@ struct Adapter::Impl {
   se::Engine& engine;
   AdapterConfig config;
   FrameSettings settings;
+  // Declared before what is created from it, so it is destroyed last. Disabled passes are destroyed at once:
+  // the SDK defers the release of their Vulkan objects until the frames in flight are done.
   std::unique_ptr<rb::Context> ctx;
   std::unique_ptr<rb::AccelerationStructureService> as;
   std::unique_ptr<rb::ShadowPass> shadows;         // only with kEffectShadows
@@ -159,8 +161,6 @@ struct Adapter::Impl {
   std::unique_ptr<rb::ReflectionPass> reflection;  // only with kEffectReflections
   std::unique_ptr<rb::Denoiser> shadowDenoiser;    // only for denoised soft shadows
   std::unique_ptr<rb::Denoiser> aoDenoiser;        // only for denoised AO
-  // Disabled passes, destroyed once no frame in flight can use them: (frameIndex when retired, object).
-  std::vector<std::pair<uint64_t, std::shared_ptr<void>>> retired;
   std::vector<rb::MeshHandle> meshes;    // parallel to engine.meshes(); null for empty meshes
   std::vector<rb::MeshHandle> deformed;  // parallel to engine.deformedInstances(): dynamic BLASes
   std::vector<rb::Instance> instances;
@@ -179,14 +179,6 @@ struct Adapter::Impl {
   void fail(std::string message) {
     if (error.empty()) error = std::move(message);
   }
-  template <typename T>
-  void retire(std::unique_ptr<T>& object) {
-    if (object) retired.emplace_back(ctx->frameIndex(), std::shared_ptr<void>(std::move(object)));
-  }
-  void releaseRetired(bool idle) {
-    const uint64_t now = ctx->frameIndex();
-    std::erase_if(retired, [&](const auto& r) { return idle || r.first + ctx->framesInFlight() + 1 <= now; });
-  }
   se::Status updateDenoisers();
   se::Status updateDynamicMeshes(const se::PrepassHookInfo& info);
   rb::GBufferDesc describePrepass(const se::PrepassHookInfo& info, bool shadingNormals) const;
@@ -195,16 +187,10 @@ struct Adapter::Impl {
 Adapter::Adapter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 Adapter::~Adapter() {
-  // The SDK destroys its objects at once; the engine's frames in flight may still use them.
+  // The passes would not need it (the SDK defers their release), but ~AccelerationStructureService and
+  // ~Context destroy what is left at once, and the engine's frames in flight may still use it; the engine
+  // offers no finer wait than idle. Impl's members then go in reverse order: passes, service, context.
   (void)impl_->engine.waitIdle();
-  impl_->retired.clear();
-  impl_->shadowDenoiser.reset();
-  impl_->aoDenoiser.reset();
-  impl_->shadows.reset();
-  impl_->ao.reset();
-  impl_->reflection.reset();
-  impl_->as.reset();
-  impl_->ctx.reset();
 }
 
 se::Result<std::unique_ptr<Adapter>> Adapter::create(se::Engine& engine, const AdapterConfig& config) {
@@ -241,10 +227,10 @@ se::Result<std::unique_ptr<Adapter>> Adapter::create(se::Engine& engine, const A
 se::Status Adapter::setEffects(EffectSet effects) {
   Impl& a = *impl_;
   if (effects & ~kAllEffects) return se::Status::failure("setEffects: unknown effect bits " + std::to_string(effects & ~kAllEffects));
-  // Disable first (their memory is released after the frames in flight), then create the new ones.
-  if (!(effects & kEffectShadows)) a.retire(a.shadows), a.retire(a.shadowDenoiser);
-  if (!(effects & kEffectAo)) a.retire(a.ao), a.retire(a.aoDenoiser);
-  if (!(effects & kEffectReflections)) a.retire(a.reflection);
+  // Disable first (the SDK releases their memory after the frames in flight), then create the new ones.
+  if (!(effects & kEffectShadows)) a.shadows.reset(), a.shadowDenoiser.reset();
+  if (!(effects & kEffectAo)) a.ao.reset(), a.aoDenoiser.reset();
+  if (!(effects & kEffectReflections)) a.reflection.reset();
   if ((effects & kEffectShadows) && !a.shadows) {
     auto p = rb::ShadowPass::create(*a.ctx);
     if (!p) return se::Status::failure(rbError("rb::ShadowPass::create", p.error()));
@@ -390,8 +376,8 @@ se::Status Adapter::Impl::updateDynamicMeshes(const se::PrepassHookInfo& info) {
 se::Status Adapter::Impl::updateDenoisers() {
   const bool wantShadow = shadows && settings.denoise && settings.sunAngularRadiusDegrees > 0.0f;
   const bool wantAo = ao && settings.denoise;
-  if (!wantShadow) retire(shadowDenoiser);
-  if (!wantAo) retire(aoDenoiser);
+  if (!wantShadow) shadowDenoiser.reset();
+  if (!wantAo) aoDenoiser.reset();
   for (auto [want, denoiser] : {std::pair{wantShadow, &shadowDenoiser}, {wantAo, &aoDenoiser}}) {
     if (!want || *denoiser) continue;
     auto d = rb::Denoiser::create(*ctx);
@@ -425,7 +411,6 @@ rb::GBufferDesc Adapter::Impl::describePrepass(const se::PrepassHookInfo& info, 
 void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& inputs) {
   Impl& a = *impl_;
   a.ctx->beginFrame();  // every frame, so deferred releases and statistics keep pace with the engine
-  a.releaseRetired(false);
   a.images = {};
   if (!a.settings.enabled || a.effects() == 0) return;
   VkCommandBuffer cmd = info.commandBuffer;
@@ -506,10 +491,7 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   }
 }
 
-void Adapter::releaseAfterIdle() {
-  impl_->releaseRetired(true);
-  impl_->ctx->releaseAfterIdle();
-}
+void Adapter::releaseAfterIdle() { impl_->ctx->releaseAfterIdle(); }
 
 void Adapter::resetHistory() {
   if (impl_->shadowDenoiser) impl_->shadowDenoiser->resetHistory();

@@ -24,7 +24,7 @@
 //      is folded into the emissive factor as its average texel.
 //
 // Where it sits in the engine's frame (everything is recorded into the engine's command buffer; the adapter
-// never submits and never waits, except in its destructor and in releaseAfterIdle's caller):
+// never submits and never waits, except in its destructor):
 //   shadow map -> depth+normal pre-pass -> [pre-pass hook: Context::beginFrame, BLAS builds, TLAS build,
 //   shadows (+denoise), AO (+denoise), reflections] -> forward lighting (samples the outputs) -> tonemap
 //
@@ -168,8 +168,10 @@ class Adapter {
   // config.effects, and registers the engine's current scene. Never throws; the error names what failed.
   static sample_engine::Result<std::unique_ptr<Adapter>> create(sample_engine::Engine& engine,
                                                                 const AdapterConfig& config = {});
-  // Waits for the engine's GPU work (Engine::waitIdle) before releasing the SDK objects. Remove the hook
-  // (engine.setPrepassHook({})) first if the engine outlives the adapter and keeps rendering.
+  // Waits for the engine's GPU work (Engine::waitIdle), because destroying the AS service and the Context
+  // releases at once what the engine's frames in flight may still use (passes alone would not need it: the
+  // SDK defers their release). Remove the hook (engine.setPrepassHook({})) first if the engine outlives the
+  // adapter and keeps rendering.
   ~Adapter();
   Adapter(const Adapter&) = delete;
   Adapter& operator=(const Adapter&) = delete;
@@ -179,8 +181,8 @@ class Adapter {
   sample_engine::Status syncScene();
 
   // Changes the effect set between frames: passes of newly enabled effects are created now (memory for their
-  // images follows on the next frame), those of disabled effects stop being recorded at once and are
-  // destroyed once the frames in flight that used them are done (or at releaseAfterIdle()).
+  // images follows on the next frame), those of disabled effects are destroyed now; the SDK frees their
+  // Vulkan objects and memory once the frames in flight that used them are done (or at releaseAfterIdle()).
   sample_engine::Status setEffects(EffectSet effects);
   EffectSet effects() const;
   // setEffects(presetDesc(p).effects) plus the preset's rays per pixel; soft presets use
@@ -193,7 +195,8 @@ class Adapter {
   // Contract check: the sample engine waits on the frame slot's fence before recording, so every frame it
   // submitted before the previous kFramesInFlight beginFrame() calls is finished, as Context::beginFrame needs.
   void recordFrame(const sample_engine::PrepassHookInfo& info, sample_engine::LightingInputs& inputs);
-  // The engine is idle (after Engine::waitIdle): releases disabled passes and the SDK's retired objects now.
+  // The engine is idle (after Engine::waitIdle): the SDK frees what destroyed passes retired now
+  // (Context::releaseAfterIdle).
   void releaseAfterIdle();
   // Forget the denoisers' history (camera cut, scene change).
   void resetHistory();

@@ -14,7 +14,7 @@ struct AoPass::Impl {
   PassCore core;
   AoOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() { core.destroy(ctx); }
+  ~Impl() { core.retire(ctx); }  // frames in flight may still trace with it
 };
 
 AoPass::AoPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

@@ -62,6 +62,14 @@ void ComputePipeline::destroy(Context& ctx) {
   setLayout = VK_NULL_HANDLE;
 }
 
+void ComputePipeline::retire(Context& ctx) {
+  if (!pipeline && !layout && !setLayout) return;
+  ComputePipeline retired = *this;
+  *this = ComputePipeline{};
+  Context* context = &ctx;
+  ctx.impl().retire([context, retired]() mutable { retired.destroy(*context); });
+}
+
 void ComputePipeline::dispatch(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes,
                                const void* constants, uint32_t constantBytes, uint32_t width,
                                uint32_t height) const {

@@ -14,7 +14,12 @@ class ComputePipeline {
   static Result<ComputePipeline> create(Context& ctx, const SpirvModule& shader,
                                         const std::vector<VkDescriptorSetLayoutBinding>& bindings,
                                         uint32_t pushConstantBytes, const char* name);
+  // Destroys now: only for a pipeline no pending command buffer uses (a failed create(), or an owner whose
+  // contract is that the GPU is done).
   void destroy(Context& ctx);
+  // Hands the pipeline and its layouts to the context's deferred release (frames in flight may still
+  // dispatch it); this object is left empty.
+  void retire(Context& ctx);
   // Binds, pushes the descriptors and constants, and dispatches 8x8 groups over width x height.
   void dispatch(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes,
                 const void* constants, uint32_t constantBytes, uint32_t width, uint32_t height) const;

@@ -219,6 +219,7 @@ Result<std::unique_ptr<Context>> Context::create(const ContextDesc& desc) {
 
 Context::Context(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
+// Contract (context.h): the GPU is done, so whatever is still retired goes now.
 Context::~Context() { impl_->releaseRetired(/*deviceIdle=*/true); }
 
 void Context::beginFrame() {

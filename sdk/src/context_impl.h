@@ -28,8 +28,21 @@ struct Context::Impl {
   };
   std::vector<PendingRelease> pendingReleases;
 
-  // Runs `release` once no frame that may have used the object is in flight any more.
+  // Runs `release` once no frame that may have used the object is in flight any more: at the beginFrame()
+  // framesInFlight frames after this one, at releaseAfterIdle(), or at ~Context. This is how every SDK object
+  // that a recorded command buffer may reference is destroyed, so the memory statistics drop when the memory
+  // is actually freed.
   void retire(std::function<void()> release) { pendingReleases.push_back({frame, std::move(release)}); }
+  // retire() for a plain handle destroyed by one device function, e.g.
+  //   c.retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
+  // `handle` is left VK_NULL_HANDLE.
+  template <typename Handle, typename DestroyFn>
+  void retireHandle(Handle& handle, DestroyFn DeviceFunctions::*destroy) {
+    if (handle == VK_NULL_HANDLE) return;
+    Handle retired = handle;
+    handle = VK_NULL_HANDLE;
+    retire([this, retired, destroy] { (vk.*destroy)(desc.device, retired, allocator()); });
+  }
   void releaseRetired(bool deviceIdle);
   // True once the GPU has finished the work recorded in `recordedFrame` (beginFrame contract or idle).
   bool frameDone(uint64_t recordedFrame) const {

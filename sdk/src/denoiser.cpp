@@ -55,12 +55,12 @@ struct Denoiser::Impl {
   double previousViewProjection[16] = {};
   double previousCamera[3] = {};
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() {
-    temporal.destroy(ctx);
-    atrous.destroy(ctx);
-    destroySampler(ctx, sampler);
-    images.destroy(ctx);
-    metrics.destroy(ctx);
+  ~Impl() {  // frames in flight may still run its dispatches
+    temporal.retire(ctx);
+    atrous.retire(ctx);
+    ctx.impl().retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
+    images.retire(ctx);
+    metrics.retire(ctx);
   }
 };
 

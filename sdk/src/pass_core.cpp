@@ -1,5 +1,6 @@
 #include "pass_core.h"
 
+#include "context_impl.h"
 #include "gbuffer_sampler.h"
 
 namespace rb {
@@ -14,11 +15,11 @@ Status PassCore::init(Context& ctx, const RayTracingPipelineDesc& desc) {
   return metrics.init(ctx, desc.name);
 }
 
-void PassCore::destroy(Context& ctx) {
-  pipeline.destroy(ctx);
-  destroySampler(ctx, sampler);
-  images.destroy(ctx);
-  metrics.destroy(ctx);
+void PassCore::retire(Context& ctx) {
+  pipeline.retire(ctx);
+  ctx.impl().retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
+  images.retire(ctx);
+  metrics.retire(ctx);
 }
 
 std::vector<VkDescriptorSetLayoutBinding> PassCore::commonBindings() {

@@ -19,7 +19,9 @@ struct PassCore {
   PassMetrics metrics;
 
   Status init(Context& ctx, const RayTracingPipelineDesc& desc);
-  void destroy(Context& ctx);
+  // Hands the pipeline, sampler, images and measurement objects to the context's deferred release: the pass
+  // may be destroyed while frames that recorded it are still in flight.
+  void retire(Context& ctx);
 
   // The bindings every pass starts with: 0 TLAS, 1 depth, 2 normal, 3 geometric normal (or the normal),
   // 4 ray counters. Pass-specific bindings follow from 5.

@@ -11,8 +11,7 @@ Status PassImages::ensure(Context& ctx, uint32_t width, uint32_t height, const s
     same = images_[i].width == width && images_[i].height == height && images_[i].format == specs[i].format;
   }
   if (same) return {};
-  for (GpuImage& img : images_) retireImage(ctx, img);
-  images_.clear();
+  retire(ctx);
   for (const Spec& s : specs) {
     Result<GpuImage> img = createStorageImage(ctx, width, height, s.format, VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                                               MemoryCategory::PassImages, s.name);
@@ -22,8 +21,8 @@ Status PassImages::ensure(Context& ctx, uint32_t width, uint32_t height, const s
   return {};
 }
 
-void PassImages::destroy(Context& ctx) {
-  for (GpuImage& img : images_) destroyImage(ctx, img);
+void PassImages::retire(Context& ctx) {
+  for (GpuImage& img : images_) retireImage(ctx, img);
   images_.clear();
 }
 

@@ -16,7 +16,8 @@ class PassImages {
   };
   // Recreates the images when the size changed (the old ones are retired: a frame in flight may read them).
   Status ensure(Context& ctx, uint32_t width, uint32_t height, const std::vector<Spec>& specs);
-  void destroy(Context& ctx);
+  // Hands every image to the context's deferred release (frames in flight may still use them).
+  void retire(Context& ctx);
   // Barrier: previous contents discarded (UNDEFINED -> GENERAL) for ray tracing shader writes.
   void beginWrite(Context& ctx, VkCommandBuffer cmd);
   // Barrier: GENERAL -> SHADER_READ_ONLY_OPTIMAL, visible to fragment, compute and ray tracing shaders.

@@ -28,11 +28,10 @@ Status PassMetrics::init(Context& ctx, const char* passName) {
   return {};
 }
 
-void PassMetrics::destroy(Context& ctx) {
-  Context::Impl& c = ctx.impl();
-  if (timestamps_) c.vk.vkDestroyQueryPool(c.desc.device, timestamps_, c.allocator());
-  timestamps_ = VK_NULL_HANDLE;
-  destroyBuffer(ctx, counters_);
+void PassMetrics::retire(Context& ctx) {
+  ctx.impl().retireHandle(timestamps_, &DeviceFunctions::vkDestroyQueryPool);
+  retireBuffer(ctx, counters_);
+  recordedFrame_.assign(recordedFrame_.size(), UINT64_MAX);
 }
 
 VkDeviceSize PassMetrics::counterOffset(Context& ctx) const {

@@ -17,7 +17,9 @@ class PassMetrics {
   static constexpr uint32_t kCounterSlots = 4096;
 
   Status init(Context& ctx, const char* passName);
-  void destroy(Context& ctx);
+  // Hands the counter buffer and the query pool to the context's deferred release (frames in flight may still
+  // write them).
+  void retire(Context& ctx);
 
   // Collects finished frames, then resets this frame's slot. Call before recording the pass.
   void beginRecording(Context& ctx, VkCommandBuffer cmd);

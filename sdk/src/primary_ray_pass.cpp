@@ -79,7 +79,7 @@ struct PrimaryRayPass::Impl {
   Context& ctx;
   RayTracingPipeline pipeline;
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() { pipeline.destroy(ctx); }
+  ~Impl() { pipeline.retire(ctx); }  // frames in flight may still trace with it
 };
 
 PrimaryRayPass::PrimaryRayPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

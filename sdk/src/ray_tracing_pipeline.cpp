@@ -175,6 +175,14 @@ void RayTracingPipeline::destroy(Context& ctx) {
   setLayout = VK_NULL_HANDLE;
 }
 
+void RayTracingPipeline::retire(Context& ctx) {
+  if (!pipeline && !layout && !setLayout && !sbt.valid()) return;
+  RayTracingPipeline retired = *this;
+  *this = RayTracingPipeline{};
+  Context* context = &ctx;
+  ctx.impl().retire([context, retired]() mutable { retired.destroy(*context); });
+}
+
 void RayTracingPipeline::bind(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes,
                               const void* constants, uint32_t constantBytes) const {
   const DeviceFunctions& vk = ctx.vk();

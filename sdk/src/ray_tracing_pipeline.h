@@ -37,7 +37,11 @@ struct RayTracingPipelineDesc {
 class RayTracingPipeline {
  public:
   static Result<RayTracingPipeline> create(Context& ctx, const RayTracingPipelineDesc& desc);
+  // Destroys now: only for a pipeline no recorded command buffer uses (a failed create()).
   void destroy(Context& ctx);
+  // Hands the pipeline, its layouts and its shader binding table to the context's deferred release (frames in
+  // flight may still trace with it); this object is left empty.
+  void retire(Context& ctx);
 
   // Binds the pipeline, pushes `writes` into set 0 and the push constants.
   void bind(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes, const void* constants,

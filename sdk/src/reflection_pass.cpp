@@ -37,13 +37,13 @@ struct ReflectionPass::Impl {
   uint32_t materialCount = 0;
   ReflectionOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() {
+  ~Impl() {  // frames in flight may still trace with it and read its material table and texture set
     Context::Impl& c = ctx.impl();
-    core.destroy(ctx);
-    destroyBuffer(ctx, materials);
-    if (pool) c.vk.vkDestroyDescriptorPool(c.desc.device, pool, c.allocator());
-    if (textureLayout) c.vk.vkDestroyDescriptorSetLayout(c.desc.device, textureLayout, c.allocator());
-    if (textureSampler) c.vk.vkDestroySampler(c.desc.device, textureSampler, c.allocator());
+    core.retire(ctx);
+    retireBuffer(ctx, materials);
+    c.retireHandle(pool, &DeviceFunctions::vkDestroyDescriptorPool);
+    c.retireHandle(textureLayout, &DeviceFunctions::vkDestroyDescriptorSetLayout);
+    c.retireHandle(textureSampler, &DeviceFunctions::vkDestroySampler);
   }
 };
 
@@ -183,11 +183,7 @@ Status ReflectionPass::setMaterials(std::span<const Material> materials, std::sp
   }
   // The previous table may be in use by frames in flight.
   retireBuffer(s.ctx, s.materials);
-  if (s.pool) {
-    VkDescriptorPool old = s.pool;
-    Context* ctx = &s.ctx;
-    c.retire([ctx, old] { ctx->vk().vkDestroyDescriptorPool(ctx->device(), old, ctx->impl().allocator()); });
-  }
+  c.retireHandle(s.pool, &DeviceFunctions::vkDestroyDescriptorPool);
   s.materials = buffer.value();
   s.pool = pool;
   s.textureSet = set;

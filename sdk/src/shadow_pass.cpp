@@ -19,7 +19,7 @@ struct ShadowPass::Impl {
   PassCore core;
   ShadowOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() { core.destroy(ctx); }
+  ~Impl() { core.retire(ctx); }  // frames in flight may still trace with it
 };
 
 ShadowPass::ShadowPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

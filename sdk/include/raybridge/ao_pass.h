@@ -4,6 +4,10 @@
 // Two estimators, as in the thesis: binary occlusion, and distance-weighted ("distance rays"), where a hit at
 // distance t counts t / R open, so far occluders fade out.
 //
+// Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output image and
+// measurement objects are handed to the Context's deferred release (see context.h) and freed once those
+// frames are done. Destroy it before its Context.
+//
 // Thread safety: externally synchronised, like the Context it was created from.
 #pragma once
 
@@ -37,6 +41,8 @@ struct AoOutputs {
 class AoPass {
  public:
   static Result<std::unique_ptr<AoPass>> create(Context& context);
+  // Retires its Vulkan objects to the context, without waiting: the images of outputs() stay valid for
+  // the frames already recorded.
   ~AoPass();
 
   Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas, const AoSettings& settings = {});

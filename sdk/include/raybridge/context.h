@@ -2,6 +2,14 @@
 // never waits on the engine's queues; everything that does GPU work records into a command buffer the engine
 // passes in.
 //
+// Lifetimes: the SDK owns them. Destroying a pass (ShadowPass, AoPass, ReflectionPass, PrimaryRayPass) or a
+// Denoiser, or replacing one of its resources (a resize, a new material table), never destroys Vulkan objects
+// at once: they are retired to the context, which destroys them and frees their memory once the frames in
+// flight that may use them are done (Context::beginFrame's contract, or releaseAfterIdle()). So the engine
+// may destroy a pass right after recording it, with no wait-idle and no retire list of its own; memoryStats()
+// drops when the memory is actually freed. Exceptions: ~AccelerationStructureService and ~Context, whose
+// contract is that the GPU is done (see there).
+//
 // Thread safety: a Context is externally synchronised. Calls on one context (and on the services and passes
 // created from it) must not overlap; distinct contexts may be used from distinct threads.
 #pragma once
@@ -82,7 +90,8 @@ struct DeviceInfo {
 };
 
 // Device memory Raybridge holds, by what it is for. Buffers no enabled effect reads are never allocated, so a
-// disabled effect shows zero bytes in its category.
+// disabled effect shows zero bytes in its category (once its destroyed pass's memory has been released).
+// Retired memory still counts until it is freed.
 enum class MemoryCategory : uint8_t {
   BlasStorage = 0,   // suballocation blocks holding BLASes
   Scratch,           // build scratch memory
@@ -108,13 +117,18 @@ struct MemoryStats {
 class Context {
  public:
   static Result<std::unique_ptr<Context>> create(const ContextDesc& desc);
+  // Contract: every service and pass created from this context is destroyed already, and the GPU has
+  // finished every command buffer Raybridge recorded into (the engine's wait-idle at shutdown, or its fences
+  // of every frame in flight). Objects still retired then (destroyed passes, replaced resources) are destroyed
+  // at once; the context never waits for the GPU itself.
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
   // Marks the start of a new frame. Contract: when the engine calls this, the GPU has finished all work the
   // engine submitted before its previous `framesInFlight` calls to beginFrame (the usual wait on the frame
-  // slot's fence). Objects retired that long ago are destroyed here.
+  // slot's fence). Objects retired that long ago are destroyed here: what was retired after beginFrame
+  // number N is destroyed by beginFrame number N + framesInFlight.
   void beginFrame();
   // The engine guarantees the device is idle (after vkDeviceWaitIdle, say): every deferred release happens now,
   // and every query (build timings, compacted sizes, pass statistics) recorded so far can be read.

@@ -4,6 +4,10 @@
 // Denoiser (it keeps that signal's history). The raw input is left untouched, so raw and denoised are both
 // available.
 //
+// Lifetime: destroying it is safe while frames that recorded it are in flight: its pipelines, history and
+// output images and measurement objects are handed to the Context's deferred release (see context.h) and
+// freed once those frames are done. Destroy it before its Context.
+//
 // Thread safety: externally synchronised, like the Context it was created from.
 #pragma once
 
@@ -39,6 +43,8 @@ struct DenoiseOutputs {
 class Denoiser {
  public:
   static Result<std::unique_ptr<Denoiser>> create(Context& context);
+  // Retires its Vulkan objects to the context, without waiting: the images of outputs() stay valid for
+  // the frames already recorded.
   ~Denoiser();
 
   // `signal`: an R16/R32 float image view with the noisy value in .r, in SHADER_READ_ONLY_OPTIMAL (the

@@ -2,6 +2,10 @@
 // acceleration-structure service end to end and is the reference for conformance tests; the effect passes
 // start from the engine's G-buffer instead of primary rays.
 //
+// Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline and shader
+// binding table are handed to the Context's deferred release (see context.h) and freed once those frames are
+// done. Destroy it before its Context.
+//
 // Thread safety: externally synchronised, like the Context it was created from.
 #pragma once
 
@@ -37,6 +41,7 @@ struct PrimaryRayTargets {
 class PrimaryRayPass {
  public:
   static Result<std::unique_ptr<PrimaryRayPass>> create(Context& context);
+  // Retires its pipeline to the context, without waiting for the frames that traced with it.
   ~PrimaryRayPass();
 
   // Records the trace. The TLAS must have been built by recordTlasBuild() earlier in submission order; the

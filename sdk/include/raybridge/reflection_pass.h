@@ -9,6 +9,10 @@
 // with TlasBuildOptions::writeShadingRecords, Instance::material set, and the engine's materials and
 // textures given to setMaterials().
 //
+// Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output image,
+// material table, texture set and measurement objects are handed to the Context's deferred release (see
+// context.h) and freed once those frames are done. Destroy it before its Context.
+//
 // Thread safety: externally synchronised, like the Context it was created from.
 #pragma once
 
@@ -53,6 +57,8 @@ struct ReflectionOutputs {
 class ReflectionPass {
  public:
   static Result<std::unique_ptr<ReflectionPass>> create(Context& context);
+  // Retires its Vulkan objects to the context, without waiting: the images of outputs() stay valid for
+  // the frames already recorded.
   ~ReflectionPass();
 
   // The engine's materials and texture views (2D, sampled, in SHADER_READ_ONLY_OPTIMAL while used). Call

@@ -6,6 +6,10 @@
 // cone or light range. Ray origins are offset along the geometric normal by the depth buffer's
 // reconstruction error, so grazing light does not cause acne.
 //
+// Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output images
+// and measurement objects are handed to the Context's deferred release (see context.h) and freed once those
+// frames are done. Destroy it before its Context.
+//
 // Thread safety: externally synchronised, like the Context it was created from.
 #pragma once
 
@@ -42,6 +46,8 @@ struct ShadowOutputs {
 class ShadowPass {
  public:
   static Result<std::unique_ptr<ShadowPass>> create(Context& context, const ShadowPassDesc& desc = {});
+  // Retires its Vulkan objects to the context, without waiting: the images of outputs() stay valid for
+  // the frames already recorded.
   ~ShadowPass();
 
   // Records the shadow rays. `tlas` comes from recordTlasBuild() earlier in submission order (ideally with
