@@ -42,6 +42,7 @@ AccelerationStructureService::Impl::~Impl() {
   // Contract: the GPU is done with everything this service recorded on the engine's queues; the async queue's
   // work is waited for on the SDK's own timeline first. Retired objects reference the storage allocators, so
   // they are released before those go.
+  handOnDeferredRetires();
   submitter.destroy();
   for (uint32_t i = 1; i < entries.size(); ++i) {
     if (entries[i].state != BlasState::Free) destroyEntry(i);
@@ -61,6 +62,19 @@ AccelerationStructureService::Impl::~Impl() {
   destroyBuffer(ctx, scratch);
   destroyDynamic();
   c.releaseRetired(true);
+}
+
+void AccelerationStructureService::Impl::retire(std::function<void()> release) {
+  if (deferRetires) {
+    deferredRetires.push_back(std::move(release));
+  } else {
+    c.retire(std::move(release));
+  }
+}
+
+void AccelerationStructureService::Impl::handOnDeferredRetires() {
+  for (std::function<void()>& release : deferredRetires) c.retire(std::move(release));
+  deferredRetires.clear();
 }
 
 VkDeviceSize AccelerationStructureService::Impl::scratchAlignment() const {
@@ -148,7 +162,7 @@ void AccelerationStructureService::Impl::destroyEntry(uint32_t index) {
   } else if (e.as) {
     VkAccelerationStructureKHR as = e.as;
     StorageAllocation alloc = e.storage;
-    c.retire([this, as, alloc] {
+    retire([this, as, alloc] {
       c.vk.vkDestroyAccelerationStructureKHR(c.desc.device, as, c.allocator());
       storage.free(alloc);
     });
@@ -169,7 +183,8 @@ Status AccelerationStructureService::Impl::makeRoom(VkDeviceSize bytes, const st
       const BlasEntry& e = entries[i];
       if (e.state == BlasState::Free || e.refCount > 0) continue;
       bool inLatestTlas = e.lastTlasSerial != 0 && e.lastTlasSerial == tlasSerial;
-      bool inFlight = e.lastTlasSerial != 0 && c.frame < e.lastUsedFrame + c.desc.framesInFlight;
+      // Not c.frame: registerMesh may run while the recording thread is in Context::beginFrame.
+      bool inFlight = e.lastTlasSerial != 0 && !frameKnownDone(e.lastUsedFrame);
       if (inLatestTlas || inFlight) continue;
       if (e.releasedOrder < oldest) {
         oldest = e.releasedOrder;
@@ -204,10 +219,53 @@ Result<std::unique_ptr<AccelerationStructureService>> AccelerationStructureServi
   return std::unique_ptr<AccelerationStructureService>(new AccelerationStructureService(std::move(impl)));
 }
 
+namespace {
+
+// Held by registerMesh/releaseMesh: the service lock, and the Context's retire queue left alone (see
+// AccelerationStructureService::Impl::deferRetires).
+class RegistrationLock {
+ public:
+  explicit RegistrationLock(AccelerationStructureService::Impl& s) : s_(s), lock_(s.mutex) {
+    s_.deferRetires = true;
+  }
+  ~RegistrationLock() { s_.deferRetires = false; }
+  RegistrationLock(const RegistrationLock&) = delete;
+  RegistrationLock& operator=(const RegistrationLock&) = delete;
+
+ private:
+  AccelerationStructureService::Impl& s_;
+  std::lock_guard<std::mutex> lock_;
+};
+
+}  // namespace
+
 Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& desc) {
   Impl& s = *impl_;
+  // Validation, the content hash and the size query read only immutable state: done before taking the lock.
   Result<ValidatedMesh> v = validateMesh(desc, s.c.vk, s.c.desc.physicalDevice, s.c.info.maxPrimitiveCount);
   if (!v) return v.error();
+  BlasEntry e;
+  e.mesh = v.value();
+  e.key = v->key;
+  {
+    VkAccelerationStructureGeometryKHR geometry;
+    VkAccelerationStructureBuildRangeInfoKHR range;
+    s.buildGeometry(e, geometry, range);
+    VkAccelerationStructureBuildGeometryInfoKHR info{
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+    info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+    info.flags = s.blasFlags(e);
+    info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+    info.geometryCount = 1;
+    info.pGeometries = &geometry;
+    s.c.vk.vkGetAccelerationStructureBuildSizesKHR(s.c.desc.device,
+                                                   VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info,
+                                                   &range.primitiveCount, &e.sizes);
+  }
+  const VkDeviceSize need = s.storageNeed(e);
+  const std::string name = desc.debugName ? std::string("mesh '") + desc.debugName + "'" : "a mesh";
+
+  RegistrationLock lock(s);
   // The registration itself: its own handle, buffers and lifetime, whatever BLAS it ends up sharing.
   auto addRegistration = [&](uint32_t blas) {
     uint32_t r;
@@ -231,32 +289,16 @@ Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& de
   if (dedupable) {
     if (auto it = s.byKey.find(v->key); it != s.byKey.end()) {
       ++s.counters.dedupHits;
-      BlasEntry& e = s.entries[it->second];
+      BlasEntry& shared = s.entries[it->second];
       MeshHandle h = addRegistration(it->second);
       // A cached BLAS (all registrations released) reads from the new one's buffers from now on.
-      if (e.refCount == 1) {
-        e.mesh = v.value();
-        e.sourceRegistration = h.index;
+      if (shared.refCount == 1) {
+        shared.mesh = v.value();
+        shared.sourceRegistration = h.index;
       }
       return h;
     }
   }
-  BlasEntry e;
-  e.mesh = v.value();
-  e.key = v->key;
-  VkAccelerationStructureGeometryKHR geometry;
-  VkAccelerationStructureBuildRangeInfoKHR range;
-  s.buildGeometry(e, geometry, range);
-  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-  info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-  info.flags = s.blasFlags(e);
-  info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-  info.geometryCount = 1;
-  info.pGeometries = &geometry;
-  s.c.vk.vkGetAccelerationStructureBuildSizesKHR(s.c.desc.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR,
-                                                 &info, &range.primitiveCount, &e.sizes);
-  VkDeviceSize need = s.storageNeed(e);
-  std::string name = desc.debugName ? std::string("mesh '") + desc.debugName + "'" : "a mesh";
   if (Status st = s.makeRoom(need, "registering " + name); !st) return st.error();
 
   uint32_t index;
@@ -284,6 +326,7 @@ Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& de
 
 Status AccelerationStructureService::releaseMesh(MeshHandle mesh) {
   Impl& s = *impl_;
+  RegistrationLock lock(s);
   Result<Registration*> r = s.lookup(mesh, "releaseMesh");
   if (!r) return r.error();
   const uint32_t index = r.value()->blas;
@@ -535,6 +578,8 @@ Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd,
 
 Result<uint32_t> AccelerationStructureService::recordPendingWork(VkCommandBuffer cmd) {
   Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  s.handOnDeferredRetires();
   if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "recordPendingWork: cmd is VK_NULL_HANDLE"};
   s.resolveBatches();
   bool recordedAny = false;
@@ -577,12 +622,16 @@ Result<uint32_t> AccelerationStructureService::recordPendingWork(VkCommandBuffer
 }
 
 Result<bool> AccelerationStructureService::isBuilt(MeshHandle mesh) const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->handOnDeferredRetires();
   Result<Registration*> r = impl_->lookup(mesh, "isBuilt");
   if (!r) return r.error();
   return impl_->entries[r.value()->blas].state == BlasState::Built;
 }
 
 Result<VkDeviceAddress> AccelerationStructureService::blasAddress(MeshHandle mesh) const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->handOnDeferredRetires();
   Result<Registration*> r = impl_->lookup(mesh, "blasAddress");
   if (!r) return r.error();
   const BlasEntry& e = impl_->entries[r.value()->blas];
@@ -594,6 +643,8 @@ Result<VkDeviceAddress> AccelerationStructureService::blasAddress(MeshHandle mes
 
 AsStats AccelerationStructureService::stats() const {
   Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  s.handOnDeferredRetires();
   s.resolveBatches();
   s.resolveDynamicSubmissions();
   AsStats out = s.counters;

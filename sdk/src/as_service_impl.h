@@ -4,9 +4,11 @@
 
 #include <raybridge/acceleration_structures.h>
 
+#include <atomic>
 #include <deque>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -153,6 +155,27 @@ struct AccelerationStructureService::Impl {
   Context& ctx;
   Context::Impl& c;
   AsServiceDesc desc;
+
+  // Thread safety (see the public header): every public call holds `mutex` while it touches the members
+  // below, so registerMesh/releaseMesh (a streaming thread) and the recording calls exclude each other.
+  // The Context's deferred-release queue and frame counter are not guarded by it (beginFrame runs on the
+  // recording thread without it), so registerMesh/releaseMesh never call Context::Impl::retire nor read
+  // Context::Impl::frame: their retires wait in `deferredRetires` until the next recording call hands them
+  // on (later than asked, which is only safer), and eviction learns which frames are done from
+  // `framesDoneBelow`.
+  std::mutex mutex;
+  bool deferRetires = false;  // set while registerMesh/releaseMesh run
+  std::vector<std::function<void()>> deferredRetires;
+  // Every frame below it is known to be done on the GPU: each recordTlasBuild retires a marker that raises it
+  // past that frame, so it advances exactly when Context::frameDone() would say so (beginFrame,
+  // releaseAfterIdle). Written when the Context releases a marker (beginFrame, without `mutex`), read by
+  // eviction; the markers share it, so they never depend on the service's lifetime.
+  std::shared_ptr<std::atomic<uint64_t>> framesDoneBelow = std::make_shared<std::atomic<uint64_t>>(0);
+  bool frameKnownDone(uint64_t frame) const { return frame < framesDoneBelow->load(); }
+  // The Context's retire(), or deferredRetires while a registration call runs.
+  void retire(std::function<void()> release);
+  // Called under `mutex` by every call other than registerMesh/releaseMesh, on the recording thread.
+  void handOnDeferredRetires();
   AsStorageAllocator storage;
   std::vector<BlasEntry> entries;
   std::vector<uint32_t> freeSlots;

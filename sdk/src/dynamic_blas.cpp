@@ -108,7 +108,7 @@ void AccelerationStructureService::Impl::retireAfterAsync(std::function<void()> 
   if (async && submitter.active() && submitter.lastSubmitted() > submitter.completedValue()) {
     asyncReleases.push_back({submitter.lastSubmitted(), std::move(release)});
   } else {
-    c.retire(std::move(release));
+    retire(std::move(release));
   }
 }
 
@@ -181,6 +181,8 @@ int32_t AccelerationStructureService::Impl::tlasCopy(const BlasEntry& e) const {
 
 Status AccelerationStructureService::updateMesh(MeshHandle mesh, const MeshUpdate& update) {
   Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  s.handOnDeferredRetires();
   Result<Registration*> r = s.lookup(mesh, "updateMesh");
   if (!r) return r.error();
   Registration& reg = *r.value();
@@ -269,6 +271,8 @@ Status AccelerationStructureService::updateMesh(MeshHandle mesh, const MeshUpdat
 
 Status AccelerationStructureService::submitDynamicWork(const AsyncBuildWait& ready) {
   Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  s.handOnDeferredRetires();
   if (!s.async) return {};  // recordPendingWork records it
   if (s.lastDynamicWriteFrame == s.c.frame) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
@@ -325,6 +329,8 @@ Status AccelerationStructureService::submitDynamicWork(const AsyncBuildWait& rea
 }
 
 bool AccelerationStructureService::fillTlasWait(VkSemaphoreSubmitInfo& out) const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->handOnDeferredRetires();
   const Impl& s = *impl_;
   if (!s.async) return false;
   uint64_t need = 0;
@@ -344,6 +350,8 @@ bool AccelerationStructureService::fillTlasWait(VkSemaphoreSubmitInfo& out) cons
 }
 
 bool AccelerationStructureService::fillVertexReuseWait(VkSemaphoreSubmitInfo& out) const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->handOnDeferredRetires();
   const Impl& s = *impl_;
   if (!s.async || s.lastVertexReadValue == 0) return false;
   out = VkSemaphoreSubmitInfo{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};

@@ -31,6 +31,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
                                                                const TlasBuildOptions& options) {
   Impl& s = *impl_;
   Context::Impl& c = s.c;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  s.handOnDeferredRetires();
   if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "recordTlasBuild: cmd is VK_NULL_HANDLE"};
   if (instances.size() > c.info.maxInstanceCount) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
@@ -158,6 +160,12 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     signature = hashCombine(signature, blas);
   }
   s.tlasSerial = serial;
+  // Tells eviction (which may run on a registration thread, away from c.frame) when this frame is done.
+  c.retire([done = s.framesDoneBelow, frame = c.frame] {
+    uint64_t seen = done->load();
+    while (seen < frame + 1 && !done->compare_exchange_weak(seen, frame + 1)) {
+    }
+  });
 
   VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
   geometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;

@@ -20,9 +20,26 @@
 // (and memory allocated with VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT). They must stay alive and unchanged
 // while their mesh is registered (a dynamic mesh may change between updateMesh() calls).
 //
-// Thread safety: externally synchronised, like the Context it was created from. That includes the async queue:
-// the SDK submits to AsServiceDesc::asyncQueue only inside submitDynamicWork(), and the engine must not use that
-// VkQueue from another thread during the call (Vulkan's external synchronisation of queues).
+// Thread safety
+//   - registerMesh() and releaseMesh() may run concurrently with any other call of this service, from any
+//     number of threads (e.g. a streaming thread registering while the render thread records).
+//   - Everything else (updateMesh, submitDynamicWork, fillTlasWait, fillVertexReuseWait, recordPendingWork,
+//     recordTlasBuild, isBuilt, blasAddress, stats, create and the destructor), and Context::beginFrame() and
+//     Context::releaseAfterIdle() of the Context it was created from, stays on one thread at a time: the
+//     recording thread. The destructor must not overlap any call.
+//   - One internal mutex per service makes this so; the recording calls hold it for their whole duration,
+//     so a registration waits for at most one of them (registerMesh validates, hashes the host copies and
+//     queries build sizes before taking it).
+//   - registerMesh/releaseMesh never touch the Context's deferred-release queue or its frame counter, which
+//     beginFrame uses without the lock: the BLASes they evict or free are handed to the Context by the next
+//     recording call of this service (so they live until framesInFlight frames after that call), and eviction
+//     takes a BLAS as no longer in flight once the Context has released the frame that last traced it.
+//   - A handle is safe to use on the recording thread from the moment registerMesh returns it until
+//     releaseMesh is called for it; releasing a handle that another thread is passing to recordTlasBuild at
+//     the same time is the engine's race (the TLAS build then fails with ErrorCode::StaleHandle or uses it).
+//   - The async queue: the SDK submits to AsServiceDesc::asyncQueue only inside submitDynamicWork(), and the
+//     engine must not use that VkQueue from another thread during the call (Vulkan's external synchronisation
+//     of queues).
 #pragma once
 
 #include <raybridge/context.h>
