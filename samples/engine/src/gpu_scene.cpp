@@ -170,6 +170,10 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
   // start as copies of it.
   std::vector<bool> deformedMesh(s.meshes.size(), false);
   for (const Instance& inst : s.instances) deformedMesh[inst.mesh] = deformedMesh[inst.mesh] || deforms(s, inst);
+  // The index buffers of deforming meshes are also read where their deformed positions are (an add-on's BLAS
+  // builds on the async compute queue): concurrent over both families, like the deformed buffers.
+  std::vector<uint32_t> sharedFamilies = {ctx.queueFamily};
+  if (ctx.asyncComputeFamily != UINT32_MAX) sharedFamilies.push_back(ctx.asyncComputeFamily);
   std::vector<std::vector<VertexAttributes>> attributes(s.meshes.size());
   std::vector<BufferRequest> requests;
   out.buffers.resize(s.meshes.size());
@@ -190,7 +194,8 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     }
     if (!mesh.indices.empty())
       requests.push_back({mesh.indices.size() * 4,
-                          VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | rtUsage, &b.indices, {}});
+                          VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | rtUsage, &b.indices,
+                          deformedMesh[m] ? std::span<const uint32_t>(sharedFamilies) : std::span<const uint32_t>()});
   }
   if (std::string e = gpu.createBuffers(requests, out.memoryBlocks); !e.empty()) return e;
   Buffer staging;

@@ -75,7 +75,8 @@ struct EngineConfig {
       vkStruct<VkPhysicalDeviceVulkan13Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
   // Also create one queue of a compute-capable family without graphics (when the device has one; lavapipe
   // does not) for add-ons, e.g. asynchronous BLAS builds: see Engine::asyncComputeQueue(). The engine never
-  // submits to it; deformed vertex buffers are then shared (CONCURRENT) between both families.
+  // submits to it; deformed vertex buffers and the index buffers of deforming meshes are then shared
+  // (CONCURRENT) between both families.
   bool requestAsyncComputeQueue = false;
   // Substring of the device name to pick. Empty: environment variable SAMPLE_ENGINE_DEVICE, else the
   // first discrete GPU, else the first device that works.
