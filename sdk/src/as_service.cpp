@@ -96,6 +96,36 @@ VkBuildAccelerationStructureFlagsKHR AccelerationStructureService::Impl::blasFla
   return f;
 }
 
+void AccelerationStructureService::Impl::queryBuildSizes(BlasEntry& e) const {
+  VkAccelerationStructureGeometryKHR geometry;
+  VkAccelerationStructureBuildRangeInfoKHR range;
+  buildGeometry(e, geometry, range);
+  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  info.flags = blasFlags(e);
+  info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  info.geometryCount = 1;
+  info.pGeometries = &geometry;
+  c.vk.vkGetAccelerationStructureBuildSizesKHR(c.desc.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info,
+                                               &range.primitiveCount, &e.sizes);
+}
+
+Result<VkQueryPool> AccelerationStructureService::Impl::takeTimestampPool(std::vector<VkQueryPool>& pools,
+                                                                          const char* what) {
+  if (pools.empty()) {
+    VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qi.queryCount = 2;
+    VkQueryPool pool;
+    VkResult r = c.vk.vkCreateQueryPool(c.desc.device, &qi, c.allocator(), &pool);
+    if (r != VK_SUCCESS) return vulkanError(r, std::string("vkCreateQueryPool (") + what + ")");
+    pools.push_back(pool);
+  }
+  VkQueryPool pool = pools.back();
+  pools.pop_back();
+  return pool;
+}
+
 void AccelerationStructureService::Impl::buildGeometry(const BlasEntry& e, VkAccelerationStructureGeometryKHR& g,
                                                       VkAccelerationStructureBuildRangeInfoKHR& range) const {
   const MeshDesc& m = e.mesh.desc;
@@ -247,21 +277,7 @@ Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& de
   BlasEntry e;
   e.mesh = v.value();
   e.key = v->key;
-  {
-    VkAccelerationStructureGeometryKHR geometry;
-    VkAccelerationStructureBuildRangeInfoKHR range;
-    s.buildGeometry(e, geometry, range);
-    VkAccelerationStructureBuildGeometryInfoKHR info{
-        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-    info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-    info.flags = s.blasFlags(e);
-    info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-    info.geometryCount = 1;
-    info.pGeometries = &geometry;
-    s.c.vk.vkGetAccelerationStructureBuildSizesKHR(s.c.desc.device,
-                                                   VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info,
-                                                   &range.primitiveCount, &e.sizes);
-  }
+  s.queryBuildSizes(e);
   const VkDeviceSize need = s.storageNeed(e);
   const std::string name = desc.debugName ? std::string("mesh '") + desc.debugName + "'" : "a mesh";
 
@@ -528,17 +544,9 @@ Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd,
   record.builds = static_cast<uint32_t>(batch.size());
 
   if (!desc.disableTimestamps && c.info.timestampsSupported) {
-    if (freeTimestampPools.empty()) {
-      VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-      qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-      qi.queryCount = 2;
-      VkQueryPool pool;
-      VkResult r = c.vk.vkCreateQueryPool(c.desc.device, &qi, c.allocator(), &pool);
-      if (r != VK_SUCCESS) return vulkanError(r, "vkCreateQueryPool (build timestamps)");
-      freeTimestampPools.push_back(pool);
-    }
-    record.timestamps = freeTimestampPools.back();
-    freeTimestampPools.pop_back();
+    Result<VkQueryPool> pool = takeTimestampPool(freeTimestampPools, "build timestamps");
+    if (!pool) return pool.error();
+    record.timestamps = pool.value();
     c.vk.vkCmdResetQueryPool(cmd, record.timestamps, 0, 2);
   }
   if (!record.compactEntries.empty()) {

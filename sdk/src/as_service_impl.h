@@ -233,6 +233,10 @@ struct AccelerationStructureService::Impl {
   void buildGeometry(const BlasEntry& e, VkAccelerationStructureGeometryKHR& geometry,
                      VkAccelerationStructureBuildRangeInfoKHR& range) const;
   VkBuildAccelerationStructureFlagsKHR blasFlags(const BlasEntry& e) const;
+  // Fills e.sizes from the driver for e.mesh built with blasFlags(e) (thread-safe: no service state).
+  void queryBuildSizes(BlasEntry& e) const;
+  // Takes a 2-query timestamp pool from `pools`, creating one when it is empty.
+  Result<VkQueryPool> takeTimestampPool(std::vector<VkQueryPool>& pools, const char* what);
   VkDeviceSize scratchAlignment() const;
   VkDeviceSize storageNeed(const BlasEntry& e) const;  // aligned storage of all its copies
 

@@ -229,18 +229,7 @@ Status AccelerationStructureService::updateMesh(MeshHandle mesh, const MeshUpdat
       }
       BlasEntry resized = e;
       resized.mesh = v.value();
-      VkAccelerationStructureGeometryKHR geometry;
-      VkAccelerationStructureBuildRangeInfoKHR range;
-      s.buildGeometry(resized, geometry, range);
-      VkAccelerationStructureBuildGeometryInfoKHR info{
-          VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-      info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-      info.flags = s.blasFlags(resized);
-      info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-      info.geometryCount = 1;
-      info.pGeometries = &geometry;
-      s.c.vk.vkGetAccelerationStructureBuildSizesKHR(s.c.desc.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR,
-                                                     &info, &range.primitiveCount, &resized.sizes);
+      s.queryBuildSizes(resized);
       const VkDeviceSize need = s.storageNeed(resized);
       // The old copies live on until the rebuild has replaced them: the budget counts the new ones from now.
       // (makeRoom evicts only released entries; this one is registered.)

@@ -262,18 +262,10 @@ Status AccelerationStructureService::Impl::recordDynamicOps(VkCommandBuffer cmd,
   batchRecord.frame = c.frame;
   VkQueryPool timestamps = VK_NULL_HANDLE;
   if (!desc.disableTimestamps && (onAsyncQueue ? asyncTimestampMask != 0 : c.info.timestampsSupported)) {
-    std::vector<VkQueryPool>& pools = onAsyncQueue ? freeAsyncTimestampPools : freeTimestampPools;
-    if (pools.empty()) {
-      VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-      qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-      qi.queryCount = 2;
-      VkQueryPool pool;
-      VkResult r = c.vk.vkCreateQueryPool(c.desc.device, &qi, c.allocator(), &pool);
-      if (r != VK_SUCCESS) return vulkanError(r, "vkCreateQueryPool (dynamic BLAS timestamps)");
-      pools.push_back(pool);
-    }
-    timestamps = pools.back();
-    pools.pop_back();
+    Result<VkQueryPool> pool =
+        takeTimestampPool(onAsyncQueue ? freeAsyncTimestampPools : freeTimestampPools, "dynamic BLAS timestamps");
+    if (!pool) return pool.error();
+    timestamps = pool.value();
     (onAsyncQueue ? sub.timestamps : batchRecord.timestamps) = timestamps;
   }
 
