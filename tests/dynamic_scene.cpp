@@ -1,5 +1,7 @@
 #include "dynamic_scene.h"
 
+#include <catch2/catch_test_macros.hpp>
+
 #include <cstring>
 
 namespace rbtest {
@@ -166,6 +168,14 @@ std::vector<float> deformed(const rbsamples::CpuMesh& mesh,
     for (int a = 0; a < 3; ++a) out[3 * v + a] += offset(v, a, &mesh.positions[3 * v]);
   }
   return out;
+}
+
+void checkDeformedTraceAgreement(const TraceComparison& c) {
+  INFO("compared " << c.compared << ", hits " << c.hitsCompared << ", hit/miss agree " << c.hitMissAgree
+                   << ", distance agree " << c.distanceAgree);
+  REQUIRE(c.hitsCompared > 300);
+  CHECK(double(c.hitMissAgree) / c.compared >= 0.995);
+  CHECK(double(c.distanceAgree) / c.hitsCompared >= 0.995);
 }
 
 }  // namespace rbtest
