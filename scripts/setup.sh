@@ -12,7 +12,7 @@ fi
 PKGS_BASE="build-essential cmake ninja-build pkg-config git
   libvulkan-dev libvulkan-volk-dev vulkan-tools glslang-tools spirv-tools vulkan-validationlayers
   libglfw3-dev libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libopenexr-dev
-  libembree-dev xvfb python3"
+  libembree-dev libcli11-dev libimgui-dev xvfb python3 clang-format"
 PKGS_BACKPORTS="mesa-vulkan-drivers libcatch2-dev"
 
 stamp=/var/tmp/raybridge-setup.stamp

@@ -8,16 +8,16 @@
 #include "denoise_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = 0) uniform sampler2D gDepth;
-layout(set = 0, binding = 1) uniform sampler2D gNormal;
-layout(set = 0, binding = 2) uniform sampler2D signalIn;  // .r
-layout(set = 0, binding = 3, r16f) uniform writeonly image2D signalOut;
+layout(set = 0, binding = RB_ATROUS_BINDING_DEPTH) uniform sampler2D gDepth;
+layout(set = 0, binding = RB_ATROUS_BINDING_NORMAL) uniform sampler2D gNormal;
+layout(set = 0, binding = RB_ATROUS_BINDING_SIGNAL_IN) uniform sampler2D signalIn;  // .r
+layout(set = 0, binding = RB_ATROUS_BINDING_SIGNAL_OUT, r16f) uniform writeonly image2D signalOut;
 
 const float kKernel[3] = float[3](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (any(greaterThanEqual(pixel, pc.size.xy))) return;
+  if (any(greaterThanEqual(pixel, pc.size))) return;
   ivec2 ip = ivec2(pixel);
   float centre = texelFetch(signalIn, ip, 0).r;
   float depth = texelFetch(gDepth, ip, 0).r;
@@ -27,12 +27,12 @@ void main() {
   }
   vec3 p = rbDnCameraRelative(pixel, depth);
   vec3 n = rbDnNormal(texelFetch(gNormal, ip, 0));
-  int step = int(pc.size.w);
+  int step = int(pc.atrousStep);
   // Local noise level: the standard deviation of the signal over the 3x3 neighbourhood.
   float m1 = 0.0, m2 = 0.0, count = 0.0;
   for (int y = -1; y <= 1; ++y) {
     for (int x = -1; x <= 1; ++x) {
-      ivec2 q = clamp(ip + ivec2(x, y), ivec2(0), ivec2(pc.size.xy) - 1);
+      ivec2 q = clamp(ip + ivec2(x, y), ivec2(0), ivec2(pc.size) - 1);
       float v = texelFetch(signalIn, q, 0).r;
       m1 += v;
       m2 += v * v;
@@ -43,17 +43,17 @@ void main() {
   // With the rays per pixel known, the noise of a fraction of n binary rays is binomial: sqrt(c (1 - c) / n)
   // at the centre value c. It is 0 where every ray agreed (umbra, fully lit, open), so a noise-free edge,
   // even a line two pixels wide, is kept; the neighbourhood's spread would mistake it for noise.
-  float samples = pc.params.y;
+  float samples = pc.signalRaysPerPixel;
   float c = clamp(centre, 0.0, 1.0);
   float noise = samples > 0.0 ? sqrt(c * (1.0 - c) / samples) : sqrt(max(m2 / count - m1 * m1, 0.0));
   float sigmaValue = 4.0 * noise + 1e-3;
-  float depthSigma = pc.cameraDelta.w;
-  float normalPower = pc.params.x;
+  float depthSigma = pc.depthSigma;
+  float normalPower = pc.normalPower;
   float sum = 0.0, weights = 0.0;
   for (int dy = -2; dy <= 2; ++dy) {
     for (int dx = -2; dx <= 2; ++dx) {
       ivec2 q = ip + ivec2(dx, dy) * step;
-      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(pc.size.xy)))) continue;
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(pc.size)))) continue;
       float qd = texelFetch(gDepth, q, 0).r;
       if (rbDnSky(qd)) continue;
       vec3 qp = rbDnCameraRelative(uvec2(q), qd);

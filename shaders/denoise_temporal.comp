@@ -6,18 +6,18 @@
 #include "denoise_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = 0) uniform sampler2D gDepth;
-layout(set = 0, binding = 1) uniform sampler2D gMotion;        // pixels, current - previous (optional)
-layout(set = 0, binding = 2) uniform sampler2D signalIn;       // this frame's noisy value
-layout(set = 0, binding = 3) uniform sampler2D historyIn;      // x: accumulated value, y: frames accumulated
-layout(set = 0, binding = 4) uniform sampler2D distanceIn;     // previous frame's view distance
-layout(set = 0, binding = 5, rg16f) uniform writeonly image2D historyOut;
-layout(set = 0, binding = 6, r32f) uniform writeonly image2D distanceOut;
-layout(set = 0, binding = 7, r16f) uniform writeonly image2D valueOut;  // the accumulated value alone
+layout(set = 0, binding = RB_TEMPORAL_BINDING_DEPTH) uniform sampler2D gDepth;
+layout(set = 0, binding = RB_TEMPORAL_BINDING_MOTION) uniform sampler2D gMotion;  // pixels, current - previous
+layout(set = 0, binding = RB_TEMPORAL_BINDING_SIGNAL) uniform sampler2D signalIn;        // this frame's noisy value
+layout(set = 0, binding = RB_TEMPORAL_BINDING_HISTORY_IN) uniform sampler2D historyIn;   // x: value, y: frames
+layout(set = 0, binding = RB_TEMPORAL_BINDING_DISTANCE_IN) uniform sampler2D distanceIn; // last frame's distance
+layout(set = 0, binding = RB_TEMPORAL_BINDING_HISTORY_OUT, rg16f) uniform writeonly image2D historyOut;
+layout(set = 0, binding = RB_TEMPORAL_BINDING_DISTANCE_OUT, r32f) uniform writeonly image2D distanceOut;
+layout(set = 0, binding = RB_TEMPORAL_BINDING_VALUE_OUT, r16f) uniform writeonly image2D valueOut;  // the value alone
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (any(greaterThanEqual(pixel, pc.size.xy))) return;
+  if (any(greaterThanEqual(pixel, pc.size))) return;
   ivec2 ip = ivec2(pixel);
   float value = texelFetch(signalIn, ip, 0).r;
   float depth = texelFetch(gDepth, ip, 0).r;
@@ -31,22 +31,22 @@ void main() {
   float dist = length(rel);
   imageStore(distanceOut, ip, vec4(dist));
   vec2 prevPixel;
-  vec3 prevRel = rel + pc.cameraDelta.xyz;
-  if ((pc.size.z & RB_DN_MOTION) != 0u) {
+  vec3 prevRel = rel + pc.cameraDelta;
+  if ((pc.flags & RB_DN_MOTION) != 0u) {
     prevPixel = vec2(pixel) + 0.5 - texelFetch(gMotion, ip, 0).xy;
   } else {
     vec4 clip = pc.previousViewProjection * vec4(prevRel, 1.0);
-    prevPixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size.xy);
+    prevPixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
   }
   float accumulated = value;
   float frames = 1.0;
   ivec2 pp = ivec2(floor(prevPixel));
-  if ((pc.size.z & RB_DN_HISTORY) != 0u && all(greaterThanEqual(pp, ivec2(0))) && all(lessThan(pp, ivec2(pc.size.xy)))) {
+  if ((pc.flags & RB_DN_HISTORY) != 0u && all(greaterThanEqual(pp, ivec2(0))) && all(lessThan(pp, ivec2(pc.size)))) {
     float prevDist = texelFetch(distanceIn, pp, 0).r;
     // The same surface: its distance from last frame's camera matches what was stored there.
     if (prevDist > 0.0 && abs(prevDist - length(prevRel)) <= 0.02 * length(prevRel) + 1e-3) {
       vec2 h = texelFetch(historyIn, pp, 0).xy;
-      frames = min(h.y + 1.0, float(pc.size.w));
+      frames = min(h.y + 1.0, float(pc.maxHistoryFrames));
       accumulated = mix(h.x, value, 1.0 / frames);
     }
   }

@@ -4,11 +4,13 @@
 // Shades the surface a reflection ray hits: its material (factors and textures), the sun with a shadow ray
 // (Lambert diffuse for dielectrics, the base colour as specular colour for metals), the sky's ambient light,
 // and emission. Attributes come from the instance's shading record, fetched by device address.
+#include "raybridge_pass_constants.glsl"
+layout(push_constant) uniform ReflectionPushConstants { ReflectionConstants pc; };
 #include "pass_inputs.glsl"
+#include "ray_counters.glsl"
 #include "reflection_common.glsl"
 
-layout(set = 0, binding = 0) uniform accelerationStructureEXT tlas;
-layout(set = 0, binding = 4) buffer RayCounters { uint rayCount[4096]; };
+layout(set = 0, binding = RB_BINDING_TLAS) uniform accelerationStructureEXT tlas;
 layout(location = 0) rayPayloadInEXT ReflectionPayload payload;
 layout(location = 1) rayPayloadEXT float shadowHit;
 hitAttributeEXT vec2 barycentrics;
@@ -56,7 +58,7 @@ void main() {
     metallic *= textureLod(textures[nonuniformEXT(m.metallicRoughnessTexture)], uv, 0.0).b;
   }
   vec3 hit = gl_WorldRayOriginEXT + gl_HitTEXT * dir;
-  vec3 toSun = normalize(pc.p0.xyz);
+  vec3 toSun = normalize(pc.sunDirection);
   float nDotL = dot(n, toSun);
   float sunVisible = 0.0;
   if (nDotL > 0.0 && dot(ng, toSun) > 0.0) {
@@ -66,13 +68,12 @@ void main() {
                 0xFF, 0, 0, 1, origin, 0.0, toSun, 1e30, 1);
     sunVisible = shadowHit == 0.0 ? 1.0 : 0.0;
     // Shadow rays from hits are the pass's rays too.
-    uvec2 pixel = gl_LaunchIDEXT.xy;
-    atomicAdd(rayCount[(pixel.x & 63u) | ((pixel.y & 63u) << 6)], 1u);
+    rbCountRays(gl_LaunchIDEXT.xy, 1u);
   }
   vec3 diffuse = base.rgb * (1.0 - metallic) / RB_PI;
   vec3 specularColour = mix(vec3(0.04), base.rgb, metallic);
   // Direct sun: diffuse, plus a broad specular approximation so metals are not black under the sun.
-  vec3 direct = (diffuse + specularColour / RB_PI) * pc.p1.xyz * max(nDotL, 0.0) * sunVisible;
-  vec3 ambient = (base.rgb * (1.0 - metallic) + specularColour * metallic) * pc.p2.xyz * pc.p2.w;
+  vec3 direct = (diffuse + specularColour / RB_PI) * pc.sunRadiance * max(nDotL, 0.0) * sunVisible;
+  vec3 ambient = (base.rgb * (1.0 - metallic) + specularColour * metallic) * pc.skyRadiance * pc.ambientIntensity;
   payload.radiance = direct + ambient + m.emissive.rgb;
 }

@@ -2,11 +2,12 @@
 #extension GL_EXT_ray_tracing : require
 #extension GL_GOOGLE_include_directive : require
 // A reflection ray that escapes sees the sky.
-#include "pass_inputs.glsl"
+#include "raybridge_pass_constants.glsl"
+layout(push_constant) uniform ReflectionPushConstants { ReflectionConstants pc; };
 
 struct ReflectionPayload {
   vec3 radiance;
 };
 layout(location = 0) rayPayloadInEXT ReflectionPayload payload;
 
-void main() { payload.radiance = pc.p2.xyz; }
+void main() { payload.radiance = pc.skyRadiance; }

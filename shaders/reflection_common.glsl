@@ -6,6 +6,8 @@
 #extension GL_EXT_buffer_reference_uvec2 : require
 #extension GL_EXT_nonuniform_qualifier : require
 
+#include "raybridge_shader_interface.glsl"
+
 struct ReflectionPayload {
   vec3 radiance;
 };
@@ -36,9 +38,13 @@ struct GpuMaterial {
   vec4 emissive;
 };
 
-layout(set = 0, binding = 7, std430) readonly buffer ShadingRecords { ShadingRecord records[]; };
-layout(set = 0, binding = 8, std430) readonly buffer Materials { GpuMaterial materials[]; };
-layout(set = 1, binding = 0) uniform sampler2D textures[];
+layout(set = 0, binding = RB_REFLECTION_BINDING_SHADING_RECORDS, std430) readonly buffer ShadingRecords {
+  ShadingRecord records[];
+};
+layout(set = 0, binding = RB_REFLECTION_BINDING_MATERIALS, std430) readonly buffer Materials {
+  GpuMaterial materials[];
+};
+layout(set = RB_REFLECTION_SET_TEXTURES, binding = 0) uniform sampler2D textures[];
 
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer FloatRef { float v; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer UintRef { uint v; };

@@ -1,7 +1,10 @@
 // Shadow rays from G-buffer surfaces towards a directional, point or spot light. Hard: one ray to the light's
 // centre. Soft: n rays over the light's disk (stratified Fibonacci spiral, rotated per pixel and frame).
 // No ray for sky pixels, surfaces facing away from the light, or pixels outside a spot cone or light range.
+#include "raybridge_pass_constants.glsl"
+layout(push_constant) uniform ShadowPushConstants { ShadowConstants pc; };
 #include "pass_inputs.glsl"
+#include "ray_counters.glsl"
 
 // RB_WRITE_HIT_DISTANCE (set by shadow_distance.rgen) adds the occluder-distance output. A separate module
 // rather than a specialization constant: the binding must not exist at all when the image is not allocated.
@@ -11,25 +14,21 @@ const bool kWriteHitDistance = true;
 const bool kWriteHitDistance = false;
 #endif
 
-layout(set = 0, binding = 0) uniform accelerationStructureEXT tlas;
-layout(set = 0, binding = 1) uniform sampler2D gDepth;
-layout(set = 0, binding = 2) uniform sampler2D gNormal;
-layout(set = 0, binding = 3) uniform sampler2D gGeometricNormal;
-layout(set = 0, binding = 4) buffer RayCounters { uint rayCount[4096]; };
-layout(set = 0, binding = 5, r16f) uniform writeonly image2D outVisibility;
+layout(set = 0, binding = RB_BINDING_TLAS) uniform accelerationStructureEXT tlas;
+layout(set = 0, binding = RB_BINDING_DEPTH) uniform sampler2D gDepth;
+layout(set = 0, binding = RB_BINDING_NORMAL) uniform sampler2D gNormal;
+layout(set = 0, binding = RB_BINDING_GEOMETRIC_NORMAL) uniform sampler2D gGeometricNormal;
+layout(set = 0, binding = RB_SHADOW_BINDING_VISIBILITY, r16f) uniform writeonly image2D outVisibility;
 #ifdef RB_WRITE_HIT_DISTANCE
-layout(set = 0, binding = 6, r32f) uniform writeonly image2D outHitDistance;
+layout(set = 0, binding = RB_SHADOW_BINDING_HIT_DISTANCE, r32f) uniform writeonly image2D outHitDistance;
 #endif
 
-// p0: xyz direction towards a directional light, or the light position in TLAS space; w: light type
-// p1: x tan(angular radius) (directional) or sphere radius; y: range (0 = none); z: cos(spot outer angle)
-// p2: xyz spot direction (from the light); u0.x: rays per pixel
 // Payload: -1 = occluded (set before tracing), 0 = reached the light (miss shader), > 0 = occluder distance.
 layout(location = 0) rayPayloadEXT float hitT;
 
 void main() {
   uvec2 pixel = gl_LaunchIDEXT.xy;
-  if (any(greaterThanEqual(pixel, pc.gbuffer.xy))) return;
+  if (any(greaterThanEqual(pixel, pc.gbuffer.size))) return;
   ivec2 ip = ivec2(pixel);
   float depth = texelFetch(gDepth, ip, 0).r;
   float visibility = 0.0;
@@ -39,29 +38,32 @@ void main() {
     visibility = 1.0;  // nothing to shadow; lighting ignores sky pixels anyway
   } else {
     vec3 n = rbDecodeNormal(texelFetch(gNormal, ip, 0), rbNormalEncoding());
-    vec3 ng = (pc.gbuffer.z & RB_GB_GEOMETRIC_NORMAL) != 0u
+    vec3 ng = (pc.gbuffer.flags & RB_GB_GEOMETRIC_NORMAL) != 0u
                   ? rbDecodeNormal(texelFetch(gGeometricNormal, ip, 0), rbNormalEncoding())
                   : n;
     vec3 facing;
     vec3 origin = rbRayOrigin(pixel, depth, ng, facing);
     vec3 surface = rbSurfacePoint(pixel, depth);
-    uint type = uint(pc.p0.w);
+    uint type = pc.lightType;
+    bool directional = type == RB_LIGHT_DIRECTIONAL;
+    // The light's extent: a directional light's disk (as a slope) or a point or spot light's sphere.
+    float spread = directional ? pc.tanAngularRadius : pc.lightRadius;
     vec3 toLight;
     float lightDistance;
-    if (type == 0u) {
-      toLight = normalize(pc.p0.xyz);
+    if (directional) {
+      toLight = normalize(pc.lightDirection);
       lightDistance = 1e30;
     } else {
-      toLight = pc.p0.xyz - surface;
+      toLight = pc.lightPosition - surface;
       lightDistance = length(toLight);
       toLight /= max(lightDistance, 1e-20);
     }
-    bool inRange = pc.p1.y <= 0.0 || lightDistance <= pc.p1.y;
-    bool inCone = type != 2u || dot(-toLight, normalize(pc.p2.xyz)) >= pc.p1.z;
+    bool inRange = pc.range <= 0.0 || lightDistance <= pc.range;
+    bool inCone = type != RB_LIGHT_SPOT || dot(-toLight, normalize(pc.spotDirection)) >= pc.cosSpotOuterAngle;
     // The shading normal decides: where it faces away, lighting is zero whatever a ray would find.
     if (dot(n, toLight) > 0.0 && dot(facing, toLight) > -0.05 && inRange && inCone) {
-      uint count = max(pc.u0.x, 1u);
-      uint seed = rbPcg(pixel.x + pc.gbuffer.x * pixel.y + rbPcg(pc.gbuffer.w));
+      uint count = max(pc.raysPerPixel, 1u);
+      uint seed = rbPcg(pixel.x + pc.gbuffer.size.x * pixel.y + rbPcg(pc.gbuffer.frameIndex));
       float jitter = rbToUnit(seed);
       float rotation = rbToUnit(rbPcg(seed)) * 2.0 * RB_PI;
       vec3 t, b;
@@ -74,13 +76,13 @@ void main() {
       for (uint i = 0u; i < count; ++i) {
         vec3 dir;
         float tMax;
-        if (pc.p1.x > 0.0) {
+        if (spread > 0.0) {
           vec2 d = count == 1u ? vec2(0.0) : rbFibonacciDisk(i, count, jitter, rotation);
-          if (type == 0u) {
-            dir = normalize(toLight + pc.p1.x * (d.x * t + d.y * b));
+          if (directional) {
+            dir = normalize(toLight + spread * (d.x * t + d.y * b));
             tMax = 1e30;
           } else {
-            vec3 target = pc.p0.xyz + pc.p1.x * (d.x * t + d.y * b);
+            vec3 target = pc.lightPosition + spread * (d.x * t + d.y * b);
             dir = target - origin;
             tMax = length(dir);
             dir /= tMax;
@@ -88,7 +90,7 @@ void main() {
           }
         } else {
           dir = toLight;
-          tMax = type == 0u ? 1e30 : 0.999 * length(pc.p0.xyz - origin);
+          tMax = directional ? 1e30 : 0.999 * length(pc.lightPosition - origin);
         }
         hitT = -1.0;  // occluded unless the miss shader runs
         traceRayEXT(tlas, flags, 0xFF, 0, 0, 0, origin, 0.0, dir, tMax, 0);
@@ -107,5 +109,5 @@ void main() {
 #ifdef RB_WRITE_HIT_DISTANCE
   imageStore(outHitDistance, ip, vec4(nearest));
 #endif
-  if (rays != 0u) atomicAdd(rayCount[(pixel.x & 63u) | ((pixel.y & 63u) << 6)], rays);
+  if (rays != 0u) rbCountRays(pixel, rays);
 }

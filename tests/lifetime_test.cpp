@@ -173,3 +173,72 @@ TEST_CASE("passes and denoisers destroyed while their frame is in flight are rel
   CHECK(end.allocations == start.allocations);
   destroyScene(fx, built);
 }
+
+TEST_CASE("effects front ends created and destroyed every frame, cycling all presets, leak nothing and never wait",
+          "[lifetime][hybrid_effects]") {
+  GpuFixture fx;
+  const uint32_t framesInFlight = fx.ctx().framesInFlight();
+  const uint32_t frames = 100;
+  TestScene scene = makeConformanceScene();
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  CpuGBuffer cpu = traceGBuffer(embree, conformanceView(48, 32));
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  BuiltScene built = buildScene(fx, *service.value(), scene);
+  GpuGBuffer gbuffer(fx, cpu);
+  REQUIRE(fx.device().waitIdle().ok());
+  fx.ctx().releaseAfterIdle();
+  const rb::MemoryStats start = fx.ctx().memoryStats();
+
+  rb::HybridFrame frame;
+  frame.gbuffer = gbuffer.desc();
+  frame.instances = built.instances;  // the front end records the service's pending work and builds the TLAS
+  frame.light.direction[0] = 0.4f;
+  frame.light.direction[2] = 0.3f;
+  const rb::Material material;  // reflection hits need a material table
+
+  FrameRing ring(fx, framesInFlight);
+  // Steady state: every frame slot has built a TLAS with and without shading records (reflection presets), so the
+  // service's per-slot TLAS buffers stop growing.
+  rb::MemoryStats steady;
+  VkDeviceSize peak = 0;
+  for (uint32_t f = 0; f < frames; ++f) {
+    const uint32_t slot = f % framesInFlight;
+    VkCommandBuffer cmd = ring.acquire(slot);
+    fx.ctx().beginFrame();
+    const rb::Preset preset = rb::Preset(f % rb::kPresetCount);
+    {
+      auto effects = rb::HybridEffects::create(fx.ctx(), service.value().get(), rb::withPreset({}, preset));
+      RB_REQUIRE_OK(effects);
+      RB_REQUIRE_OK(effects.value()->setMaterials({&material, 1}, {}));
+      RB_REQUIRE_OK(effects.value()->record(cmd, frame));
+      const rb::PresetDesc want = rb::presetDesc(preset);
+      const rb::HybridOutputs& out = effects.value()->outputs();
+      INFO("frame " << f << " preset " << rb::toString(preset));
+      // Exactly the preset's effects produce images; soft shadows also a denoised one besides the raw.
+      CHECK((out.shadowRaw.view != VK_NULL_HANDLE) == bool(want.effects & rb::kEffectShadows));
+      CHECK((out.ao.view != VK_NULL_HANDLE) == bool(want.effects & rb::kEffectAo));
+      CHECK((out.reflection.view != VK_NULL_HANDLE) == bool(want.effects & rb::kEffectReflections));
+      CHECK((out.shadow.view != out.shadowRaw.view) == (want.shadowRaysPerPixel > 1));
+      CHECK((effects.value()->shadowDenoiser() != nullptr) == (want.shadowRaysPerPixel > 1));
+      for (const rb::EffectImage* image : {&out.shadow, &out.ao, &out.reflection})
+        if (image->view) CHECK((image->layout == VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL && image->width == 48));
+      ring.submit(slot);
+    }  // destroyed while its frame is in flight
+    if (f + 1 == 2 * rb::kPresetCount) steady = fx.ctx().memoryStats();
+    peak = std::max(peak, passBytes(fx.ctx().memoryStats()) - passBytes(start));
+  }
+  REQUIRE(peak > 0);
+
+  REQUIRE(fx.device().waitIdle().ok());
+  fx.ctx().releaseAfterIdle();
+  const rb::MemoryStats end = fx.ctx().memoryStats();
+  CHECK(passBytes(end) == passBytes(start));  // every pass, denoiser and shader table of 100 front ends freed
+  using C = rb::MemoryCategory;
+  for (C c : {C::BlasStorage, C::Scratch, C::Tlas}) {
+    INFO(rb::toString(c));
+    CHECK(end.of(c) == steady.of(c));  // the service's per-slot TLAS buffers are reused, not regrown
+  }
+  destroyScene(fx, built);
+}

@@ -73,6 +73,9 @@ TEST_CASE("a mirror reflects a coloured box where Embree says it should", "[refl
   settings.sunDirection[0] = 0.3f;
   settings.sunDirection[1] = 1.0f;
   settings.sunDirection[2] = 0.6f;
+  // Explicit lighting, so the reference below reads the same values the pass shades with.
+  for (int i = 0; i < 3; ++i) settings.sunRadiance[i] = rb::kDefaultSunRadiance, settings.skyRadiance[i] = rb::kDefaultSkyRadiance[i];
+  settings.ambientIntensity = rb::kDefaultAmbientIntensity;
 
   SECTION("mirror floor") {
     CpuGBuffer cpu = traceGBuffer(embree, view, {0.0f, 1.0f});  // floor a mirror, box rough

@@ -84,7 +84,7 @@ GpuGBuffer::Image GpuGBuffer::upload(VkFormat format, VkImageAspectFlags aspect,
   VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mai.allocationSize = req.size;
   mai.memoryTypeIndex =
-      uint32_t(fx_.ctx().impl().findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0));
+      uint32_t(rb::internal::contextImpl(fx_.ctx()).findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0));
   REQUIRE(vk.vkAllocateMemory(device, &mai, nullptr, &img.memory) == VK_SUCCESS);
   vk.vkBindImageMemory(device, img.image, img.memory, 0);
   VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};

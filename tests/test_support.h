@@ -2,6 +2,7 @@
 // context on it, and helpers to upload meshes and read images back.
 #pragma once
 
+#include <raybridge/headless_device.h>
 #include <raybridge/raybridge.h>
 
 #include <catch2/catch_test_macros.hpp>
@@ -34,7 +35,7 @@ class GpuFixture {
 
   rb::HeadlessDevice& device() { return *device_; }
   rb::Context& ctx() { return *ctx_; }
-  const rb::DeviceFunctions& vk() { return ctx_->vk(); }
+  const rb::DeviceFunctions& vk() { return rb::internal::deviceFunctions(*ctx_); }
 
   UploadedMesh upload(const rbsamples::CpuMesh& mesh, bool withHostCopies = true);
   void destroy(UploadedMesh& mesh);

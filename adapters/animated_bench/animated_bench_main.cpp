@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "animated_scene.h"
+#include "cli_support.h"
 #include "raybridge_sample_engine_adapter.h"
 
 namespace se = sample_engine;
@@ -56,67 +57,70 @@ const Mode kModes[] = {
      "characters frozen: no BLAS work (baseline)"},
 };
 
-const char* kUsage =
-    "usage: raybridge-animated-bench [--characters 1,10,50,200] [--frames 300] [--warmup 30] [--width 2560]\n"
-    "         [--height 1440] [--modes sync-refit,sync-refit-only,sync-rebuild,async,async-late,frozen]\n"
-    "         [--scenes DIR] [--out FILE.json] [--device SUBSTR] [--validation] [--quick]\n"
-    "  --quick: 1 and 2 characters, 12 frames at 192x108 (a smoke run for CI, with --validation)\n";
-
-bool parseList(const std::string& text, std::vector<uint32_t>& out) {
-  out.clear();
-  size_t start = 0;
-  while (start <= text.size()) {
-    const size_t comma = text.find(',', start);
-    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (item.empty() || item.find_first_not_of("0123456789") != std::string::npos || item.size() > 4) return false;
-    out.push_back(uint32_t(std::stoul(item)));
-    if (out.back() == 0) return false;
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return !out.empty();
+std::vector<std::string> modeNames() {
+  std::vector<std::string> names;
+  for (const Mode& m : kModes) names.push_back(m.name);
+  return names;
 }
 
+void addOptions(CLI::App& app, Options& o) {
+  rbCli::prepare(app);
+  app.description(
+      "Skinned characters walking on the demo scene with hard shadows and AO, in each way of keeping their BLASes\n"
+      "up to date; writes JSON and prints a table.");
+  app.add_option_function<std::string>(
+         "--characters", [&o](const std::string& v) { rbCli::parseWholeNumberList(v, 1, 9999, o.characters); },
+         "character counts, one run each (default 1,10,50,200)")
+      ->type_name("N,N,...")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            std::vector<uint32_t> counts;
+            return rbCli::parseWholeNumberList(v, 1, 9999, counts);
+          },
+          ""));
+  app.add_option("--frames", o.frames, "measured frames per run (default 300)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(2, 100000));
+  app.add_option("--warmup", o.warmup, "frames before measuring (default 30)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(1, 10000));
+  app.add_option("--width", o.width, "image width (default 2560)")->type_name("W")->check(rbCli::wholeNumber(16, 8192));
+  app.add_option("--height", o.height, "image height (default 1440)")
+      ->type_name("H")
+      ->check(rbCli::wholeNumber(16, 8192));
+  std::string modes;
+  for (const Mode& m : kModes) modes += std::string("\n  ") + m.name + ": " + m.what;
+  app.add_option("--modes", o.modes, "comma-separated subset of the modes (default: all):" + modes)
+      ->type_name("LIST")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            uint32_t set = 0;
+            return rbCli::parseNameSet(v, modeNames(), "a mode", set);
+          },
+          ""));
+  app.add_option("--scenes", o.scenes, "folder of the glTF models (default ../shared/scenes)")->type_name("DIR");
+  app.add_option("--out", o.out, "JSON report (default animated_bench.json)")->type_name("FILE.json");
+  app.add_option("--device", o.device, "pick the Vulkan device whose name contains SUBSTR")->type_name("SUBSTR");
+  app.add_flag("--validation", o.validation, "enable VK_LAYER_KHRONOS_validation (also RAYBRIDGE_VALIDATION=1)");
+  app.add_flag("--quick", o.quick, "1 and 2 characters, 12 frames at 192x108 (a smoke run for CI, with\n--validation)");
+}
+
+std::string usage() {
+  Options unused;
+  CLI::App app{"", "raybridge-animated-bench"};
+  addOptions(app, unused);
+  return app.help();
+}
+
+// Parses argv; returns "" or an error naming the option and the value. --help prints the help and exits 0.
 std::string parse(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
-    auto number = [&](uint32_t& out, uint32_t min, uint32_t max) -> std::string {
-      const char* v = value();
-      if (!v) return a + " needs a value";
-      std::vector<uint32_t> one;
-      if (!parseList(v, one) || one.size() != 1 || one[0] < min || one[0] > max)
-        return a + ": '" + v + "' is not a whole number in " + std::to_string(min) + ".." + std::to_string(max);
-      out = one[0];
-      return {};
-    };
-    std::string e;
-    if (a == "--quick") {
-      o.quick = true;
-    } else if (a == "--validation") {
-      o.validation = true;
-    } else if (a == "--characters") {
-      const char* v = value();
-      if (!v || !parseList(v, o.characters)) return "--characters: expected counts like 1,10,50,200";
-    } else if (a == "--frames") {
-      e = number(o.frames, 2, 100000);
-    } else if (a == "--warmup") {
-      e = number(o.warmup, 1, 10000);
-    } else if (a == "--width") {
-      e = number(o.width, 16, 8192);
-    } else if (a == "--height") {
-      e = number(o.height, 16, 8192);
-    } else if (a == "--scenes" || a == "--out" || a == "--modes" || a == "--device") {
-      const char* v = value();
-      if (!v) return a + " needs a value";
-      (a == "--scenes" ? o.scenes : a == "--out" ? o.out : a == "--modes" ? o.modes : o.device) = v;
-    } else if (a == "--help" || a == "-h") {
-      std::printf("%s", kUsage);
-      std::exit(0);
-    } else {
-      return "unknown option '" + a + "'";
-    }
-    if (!e.empty()) return e;
+  CLI::App app{"", "raybridge-animated-bench"};
+  addOptions(app, o);
+  bool help = false;
+  if (std::string e = rbCli::parse(app, argc, argv, help); !e.empty()) return e;
+  if (help) {
+    std::printf("%s", app.help().c_str());
+    std::exit(0);
   }
   if (o.quick) {
     o.characters = {1, 2};
@@ -124,14 +128,6 @@ std::string parse(int argc, char** argv, Options& o) {
     o.warmup = 3;
     o.width = 192;
     o.height = 108;
-  }
-  if (!o.modes.empty()) {
-    std::string rest = o.modes + ",";
-    for (size_t p; (p = rest.find(',')) != std::string::npos; rest.erase(0, p + 1)) {
-      const std::string m = rest.substr(0, p);
-      if (std::none_of(std::begin(kModes), std::end(kModes), [&](const Mode& k) { return m == k.name; }))
-        return "--modes: '" + m + "' is not one of sync-refit, sync-refit-only, sync-rebuild, async, async-late, frozen";
-    }
   }
   return {};
 }
@@ -164,19 +160,17 @@ se::Result<json> runMode(se::Engine& engine, const rbAnimated::AnimatedScene& sc
                          const Options& o) {
   using R = se::Result<json>;
   rbAdapter::AdapterConfig ac;
-  ac.effects = rbAdapter::kEffectShadows | rbAdapter::kEffectAo;
+  ac.preset = rb::Preset::Low;  // hard shadows, AO 4
   ac.accelerationStructures.dynamicMode = mode.dynamicMode;
   ac.accelerationStructures.refitPolicy.kind = mode.policy;
   auto created = rbAdapter::Adapter::create(engine, ac);
   if (!created) return R::failure("adapter: " + created.error);
   rbAdapter::Adapter& adapter = *created.value;
-  if (se::Status s = adapter.applyPreset(rbAdapter::Preset::Low); !s) return R::failure(s.error);  // hard shadows, AO 4
   engine.setPrepassHook(adapter.prepassHook());
 
   se::FrameParams params;
   params.camera = engine.scene().camera ? *engine.scene().camera : se::defaultCameraFor(engine.sceneBounds());
   if (engine.scene().sun) params.sun = *engine.scene().sun;
-  adapter.settings().lightingFrom(params);
   params.animations = scene.playbacks;
   const double dt = 1.0 / 60.0;
 
@@ -220,13 +214,13 @@ se::Result<json> runMode(se::Engine& engine, const rbAnimated::AnimatedScene& sc
     // The latest resolved async submission, in frames that submitted one (a frozen frame submits nothing).
     const bool submitted = as.async && as.lastFrameRefitTriangles + as.lastFrameRebuildTriangles > 0;
     s.asyncMs.push_back(submitted ? as.lastAsyncGpuMs : 0.0);
-    s.shadowMs.push_back(adapter.stats().shadow.gpuMs);
+    s.shadowMs.push_back(adapter.effects().stats().shadow.gpuMs);
     s.refitTriangles.push_back(double(as.lastFrameRefitTriangles));
     s.rebuildTriangles.push_back(double(as.lastFrameRebuildTriangles));
     s.staleBlas.push_back(double(as.staleBlas));
   }
   if (se::Status st = engine.waitIdle(); !st) return R::failure(st.error);
-  adapter.releaseAfterIdle();
+  adapter.context().releaseAfterIdle();
   const rb::AsStats as = adapter.accelerationStructures().stats();
   countBatches(as);
   const rb::MemoryStats mem = adapter.context().memoryStats();
@@ -265,7 +259,7 @@ se::Result<json> runMode(se::Engine& engine, const rbAnimated::AnimatedScene& sc
 int main(int argc, char** argv) {
   Options o;
   if (std::string e = parse(argc, argv, o); !e.empty()) {
-    std::fprintf(stderr, "raybridge-animated-bench: error: %s\n%s", e.c_str(), kUsage);
+    std::fprintf(stderr, "raybridge-animated-bench: error: %s\n%s", e.c_str(), usage().c_str());
     return 2;
   }
   if (const char* v = std::getenv("RAYBRIDGE_VALIDATION"); v && std::string(v) == "1") o.validation = true;

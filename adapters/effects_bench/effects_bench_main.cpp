@@ -109,9 +109,9 @@ int main(int argc, char** argv) {
 
   std::vector<EffectResult> results;
   using Sweep = se::Result<EffectResult> (*)(FrameDriver&, const SweepPlan&);
-  const std::pair<rbAdapter::Effect, Sweep> sweeps[] = {{rbAdapter::kEffectShadows, runShadowSweep},
-                                                        {rbAdapter::kEffectAo, runAoSweep},
-                                                        {rbAdapter::kEffectReflections, runReflectionSweep}};
+  const std::pair<rb::EffectBits, Sweep> sweeps[] = {{rb::kEffectShadows, runShadowSweep},
+                                                        {rb::kEffectAo, runAoSweep},
+                                                        {rb::kEffectReflections, runReflectionSweep}};
   for (auto [flag, sweep] : sweeps) {
     if (!(o.effects & flag)) continue;
     auto r = sweep(driver, plan);

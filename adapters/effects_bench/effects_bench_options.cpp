@@ -1,32 +1,26 @@
-// Command-line parsing of raybridge-effects-bench (see the header).
+// Command-line parsing of raybridge-effects-bench, through CLI11 (see the header and
+// samples/common/cli_support.h).
 #include "effects_bench_options.h"
 
-#include <charconv>
-#include <cstdlib>
-#include <string_view>
+#include <vector>
+
+#include "cli_support.h"
 
 namespace rbEffects {
 
 namespace {
 
-bool parseUint(std::string_view text, uint32_t& out) {
-  const char* end = text.data() + text.size();
-  auto [p, ec] = std::from_chars(text.data(), end, out);
-  return ec == std::errc() && p == end;
-}
+const std::vector<std::string> kEffectNames = {"shadows", "ao", "reflections"};  // bit i = name i
+static_assert(rb::kEffectShadows == 1 && rb::kEffectAo == 2 && rb::kEffectReflections == 4);
+constexpr uint64_t kMaxReferenceRays = 1u << 20;
 
-bool parseFloat(const std::string& text, float& out) {
-  char* end = nullptr;
-  out = std::strtof(text.c_str(), &end);
-  return !text.empty() && end == text.c_str() + text.size();
-}
-
-// "N" (every effect) or "shadows=N,ao=N,reflections=N" (any subset).
-std::string parseReferenceRays(std::string_view text, Options& o) {
-  uint32_t all = 0;
-  if (parseUint(text, all)) {
-    if (all == 0) return "--reference-rays: must be at least 1";
-    o.referenceRaysShadows = o.referenceRaysAo = o.referenceRaysReflections = all;
+// "N" (every effect) or "shadows=N,ao=N,reflections=N" (any subset); "" or an error without the option name.
+std::string parseReferenceRays(std::string_view text, Options* o) {
+  if (text.find('=') == std::string_view::npos) {
+    uint64_t all = 0;
+    if (std::string e = rbCli::parseWholeNumber(text, 1, kMaxReferenceRays, all); !e.empty())
+      return e + " (or EFFECT=N,...)";
+    if (o) o->referenceRaysShadows = o->referenceRaysAo = o->referenceRaysReflections = uint32_t(all);
     return {};
   }
   while (!text.empty()) {
@@ -34,90 +28,100 @@ std::string parseReferenceRays(std::string_view text, Options& o) {
     const std::string_view item = text.substr(0, comma);
     text = comma == std::string_view::npos ? std::string_view() : text.substr(comma + 1);
     const size_t eq = item.find('=');
-    uint32_t n = 0;
-    if (eq == std::string_view::npos || !parseUint(item.substr(eq + 1), n) || n == 0)
-      return "--reference-rays: bad item '" + std::string(item) + "' (want N or EFFECT=N,...)";
+    uint64_t n = 0;
+    if (eq == std::string_view::npos || !rbCli::parseWholeNumber(item.substr(eq + 1), 1, kMaxReferenceRays, n).empty())
+      return "bad item " + rbCli::quote(item) + " (want N or EFFECT=N,... with N in 1.." +
+             std::to_string(kMaxReferenceRays) + ")";
     const std::string_view name = item.substr(0, eq);
-    if (name == "shadows") o.referenceRaysShadows = n;
-    else if (name == "ao") o.referenceRaysAo = n;
-    else if (name == "reflections") o.referenceRaysReflections = n;
-    else return "--reference-rays: unknown effect '" + std::string(name) + "'";
+    if (name == "shadows") {
+      if (o) o->referenceRaysShadows = uint32_t(n);
+    } else if (name == "ao") {
+      if (o) o->referenceRaysAo = uint32_t(n);
+    } else if (name == "reflections") {
+      if (o) o->referenceRaysReflections = uint32_t(n);
+    } else {
+      return "unknown effect " + rbCli::quote(name) + " (shadows, ao, reflections)";
+    }
   }
   return {};
+}
+
+void addOptions(CLI::App& app, Options& o) {
+  rbCli::prepare(app);
+  app.description(
+      "For each effect: sweeps traced rays per pixel (raw and denoised) and the raster counterpart's\n"
+      "resolution or kernel, times each setting with GPU timestamps (median of --frames frames) and measures\n"
+      "its error (RMSE over surface pixels) against a converged reference traced by Raybridge.");
+  app.footer("Defaults: 1920x1080 on a GPU, 320x180 on a CPU device; --quick: tiny size, few settings, and checks.");
+  app.add_option("--scenario", o.scenario, "what to measure (default and only: speed-vs-error)")
+      ->type_name("NAME")
+      ->check(rbCli::oneOf({"speed-vs-error"}));
+  app.add_option_function<std::string>(
+         "--effects",
+         [&o](const std::string& value) { rbCli::parseNameSet(value, kEffectNames, "an effect", o.effects); },
+         "effects to sweep, comma-separated (default shadows,ao,reflections)")
+      ->type_name("LIST")
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            uint32_t set = 0;
+            std::string e = rbCli::parseNameSet(value, kEffectNames, "an effect", set);
+            return !e.empty() ? e
+                   : set == 0 ? std::string("no effect given (shadows, ao, reflections)")
+                              : std::string();
+          },
+          ""));
+  app.add_option_function<uint32_t>(
+         "--width", [&o](const uint32_t& v) { o.width = v; }, "image width, with --height (default: see below)")
+      ->type_name("W")
+      ->check(rbCli::wholeNumber(16, 16384));
+  app.add_option_function<uint32_t>(
+         "--height", [&o](const uint32_t& v) { o.height = v; }, "image height")
+      ->type_name("H")
+      ->check(rbCli::wholeNumber(16, 16384));
+  app.add_option("--out", o.out, "JSON report (default: none)")->type_name("FILE.json");
+  app.add_option("--images", o.images, "folder for the PNGs (FLIP input; default: none)")->type_name("DIR");
+  app.add_option_function<std::string>(
+         "--reference-rays", [&o](const std::string& value) { parseReferenceRays(value, &o); },
+         "total rays per pixel of each effect's reference (default: chosen from the\n"
+         "device and --quick)")
+      ->type_name("N|shadows=N,ao=N,reflections=N")
+      ->check(CLI::Validator([](std::string& value) { return parseReferenceRays(value, nullptr); }, ""));
+  app.add_option("--raw-rate-json", o.rawRateJson, "raybridge-bench JSON with the gigarays scenario")
+      ->type_name("BENCH.json");
+  app.add_option_function<uint32_t>(
+         "--frames", [&o](const uint32_t& v) { o.timedFrames = v; },
+         "frames whose median is reported (default 7 on a GPU, 3 on a CPU)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(1, 100000));
+  app.add_option("--ao-range", o.aoRange, "world units: the traced AO range and the SSAO radius (default 1)")
+      ->type_name("R")
+      ->check(rbCli::realNumber(rbCli::above(0.0), rbCli::unbounded(), " (world units)"));
+  app.add_option("--reflection-roughness", o.reflectionRoughness,
+                 "traced reflections' threshold, 1 = every surface traces (default 1)")
+      ->type_name("T")
+      ->check(rbCli::realNumber(rbCli::above(0.0), rbCli::atMost(1.0)));
+  app.add_flag("--quick", o.quick, "tiny size, few settings, and checks (a smoke run)");
+  app.add_option("--device", o.device, "pick the Vulkan device whose name contains SUBSTR")->type_name("SUBSTR");
+  app.add_flag("--validation", o.validation, "enable VK_LAYER_KHRONOS_validation (also RAYBRIDGE_VALIDATION=1)");
 }
 
 }  // namespace
 
 const char* usage() {
-  return "usage: raybridge-effects-bench [--scenario speed-vs-error] [--effects shadows,ao,reflections]\n"
-         "                               [--width W --height H] [--out FILE.json] [--images DIR]\n"
-         "                               [--reference-rays N | shadows=N,ao=N,reflections=N]\n"
-         "                               [--raw-rate-json BENCH.json] [--frames N] [--ao-range R]\n"
-         "                               [--reflection-roughness T] [--quick] [--device SUBSTR] [--validation]\n"
-         "For each effect: sweeps traced rays per pixel (raw and denoised) and the raster counterpart's\n"
-         "resolution or kernel, times each setting with GPU timestamps (median of --frames frames) and measures\n"
-         "its error (RMSE over surface pixels) against a converged reference traced by Raybridge.\n"
-         "Defaults: 1920x1080 on a GPU, 320x180 on a CPU device; --quick: tiny size, few settings, and checks.\n";
+  static const std::string help = [] {
+    Options unused;
+    CLI::App app{"", "raybridge-effects-bench"};
+    addOptions(app, unused);
+    return app.help();
+  }();
+  return help.c_str();
 }
 
 std::string parseOptions(int argc, char** argv, Options& o) {
-  for (int i = 0; i < argc; ++i) {
-    if (i) o.commandLine.push_back(' ');
-    o.commandLine.append(argv[i]);
-  }
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](std::string& out) -> bool {
-      if (i + 1 >= argc) return false;
-      out = argv[++i];
-      return true;
-    };
-    std::string v;
-    auto needValue = [&]() { return arg + ": missing value"; };
-    auto uintArg = [&](std::optional<uint32_t>& out, uint32_t min) -> std::string {
-      uint32_t n = 0;
-      if (!value(v)) return needValue();
-      if (!parseUint(v, n) || n < min) return arg + ": bad value '" + v + "'";
-      out = n;
-      return {};
-    };
-    std::string e;
-    if (arg == "--help" || arg == "-h") o.help = true;
-    else if (arg == "--quick") o.quick = true;
-    else if (arg == "--validation") o.validation = true;
-    else if (arg == "--scenario") {
-      if (!value(o.scenario)) return needValue();
-      if (o.scenario != "speed-vs-error") return "--scenario: unknown scenario '" + o.scenario + "' (only speed-vs-error)";
-    } else if (arg == "--effects") {
-      if (!value(v)) return needValue();
-      if (std::string err = rbAdapter::parseEffects(v, o.effects); !err.empty()) return "--effects: " + err;
-      if (o.effects == 0) return "--effects: no effect given";
-    } else if (arg == "--width") e = uintArg(o.width, 16);
-    else if (arg == "--height") e = uintArg(o.height, 16);
-    else if (arg == "--frames") e = uintArg(o.timedFrames, 1);
-    else if (arg == "--out") {
-      if (!value(o.out)) return needValue();
-    } else if (arg == "--images") {
-      if (!value(o.images)) return needValue();
-    } else if (arg == "--raw-rate-json") {
-      if (!value(o.rawRateJson)) return needValue();
-    } else if (arg == "--device") {
-      if (!value(o.device)) return needValue();
-    } else if (arg == "--reference-rays") {
-      if (!value(v)) return needValue();
-      e = parseReferenceRays(v, o);
-    } else if (arg == "--ao-range") {
-      if (!value(v)) return needValue();
-      if (!parseFloat(v, o.aoRange) || !(o.aoRange > 0.0f)) return "--ao-range: bad value '" + v + "'";
-    } else if (arg == "--reflection-roughness") {
-      if (!value(v)) return needValue();
-      if (!parseFloat(v, o.reflectionRoughness) || !(o.reflectionRoughness > 0.0f) || o.reflectionRoughness > 1.0f)
-        return "--reflection-roughness: bad value '" + v + "' (want (0, 1])";
-    } else {
-      return "unknown option '" + arg + "'";
-    }
-    if (!e.empty()) return e;
-  }
+  o.commandLine = rbCli::commandLine(argc, argv);
+  CLI::App app{"", "raybridge-effects-bench"};
+  addOptions(app, o);
+  if (std::string e = rbCli::parse(app, argc, argv, o.help); !e.empty() || o.help) return e;
   if (o.width.has_value() != o.height.has_value()) return "--width and --height go together";
   return {};
 }

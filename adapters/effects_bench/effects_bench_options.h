@@ -5,20 +5,20 @@
 #include <optional>
 #include <string>
 
-#include "raybridge_sample_engine_adapter.h"
+#include <raybridge/presets.h>
 
 namespace rbEffects {
 
 struct Options {
   std::string scenario = "speed-vs-error";
-  rbAdapter::EffectSet effects = rbAdapter::kAllEffects;
+  rb::EffectSet effects = rb::kAllEffects;
   // Empty: 1920x1080 on a GPU, 320x180 on a CPU device (lavapipe); --quick: 160x90.
   std::optional<uint32_t> width, height;
   std::string out;     // JSON file; empty = none
   std::string images;  // folder for the PNGs (FLIP input); empty = none
   // Total rays per pixel of each effect's reference; unset = defaults chosen from the device and --quick.
   std::optional<uint32_t> referenceRaysShadows, referenceRaysAo, referenceRaysReflections;
-  std::string rawRateJson;  // raybridge-bench JSON with the gigarays scenario
+  std::string rawRateJson;              // raybridge-bench JSON with the gigarays scenario
   std::optional<uint32_t> timedFrames;  // frames whose median is reported; unset = 7 on a GPU, 3 on a CPU
   float aoRange = 1.0f;                 // world units: the traced AO range and the SSAO radius
   float reflectionRoughness = 1.0f;     // traced reflections threshold: 1 = every surface traces
@@ -29,8 +29,10 @@ struct Options {
   std::string commandLine;  // as given, for the JSON
 };
 
-// Parses argv; returns an error naming the problem, or "" on success.
+// Parses argv; returns an error naming the option and the bad value, or "" on success (options.help is set for
+// -h/--help).
 std::string parseOptions(int argc, char** argv, Options& options);
+// The help CLI11 generates for these options.
 const char* usage();
 
 }  // namespace rbEffects

@@ -31,7 +31,6 @@ se::Result<std::unique_ptr<FrameDriver>> FrameDriver::create(const Config& confi
   auto adapter = rbAdapter::Adapter::create(e, {});
   if (!adapter) return R::failure("adapter: " + adapter.error);
   d->adapter_ = std::move(adapter.value);
-  d->adapter_->settings().lightingFrom(d->base_);
   auto capture = rbRender::FrameCapture::create(e);
   if (!capture) return R::failure(capture.error);
   d->capture_ = std::move(capture.value);
@@ -41,10 +40,10 @@ se::Result<std::unique_ptr<FrameDriver>> FrameDriver::create(const Config& confi
     self->adapter_->recordFrame(info, inputs);
     if (!self->captureNext_) return;
     self->captureNext_ = false;
-    const rbAdapter::FrameImages& fi = self->adapter_->lastImages();
-    const std::vector<rbRender::CaptureImage> images = {{"shadow_raw", fi.shadowRaw, 1}, {"shadow", fi.shadow, 1},
-                                                        {"ao_raw", fi.aoRaw, 1},         {"ao", fi.ao, 1},
-                                                        {"reflection", fi.reflection, 4}};
+    const rb::HybridOutputs& fo = self->adapter_->effects().outputs();
+    const std::vector<rbRender::CaptureImage> images = {{"shadow_raw", fo.shadowRaw.image, 1}, {"shadow", fo.shadow.image, 1},
+                                                        {"ao_raw", fo.aoRaw.image, 1},         {"ao", fo.ao.image, 1},
+                                                        {"reflection", fo.reflection.image, 4}};
     if (se::Status s = self->capture_->record(info, info.normalRoughness, images); !s) self->captureError_ = s.error;
   });
   return R::success(std::move(d));
@@ -64,11 +63,11 @@ se::Status FrameDriver::setRenderSize(uint32_t width, uint32_t height) { return 
 se::Status FrameDriver::finishFrame(FrameSample* sample) {
   if (se::Status s = engine_->waitIdle(); !s) return s;
   // The device is idle: the SDK may read every timestamp and ray counter recorded so far.
-  adapter_->releaseAfterIdle();
+  adapter_->context().releaseAfterIdle();
   if (!adapter_->lastError().empty()) return se::Status::failure("Raybridge: " + adapter_->lastError());
   if (sample) {
     sample->engine = engine_->lastTimings();
-    sample->passes = adapter_->stats();
+    sample->passes = adapter_->effects().stats();
   }
   return se::Status::success();
 }

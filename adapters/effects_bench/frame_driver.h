@@ -18,7 +18,7 @@ namespace rbEffects {
 // One timed frame: the engine's pass timings and the adapter's pass statistics of that same frame.
 struct FrameSample {
   sample_engine::PassTimings engine;
-  rbAdapter::EffectStats passes;
+  rb::HybridStats passes;
   // Engine passes of a steady-state frame: the optional shadow-visibility output and the one-time probe
   // capture are left out (the first is a readback aid, the second is reported on its own).
   double frameMs() const {

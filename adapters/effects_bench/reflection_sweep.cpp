@@ -40,20 +40,25 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
     };
   };
 
-  if (se::Status st = adapter.setEffects(rbAdapter::kEffectReflections); !st) return R::failure(st.error);
-  s.enabled = true;
-  s.lightingFrom(base);
+  rb::HybridEffectsDesc desc;
+  desc.effects = rb::kEffectReflections;
   // Every surface traces (threshold 1 by default): the engine treats untraced pixels as reflecting nothing, so a
   // lower threshold would make the reference itself wrong on rough surfaces.
-  s.reflectionRoughnessThreshold = plan.reflectionRoughness;
+  desc.reflections.roughnessThreshold = plan.reflectionRoughness;
+  auto apply = [&](uint32_t rays) {
+    desc.reflections.raysPerPixel = rays;
+    rb::Status st = adapter.effects().setDesc(desc);
+    return st ? se::Status::success() : se::Status::failure("HybridEffects::setDesc: " + st.error().message);
+  };
+  s.enabled = true;
   const uint32_t perFrame = std::min(plan.referenceReflections, kReferenceRaysPerFrame);
-  s.reflectionRaysPerPixel = perFrame;
+  if (se::Status st = apply(perFrame); !st) return R::failure(st.error);
   const uint32_t frames = (plan.referenceReflections + perFrame - 1) / perFrame;
   result.reference.raysPerFrame = perFrame;
   progress("reflections: reference, %u rays per pixel (%u frames of %u)", plan.referenceReflections, frames, perFrame);
   auto ref = traceReference(
       driver, base, frames, 3, [&](const rbRender::CapturedFrame&) { return hdrRgb(driver.engine()); },
-      &rbAdapter::EffectStats::reflection, result.reference);
+      &rb::HybridStats::reflection, result.reference);
   if (!ref) return R::failure("reflections reference: " + ref.error);
   const std::vector<uint8_t>& mask = ref.value.mask;
   result.surfacePixels = countSet(mask);
@@ -82,7 +87,7 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
 
   // Traced rows (the reflection is not denoised: raw only).
   for (uint32_t n : plan.reflectionRays) {
-    s.reflectionRaysPerPixel = n;
+    if (se::Status st = apply(n); !st) return R::failure(st.error);
     auto samples = driver.run(base, plan.warmupFrames, plan.timedFrames);
     if (!samples) return R::failure(samples.error);
     if (auto cap = driver.capture(base); !cap) return R::failure(cap.error);
@@ -93,7 +98,7 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
     row.setting = std::to_string(n) + (n == 1 ? " ray" : " rays");
     row.id = "traced_raw_r" + std::to_string(n);
     row.params = {{"rays_per_pixel", n}, {"roughness_threshold", plan.reflectionRoughness}};
-    const PassResult pass = passMedian(samples.value, "reflection", &rbAdapter::EffectStats::reflection);
+    const PassResult pass = passMedian(samples.value, "reflection", &rb::HybridStats::reflection);
     row.passes = {pass};
     row.effectMs = pass.gpuMs;
     row.effectMsOf = "reflection";

@@ -9,7 +9,7 @@
 namespace rbEffects {
 
 namespace se = sample_engine;
-using Stats = rbAdapter::EffectStats;
+using Stats = rb::HybridStats;
 
 namespace {
 
@@ -22,14 +22,14 @@ struct RasterSetting {
 // Everything that differs between the shadow and the AO sweep.
 struct ScalarEffect {
   std::string name, compared, effectMsNote;
-  rbAdapter::Effect flag{};
+  rb::EffectBits flag{};
   const char* passName = "";
   const char* denoiseName = "";
   rb::PassStats Stats::*pass = nullptr;
   rb::PassStats Stats::*denoise = nullptr;
   const char* rawImage = "";       // capture names (FrameDriver::capture)
   const char* denoisedImage = "";
-  std::function<void(rbAdapter::FrameSettings&, uint32_t)> setRays;
+  std::function<void(rb::HybridEffectsDesc&, uint32_t)> setRays;
   std::vector<uint32_t> rays;
   uint32_t referenceRays = 0;
   se::FrameParams tracedParams;  // engine parameters of traced rows and of the reference
@@ -55,15 +55,21 @@ se::Result<EffectResult> runScalarSweep(FrameDriver& driver, const SweepPlan& pl
   result.effectMsNote = fx.effectMsNote;
   rbAdapter::Adapter& adapter = driver.adapter();
   rbAdapter::FrameSettings& s = adapter.settings();
+  rb::HybridEffectsDesc desc;  // what the traced rows run, applied before each run
+  auto apply = [&](bool denoise, uint32_t rays) {
+    desc.effects = fx.flag;
+    desc.shadows.disableDenoiser = desc.ao.disableDenoiser = !denoise;
+    fx.setRays(desc, rays);
+    rb::Status st = adapter.effects().setDesc(desc);
+    return st ? se::Status::success() : se::Status::failure("HybridEffects::setDesc: " + st.error().message);
+  };
   const uint32_t w = plan.width, h = plan.height;
   auto grey = [&](const std::vector<float>& v) { return [&v, w, h](const std::string& p) { return writeGreyPng(p, v, w, h); }; };
 
   // Reference: the raw traced buffer, many rays per frame, no denoiser, averaged over frames.
-  if (se::Status st = adapter.setEffects(fx.flag); !st) return R::failure(st.error);
   s.enabled = true;
-  s.denoise = false;
   const uint32_t perFrame = std::min(fx.referenceRays, kReferenceRaysPerFrame);
-  fx.setRays(s, perFrame);
+  if (se::Status st = apply(false, perFrame); !st) return R::failure(st.error);
   result.reference.raysPerFrame = perFrame;
   progress("%s: reference, %u rays per pixel (%u frames of %u)", fx.name.c_str(), fx.referenceRays,
            (fx.referenceRays + perFrame - 1) / perFrame, perFrame);
@@ -100,13 +106,12 @@ se::Result<EffectResult> runScalarSweep(FrameDriver& driver, const SweepPlan& pl
 
   // Traced rows: one run per ray count gives both the raw and the denoised row (the raw image stays available).
   for (uint32_t n : fx.rays) {
-    s.denoise = true;
-    fx.setRays(s, n);
+    if (se::Status st = apply(true, n); !st) return R::failure(st.error);
     auto samples = driver.run(fx.tracedParams, plan.warmupFrames, plan.timedFrames);
     if (!samples) return R::failure(samples.error);
     // Single-frame denoising: the history is reset so that the capture frame's output uses that frame's rays
     // only (a static camera would otherwise accumulate the timed frames, which a moving camera cannot).
-    adapter.resetHistory();
+    adapter.effects().resetHistory();
     auto cap = driver.capture(fx.tracedParams);
     if (!cap) return R::failure(cap.error);
     const PassResult pass = passMedian(samples.value, fx.passName, fx.pass);
@@ -163,7 +168,7 @@ se::Result<EffectResult> runShadowSweep(FrameDriver& driver, const SweepPlan& pl
   fx.effectMsNote =
       "traced: ShadowPass (+ Denoiser) GPU ms; raster: the shadow-map pass only (the PCF lookups run inside the "
       "lighting pass and cannot be timed apart: compare frame ms too)";
-  fx.flag = rbAdapter::kEffectShadows;
+  fx.flag = rb::kEffectShadows;
   fx.passName = "shadow";
   fx.denoiseName = "shadow_denoise";
   fx.pass = &Stats::shadow;
@@ -171,9 +176,9 @@ se::Result<EffectResult> runShadowSweep(FrameDriver& driver, const SweepPlan& pl
   fx.rawImage = "shadow_raw";
   fx.denoisedImage = "shadow";
   const float radius = plan.sunRadiusDegrees;
-  fx.setRays = [radius](rbAdapter::FrameSettings& s, uint32_t n) {
-    s.sunAngularRadiusDegrees = radius;
-    s.shadowRaysPerPixel = n;
+  fx.setRays = [radius](rb::HybridEffectsDesc& d, uint32_t n) {
+    d.shadows.softAngularRadiusDegrees = radius;  // one ray too samples the disk (a noisy soft shadow, not hard)
+    d.shadows.raysPerPixel = n;
   };
   fx.rays = plan.shadowRays;
   fx.referenceRays = plan.referenceShadows;
@@ -206,7 +211,7 @@ se::Result<EffectResult> runAoSweep(FrameDriver& driver, const SweepPlan& plan) 
   fx.name = "ao";
   fx.compared = "ambient-occlusion open fraction (1 = open), surface pixels";
   fx.effectMsNote = "traced: AoPass (+ Denoiser) GPU ms; raster: the SSAO pass with its blur";
-  fx.flag = rbAdapter::kEffectAo;
+  fx.flag = rb::kEffectAo;
   fx.passName = "ao";
   fx.denoiseName = "ao_denoise";
   fx.pass = &Stats::ao;
@@ -214,10 +219,10 @@ se::Result<EffectResult> runAoSweep(FrameDriver& driver, const SweepPlan& plan) 
   fx.rawImage = "ao_raw";
   fx.denoisedImage = "ao";
   const float range = plan.aoRange;
-  fx.setRays = [range](rbAdapter::FrameSettings& s, uint32_t n) {
-    s.aoRaysPerPixel = n;
-    s.aoRange = range;
-    s.aoEstimator = rb::AoEstimator::Binary;  // the SSAO counterpart is binary too (occluded or not)
+  fx.setRays = [range](rb::HybridEffectsDesc& d, uint32_t n) {
+    d.ao.raysPerPixel = n;
+    d.ao.range = range;
+    d.ao.estimator = rb::AoEstimator::Binary;  // the SSAO counterpart is binary too (occluded or not)
   };
   fx.rays = plan.aoRays;
   fx.referenceRays = plan.referenceAo;

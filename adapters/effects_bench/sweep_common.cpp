@@ -48,7 +48,7 @@ nlohmann::json engineMedians(const std::vector<FrameSample>& samples) {
 }
 
 PassResult passMedian(const std::vector<FrameSample>& samples, const char* name,
-                      rb::PassStats rbAdapter::EffectStats::*member) {
+                      rb::PassStats rb::HybridStats::*member) {
   PassResult p;
   p.name = name;
   p.gpuMs = medianOf(samples, [member](const FrameSample& s) { return (s.passes.*member).gpuMs; });
@@ -58,7 +58,7 @@ PassResult passMedian(const std::vector<FrameSample>& samples, const char* name,
 
 se::Result<ReferenceImage> traceReference(FrameDriver& driver, const se::FrameParams& params, uint32_t frames,
                                           uint32_t channels, const Extract& extract,
-                                          rb::PassStats rbAdapter::EffectStats::*counted, Reference& out) {
+                                          rb::PassStats rb::HybridStats::*counted, Reference& out) {
   using R = se::Result<ReferenceImage>;
   const auto start = std::chrono::steady_clock::now();
   // Two untimed frames first: BLAS builds, pass creation and pipeline compilation are not part of any sample.

@@ -38,7 +38,7 @@ double medianOf(const std::vector<FrameSample>& samples, const std::function<dou
 nlohmann::json engineMedians(const std::vector<FrameSample>& samples);
 // Median GPU ms and rays of one SDK pass.
 PassResult passMedian(const std::vector<FrameSample>& samples, const char* name,
-                      rb::PassStats rbAdapter::EffectStats::*member);
+                      rb::PassStats rb::HybridStats::*member);
 
 // Traces the converged reference: frames of `params` (the adapter set up by the caller), each with fresh
 // noise (the SDK seeds its samplers per frame), the extracted values averaged on the CPU. Also returns the
@@ -50,7 +50,7 @@ struct ReferenceImage {
 using Extract = std::function<sample_engine::Result<std::vector<float>>(const rbRender::CapturedFrame&)>;
 sample_engine::Result<ReferenceImage> traceReference(FrameDriver& driver, const sample_engine::FrameParams& params,
                                                      uint32_t frames, uint32_t channels, const Extract& extract,
-                                                     rb::PassStats rbAdapter::EffectStats::*counted, Reference& out);
+                                                     rb::PassStats rb::HybridStats::*counted, Reference& out);
 
 // Writes `<imagesDir>/<effect>/<id>.png` with `write` and returns the path relative to imagesDir ("" when no
 // images are written).

@@ -150,31 +150,25 @@ int main(int argc, char** argv) {
   params.sun.direction = glm::normalize(params.sun.direction);
 
   const ResolvedEffects fx = resolve(o);
-  const bool wantShadows = fx.effects & rbAdapter::kEffectShadows, wantAo = fx.effects & rbAdapter::kEffectAo,
-             wantReflections = fx.effects & rbAdapter::kEffectReflections;
+  const rb::EffectSet effects = fx.hybrid.effects;
+  const bool wantShadows = effects & rb::kEffectShadows, wantAo = effects & rb::kEffectAo,
+             wantReflections = effects & rb::kEffectReflections;
   std::unique_ptr<rbAdapter::Adapter> adapter;
   if (hybrid) {
     rbAdapter::AdapterConfig ac;
-    ac.effects = fx.effects;
-    ac.normals = o.geometricNormals ? rbAdapter::GBufferNormals::Geometric : rbAdapter::GBufferNormals::Shading;
+    ac.effects = fx.hybrid;
+    ac.geometricNormals = o.geometricNormals;
     ac.accelerationStructures.dynamicMode = o.dynamicMode;
     auto a = rbAdapter::Adapter::create(engine, ac);
     if (!a) return fail("adapter: " + a.error);
     adapter = std::move(a.value);
-    rbAdapter::FrameSettings& s = adapter->settings();
-    s.denoise = o.denoise;
-    s.sunAngularRadiusDegrees = fx.sunRadiusDegrees;
-    s.shadowRaysPerPixel = fx.shadowRays;
-    s.aoRaysPerPixel = fx.aoRays;
-    s.aoRange = fx.aoRange;
-    s.aoEstimator = o.aoEstimator;
-    s.reflectionRoughnessThreshold = fx.reflectionRoughness;
-    s.reflectionRaysPerPixel = fx.reflectionRays;
-    s.lightingFrom(params);
   } else {
-    // The engine's own counterparts of the effects (its shadow map is always on).
+    // The engine's own counterparts of the effects: the preset's shadow map and PCF, SSAO, the probe.
+    params.shadow.enabled = fx.raster.mapSize > 0;
+    if (fx.raster.mapSize) params.shadow.mapSize = fx.raster.mapSize;
+    params.shadow.pcfKernelSize = fx.raster.pcfKernel ? fx.raster.pcfKernel : 1u;  // 0 = one hardware 2x2 tap
     params.ssao.enabled = wantAo;
-    params.ssao.radius = fx.aoRange;
+    params.ssao.radius = fx.hybrid.ao.range ? fx.hybrid.ao.range : rb::kDefaultAoRange;
     params.reflectionProbe.enabled = wantReflections;
     params.outputShadowVisibility = o.dump;
   }
@@ -195,9 +189,10 @@ int main(int argc, char** argv) {
     const bool geometric = o.geometricNormals;
     std::vector<CaptureImage> images;
     if (adapter) {
-      const rbAdapter::FrameImages& fi = adapter->lastImages();
-      images = {{"shadow", fi.shadow, 1}, {"ao", fi.ao, 1}, {"ao_raw", fi.aoRaw, 1}, {"reflection", fi.reflection, 4}};
-      if (fi.shadowRaw != fi.shadow) images.push_back({"shadow_raw", fi.shadowRaw, 1});  // denoised soft shadows
+      const rb::HybridOutputs& fo = adapter->effects().outputs();
+      images = {{"shadow", fo.shadow.image, 1}, {"ao", fo.ao.image, 1}, {"ao_raw", fo.aoRaw.image, 1},
+                {"reflection", fo.reflection.image, 4}};
+      if (fo.shadowRaw.image != fo.shadow.image) images.push_back({"shadow_raw", fo.shadowRaw.image, 1});  // denoised
     }
     if (se::Status s = capture->record(info, geometric ? info.geometricNormal : info.normalRoughness, images); !s)
       captureError = s.error;
@@ -258,21 +253,31 @@ int main(int argc, char** argv) {
   stats["camera"] = {{"eye", vec(params.camera.eye)},     {"target", vec(params.camera.target)},
                      {"fovy_degrees", params.camera.fovYDegrees}, {"z_near", params.camera.zNear},
                      {"z_far", params.camera.zFar},        {"source", cameraSource}};
+  const rb::HybridEffectsDesc& hd = fx.hybrid;
+  const uint32_t shadowRays = hd.shadows.raysPerPixel ? hd.shadows.raysPerPixel : 1u;  // the engine's sun has no size
   stats["sun"] = {{"direction", vec(params.sun.direction)},
                   {"angular_radius_degrees", hybrid && wantShadows ? fx.sunRadiusDegrees : 0.0f},
-                  {"rays_per_pixel", hybrid && wantShadows ? fx.shadowRays : 0u}};
-  stats["preset"] = rbAdapter::toString(o.preset);
-  stats["effects"] = {{"enabled", rbAdapter::effectsToString(fx.effects)},
-                      {"denoise", o.denoise},
-                      {"ao_rays_per_pixel", wantAo ? fx.aoRays : 0u},
-                      {"ao_range", fx.aoRange},
-                      {"ao_estimator", o.aoEstimator == rb::AoEstimator::Binary ? "binary" : "distance"},
-                      {"reflection_roughness_threshold", fx.reflectionRoughness},
-                      {"reflection_rays_per_pixel", wantReflections ? fx.reflectionRays : 0u}};
-  if (!hybrid)
-    stats["effects"]["raster_counterparts"] = {{"shadows", "shadow map (always on)"},
-                                               {"ao", wantAo ? "SSAO" : "off"},
-                                               {"reflections", wantReflections ? "reflection probe" : "constant sky"}};
+                  {"rays_per_pixel", hybrid && wantShadows ? shadowRays : 0u}};
+  stats["preset"] = rb::toString(o.preset);
+  stats["effects"] = {
+      {"enabled", effectSetToString(effects)},
+      {"denoise", o.denoise},
+      {"ao_rays_per_pixel", wantAo ? (hd.ao.raysPerPixel ? hd.ao.raysPerPixel : rb::kDefaultAoRays) : 0u},
+      {"ao_range", hd.ao.range ? hd.ao.range : rb::kDefaultAoRange},
+      {"ao_estimator", hd.ao.estimator == rb::AoEstimator::Binary ? "binary" : "distance"},
+      {"reflection_roughness_threshold",
+       hd.reflections.roughnessThreshold ? hd.reflections.roughnessThreshold : rb::kDefaultReflectionRoughnessThreshold},
+      {"reflection_rays_per_pixel",
+       wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays) : 0u}};
+  if (!hybrid) {
+    const se::ShadowMapStats sm = engine.lastShadowMapStats();
+    stats["effects"]["raster_counterparts"] = {
+        {"shadows", sm.enabled ? "shadow map" : "none (unshadowed sun)"},
+        {"shadow_map_size", sm.enabled ? sm.mapSize : 0u},
+        {"pcf_kernel", sm.enabled ? sm.pcfKernel : 0u},
+        {"ao", wantAo ? "SSAO" : "off"},
+        {"reflections", wantReflections ? "reflection probe" : "constant sky"}};
+  }
   stats["engine_gpu_ms"] = {{"valid", timings.valid},         {"shadow_map", timings.shadowMs},
                             {"probe", timings.probeMs},       {"ssao", timings.ssaoMs},
                             {"shadow_visibility_output", timings.shadowVisibilityMs},
@@ -288,7 +293,8 @@ int main(int argc, char** argv) {
     const rb::DeviceInfo& di = adapter->context().deviceInfo();
     stats["device"]["driver"] = di.driverName;
     stats["device"]["driver_info"] = di.driverInfo;
-    const rbAdapter::EffectStats es = adapter->stats();
+    const rb::HybridEffects& fxo = adapter->effects();
+    const rb::HybridStats es = fxo.stats();
     const rb::AsStats as = adapter->accelerationStructures().stats();
     double buildMs = 0.0;
     for (const rb::BuildBatchTiming& b : as.batches) buildMs += b.gpuMs;
@@ -300,12 +306,12 @@ int main(int argc, char** argv) {
     nlohmann::json passes = nlohmann::json::object();
     uint64_t rays = 0;
     const std::pair<const char*, const rb::PassStats*> all[] = {
-        {"shadow", adapter->shadowPass() ? &es.shadow : nullptr},
-        {"shadow_denoise", adapter->shadowDenoiser() ? &es.shadowDenoise : nullptr},
-        {"ao", adapter->aoPass() ? &es.ao : nullptr},
-        {"ao_denoise", adapter->aoDenoiser() ? &es.aoDenoise : nullptr},
-        {"reflection", adapter->reflectionPass() ? &es.reflection : nullptr}};
-    std::printf("Raybridge (%s):", rbAdapter::effectsToString(fx.effects).c_str());
+        {"shadow", fxo.shadowPass() ? &es.shadow : nullptr},
+        {"shadow_denoise", fxo.shadowDenoiser() ? &es.shadowDenoise : nullptr},
+        {"ao", fxo.aoPass() ? &es.ao : nullptr},
+        {"ao_denoise", fxo.aoDenoiser() ? &es.aoDenoise : nullptr},
+        {"reflection", fxo.reflectionPass() ? &es.reflection : nullptr}};
+    std::printf("Raybridge (%s):", effectSetToString(effects).c_str());
     for (const auto& [name, p] : all) {
       if (!p) continue;
       passes[name] = {{"gpu_ms", p->gpuMs}, {"rays", p->rays}, {"rays_per_second", p->raysPerSecond()}, {"frame", p->frame}};
@@ -322,8 +328,8 @@ int main(int argc, char** argv) {
          {{"blas_build_gpu_ms", buildMs}, {"build_batches", as.batches.size()}, {"blas_count", as.blasCount},
           {"blas_triangles", as.triangles}, {"blas_bytes", as.blasBytes}, {"tlas_bytes", as.tlasBytes},
           {"scratch_bytes", as.scratchBytes}, {"storage_block_bytes", as.storageBlockBytes},
-          {"dedup_hits", as.dedupHits}, {"tlas_instances", adapter->lastTlas().instanceCount},
-          {"tlas_skipped_instances", adapter->lastTlas().skippedInstances},
+          {"dedup_hits", as.dedupHits}, {"tlas_instances", fxo.lastTlas().instanceCount},
+          {"tlas_skipped_instances", fxo.lastTlas().skippedInstances},
           {"dynamic_builds", o.dynamicMode == rb::DynamicBuildMode::InFrame          ? "in-frame"
                              : o.dynamicMode == rb::DynamicBuildMode::AsyncSameFrame ? "async"
                                                                                      : "async-late"},

@@ -4,10 +4,14 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
-#include "raybridge_sample_engine_adapter.h"
+#include <raybridge/acceleration_structures.h>
+#include <raybridge/ao_pass.h>
+#include <raybridge/hybrid_effects.h>
+#include <raybridge/presets.h>
 
 namespace rbRender {
 
@@ -21,16 +25,20 @@ struct RenderOptions {
   float fovYDegrees = 0.0f;
   std::optional<glm::vec3> sun;  // towards the sun; empty = the scene's sun, else the engine's default
   // Effects and their quality: the preset gives defaults, explicit options win (see resolve()).
-  rbAdapter::Preset preset = rbAdapter::Preset::High;
-  std::optional<rbAdapter::EffectSet> effects;  // --effects: overrides the preset's set
-  std::optional<float> sunRadiusDegrees;        // --sun-radius; else 0.5 for soft presets, 0 for hard ones
-  std::optional<uint32_t> shadowRays;           // --shadow-rays; else the preset's
-  std::optional<uint32_t> aoRays;               // --ao-rays; else the preset's (4 where it has no AO)
-  std::optional<float> aoRange;                 // --ao-range; else the SDK's 1.0
+  rb::Preset preset = rb::Preset::High;
+  std::optional<rb::EffectSet> effects;   // --effects: overrides the preset's set
+  std::optional<float> sunRadiusDegrees;  // --sun-radius; 0 = hard; else the SDK's 0.5 when shadows are soft
+  std::optional<uint32_t> shadowRays;     // --shadow-rays; else the preset's (4 where it has no shadows)
+  std::optional<uint32_t> aoRays;         // --ao-rays; else the preset's (4 where it has no AO)
+  std::optional<float> aoRange;           // --ao-range; else the SDK's 1.0
   rb::AoEstimator aoEstimator = rb::AoEstimator::Binary;  // --ao-estimator binary|distance
-  std::optional<float> reflectionRoughness;     // --reflection-roughness threshold; else the default below
-  std::optional<uint32_t> reflectionRays;       // --reflection-rays; else the default below
-  bool denoise = true;                          // --no-denoise
+  std::optional<float> reflectionRoughness;               // --reflection-roughness threshold; else the default below
+  std::optional<uint32_t> reflectionRays;                 // --reflection-rays; else the default below
+  bool denoise = true;                                    // --no-denoise
+  // Raster mode's shadow map: --shadow-map-size (0 = none, else 1024..8192) and --pcf (taps per axis, 1..9);
+  // else the preset's raster counterpart.
+  std::optional<uint32_t> shadowMapSize;
+  std::optional<uint32_t> pcfKernel;
   Mode mode = Mode::Hybrid;
   std::string out = "out";
   bool dump = false;
@@ -50,20 +58,32 @@ struct RenderOptions {
   bool help = false;
 };
 
-// What the preset and the explicit options amount to.
+// The render command's reflection defaults (the SDK's are 0.3 and 1): the demo's copper (roughness 0.45)
+// reflects, glossy pixels average 4 rays.
+inline constexpr float kDefaultReflectionRoughness = 0.5f;
+inline constexpr uint32_t kDefaultReflectionRays = 4;
+
+// What the preset and the explicit options amount to. Ray counts, the AO range and the reflection threshold are
+// explicit; hybrid.shadows.softAngularRadiusDegrees stays 0 (the SDK's 0.5) unless --sun-radius gives one.
 struct ResolvedEffects {
-  rbAdapter::EffectSet effects = 0;
-  float sunRadiusDegrees = 0.0f;  // 0 = hard shadows
-  uint32_t shadowRays = 1;        // effective rays per pixel (1 for hard shadows)
-  uint32_t aoRays = 4;
-  float aoRange = 1.0f;
-  float reflectionRoughness = 0.3f;
-  uint32_t reflectionRays = 1;
+  // What --mode hybrid runs: the preset's effects and rays, overridden by the explicit options.
+  rb::HybridEffectsDesc hybrid;
+  // What --mode raster draws: the preset's shadow map/PCF, overridden by --shadow-map-size/--pcf.
+  rb::RasterShadowDesc raster;
+  float sunRadiusDegrees = 0.0f;  // effective angular radius of the sun for soft shadows (0 = hard), for printing
 };
 ResolvedEffects resolve(const RenderOptions& options);
 
-// Parses argv; returns an error message naming the problem, or "" on success.
+// "shadows,ao,reflections" (any order and subset; "" or "none" = no effect) -> EffectSet. Returns "" or an
+// error naming the bad item ("'bogus' in 'shadows,bogus' is not an effect (shadows, ao, reflections)").
+std::string parseEffectSet(std::string_view text, rb::EffectSet& out);
+// "shadows,ao,reflections" in that order; "" for no effect.
+std::string effectSetToString(rb::EffectSet effects);
+
+// Parses argv; returns an error message naming the option and the bad value, or "" on success (options.help is
+// set for -h/--help: print renderUsage() and exit 0).
 std::string parseRenderOptions(int argc, char** argv, RenderOptions& options);
+// The help CLI11 generates for the options parseRenderOptions accepts.
 const char* renderUsage();
 
 }  // namespace rbRender

@@ -1,6 +1,7 @@
 // Tests of the sample-engine adapter and raybridge-render: bad input, a dumped hybrid render with every effect
 // (files, statistics, AO contact darkening), raster vs hybrid shadows on the demo scene, pass memory that
 // follows the enabled effects. The validation layer is on; any error fails.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -78,30 +79,54 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
   };
   const fs::path malformed = dir / "malformed.gltf";
   std::ofstream(malformed) << "{ \"asset\": { \"version\": \"2.0\" }, \"meshes\": [ { \"primitives\": ";
+  // Each message names the option and the bad value, and the valid range or names.
   const std::vector<Case> cases = {
       {"--scene " + (dir / "missing.gltf").string(), "missing.gltf' does not exist"},
       {"--scene " + malformed.string(), "cannot load glTF"},
-      {"--camera 1,2,3,1,2,3,45", "eye equals target"},
-      {"--width 0", "--width: 0 is outside"},
-      {"--height 100000", "--height: 100000 is outside"},
-      {"--width abc", "'abc' is not a whole number"},
-      {"--sun 1,x,0", "'x' in '1,x,0' is not a number"},
+      {"--camera 1,2,3,1,2,3,45", "--camera: eye equals target"},
+      {"--camera 1,2,3,0,0,0,180", "--camera: fovy 180 is outside (0, 180)"},
+      {"--width 0", "--width: 0 is outside 1..16384"},
+      {"--height 100000", "--height: 100000 is outside 1..16384"},
+      {"--width abc", "--width: 'abc' is not a whole number in 1..16384"},
+      {"--sun 1,x,0", "--sun: 'x' in '1,x,0' is not a number"},
       {"--frobnicate", "unknown option '--frobnicate'"},
-      {"--preset nonsense", "--preset: 'nonsense' is not low, medium, high, ultra"},
-      {"--effects shadows,bogus", "--effects: 'bogus' in 'shadows,bogus' is not an effect"},
-      {"--effects ''", "--effects: the list is empty"},
+      {"stray", "unexpected argument 'stray'"},
+      {"--preset nonsense", "--preset: 'nonsense' is not a preset (none, hard-shadows, ao, ao16, reflections, "
+                            "soft-shadows, soft-shadows8, low, medium, high, ultra)"},
+      {"--effects shadows,bogus", "--effects: 'bogus' in 'shadows,bogus' is not an effect (shadows, ao, reflections)"},
       {"--ao-rays 0", "--ao-rays: 0 is outside 1..4096"},
       {"--ao-range -1", "--ao-range: -1 must be greater than 0"},
       {"--ao-range abc", "--ao-range: 'abc' is not a number"},
       {"--ao-estimator cosine", "--ao-estimator: 'cosine' is not binary or distance"},
       {"--reflection-roughness 1.5", "--reflection-roughness: 1.5 is outside (0, 1]"},
       {"--reflection-rays 0", "--reflection-rays: 0 is outside 1..64"},
+      {"--sun-radius 45", "--sun-radius: 45 is outside [0, 45) degrees"},
+      {"--shadow-map-size 5", "--shadow-map-size: 5 is outside 1024..8192 (or 0 = no shadow map)"},
+      {"--pcf 0", "--pcf: 0 is outside 1..9"},
+      {"--mode fast", "--mode: 'fast' is not raster or hybrid"},
   };
   for (const Case& c : cases) {
     const RunResult r = runRender(c.args + " --out " + (dir / "out").string());
     INFO(c.args << "\n" << r.output);
     CHECK(r.exitCode != 0);
     CHECK(contains(r.output, c.expected));
+  }
+  {
+    const RunResult r = runRender("--out " + (dir / "out").string() + " --width");  // the value is missing
+    INFO(r.output);
+    CHECK(r.exitCode != 0);
+    CHECK(contains(r.output, "--width needs a value"));
+  }
+  CHECK_FALSE(fs::exists(dir / "out" / "final.png"));
+
+  // --help (and -h) print the generated help, with every option and the presets, and exit 0 without rendering.
+  for (const char* help : {"--help", "-h"}) {
+    const RunResult r = runRender(std::string(help) + " --out " + (dir / "out").string());
+    INFO(help << "\n" << r.output);
+    CHECK(r.exitCode == 0);
+    for (const char* part : {"Usage: raybridge-render", "--preset", "--effects", "--shadow-map-size", "--pcf",
+                             "--dynamic-builds", "soft-shadows8"})
+      CHECK(contains(r.output, part));
   }
   CHECK_FALSE(fs::exists(dir / "out" / "final.png"));
 }
@@ -187,7 +212,7 @@ TEST_CASE("hybrid and raster shadow the same ground regions of the demo scene", 
   REQUIRE(engine->loadScene(se::makeDefaultDemoScene()).ok());
   const uint32_t w = 256, h = 144;
   REQUIRE(engine->setRenderSize(w, h).ok());
-  auto adapter = rbAdapter::Adapter::create(*engine, {});
+  auto adapter = rbAdapter::Adapter::create(*engine, {.preset = rb::Preset::HardShadows});
   INFO(adapter.error);
   REQUIRE(adapter.ok());
   engine->setPrepassHook(adapter.value->prepassHook());
@@ -238,12 +263,10 @@ TEST_CASE("the adapter without effects allocates no pass images and builds nothi
   auto engine = makeEngine();
   REQUIRE(engine->loadScene(se::makeDefaultDemoScene()).ok());
   REQUIRE(engine->setRenderSize(64, 48).ok());
-  rbAdapter::AdapterConfig config;
-  config.effects = 0;
-  auto adapter = rbAdapter::Adapter::create(*engine, config);
+  auto adapter = rbAdapter::Adapter::create(*engine, {});  // zero config: no effect
   INFO(adapter.error);
   REQUIRE(adapter.ok());
-  CHECK(adapter.value->shadowPass() == nullptr);
+  CHECK(adapter.value->effects().shadowPass() == nullptr);
   engine->setPrepassHook(adapter.value->prepassHook());
   se::FrameParams params;
   params.camera = *engine->scene().camera;
@@ -263,7 +286,7 @@ TEST_CASE("the adapter with shadows allocates the visibility image once frames a
   auto engine = makeEngine();
   REQUIRE(engine->loadScene(se::makeDefaultDemoScene()).ok());
   REQUIRE(engine->setRenderSize(64, 48).ok());
-  auto adapter = rbAdapter::Adapter::create(*engine, {});
+  auto adapter = rbAdapter::Adapter::create(*engine, {.preset = rb::Preset::HardShadows});
   REQUIRE(adapter.ok());
   engine->setPrepassHook(adapter.value->prepassHook());
   se::FrameParams params;
@@ -271,7 +294,7 @@ TEST_CASE("the adapter with shadows allocates the visibility image once frames a
   REQUIRE(engine->renderFrame(params).ok());
   REQUIRE(engine->waitIdle().ok());
   CHECK(adapter.value->context().memoryStats().of(rb::MemoryCategory::PassImages) >= 64 * 48 * 2);
-  CHECK(adapter.value->lastTlas().instanceCount == engine->scene().instances.size());
+  CHECK(adapter.value->effects().lastTlas().instanceCount == engine->scene().instances.size());
   engine->setPrepassHook({});
   adapter.value.reset();
   CHECK(engine->validationErrorCount() == 0);
@@ -281,10 +304,11 @@ TEST_CASE("pass memory follows the enabled effects at run time", "[adapter][memo
   auto engine = makeEngine();
   REQUIRE(engine->loadScene(se::makeDefaultDemoScene()).ok());
   REQUIRE(engine->setRenderSize(64, 48).ok());
-  auto created = rbAdapter::Adapter::create(*engine, {});  // shadows only
+  auto created = rbAdapter::Adapter::create(*engine, {.preset = rb::Preset::HardShadows});
   INFO(created.error);
   REQUIRE(created.ok());
   rbAdapter::Adapter& adapter = *created.value;
+  rb::HybridEffects& fx = adapter.effects();
   engine->setPrepassHook(adapter.prepassHook());
   se::FrameParams params;
   params.camera = *engine->scene().camera;
@@ -292,7 +316,7 @@ TEST_CASE("pass memory follows the enabled effects at run time", "[adapter][memo
   auto settle = [&] {  // frames in flight retire what was disabled; then release it while idle
     for (uint32_t i = 0; i < se::kFramesInFlight + 1; ++i) REQUIRE(engine->renderFrame(params).ok());
     REQUIRE(engine->waitIdle().ok());
-    adapter.releaseAfterIdle();
+    adapter.context().releaseAfterIdle();
     INFO(adapter.lastError());
     REQUIRE(adapter.lastError().empty());
     return adapter.context().memoryStats();
@@ -301,39 +325,46 @@ TEST_CASE("pass memory follows the enabled effects at run time", "[adapter][memo
   const rb::MemoryStats shadowOnly = settle();
   CHECK(shadowOnly.of(C::PassImages) >= 64 * 48 * 2);
   CHECK(shadowOnly.of(C::PassBuffers) > 0);
-  CHECK(adapter.aoPass() == nullptr);
-  CHECK(adapter.reflectionPass() == nullptr);
+  CHECK(fx.aoPass() == nullptr);
+  CHECK(fx.reflectionPass() == nullptr);
+  CHECK(fx.shadowDenoiser() == nullptr);  // hard shadows are never denoised
 
-  REQUIRE(adapter.applyPreset(rbAdapter::Preset::Ultra).ok());  // all effects, soft shadows: two denoisers
+  REQUIRE(fx.applyPreset(rb::Preset::Ultra).ok());  // all effects, soft shadows: two denoisers
   const rb::MemoryStats all = settle();
-  CHECK(adapter.effects() == rbAdapter::kAllEffects);
-  CHECK(adapter.aoPass() != nullptr);
-  CHECK(adapter.reflectionPass() != nullptr);
-  CHECK(adapter.shadowDenoiser() != nullptr);
-  CHECK(adapter.aoDenoiser() != nullptr);
+  CHECK(fx.desc().effects == rb::kAllEffects);
+  CHECK(fx.aoPass() != nullptr);
+  CHECK(fx.reflectionPass() != nullptr);
+  CHECK(fx.shadowDenoiser() != nullptr);
+  CHECK(fx.aoDenoiser() != nullptr);
   // AO image + reflection image + two denoisers' history: well above the shadow-only images.
   CHECK(all.of(C::PassImages) >= shadowOnly.of(C::PassImages) + 64 * 48 * (2 + 8));
   CHECK(all.of(C::PassBuffers) > shadowOnly.of(C::PassBuffers));
-  const rbAdapter::EffectStats stats = adapter.stats();
+  const rb::HybridStats stats = fx.stats();
   CHECK(stats.ao.rays > 0);
   CHECK(stats.reflection.rays > 0);
+  // Ultra: 8 soft shadow rays and 16 AO rays per lit/surface pixel, at most.
+  CHECK(stats.shadow.rays <= uint64_t(64 * 48 * 8));
+  CHECK(stats.ao.rays <= uint64_t(64 * 48 * 16));
+  CHECK(stats.ao.rays > uint64_t(64 * 48 * 4));
 
-  adapter.settings().denoise = false;  // the denoisers go, the passes stay
-  const rb::MemoryStats raw = settle();
-  CHECK(adapter.shadowDenoiser() == nullptr);
-  CHECK(adapter.aoDenoiser() == nullptr);
-  CHECK(raw.of(C::PassImages) < all.of(C::PassImages));
+  rb::HybridEffectsDesc raw = fx.desc();  // the denoisers go, the passes stay
+  raw.shadows.disableDenoiser = raw.ao.disableDenoiser = true;
+  REQUIRE(fx.setDesc(raw).ok());
+  const rb::MemoryStats rawMemory = settle();
+  CHECK(fx.shadowDenoiser() == nullptr);
+  CHECK(fx.aoDenoiser() == nullptr);
+  CHECK(rawMemory.of(C::PassImages) < all.of(C::PassImages));
 
-  REQUIRE(adapter.setEffects(rbAdapter::kEffectShadows).ok());
+  REQUIRE(fx.applyPreset(rb::Preset::HardShadows).ok());
   const rb::MemoryStats back = settle();
-  CHECK(adapter.aoPass() == nullptr);
-  CHECK(adapter.reflectionPass() == nullptr);
+  CHECK(fx.aoPass() == nullptr);
+  CHECK(fx.reflectionPass() == nullptr);
   CHECK(back.of(C::PassImages) == shadowOnly.of(C::PassImages));
   CHECK(back.of(C::PassBuffers) == shadowOnly.of(C::PassBuffers));
 
-  REQUIRE(adapter.setEffects(0).ok());
+  REQUIRE(fx.applyPreset(rb::Preset::None).ok());
   const rb::MemoryStats none = settle();
-  CHECK(adapter.shadowPass() == nullptr);
+  CHECK(fx.shadowPass() == nullptr);
   CHECK(none.of(C::PassImages) == 0);
   CHECK(none.of(C::PassBuffers) == 0);
 
@@ -342,27 +373,41 @@ TEST_CASE("pass memory follows the enabled effects at run time", "[adapter][memo
   CHECK(engine->validationErrorCount() == 0);
 }
 
-TEST_CASE("effect names and presets", "[adapter][presets]") {
-  rbAdapter::EffectSet set = 0;
-  CHECK(rbAdapter::parseEffects("reflections,shadows", set).empty());
-  CHECK(set == (rbAdapter::kEffectShadows | rbAdapter::kEffectReflections));
-  CHECK(rbAdapter::effectsToString(set) == "shadows,reflections");
-  CHECK(contains(rbAdapter::parseEffects("ao,shadow", set), "'shadow'"));
-  for (const char* name : {"low", "medium", "high", "ultra", "shadows", "ao", "reflections"}) {
-    INFO(name);
-    const auto p = rbAdapter::parsePreset(name);
-    REQUIRE(p.has_value());
-    CHECK(std::string(rbAdapter::toString(*p)) == name);
+TEST_CASE("all eleven presets render in both modes; raster mode follows the preset's shadow map and PCF",
+          "[render][presets]") {
+  REQUIRE(rb::kPresetCount == 11);
+  for (uint32_t i = 0; i < rb::kPresetCount; ++i) {
+    const rb::Preset preset = rb::Preset(i);
+    const rb::PresetDesc want = rb::presetDesc(preset);
+    for (const char* mode : {"raster", "hybrid"}) {
+      const fs::path dir = tempDir(std::string("preset_") + rb::toString(preset) + "_" + mode);
+      const RunResult r = runRender(std::string("--mode ") + mode + " --preset " + rb::toString(preset) +
+                                    " --width 64 --height 40 --frames 4 --dump --out " + dir.string());
+      INFO(rb::toString(preset) << " " << mode << "\n" << r.output);
+      REQUIRE(r.exitCode == 0);
+      const nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir / "stats.json"));
+      CHECK(stats["preset"] == rb::toString(preset));
+      CHECK(stats["validation"]["errors"] == 0);
+      if (std::string(mode) == "raster") {
+        // What the engine reports it drew (after its own clamping), not what was asked for.
+        const nlohmann::json& raster = stats["effects"]["raster_counterparts"];
+        CHECK(raster["shadow_map_size"] == want.raster.mapSize);
+        CHECK(raster["pcf_kernel"] == (want.raster.mapSize ? std::max(1u, want.raster.pcfKernel) : 0u));
+        CHECK(stats["rays_traced"] == 0);
+        continue;
+      }
+      const nlohmann::json& passes = stats["raybridge"]["passes"];
+      CHECK(passes.contains("shadow") == bool(want.effects & rb::kEffectShadows));
+      CHECK(passes.contains("ao") == bool(want.effects & rb::kEffectAo));
+      CHECK(passes.contains("reflection") == bool(want.effects & rb::kEffectReflections));
+      // Soft shadows (more than one ray) are denoised, hard ones never; the reported rays per pixel are the table's.
+      CHECK(passes.contains("shadow_denoise") == (want.shadowRaysPerPixel > 1));
+      if (want.effects & rb::kEffectShadows) CHECK(stats["sun"]["rays_per_pixel"] == want.shadowRaysPerPixel);
+      if (want.effects & rb::kEffectAo) CHECK(stats["effects"]["ao_rays_per_pixel"] == want.aoRaysPerPixel);
+      if (want.effects == 0) CHECK(stats["rays_traced"] == 0);
+      else CHECK(stats["rays_traced"].get<uint64_t>() > 0);
+    }
   }
-  CHECK_FALSE(rbAdapter::parsePreset("High").has_value());
-  const rbAdapter::PresetDesc low = rbAdapter::presetDesc(rbAdapter::Preset::Low);
-  CHECK(low.effects == (rbAdapter::kEffectShadows | rbAdapter::kEffectAo));
-  CHECK_FALSE(low.softShadows);
-  CHECK(low.aoRaysPerPixel == 4);
-  const rbAdapter::PresetDesc ultra = rbAdapter::presetDesc(rbAdapter::Preset::Ultra);
-  CHECK(ultra.effects == rbAdapter::kAllEffects);
-  CHECK(ultra.shadowRaysPerPixel == 8);
-  CHECK(ultra.aoRaysPerPixel == 16);
 }
 
 TEST_CASE("raybridge-render --mode raster uses the engine's shadow map, SSAO and reflection probe", "[render][raster]") {

@@ -1,7 +1,7 @@
 // raybridge-viewer: the sample engine in a GLFW window with the Raybridge adapter, toggling at run time between
 // the engine's own terms (shadow map, SSAO, reflection probe) and Raybridge's ray-traced shadows, AO and
-// reflections, and between presets. Combines exactly one platform side (the engine's GLFW Window)
-// with the adapter.
+// reflections, and between presets, with a Dear ImGui overlay (viewer_overlay.h, viewer_panel.h) showing the
+// controls and the statistics. Combines exactly one platform side (the engine's GLFW Window) with the adapter.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,10 +11,13 @@
 
 #include <GLFW/glfw3.h>
 
+#include "cli_support.h"
 #include "raybridge_sample_engine_adapter.h"
 #include "sample_engine/gltf_loader.h"
 #include "sample_engine/procedural.h"
 #include "sample_engine/window.h"
+#include "viewer_overlay.h"
+#include "viewer_panel.h"
 
 namespace se = sample_engine;
 
@@ -22,19 +25,17 @@ namespace {
 
 struct Options {
   std::string scene;
-  int width = 1280, height = 720;
-  int frames = 0;  // 0 = until closed
+  uint32_t width = 1280, height = 720;
+  uint32_t frames = 0;  // 0 = until closed
   std::string screenshot;
-  rbAdapter::Preset preset = rbAdapter::Preset::High;
+  rb::Preset preset = rb::Preset::High;
   bool validation = false;
+  bool overlay = true;            // the ImGui window is shown at start (F1 toggles it)
+  bool screenshotOverlay = true;  // the screenshot shows the overlay when it is shown
 };
 
-const char* kUsage =
-    "usage: raybridge-viewer [--scene FILE.gltf] [--width W] [--height H] [--frames N] [--screenshot FILE.png]\n"
-    "                        [--preset low|medium|high|ultra|shadows|ao|reflections] [--validation]\n";
-
 const char* kKeys =
-    "keys: drag = orbit, scroll = zoom, W/A/S/D/Q/E = move (Shift = faster)\n"
+    "keys: drag = orbit, scroll = zoom, W/A/S/D/Q/E = move (Shift = faster), F1 = overlay on/off\n"
     "      M = mode raster (shadow map, SSAO, probe) <-> hybrid (Raybridge), P = next preset,\n"
     "      H = shadows hard <-> soft, O = ambient occlusion on/off, R = reflections on/off, N = denoise on/off,\n"
     "      Left/Right = sun azimuth, Up/Down = sun elevation, Space = pause/resume the animation, Esc = quit\n";
@@ -44,33 +45,55 @@ int fail(const std::string& message) {
   return 1;
 }
 
-bool parse(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const bool hasValue = i + 1 < argc;
-    if (a == "--validation") o.validation = true;
-    else if (a == "--scene" && hasValue) o.scene = argv[++i];
-    else if (a == "--screenshot" && hasValue) o.screenshot = argv[++i];
-    else if (a == "--width" && hasValue) o.width = std::atoi(argv[++i]);
-    else if (a == "--height" && hasValue) o.height = std::atoi(argv[++i]);
-    else if (a == "--frames" && hasValue) o.frames = std::atoi(argv[++i]);
-    else if (a == "--preset" && hasValue) {
-      auto p = rbAdapter::parsePreset(argv[++i]);
-      if (!p) {
-        std::fprintf(stderr, "raybridge-viewer: error: --preset: '%s' is not a preset\n%s", argv[i], kUsage);
-        return false;
-      }
-      o.preset = *p;
-    } else {
-      std::fprintf(stderr, "raybridge-viewer: error: unknown option or missing value '%s'\n%s", a.c_str(), kUsage);
-      return false;
-    }
+// Returns 0 to go on, else the exit code (0 after --help is signalled through `exitNow`).
+int parse(int argc, char** argv, Options& o, bool& exitNow) {
+  exitNow = false;
+  CLI::App app{"", "raybridge-viewer"};
+  rbCli::prepare(app);
+  app.description(
+      "The sample engine in a window with Raybridge's effects (default: the procedural demo scene, 1280x720,\n"
+      "preset high), with an overlay of controls and statistics.");
+  app.footer(kKeys);
+  app.add_option("--scene", o.scene, "glTF scene to show (default: the engine's procedural demo scene)")
+      ->type_name("FILE.gltf|.glb")
+      ->check(rbCli::nonEmpty("file name"));
+  app.add_option("--width", o.width, "window width (default 1280)")->type_name("W")->check(rbCli::wholeNumber(1, 16384));
+  app.add_option("--height", o.height, "window height (default 720)")->type_name("H")->check(rbCli::wholeNumber(1, 16384));
+  app.add_option("--frames", o.frames, "quit after N frames (default 0 = run until the window is closed)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(0, 100000000));
+  app.add_option("--screenshot", o.screenshot, "write the last frame to this PNG when quitting")
+      ->type_name("FILE.png")
+      ->check(rbCli::nonEmpty("file name"));
+  app.add_option_function<std::string>(
+         "--preset", [&o](const std::string& value) { o.preset = *rb::parsePreset(value); },
+         std::string("effects and quality at start (default high): one of\n") + rb::presetNames())
+      ->type_name("NAME")
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            return rb::parsePreset(value) ? std::string()
+                                          : rbCli::quote(value) + " is not a preset (" + rb::presetNames() + ")";
+          },
+          ""));
+  app.add_flag("--validation", o.validation,
+               "enable the Vulkan validation layer; exit code 3 when it reported errors\n"
+               "(also RAYBRIDGE_VALIDATION=1)");
+  app.add_flag_callback("--no-overlay", [&o] { o.overlay = false; },
+                        "start with the overlay hidden (F1 shows it; default: shown)");
+  app.add_flag_callback("--no-screenshot-overlay", [&o] { o.screenshotOverlay = false; },
+                        "keep the overlay out of --screenshot: one more frame is rendered without it\n"
+                        "(default: the screenshot shows what the window shows, overlay included)");
+  bool help = false;
+  if (std::string e = rbCli::parse(app, argc, argv, help); !e.empty()) {
+    std::fprintf(stderr, "raybridge-viewer: error: %s\nRun with --help for the options.\n", e.c_str());
+    exitNow = true;
+    return 2;
   }
-  if (o.width <= 0 || o.height <= 0 || o.width > 16384 || o.height > 16384 || o.frames < 0) {
-    std::fprintf(stderr, "raybridge-viewer: error: invalid size or frame count\n%s", kUsage);
-    return false;
+  if (help) {
+    std::printf("%s", app.help().c_str());
+    exitNow = true;
   }
-  return true;
+  return 0;
 }
 
 // Orbit camera around a target, as in the engine demo.
@@ -101,11 +124,25 @@ struct Keys {
   bool down(int key) const { return glfwGetKey(window, key) == GLFW_PRESS; }
 };
 
+std::string effectsToString(rb::EffectSet set) {
+  std::string s;
+  for (auto [bit, name] : {std::pair{rb::kEffectShadows, "shadows"}, std::pair{rb::kEffectAo, "ao"},
+                           std::pair{rb::kEffectReflections, "reflections"}})
+    if (set & bit) s += (s.empty() ? "" : ",") + std::string(name);
+  return s.empty() ? "none" : s;
+}
+
+// The effect settings the viewer switches, as HybridEffectsDesc spells them.
+uint32_t shadowRays(const rb::HybridEffectsDesc& d) { return d.shadows.raysPerPixel ? d.shadows.raysPerPixel : 1u; }
+uint32_t aoRays(const rb::HybridEffectsDesc& d) { return d.ao.raysPerPixel ? d.ao.raysPerPixel : rb::kDefaultAoRays; }
+bool denoiseOn(const rb::HybridEffectsDesc& d) { return !d.shadows.disableDenoiser || !d.ao.disableDenoiser; }
+
 }  // namespace
 
 int main(int argc, char** argv) {
   Options o;
-  if (!parse(argc, argv, o)) return 2;
+  bool exitNow = false;
+  if (int code = parse(argc, argv, o, exitNow); exitNow) return code;
   if (const char* v = std::getenv("RAYBRIDGE_VALIDATION"); v && std::string(v) == "1") o.validation = true;
 
   se::Scene scene = se::makeDefaultDemoScene();
@@ -114,7 +151,7 @@ int main(int argc, char** argv) {
     if (!r.ok()) return fail("--scene: cannot load glTF '" + o.scene + "': " + r.error);
     scene = std::move(r.scene);
   }
-  auto win = se::Window::create("Raybridge viewer", o.width, o.height);
+  auto win = se::Window::create("Raybridge viewer", int(o.width), int(o.height));
   if (!win) return fail(win.error);
   se::Window& window = *win.value;
 
@@ -134,12 +171,29 @@ int main(int argc, char** argv) {
   window.framebufferSize(fbw, fbh);
   if (se::Status s = engine.attachSurface(surface.value, uint32_t(fbw), uint32_t(fbh)); !s) return fail(s.error);
 
-  auto adapter = rbAdapter::Adapter::create(engine, {});
+  rbAdapter::AdapterConfig adapterConfig;
+  adapterConfig.preset = o.preset;
+  auto adapter = rbAdapter::Adapter::create(engine, adapterConfig);
   if (!adapter) return fail("adapter: " + adapter.error);
-  rbAdapter::FrameSettings& rt = adapter.value->settings();
-  rbAdapter::Preset preset = o.preset;
-  if (se::Status s = adapter.value->applyPreset(preset); !s) return fail("adapter: " + s.error);
-  engine.setPrepassHook(adapter.value->prepassHook());
+  rbAdapter::Adapter& rt = *adapter.value;
+  rb::HybridEffects& fx = rt.effects();
+  rb::Preset preset = o.preset;
+  engine.setPrepassHook(rt.prepassHook());
+
+  GLFWwindow* glfwWindow = static_cast<GLFWwindow*>(window.glfwHandle());
+  auto overlayCreated = rbViewer::ImGuiOverlay::create(glfwWindow);
+  if (!overlayCreated) return fail("overlay: " + overlayCreated.error);
+  rbViewer::ImGuiOverlay& overlay = *overlayCreated.value;
+  engine.setOverlayHook(overlay.hook());
+  // Whatever way main() ends: the engine stops calling the overlay and is idle before the overlay goes.
+  struct OverlayDetach {
+    se::Engine& engine;
+    ~OverlayDetach() {
+      engine.setOverlayHook({});
+      (void)engine.waitIdle();
+    }
+  } overlayDetach{engine};
+  bool showOverlay = o.overlay;
 
   se::FrameParams params;
   params.camera = engine.scene().camera ? *engine.scene().camera : se::defaultCameraFor(engine.sceneBounds());
@@ -149,80 +203,159 @@ int main(int argc, char** argv) {
 
   std::printf("device: %s\n%s", engine.deviceInfo().name.c_str(), kKeys);
   Orbit orbit = Orbit::from(params.camera);
-  Keys keys{static_cast<GLFWwindow*>(window.glfwHandle())};
+  Keys keys{glfwWindow};
   const float sceneSize = std::max(engine.sceneBounds().radius(), 1.0f);
   double lastX = 0, lastY = 0;
   window.cursorPosition(lastX, lastY);
   auto last = std::chrono::steady_clock::now();
-  int frames = 0;
+  double frameMs = 0.0;
+  uint32_t frames = 0;
   bool paused = false;  // the animation clock (real time) stops while paused
+  bool overlayDrawn = false;  // the last rendered frame has the overlay in it
+
   auto printState = [&] {
-    const rbAdapter::EffectSet fx = adapter.value->effects();
+    const rb::HybridEffectsDesc& d = fx.desc();
     std::printf("mode %s, preset %s, effects [%s], shadows %s (%u rays), AO %u rays, denoise %s, sun azimuth %.0f "
                 "elevation %.0f deg\n",
-                rt.enabled ? "hybrid" : "raster", rbAdapter::toString(preset),
-                rbAdapter::effectsToString(fx).c_str(), rt.sunAngularRadiusDegrees > 0.0f ? "soft" : "hard",
-                rt.sunAngularRadiusDegrees > 0.0f ? rt.shadowRaysPerPixel : 1u, rt.aoRaysPerPixel,
-                rt.denoise ? "on" : "off", glm::degrees(sunAzimuth), glm::degrees(sunElevation));
+                rt.settings().enabled ? "hybrid" : "raster", rb::toString(preset), effectsToString(d.effects).c_str(),
+                shadowRays(d) > 1 ? "soft" : "hard", shadowRays(d), aoRays(d), denoiseOn(d) ? "on" : "off",
+                glm::degrees(sunAzimuth), glm::degrees(sunElevation));
   };
-  auto toggle = [&](rbAdapter::Effect effect) {
-    if (se::Status s = adapter.value->setEffects(adapter.value->effects() ^ effect); !s)
-      std::fprintf(stderr, "raybridge-viewer: %s\n", s.error.c_str());
+  auto setDesc = [&](const rb::HybridEffectsDesc& d) {
+    if (rb::Status s = fx.setDesc(d); !s) std::fprintf(stderr, "raybridge-viewer: %s\n", s.error().message.c_str());
     printState();
   };
+  auto applyPreset = [&](rb::Preset p) {
+    preset = p;
+    setDesc(rb::withPreset(fx.desc(), p));
+  };
+  auto toggleEffects = [&](rb::EffectSet bits) {
+    rb::HybridEffectsDesc d = fx.desc();
+    d.effects ^= bits;
+    setDesc(d);
+  };
+  auto toggleSoftShadows = [&] {
+    rb::HybridEffectsDesc d = fx.desc();
+    const uint32_t presetRays = rb::presetDesc(preset).shadowRaysPerPixel;
+    d.shadows.raysPerPixel = shadowRays(d) > 1 ? 1u : (presetRays > 1 ? presetRays : rb::kDefaultSoftShadowRays);
+    setDesc(d);
+  };
+  auto toggleDenoise = [&] {
+    rb::HybridEffectsDesc d = fx.desc();
+    d.shadows.disableDenoiser = d.ao.disableDenoiser = denoiseOn(d);
+    setDesc(d);
+  };
+  auto setHybrid = [&](bool hybrid) {
+    rt.settings().enabled = hybrid;
+    printState();
+  };
+
+  // Raster mode: the engine's own counterparts of the enabled effects; its shadow map is the preset's (the
+  // engine's default one when the preset has none). Hybrid mode: Raybridge's visibility replaces the map.
+  auto engineTerms = [&] {
+    const rb::EffectSet fxOn = fx.desc().effects;
+    const bool raster = !rt.settings().enabled;
+    const rb::RasterShadowDesc r = rb::presetDesc(preset).raster;
+    params.shadow = se::ShadowSettings{};
+    params.shadow.enabled = raster && (fxOn & rb::kEffectShadows);
+    if (r.mapSize) params.shadow.mapSize = r.mapSize, params.shadow.pcfKernelSize = r.pcfKernel;
+    params.ssao.enabled = raster && (fxOn & rb::kEffectAo);
+    params.reflectionProbe.enabled = raster && (fxOn & rb::kEffectReflections);
+  };
+
+  auto render = [&](bool withOverlay) -> se::Status {
+    overlayDrawn = withOverlay;
+    if (withOverlay) {
+      overlay.beginFrame();
+      const rb::HybridEffectsDesc& d = fx.desc();
+      rbViewer::PanelModel m;
+      m.device = engine.deviceInfo().name;
+      m.hybrid = rt.settings().enabled;
+      m.preset = preset;
+      m.effects = d.effects;
+      m.denoise = denoiseOn(d);
+      m.shadowRays = (d.effects & rb::kEffectShadows) ? shadowRays(d) : 0u;
+      m.aoRays = (d.effects & rb::kEffectAo) ? aoRays(d) : 0u;
+      m.paused = paused;
+      m.sunAzimuthDegrees = glm::degrees(sunAzimuth);
+      m.sunElevationDegrees = glm::degrees(sunElevation);
+      m.frameMs = frameMs;
+      m.engine = engine.lastTimings();
+      m.effectStats = fx.stats();
+      m.as = rt.accelerationStructures().stats();
+      m.memory = rt.context().memoryStats();
+      const rbViewer::PanelRequests req = rbViewer::drawPanel(m);
+      overlay.endFrame();
+      // Applied before the frame, as the keys are.
+      if (req.hybrid) setHybrid(*req.hybrid);
+      if (req.preset) applyPreset(*req.preset);
+      if (req.toggleEffects) toggleEffects(req.toggleEffects);
+      if (req.toggleSoftShadows) toggleSoftShadows();
+      if (req.toggleDenoise) toggleDenoise();
+      engineTerms();
+    }
+    se::Status s = engine.renderFrame(params);
+    if (s && !overlay.lastError().empty()) return se::Status::failure("overlay: " + overlay.lastError());
+    return s;
+  };
+
   printState();
   while (!window.shouldClose()) {
     window.pollEvents();
     if (window.keyDown(se::Window::Key::Escape)) window.requestClose();
     const auto now = std::chrono::steady_clock::now();
     const float dt = std::min(std::chrono::duration<float>(now - last).count(), 0.1f);
+    frameMs = frameMs * 0.9 + 100.0 * double(std::chrono::duration<float>(now - last).count());
     last = now;
+    const bool uiKeyboard = showOverlay && overlay.wantsKeyboard();
+    const bool uiMouse = showOverlay && overlay.wantsMouse();
 
-    if (keys.pressed(GLFW_KEY_SPACE)) paused = !paused, std::printf("animation %s at %.2f s\n", paused ? "paused" : "playing", params.time);
+    if (keys.pressed(GLFW_KEY_F1)) showOverlay = !showOverlay;
+    if (!uiKeyboard) {
+      if (keys.pressed(GLFW_KEY_SPACE)) {
+        paused = !paused;
+        rt.settings().updateDeformedMeshes = !paused;  // a paused animation costs no BLAS work
+        std::printf("animation %s at %.2f s\n", paused ? "paused" : "playing", params.time);
+      }
+      if (keys.pressed(GLFW_KEY_M)) setHybrid(!rt.settings().enabled);
+      if (keys.pressed(GLFW_KEY_H)) toggleSoftShadows();
+      if (keys.pressed(GLFW_KEY_O)) toggleEffects(rb::kEffectAo);
+      if (keys.pressed(GLFW_KEY_R)) toggleEffects(rb::kEffectReflections);
+      if (keys.pressed(GLFW_KEY_N)) toggleDenoise();
+      if (keys.pressed(GLFW_KEY_P)) applyPreset(rb::Preset((uint32_t(preset) + 1) % rb::kPresetCount));
+    }
     if (!paused) params.time += dt;
-    if (keys.pressed(GLFW_KEY_M)) rt.enabled = !rt.enabled, printState();
-    if (keys.pressed(GLFW_KEY_H)) {
-      rt.sunAngularRadiusDegrees = rt.sunAngularRadiusDegrees > 0.0f ? 0.0f : rbAdapter::kDefaultSoftSunRadiusDegrees;
-      if (rt.shadowRaysPerPixel < 2) rt.shadowRaysPerPixel = 4;
-      printState();
-    }
-    if (keys.pressed(GLFW_KEY_O)) toggle(rbAdapter::kEffectAo);
-    if (keys.pressed(GLFW_KEY_R)) toggle(rbAdapter::kEffectReflections);
-    if (keys.pressed(GLFW_KEY_N)) rt.denoise = !rt.denoise, printState();
-    if (keys.pressed(GLFW_KEY_P)) {
-      preset = rbAdapter::Preset((int(preset) + 1) % (int(rbAdapter::Preset::ReflectionsOnly) + 1));
-      if (se::Status s = adapter.value->applyPreset(preset); !s) return fail("adapter: " + s.error);
-      printState();
-    }
     const float sunSpeed = 0.8f * dt;
-    if (keys.down(GLFW_KEY_LEFT)) sunAzimuth -= sunSpeed;
-    if (keys.down(GLFW_KEY_RIGHT)) sunAzimuth += sunSpeed;
-    if (keys.down(GLFW_KEY_UP)) sunElevation = std::min(sunElevation + sunSpeed, glm::radians(89.0f));
-    if (keys.down(GLFW_KEY_DOWN)) sunElevation = std::max(sunElevation - sunSpeed, glm::radians(3.0f));
+    if (!uiKeyboard) {
+      if (keys.down(GLFW_KEY_LEFT)) sunAzimuth -= sunSpeed;
+      if (keys.down(GLFW_KEY_RIGHT)) sunAzimuth += sunSpeed;
+      if (keys.down(GLFW_KEY_UP)) sunElevation = std::min(sunElevation + sunSpeed, glm::radians(89.0f));
+      if (keys.down(GLFW_KEY_DOWN)) sunElevation = std::max(sunElevation - sunSpeed, glm::radians(3.0f));
+    }
     params.sun.direction = {std::cos(sunElevation) * std::sin(sunAzimuth), std::sin(sunElevation),
                             std::cos(sunElevation) * std::cos(sunAzimuth)};
-    rt.lightingFrom(params);
-    // Raster mode: the engine's own counterparts of the enabled effects (its shadow map is always on).
-    params.ssao.enabled = !rt.enabled && (adapter.value->effects() & rbAdapter::kEffectAo);
-    params.reflectionProbe.enabled = !rt.enabled && (adapter.value->effects() & rbAdapter::kEffectReflections);
+    engineTerms();
 
     double x, y;
     window.cursorPosition(x, y);
-    if (window.mouseButtonDown(0)) {
+    if (window.mouseButtonDown(0) && !uiMouse) {
       orbit.yaw -= float(x - lastX) * 0.005f;
       orbit.pitch = std::clamp(orbit.pitch + float(y - lastY) * 0.005f, -1.5f, 1.5f);
     }
     lastX = x;
     lastY = y;
-    orbit.distance = std::max(orbit.distance * std::pow(0.9f, float(window.takeScrollDelta())), 0.05f);
+    const double scroll = window.takeScrollDelta();
+    if (!uiMouse) orbit.distance = std::max(orbit.distance * std::pow(0.9f, float(scroll)), 0.05f);
     const float speed = sceneSize * 0.5f * dt * (window.keyDown(se::Window::Key::LeftShift) ? 4.0f : 1.0f);
     const glm::vec3 forward(-std::sin(orbit.yaw), 0.0f, -std::cos(orbit.yaw)), right(-forward.z, 0.0f, forward.x);
-    if (window.keyDown(se::Window::Key::W)) orbit.target += forward * speed;
-    if (window.keyDown(se::Window::Key::S)) orbit.target -= forward * speed;
-    if (window.keyDown(se::Window::Key::D)) orbit.target += right * speed;
-    if (window.keyDown(se::Window::Key::A)) orbit.target -= right * speed;
-    if (window.keyDown(se::Window::Key::E)) orbit.target.y += speed;
-    if (window.keyDown(se::Window::Key::Q)) orbit.target.y -= speed;
+    if (!uiKeyboard) {
+      if (window.keyDown(se::Window::Key::W)) orbit.target += forward * speed;
+      if (window.keyDown(se::Window::Key::S)) orbit.target -= forward * speed;
+      if (window.keyDown(se::Window::Key::D)) orbit.target += right * speed;
+      if (window.keyDown(se::Window::Key::A)) orbit.target -= right * speed;
+      if (window.keyDown(se::Window::Key::E)) orbit.target.y += speed;
+      if (window.keyDown(se::Window::Key::Q)) orbit.target.y -= speed;
+    }
     orbit.apply(params.camera);
 
     int w = 0, h = 0;
@@ -230,11 +363,11 @@ int main(int argc, char** argv) {
     if (w == 0 || h == 0) continue;  // minimised
     const VkExtent2D size = engine.renderSize();
     if (uint32_t(w) != size.width || uint32_t(h) != size.height) (void)engine.resizeSwapchain(uint32_t(w), uint32_t(h));
-    if (se::Status s = engine.renderFrame(params); !s) return fail(s.error);
-    if (!adapter.value->lastError().empty()) return fail("Raybridge: " + adapter.value->lastError());
+    if (se::Status s = render(showOverlay); !s) return fail(s.error);
+    if (!rt.lastError().empty()) return fail("Raybridge: " + rt.lastError());
     if (++frames % 60 == 0) {
       const se::PassTimings t = engine.lastTimings();
-      const rbAdapter::EffectStats es = adapter.value->stats();
+      const rb::HybridStats es = fx.stats();
       std::printf("GPU ms: shadow map %.1f probe %.1f prepass %.1f ssao %.1f hook (Raybridge) %.1f [shadows %.1f+%.1f, "
                   "AO %.1f+%.1f, reflections %.1f] lighting %.1f tonemap %.1f\n",
                   t.shadowMs, t.probeMs, t.prepassMs, t.ssaoMs, t.hookMs, es.shadow.gpuMs, es.shadowDenoise.gpuMs,
@@ -242,14 +375,20 @@ int main(int argc, char** argv) {
     }
     if (o.frames > 0 && frames >= o.frames) window.requestClose();
   }
-  if (se::Status s = engine.waitIdle(); !s) return fail(s.error);
   if (!o.screenshot.empty()) {
+    // The last frame showed the overlay but the screenshot should not: one more frame without it.
+    if (overlayDrawn && !o.screenshotOverlay)
+      if (se::Status s = render(false); !s) return fail(s.error);
+    if (se::Status s = engine.waitIdle(); !s) return fail(s.error);
     auto ldr = engine.readbackLdr();
     if (!ldr) return fail(ldr.error);
     if (se::Status s = se::writePng(o.screenshot, ldr.value); !s) return fail(s.error);
     std::printf("wrote %s\n", o.screenshot.c_str());
   }
-  std::printf("rendered %d frames\n", frames);
+  if (se::Status s = engine.waitIdle(); !s) return fail(s.error);
+  std::printf("rendered %u frames\n", frames);
+  engine.setOverlayHook({});
+  overlayCreated.value.reset();
   engine.setPrepassHook({});
   adapter.value.reset();
   if (o.validation) {

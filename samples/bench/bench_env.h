@@ -3,6 +3,7 @@
 // turns it into a message and a non-zero exit code.
 #pragma once
 
+#include <raybridge/headless_device.h>
 #include <raybridge/raybridge.h>
 
 #include <functional>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "bench_options.h"
+#include "context_access.h"
 #include "device_functions.h"
 #include "gpu_memory.h"
 #include "procedural_meshes.h"
@@ -61,7 +63,7 @@ class BenchEnv {
 
   rb::HeadlessDevice& device() { return *device_; }
   rb::Context& ctx() { return *ctx_; }
-  const rb::DeviceFunctions& vk() const { return ctx_->vk(); }
+  const rb::DeviceFunctions& vk() const { return rb::internal::deviceFunctions(*ctx_); }
   const rb::DeviceInfo& info() const { return ctx_->deviceInfo(); }
   const BenchOptions& options() const { return options_; }
   const BenchSizes& sizes() const { return sizes_; }

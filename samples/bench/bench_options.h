@@ -14,15 +14,17 @@ struct BenchOptions {
   bool full = false;             // the GPU sizes even on a CPU device (1M triangles, ...)
   uint32_t width = 0;            // 0 = automatic: 1920x1080 on a GPU, smaller on a CPU device
   uint32_t height = 0;
-  std::string device;            // substring of the device name; empty = $RAYBRIDGE_DEVICE or automatic
-  std::string scenesDir;         // glTF models, one folder each; default <source>/../shared/scenes
-  std::string commandLine;       // as typed, for the report
+  std::string device;       // substring of the device name; empty = $RAYBRIDGE_DEVICE or automatic
+  std::string scenesDir;    // glTF models, one folder each; default <source>/../shared/scenes
+  std::string commandLine;  // as typed, for the report
   bool help = false;
 };
 
 const std::vector<std::string>& scenarioNames();
+// The help CLI11 generates for these options.
 std::string usage();
-// Parses argv; returns false with a message in `error` on a bad command line.
+// Parses argv; returns false with a message in `error` (naming the option and the bad value) on a bad command
+// line. options.help is set for -h/--help.
 bool parseOptions(int argc, char** argv, BenchOptions& options, std::string& error);
 
 }  // namespace rbbench

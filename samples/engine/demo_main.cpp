@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "cli_support.h"
 #include "sample_engine/engine.h"
 #include "sample_engine/gltf_loader.h"
 #include "sample_engine/procedural.h"
@@ -36,65 +37,68 @@ struct Options {
   bool restPose = false;
 };
 
-void usage() {
-  std::printf(
-      "usage: raybridge-engine-demo [--out FILE.png] [--exr FILE.exr] [--width W] [--height H]\n"
-      "                             [--scene FILE.gltf|.glb] [--shadow-map-size N] [--pcf N]\n"
-      "                             [--ssao KERNEL] [--probe RES] [--effects PREFIX]\n"
-      "                             [--time T] [--animation N|NAME] [--rest-pose]\n"
-      "                             [--validation] [--frames N] [--window]\n"
-      "  Headless by default: renders one frame and writes the PNG (and EXR of the HDR image).\n"
-      "  --time T poses the scene's animation at T seconds (>= 0; headless frames end there, 1/30 s apart;\n"
-      "  the viewer plays from T), --animation picks it by index or name, --rest-pose plays none.\n"
-      "  --ssao enables the engine's SSAO with KERNEL samples, --probe a RES^2-per-face reflection probe;\n"
-      "  --effects writes the shadow-map visibility (and SSAO) images as PREFIX_shadow.png / PREFIX_ssao.png.\n"
-      "  --window opens a viewer: drag = orbit, scroll = zoom, WASD/QE = move, Shift = faster, Esc = quit.\n");
+void addOptions(CLI::App& app, Options& o) {
+  rbCli::prepare(app);
+  app.description(
+      "Renders the default demo scene (or a glTF file) headless: one frame, written as a PNG (and an EXR of the\n"
+      "HDR image); --window opens an interactive viewer instead.");
+  app.footer("Viewer (--window): drag = orbit, scroll = zoom, WASD/QE = move, Shift = faster, Esc = quit.");
+  app.add_option("--out", o.out, "PNG to write (default engine_demo.png)")->type_name("FILE.png");
+  app.add_option("--exr", o.exr, "also the HDR image as an EXR")->type_name("FILE.exr");
+  app.add_option("--width", o.width, "image width (default 1280)")->type_name("W")->check(rbCli::wholeNumber(1, 16384));
+  app.add_option("--height", o.height, "image height (default 720)")
+      ->type_name("H")
+      ->check(rbCli::wholeNumber(1, 16384));
+  app.add_option("--scene", o.scene, "scene to render (default: the procedural demo scene)")
+      ->type_name("FILE.gltf|.glb")
+      ->check(rbCli::nonEmpty("file name"));
+  app.add_option("--shadow-map-size", o.shadowMapSize, "shadow map texels per side (default 2048)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(kMinShadowMapSize, kMaxShadowMapSize));
+  app.add_option("--pcf", o.pcf, "PCF taps per axis (default 3)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(1, kMaxShadowPcfKernel));
+  app.add_option("--ssao", o.ssaoKernel, "enables the engine's SSAO with KERNEL samples (default 0 = off)")
+      ->type_name("KERNEL")
+      ->check(rbCli::zeroOrWholeNumber(1, 64, "off"));
+  app.add_option("--probe", o.probeResolution, "a RES^2-per-face reflection probe (default 0 = constant sky)")
+      ->type_name("RES")
+      ->check(rbCli::zeroOrWholeNumber(8, 512, "constant sky"));
+  app.add_option("--effects", o.effectsPrefix,
+                 "writes the shadow-map visibility (and SSAO) images as PREFIX_shadow.png /\nPREFIX_ssao.png")
+      ->type_name("PREFIX")
+      ->check(rbCli::nonEmpty("prefix"));
+  app.add_option("--time", o.time,
+                 "poses the scene's animation at T seconds (headless frames end there, 1/30 s\n"
+                 "apart; the viewer plays from T) (default 0)")
+      ->type_name("T")
+      ->check(rbCli::realNumber(rbCli::atLeast(0.0)));
+  app.add_option("--animation", o.animation, "the animation that plays, by index or name (default: the first)")
+      ->type_name("N|NAME")
+      ->check(rbCli::nonEmpty("index or name"));
+  app.add_flag("--rest-pose", o.restPose, "play no animation");
+  app.add_flag("--validation", o.validation, "enable VK_LAYER_KHRONOS_validation");
+  app.add_option("--frames", o.frames,
+                 "headless: frames to render (the last is written); --window: close after N\n"
+                 "frames (default 0 = one frame / run until closed)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(0, 1000000));
+  app.add_flag("--window", o.window, "open the interactive viewer");
 }
 
+// Parses argv; false after printing an error that names the option and the value. --help prints the help and
+// exits 0.
 bool parse(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    std::string a = argv[i];
-    auto next = [&](const char* name) -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "%s needs a value\n", name);
-        return nullptr;
-      }
-      return argv[++i];
-    };
-    const char* v = nullptr;
-    if (a == "--out") { if (!(v = next("--out"))) return false; o.out = v; }
-    else if (a == "--exr") { if (!(v = next("--exr"))) return false; o.exr = v; }
-    else if (a == "--scene") { if (!(v = next("--scene"))) return false; o.scene = v; }
-    else if (a == "--width") { if (!(v = next("--width"))) return false; o.width = uint32_t(std::atoi(v)); }
-    else if (a == "--height") { if (!(v = next("--height"))) return false; o.height = uint32_t(std::atoi(v)); }
-    else if (a == "--shadow-map-size") { if (!(v = next(a.c_str()))) return false; o.shadowMapSize = uint32_t(std::atoi(v)); }
-    else if (a == "--pcf") { if (!(v = next("--pcf"))) return false; o.pcf = uint32_t(std::atoi(v)); }
-    else if (a == "--ssao") { if (!(v = next("--ssao"))) return false; o.ssaoKernel = uint32_t(std::atoi(v)); }
-    else if (a == "--probe") { if (!(v = next("--probe"))) return false; o.probeResolution = uint32_t(std::atoi(v)); }
-    else if (a == "--effects") { if (!(v = next("--effects"))) return false; o.effectsPrefix = v; }
-    else if (a == "--frames") { if (!(v = next("--frames"))) return false; o.frames = std::atoi(v); }
-    else if (a == "--time") {
-      if (!(v = next("--time"))) return false;
-      char* end = nullptr;
-      o.time = std::strtod(v, &end);
-      if (end == v || *end != '\0' || !std::isfinite(o.time) || o.time < 0.0) {
-        std::fprintf(stderr, "--time %s: expected seconds, finite and >= 0\n", v);
-        return false;
-      }
-    }
-    else if (a == "--animation") { if (!(v = next("--animation"))) return false; o.animation = v; }
-    else if (a == "--rest-pose") o.restPose = true;
-    else if (a == "--window") o.window = true;
-    else if (a == "--validation") o.validation = true;
-    else if (a == "--help" || a == "-h") { usage(); std::exit(0); }
-    else {
-      std::fprintf(stderr, "unknown argument %s\n", a.c_str());
-      return false;
-    }
-  }
-  if (o.width == 0 || o.height == 0) {
-    std::fprintf(stderr, "width and height must be positive\n");
+  CLI::App app{"", "raybridge-engine-demo"};
+  addOptions(app, o);
+  bool help = false;
+  if (std::string e = rbCli::parse(app, argc, argv, help); !e.empty()) {
+    std::fprintf(stderr, "raybridge-engine-demo: error: %s\nsee raybridge-engine-demo --help\n", e.c_str());
     return false;
+  }
+  if (help) {
+    std::printf("%s", app.help().c_str());
+    std::exit(0);
   }
   return true;
 }
@@ -330,9 +334,6 @@ int runWindow(const Options& o) {
 
 int main(int argc, char** argv) {
   Options o;
-  if (!parse(argc, argv, o)) {
-    usage();
-    return 1;
-  }
+  if (!parse(argc, argv, o)) return 1;
   return o.window ? runWindow(o) : runHeadless(o);
 }

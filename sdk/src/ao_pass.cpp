@@ -28,8 +28,9 @@ Result<std::unique_ptr<AoPass>> AoPass::create(Context& context) {
   p.misses = {SpirvModule::of(spirv::occlusion_rmiss)};
   p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::occlusion_rchit), {}}};
   p.bindings = PassCore::commonBindings();
-  p.bindings.push_back({5, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr});
-  p.pushConstantBytes = sizeof(PassConstants);
+  p.bindings.push_back(
+      {RB_AO_BINDING_OUTPUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr});
+  p.pushConstantBytes = sizeof(AoConstants);
   if (Status s = impl->core.init(context, p); !s) return s.error();
   return std::unique_ptr<AoPass>(new AoPass(std::move(impl)));
 }
@@ -38,7 +39,7 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   Impl& s = *impl_;
   auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "AoPass: " + m}; };
   if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
-  float range = settings.range == 0.0f ? 1.0f : settings.range;
+  float range = settings.range == 0.0f ? kDefaultAoRange : settings.range;
   if (!(range > 0.0f) || !std::isfinite(range)) {
     return invalid("AoSettings::range " + std::to_string(settings.range) + " must be a positive number");
   }
@@ -48,16 +49,16 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   if (settings.estimator != AoEstimator::Binary && settings.estimator != AoEstimator::DistanceWeighted) {
     return invalid("AoSettings::estimator has an unknown value");
   }
-  PassConstants pc{};
-  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "AoPass", pc); !st) return st;
-  pc.p0[0] = range;
-  pc.u0[0] = settings.raysPerPixel ? settings.raysPerPixel : 4u;
-  pc.u0[1] = settings.estimator == AoEstimator::DistanceWeighted ? 1u : 0u;
+  AoConstants pc{};
+  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "AoPass", pc.gbuffer); !st) return st;
+  pc.range = range;
+  pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultAoRays;
+  pc.estimator = static_cast<uint32_t>(settings.estimator);  // RB_AO_*
 
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}}); !st) return st;
   DescriptorWrites w;
   s.core.writeCommon(s.ctx, w, g, tlas);
-  w.storageImage(5, s.core.images[0].view);
+  w.storageImage(RB_AO_BINDING_OUTPUT, s.core.images[0].view);
   s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
   s.outputs.ao = s.core.images[0].image;
   s.outputs.aoView = s.core.images[0].view;

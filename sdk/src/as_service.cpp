@@ -28,7 +28,7 @@ void recordAsBarrier(const DeviceFunctions& vk, VkCommandBuffer cmd, VkPipelineS
 
 AccelerationStructureService::Impl::Impl(Context& context, const AsServiceDesc& d)
     : ctx(context),
-      c(context.impl()),
+      c(internal::contextImpl(context)),
       desc(d),
       storage(context, d.storageBlockBytes ? d.storageBlockBytes : kDefaultBlockBytes) {
   if (desc.scratchBudgetBytes == 0) desc.scratchBudgetBytes = kDefaultScratchBudget;
@@ -39,9 +39,9 @@ AccelerationStructureService::Impl::Impl(Context& context, const AsServiceDesc& 
 }
 
 AccelerationStructureService::Impl::~Impl() {
-  // Contract: the GPU is done with everything this service recorded on the engine's queues; the async queue's
-  // work is waited for on the SDK's own timeline first. Retired objects reference the storage allocators, so
-  // they are released before those go.
+  // Contract: the GPU is done with everything this service recorded or submitted, on the engine's queues and on
+  // the async queue (the SDK never waits). Retired objects reference the storage allocators, so they are released
+  // before those go.
   handOnDeferredRetires();
   submitter.destroy();
   for (uint32_t i = 1; i < entries.size(); ++i) {

@@ -25,14 +25,8 @@ Status AsyncSubmitter::create(Context::Impl& c, VkQueue queue, uint32_t family) 
 
 void AsyncSubmitter::destroy() {
   if (!c_) return;
+  // Contract (~AccelerationStructureService): the GPU is done, the async queue included; the SDK never waits.
   Context::Impl& c = *c_;
-  if (semaphore_ && lastValue_ > 0) {
-    VkSemaphoreWaitInfo wi{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
-    wi.semaphoreCount = 1;
-    wi.pSemaphores = &semaphore_;
-    wi.pValues = &lastValue_;
-    (void)c.vk.vkWaitSemaphores(c.desc.device, &wi, UINT64_MAX);
-  }
   if (pool_) c.vk.vkDestroyCommandPool(c.desc.device, pool_, c.allocator());  // frees the command buffers
   if (semaphore_) c.vk.vkDestroySemaphore(c.desc.device, semaphore_, c.allocator());
   pool_ = VK_NULL_HANDLE;

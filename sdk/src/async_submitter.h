@@ -14,7 +14,7 @@ namespace rb {
 class AsyncSubmitter {
  public:
   Status create(Context::Impl& c, VkQueue queue, uint32_t family);
-  // Waits on the host for the last submission (the SDK's timeline only), then destroys everything.
+  // Destroys everything. Contract: every submission is done (the engine's wait-idle, or its wait on semaphore()).
   void destroy();
   bool active() const { return semaphore_ != VK_NULL_HANDLE; }
 

@@ -9,21 +9,20 @@ namespace rb {
 
 namespace {
 
-static_assert(kRefitClusterTriangles == 64, "shaders/blas_cluster_bounds.comp reduces 64 triangles per workgroup");
-
 // Below the minimum maxComputeWorkGroupCount[0] every device supports.
 constexpr uint32_t kMaxGroupsPerDispatch = 65535;
 
+// ClusterBoundsConstants::positionFormat (RB_POSITION_* in shaders/raybridge_shader_interface.glsl).
 enum ClusterPositionFormat : uint32_t {
-  kPositionRgb32f = 0,
-  kPositionRg32f,
-  kPositionRgba32f,
-  kPositionRgba16f,
-  kPositionRg16f,
-  kPositionRgba16Snorm,
-  kPositionRg16Snorm,
-  kPositionRgba8Snorm,
-  kPositionUnknown,
+  kPositionRgb32f = RB_POSITION_RGB32F,
+  kPositionRg32f = RB_POSITION_RG32F,
+  kPositionRgba32f = RB_POSITION_RGBA32F,
+  kPositionRgba16f = RB_POSITION_RGBA16F,
+  kPositionRg16f = RB_POSITION_RG16F,
+  kPositionRgba16Snorm = RB_POSITION_RGBA16_SNORM,
+  kPositionRg16Snorm = RB_POSITION_RG16_SNORM,
+  kPositionRgba8Snorm = RB_POSITION_RGBA8_SNORM,
+  kPositionUnknown,  // not measurable: such meshes are rebuilt by refit count
 };
 
 ClusterPositionFormat positionFormat(VkFormat format) {
@@ -68,14 +67,16 @@ uint32_t ClusterBoundsPass::clusterCount(uint32_t triangleCount) {
 
 void ClusterBoundsPass::record(Context& ctx, VkCommandBuffer cmd, const MeshDesc& m,
                                VkDeviceAddress clusterAreas) const {
-  const DeviceFunctions& vk = ctx.vk();
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.pipeline);
   ClusterBoundsConstants pc{};
   pc.positions = m.vertexAddress;
   pc.indices = m.indexAddress;
   pc.positionStride = m.vertexStride;
   pc.positionFormat = positionFormat(m.vertexFormat);
-  pc.indexType = m.indexType == IndexType::Uint32 ? 0u : m.indexType == IndexType::Uint16 ? 1u : 2u;
+  pc.indexType = m.indexType == IndexType::Uint32   ? RB_INDEX_U32
+                 : m.indexType == IndexType::Uint16 ? RB_INDEX_U16
+                                                    : RB_INDEX_NONE;
   pc.triangleCount = m.triangleCount;
   const uint32_t clusters = clusterCount(m.triangleCount);
   for (uint32_t first = 0; first < clusters; first += kMaxGroupsPerDispatch) {

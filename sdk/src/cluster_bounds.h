@@ -7,23 +7,9 @@
 
 #include "compute_pipeline.h"
 #include "mesh_validation.h"
+#include "pass_constants.h"
 
 namespace rb {
-
-// Mirrors ClusterBoundsConstants in shaders/blas_cluster_bounds.comp.
-struct ClusterBoundsConstants {
-  uint64_t positions;
-  uint64_t indices;
-  uint64_t clusterAreas;
-  uint32_t positionStride;
-  uint32_t positionFormat;  // ClusterPositionFormat
-  uint32_t indexType;       // 0 u32, 1 u16, 2 none
-  uint32_t triangleCount;
-  uint32_t firstCluster;
-  uint32_t pad;
-};
-static_assert(sizeof(ClusterBoundsConstants) == 48, "must match shaders/blas_cluster_bounds.comp");
-static_assert(offsetof(ClusterBoundsConstants, positionStride) == 24, "must match shaders/blas_cluster_bounds.comp");
 
 class ClusterBoundsPass {
  public:

@@ -9,7 +9,7 @@ namespace rb {
 Result<ComputePipeline> ComputePipeline::create(Context& ctx, const SpirvModule& shader,
                                                 const std::vector<VkDescriptorSetLayoutBinding>& bindings,
                                                 uint32_t pushConstantBytes, const char* name) {
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   ComputePipeline p;
   VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   sl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
@@ -53,7 +53,7 @@ Result<ComputePipeline> ComputePipeline::create(Context& ctx, const SpirvModule&
 }
 
 void ComputePipeline::destroy(Context& ctx) {
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   if (pipeline) c.vk.vkDestroyPipeline(c.desc.device, pipeline, c.allocator());
   if (layout) c.vk.vkDestroyPipelineLayout(c.desc.device, layout, c.allocator());
   if (setLayout) c.vk.vkDestroyDescriptorSetLayout(c.desc.device, setLayout, c.allocator());
@@ -67,13 +67,13 @@ void ComputePipeline::retire(Context& ctx) {
   ComputePipeline retired = *this;
   *this = ComputePipeline{};
   Context* context = &ctx;
-  ctx.impl().retire([context, retired]() mutable { retired.destroy(*context); });
+  internal::contextImpl(ctx).retire([context, retired]() mutable { retired.destroy(*context); });
 }
 
 void ComputePipeline::dispatch(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes,
                                const void* constants, uint32_t constantBytes, uint32_t width,
                                uint32_t height) const {
-  const DeviceFunctions& vk = ctx.vk();
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
   vk.vkCmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, static_cast<uint32_t>(writes.size()),
                                writes.data());

@@ -239,7 +239,9 @@ const DeviceInfo& Context::deviceInfo() const { return impl_->info; }
 VkDevice Context::device() const { return impl_->desc.device; }
 VkPhysicalDevice Context::physicalDevice() const { return impl_->desc.physicalDevice; }
 MemoryStats Context::memoryStats() const { return impl_->memory; }
-const DeviceFunctions& Context::vk() const { return impl_->vk; }
+namespace internal {
+const DeviceFunctions& deviceFunctions(const Context& ctx) { return ContextAccess::impl(ctx).vk; }
+}  // namespace internal
 
 void Context::Impl::releaseRetired(bool deviceIdle) {
   // Released in retirement order: a later release may depend on an earlier one still existing.

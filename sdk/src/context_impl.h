@@ -7,7 +7,9 @@
 #include <functional>
 #include <vector>
 
+#include "context_access.h"
 #include "device_functions.h"
+#include "vulkan_errors.h"
 
 namespace rb {
 
@@ -51,10 +53,5 @@ struct Context::Impl {
   int32_t findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
   const VkAllocationCallbacks* allocator() const { return desc.allocationCallbacks; }
 };
-
-// Builds an Error for a failed Vulkan call: "<what> failed: VK_ERROR_... ".
-Error vulkanError(VkResult result, const std::string& what);
-const char* toString(VkResult result);
-const char* formatName(VkFormat format);
 
 }  // namespace rb

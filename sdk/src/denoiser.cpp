@@ -17,17 +17,6 @@ namespace rb {
 
 namespace {
 
-// Mirrors DenoiseConstants in shaders/denoise_common.glsl.
-struct DenoiseConstants {
-  float inverseProjection[16];
-  float viewToWorld[3][4];
-  float previousViewProjection[16];
-  float cameraDelta[4];
-  uint32_t size[4];
-  float params[4];
-};
-static_assert(sizeof(DenoiseConstants) == 224, "must match shaders/denoise_common.glsl");
-
 // column-major a * b for 4x4 matrices in double.
 void multiply(const double a[16], const double b[16], double out[16]) {
   for (int c = 0; c < 4; ++c) {
@@ -58,7 +47,7 @@ struct Denoiser::Impl {
   ~Impl() {  // frames in flight may still run its dispatches
     temporal.retire(ctx);
     atrous.retire(ctx);
-    ctx.impl().retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
+    internal::contextImpl(ctx).retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
     images.retire(ctx);
     metrics.retire(ctx);
   }
@@ -78,14 +67,19 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context) {
   };
   Result<ComputePipeline> t = ComputePipeline::create(
       context, SpirvModule::of(spirv::denoise_temporal_comp),
-      {sampled(0), sampled(1), sampled(2), sampled(3), sampled(4), storage(5), storage(6), storage(7)},
+      {sampled(RB_TEMPORAL_BINDING_DEPTH), sampled(RB_TEMPORAL_BINDING_MOTION), sampled(RB_TEMPORAL_BINDING_SIGNAL),
+       sampled(RB_TEMPORAL_BINDING_HISTORY_IN), sampled(RB_TEMPORAL_BINDING_DISTANCE_IN),
+       storage(RB_TEMPORAL_BINDING_HISTORY_OUT), storage(RB_TEMPORAL_BINDING_DISTANCE_OUT),
+       storage(RB_TEMPORAL_BINDING_VALUE_OUT)},
       sizeof(DenoiseConstants),
       "denoiser temporal");
   if (!t) return t.error();
   impl->temporal = t.value();
   Result<ComputePipeline> a =
       ComputePipeline::create(context, SpirvModule::of(spirv::denoise_atrous_comp),
-                              {sampled(0), sampled(1), sampled(2), storage(3)}, sizeof(DenoiseConstants),
+                              {sampled(RB_ATROUS_BINDING_DEPTH), sampled(RB_ATROUS_BINDING_NORMAL),
+                               sampled(RB_ATROUS_BINDING_SIGNAL_IN), storage(RB_ATROUS_BINDING_SIGNAL_OUT)},
+                              sizeof(DenoiseConstants),
                               "denoiser a-trous");
   if (!a) return a.error();
   impl->atrous = a.value();
@@ -112,22 +106,23 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
     return invalid("both temporal and spatial filtering are disabled; use the raw signal instead");
   }
   // The G-buffer checks and camera terms are those of the ray tracing passes (no TLAS involved here).
-  PassConstants pass{};
+  GBufferConstants pass{};
   TlasInfo noTlas;
   noTlas.tlas = reinterpret_cast<VkAccelerationStructureKHR>(uintptr_t(1));  // fillGBufferConstants wants one
   if (Status st = fillGBufferConstants(g, noTlas, ctx.frameIndex(), "Denoiser", pass); !st) return st;
   DenoiseConstants pc{};
   std::memcpy(pc.inverseProjection, pass.inverseProjection, sizeof pc.inverseProjection);
   std::memcpy(pc.viewToWorld, pass.viewToWorld, sizeof pc.viewToWorld);
+  pc.wAtDepthOne = pass.wAtDepthOne;
   uint32_t flags = 0;
-  if (g.depthConvention == DepthConvention::ReversedZ) flags |= 1u;
-  if (g.normalEncoding == NormalEncoding::Octahedral) flags |= 2u;
-  if (g.motionVectors.view) flags |= 8u;
+  if (g.depthConvention == DepthConvention::ReversedZ) flags |= RB_DN_REVERSED_Z;
+  if (g.normalEncoding == NormalEncoding::Octahedral) flags |= RB_DN_OCTAHEDRAL;
+  if (g.motionVectors.view) flags |= RB_DN_MOTION;
   pc.size[0] = g.width;
   pc.size[1] = g.height;
-  pc.cameraDelta[3] = settings.depthSigma > 0.0f ? settings.depthSigma : 0.005f;
-  pc.params[0] = settings.normalPower > 0.0f ? settings.normalPower : 32.0f;
-  pc.params[1] = float(settings.raysPerPixel);
+  pc.depthSigma = settings.depthSigma > 0.0f ? settings.depthSigma : 0.005f;
+  pc.normalPower = settings.normalPower > 0.0f ? settings.normalPower : 32.0f;
+  pc.signalRaysPerPixel = float(settings.raysPerPixel);
 
   // This frame's camera: projection * rotation-only view, kept for next frame's reprojection.
   double camera[3];
@@ -150,7 +145,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
   if (resized) s.historyValid = false;
   const PassImages& im = s.images;
-  const DeviceFunctions& vk = ctx.vk();
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   const uint32_t cur = s.parity, prev = 1 - s.parity;
 
   s.metrics.beginRecording(ctx, cmd);
@@ -192,20 +187,20 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   const GpuImage* last = nullptr;
   if (temporal) {
     uint32_t maxHistory = settings.maxHistoryFrames ? settings.maxHistoryFrames : 32u;
-    pc.size[2] = flags | (historyUsable ? 4u : 0u);
-    pc.size[3] = maxHistory;
+    pc.flags = flags | (historyUsable ? RB_DN_HISTORY : 0u);
+    pc.maxHistoryFrames = maxHistory;
     for (int i = 0; i < 16; ++i) pc.previousViewProjection[i] = static_cast<float>(s.previousViewProjection[i]);
     for (int i = 0; i < 3; ++i) pc.cameraDelta[i] = static_cast<float>(camera[i] - s.previousCamera[i]);
     DescriptorWrites w;
-    w.sampledImage(0, g.depth.view, s.sampler, readLayout(g.depth));
+    w.sampledImage(RB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
     const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
-    w.sampledImage(1, motion.view, s.sampler, readLayout(motion));
-    w.sampledImage(2, signal, s.sampler, ro);
-    w.sampledImage(3, im[prev].view, s.sampler, ro);
-    w.sampledImage(4, im[2 + prev].view, s.sampler, ro);
-    w.storageImage(5, im[cur].view);
-    w.storageImage(6, im[2 + cur].view);
-    w.storageImage(7, im[6].view);
+    w.sampledImage(RB_TEMPORAL_BINDING_MOTION, motion.view, s.sampler, readLayout(motion));
+    w.sampledImage(RB_TEMPORAL_BINDING_SIGNAL, signal, s.sampler, ro);
+    w.sampledImage(RB_TEMPORAL_BINDING_HISTORY_IN, im[prev].view, s.sampler, ro);
+    w.sampledImage(RB_TEMPORAL_BINDING_DISTANCE_IN, im[2 + prev].view, s.sampler, ro);
+    w.storageImage(RB_TEMPORAL_BINDING_HISTORY_OUT, im[cur].view);
+    w.storageImage(RB_TEMPORAL_BINDING_DISTANCE_OUT, im[2 + cur].view);
+    w.storageImage(RB_TEMPORAL_BINDING_VALUE_OUT, im[6].view);
     s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
     barrier(im[cur], VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
     barrier(im[2 + cur], VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
@@ -218,7 +213,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   }
   if (!settings.disableSpatial) {
     uint32_t iterations = settings.spatialIterations ? settings.spatialIterations : 2u;
-    pc.size[2] = flags;
+    pc.flags = flags;
     for (uint32_t i = 0; i < iterations; ++i) {
       const GpuImage& out = im[4 + (i % 2)];
       if (i >= 2) {
@@ -226,12 +221,12 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
         barrier(out, ro, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_SHADER_WRITE_BIT);
         flush(cs, cs);
       }
-      pc.size[3] = 1u << i;
+      pc.atrousStep = 1u << i;
       DescriptorWrites w;
-      w.sampledImage(0, g.depth.view, s.sampler, readLayout(g.depth));
-      w.sampledImage(1, g.normal.view, s.sampler, readLayout(g.normal));
-      w.sampledImage(2, current, s.sampler, ro);
-      w.storageImage(3, out.view);
+      w.sampledImage(RB_ATROUS_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
+      w.sampledImage(RB_ATROUS_BINDING_NORMAL, g.normal.view, s.sampler, readLayout(g.normal));
+      w.sampledImage(RB_ATROUS_BINDING_SIGNAL_IN, current, s.sampler, ro);
+      w.storageImage(RB_ATROUS_BINDING_SIGNAL_OUT, out.view);
       s.atrous.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
       barrier(out, VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
       flush(cs, readers);

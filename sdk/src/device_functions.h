@@ -79,11 +79,10 @@ namespace rb {
   X(vkBeginCommandBuffer)                           \
   X(vkEndCommandBuffer)                             \
   X(vkResetCommandBuffer)                           \
-  X(vkQueueSubmit)                                  \
+  X(vkQueueSubmit) /* async BLAS builds only, on AsServiceDesc::asyncQueue */ \
   X(vkCreateSemaphore)                              \
   X(vkDestroySemaphore)                             \
-  X(vkGetSemaphoreCounterValue)                     \
-  X(vkWaitSemaphores)
+  X(vkGetSemaphoreCounterValue)
 
 struct DeviceFunctions {
 #define RB_DECLARE(name) PFN_##name name = nullptr;

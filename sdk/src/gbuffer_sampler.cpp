@@ -5,7 +5,7 @@
 namespace rb {
 
 Result<VkSampler> createNearestSampler(Context& ctx) {
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   VkSamplerCreateInfo info{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
   info.magFilter = info.minFilter = VK_FILTER_NEAREST;
   info.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
@@ -18,7 +18,9 @@ Result<VkSampler> createNearestSampler(Context& ctx) {
 }
 
 void destroySampler(Context& ctx, VkSampler& sampler) {
-  if (sampler) ctx.vk().vkDestroySampler(ctx.device(), sampler, ctx.impl().allocator());
+  if (sampler) {
+    internal::deviceFunctions(ctx).vkDestroySampler(ctx.device(), sampler, internal::contextImpl(ctx).allocator());
+  }
   sampler = VK_NULL_HANDLE;
 }
 

@@ -47,7 +47,7 @@ Result<VkDeviceMemory> allocate(Context::Impl& c, const VkMemoryRequirements& re
 
 Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryLocation location,
                                MemoryCategory category, const char* what, std::span<const uint32_t> sharedWith) {
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   GpuBuffer out;
   out.size = size;
   out.category = category;
@@ -91,7 +91,7 @@ Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFla
 
 void destroyBuffer(Context& ctx, GpuBuffer& buffer) {
   if (!buffer.valid()) return;
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   c.vk.vkDestroyBuffer(c.desc.device, buffer.buffer, c.allocator());
   c.vk.vkFreeMemory(c.desc.device, buffer.memory, c.allocator());
   account(c, buffer.category, buffer.allocatedBytes, false);
@@ -103,12 +103,12 @@ void retireBuffer(Context& ctx, GpuBuffer& buffer) {
   GpuBuffer copy = buffer;
   buffer = GpuBuffer{};
   Context* context = &ctx;
-  ctx.impl().retire([context, copy]() mutable { destroyBuffer(*context, copy); });
+  internal::contextImpl(ctx).retire([context, copy]() mutable { destroyBuffer(*context, copy); });
 }
 
 Result<GpuImage> createStorageImage(Context& ctx, uint32_t width, uint32_t height, VkFormat format,
                                     VkImageUsageFlags extraUsage, MemoryCategory category, const char* what) {
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   GpuImage out;
   out.format = format;
   out.width = width;
@@ -153,7 +153,7 @@ Result<GpuImage> createStorageImage(Context& ctx, uint32_t width, uint32_t heigh
 
 void destroyImage(Context& ctx, GpuImage& image) {
   if (!image.valid()) return;
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   c.vk.vkDestroyImageView(c.desc.device, image.view, c.allocator());
   c.vk.vkDestroyImage(c.desc.device, image.image, c.allocator());
   c.vk.vkFreeMemory(c.desc.device, image.memory, c.allocator());
@@ -166,7 +166,7 @@ void retireImage(Context& ctx, GpuImage& image) {
   GpuImage copy = image;
   image = GpuImage{};
   Context* context = &ctx;
-  ctx.impl().retire([context, copy]() mutable { destroyImage(*context, copy); });
+  internal::contextImpl(ctx).retire([context, copy]() mutable { destroyImage(*context, copy); });
 }
 
 }  // namespace rb

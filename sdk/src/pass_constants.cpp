@@ -70,7 +70,7 @@ void cameraPosition(const GBufferDesc& g, double out[3]) {
 }
 
 Status fillGBufferConstants(const GBufferDesc& g, const TlasInfo& tlas, uint64_t frame, const char* passName,
-                            PassConstants& out) {
+                            GBufferConstants& out) {
   auto invalid = [&](const std::string& m) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS, std::string(passName) + ": " + m};
   };
@@ -103,7 +103,7 @@ Status fillGBufferConstants(const GBufferDesc& g, const TlasInfo& tlas, uint64_t
     out.viewToWorld[c][3] = 0.0f;
   }
   // w at depth 1, formed in double: the shader adds the small term a * (depth - 1) to it without cancellation.
-  out.viewToWorld[0][3] = static_cast<float>(invProj[11] + invProj[15]);
+  out.wAtDepthOne = static_cast<float>(invProj[11] + invProj[15]);
   double cam[3];
   cameraPosition(g, cam);
   for (int i = 0; i < 3; ++i) out.cameraToTlas[i] = static_cast<float>(cam[i] - tlas.originOffset[i]);
@@ -111,24 +111,24 @@ Status fillGBufferConstants(const GBufferDesc& g, const TlasInfo& tlas, uint64_t
   switch (g.depthFormat) {
     case VK_FORMAT_UNDEFINED:
     case VK_FORMAT_D32_SFLOAT:
-    case VK_FORMAT_D32_SFLOAT_S8_UINT: out.cameraToTlas[3] = 0.0f; break;
+    case VK_FORMAT_D32_SFLOAT_S8_UINT: out.depthQuantum = 0.0f; break;
     case VK_FORMAT_X8_D24_UNORM_PACK32:
-    case VK_FORMAT_D24_UNORM_S8_UINT: out.cameraToTlas[3] = 1.0f / 16777215.0f; break;
+    case VK_FORMAT_D24_UNORM_S8_UINT: out.depthQuantum = 1.0f / 16777215.0f; break;
     case VK_FORMAT_D16_UNORM:
-    case VK_FORMAT_D16_UNORM_S8_UINT: out.cameraToTlas[3] = 1.0f / 65535.0f; break;
+    case VK_FORMAT_D16_UNORM_S8_UINT: out.depthQuantum = 1.0f / 65535.0f; break;
     default: return invalid("GBufferDesc::depthFormat is not a depth format");
   }
-  out.gbuffer[0] = g.width;
-  out.gbuffer[1] = g.height;
+  out.size[0] = g.width;
+  out.size[1] = g.height;
   uint32_t flags = 0;
-  if (g.depthConvention == DepthConvention::ReversedZ) flags |= kGbReversedZ;
-  if (g.normalEncoding == NormalEncoding::Octahedral) flags |= kGbOctahedral;
-  if (g.geometricNormal.view) flags |= kGbGeometricNormal;
-  if (g.roughnessInNormalW) flags |= kGbRoughnessInNormalW;
-  if (g.roughnessMetalness.view) flags |= kGbRoughnessImage;
-  if (g.albedo.view) flags |= kGbAlbedoImage;
-  out.gbuffer[2] = flags;
-  out.gbuffer[3] = static_cast<uint32_t>(frame);
+  if (g.depthConvention == DepthConvention::ReversedZ) flags |= RB_GB_REVERSED_Z;
+  if (g.normalEncoding == NormalEncoding::Octahedral) flags |= RB_GB_OCTAHEDRAL;
+  if (g.geometricNormal.view) flags |= RB_GB_GEOMETRIC_NORMAL;
+  if (g.roughnessInNormalW) flags |= RB_GB_ROUGHNESS_IN_NORMAL_W;
+  if (g.roughnessMetalness.view) flags |= RB_GB_ROUGHNESS_IMAGE;
+  if (g.albedo.view) flags |= RB_GB_ALBEDO_IMAGE;
+  out.flags = flags;
+  out.frameIndex = static_cast<uint32_t>(frame);
   return {};
 }
 

@@ -1,37 +1,187 @@
-// The push constants every G-buffer pass shares (mirrors PassConstants in shaders/pass_inputs.glsl), and the
-// code that fills their camera and G-buffer part.
+// The push constants of every pass (mirrors of shaders/raybridge_pass_constants.glsl), and the code that fills
+// the camera and G-buffer part the G-buffer passes share.
 #pragma once
 
 #include <raybridge/acceleration_structures.h>
+#include <raybridge/ao_pass.h>
+#include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
+
+// Bindings, flags and enumerations shared with the GLSL (only #defines).
+#include "raybridge_shader_interface.glsl"
 
 namespace rb {
 
-struct PassConstants {
-  float inverseProjection[16];
-  float viewToWorld[3][4];  // columns
-  float cameraToTlas[4];    // xyz camera position in TLAS space, w depth quantum
-  uint32_t gbuffer[4];      // width, height, flags, frame index
-  float p0[4], p1[4], p2[4];
-  uint32_t u0[4];
-};
-static_assert(sizeof(PassConstants) == 208, "must match shaders/pass_inputs.glsl");
+// One push constant struct per pass, each mirroring the struct of the same name in
+// shaders/raybridge_pass_constants.glsl field by field (std430: a vec3 is 16-byte aligned and may be followed by
+// a scalar, a mat3 is three columns 16 bytes apart). The asserts below hold the offsets written there.
+#define RB_ASSERT_OFFSET(type, field, offset) \
+  static_assert(offsetof(type, field) == (offset), #type "::" #field " must match raybridge_pass_constants.glsl")
 
-enum GBufferFlags : uint32_t {
-  kGbReversedZ = 1,
-  kGbOctahedral = 2,
-  kGbGeometricNormal = 4,
-  kGbRoughnessInNormalW = 8,
-  kGbRoughnessImage = 16,
-  kGbAlbedoImage = 32,
+struct GBufferConstants {
+  float inverseProjection[16];
+  float viewToWorld[3][4];  // columns; .w unused
+  float cameraToTlas[3];    // camera position in the TLAS's space
+  float depthQuantum;       // one step of the stored depth value; 0 = float depth
+  uint32_t size[2];
+  uint32_t flags;           // RB_GB_*
+  uint32_t frameIndex;
+  float wAtDepthOne;        // w of inverse(projection) * (x, y, 1, 1)
+  uint32_t pad[3];
 };
+static_assert(sizeof(GBufferConstants) == 160);
+RB_ASSERT_OFFSET(GBufferConstants, inverseProjection, 0);
+RB_ASSERT_OFFSET(GBufferConstants, viewToWorld, 64);
+RB_ASSERT_OFFSET(GBufferConstants, cameraToTlas, 112);
+RB_ASSERT_OFFSET(GBufferConstants, depthQuantum, 124);
+RB_ASSERT_OFFSET(GBufferConstants, size, 128);
+RB_ASSERT_OFFSET(GBufferConstants, flags, 136);
+RB_ASSERT_OFFSET(GBufferConstants, frameIndex, 140);
+RB_ASSERT_OFFSET(GBufferConstants, wAtDepthOne, 144);
+
+struct ShadowConstants {
+  GBufferConstants gbuffer;
+  float lightDirection[3];  // towards a directional light, unit length
+  uint32_t lightType;       // RB_LIGHT_* = rb::LightType
+  float lightPosition[3];   // point and spot lights, TLAS space
+  float lightRadius;        // point and spot lights; 0 = hard shadows
+  float spotDirection[3];   // from the light, unit length
+  float cosSpotOuterAngle;
+  float tanAngularRadius;   // directional light; 0 = hard shadows
+  float range;              // point and spot lights; 0 = unlimited
+  uint32_t raysPerPixel;
+  uint32_t pad0;
+};
+static_assert(sizeof(ShadowConstants) == 224);
+RB_ASSERT_OFFSET(ShadowConstants, gbuffer, 0);
+RB_ASSERT_OFFSET(ShadowConstants, lightDirection, 160);
+RB_ASSERT_OFFSET(ShadowConstants, lightType, 172);
+RB_ASSERT_OFFSET(ShadowConstants, lightPosition, 176);
+RB_ASSERT_OFFSET(ShadowConstants, lightRadius, 188);
+RB_ASSERT_OFFSET(ShadowConstants, spotDirection, 192);
+RB_ASSERT_OFFSET(ShadowConstants, cosSpotOuterAngle, 204);
+RB_ASSERT_OFFSET(ShadowConstants, tanAngularRadius, 208);
+RB_ASSERT_OFFSET(ShadowConstants, range, 212);
+RB_ASSERT_OFFSET(ShadowConstants, raysPerPixel, 216);
+
+struct AoConstants {
+  GBufferConstants gbuffer;
+  float range;
+  uint32_t raysPerPixel;
+  uint32_t estimator;  // RB_AO_* = rb::AoEstimator
+  uint32_t pad0;
+};
+static_assert(sizeof(AoConstants) == 176);
+RB_ASSERT_OFFSET(AoConstants, gbuffer, 0);
+RB_ASSERT_OFFSET(AoConstants, range, 160);
+RB_ASSERT_OFFSET(AoConstants, raysPerPixel, 164);
+RB_ASSERT_OFFSET(AoConstants, estimator, 168);
+
+struct ReflectionConstants {
+  GBufferConstants gbuffer;
+  float sunDirection[3];  // towards the sun, unit length
+  float roughnessThreshold;
+  float sunRadiance[3];
+  float ambientIntensity;
+  float skyRadiance[3];
+  uint32_t raysPerPixel;
+};
+static_assert(sizeof(ReflectionConstants) == 208);
+RB_ASSERT_OFFSET(ReflectionConstants, gbuffer, 0);
+RB_ASSERT_OFFSET(ReflectionConstants, sunDirection, 160);
+RB_ASSERT_OFFSET(ReflectionConstants, roughnessThreshold, 172);
+RB_ASSERT_OFFSET(ReflectionConstants, sunRadiance, 176);
+RB_ASSERT_OFFSET(ReflectionConstants, ambientIntensity, 188);
+RB_ASSERT_OFFSET(ReflectionConstants, skyRadiance, 192);
+RB_ASSERT_OFFSET(ReflectionConstants, raysPerPixel, 204);
+
+struct PrimaryConstants {
+  float eye[3];
+  float tMin;
+  float right[3];  // pre-scaled by tan(fovY / 2) * aspect ratio
+  float tMax;
+  float up[3];     // pre-scaled by tan(fovY / 2)
+  uint32_t width;
+  float forward[3];
+  uint32_t height;
+};
+static_assert(sizeof(PrimaryConstants) == 64);
+RB_ASSERT_OFFSET(PrimaryConstants, eye, 0);
+RB_ASSERT_OFFSET(PrimaryConstants, tMin, 12);
+RB_ASSERT_OFFSET(PrimaryConstants, right, 16);
+RB_ASSERT_OFFSET(PrimaryConstants, tMax, 28);
+RB_ASSERT_OFFSET(PrimaryConstants, up, 32);
+RB_ASSERT_OFFSET(PrimaryConstants, width, 44);
+RB_ASSERT_OFFSET(PrimaryConstants, forward, 48);
+RB_ASSERT_OFFSET(PrimaryConstants, height, 60);
+
+struct DenoiseConstants {
+  float inverseProjection[16];
+  float viewToWorld[3][4];  // as GBufferConstants::viewToWorld
+  float previousViewProjection[16];
+  float cameraDelta[3];     // current camera position - previous camera position
+  float depthSigma;
+  uint32_t size[2];
+  uint32_t flags;           // RB_DN_*
+  uint32_t atrousStep;      // a-trous pass
+  uint32_t maxHistoryFrames;  // temporal pass
+  float wAtDepthOne;
+  float normalPower;
+  float signalRaysPerPixel;  // 0 = unknown
+};
+static_assert(sizeof(DenoiseConstants) == 224);
+RB_ASSERT_OFFSET(DenoiseConstants, inverseProjection, 0);
+RB_ASSERT_OFFSET(DenoiseConstants, viewToWorld, 64);
+RB_ASSERT_OFFSET(DenoiseConstants, previousViewProjection, 112);
+RB_ASSERT_OFFSET(DenoiseConstants, cameraDelta, 176);
+RB_ASSERT_OFFSET(DenoiseConstants, depthSigma, 188);
+RB_ASSERT_OFFSET(DenoiseConstants, size, 192);
+RB_ASSERT_OFFSET(DenoiseConstants, flags, 200);
+RB_ASSERT_OFFSET(DenoiseConstants, atrousStep, 204);
+RB_ASSERT_OFFSET(DenoiseConstants, maxHistoryFrames, 208);
+RB_ASSERT_OFFSET(DenoiseConstants, wAtDepthOne, 212);
+RB_ASSERT_OFFSET(DenoiseConstants, normalPower, 216);
+RB_ASSERT_OFFSET(DenoiseConstants, signalRaysPerPixel, 220);
+
+struct ClusterBoundsConstants {
+  uint64_t positions;  // device addresses
+  uint64_t indices;
+  uint64_t clusterAreas;
+  uint32_t positionStride;
+  uint32_t positionFormat;  // RB_POSITION_*
+  uint32_t indexType;       // RB_INDEX_*
+  uint32_t triangleCount;
+  uint32_t firstCluster;
+  uint32_t pad0;
+};
+static_assert(sizeof(ClusterBoundsConstants) == 48);
+RB_ASSERT_OFFSET(ClusterBoundsConstants, positions, 0);
+RB_ASSERT_OFFSET(ClusterBoundsConstants, indices, 8);
+RB_ASSERT_OFFSET(ClusterBoundsConstants, clusterAreas, 16);
+RB_ASSERT_OFFSET(ClusterBoundsConstants, positionStride, 24);
+RB_ASSERT_OFFSET(ClusterBoundsConstants, positionFormat, 28);
+RB_ASSERT_OFFSET(ClusterBoundsConstants, indexType, 32);
+RB_ASSERT_OFFSET(ClusterBoundsConstants, triangleCount, 36);
+RB_ASSERT_OFFSET(ClusterBoundsConstants, firstCluster, 40);
+
+#undef RB_ASSERT_OFFSET
+
+// The enumerations the shaders test, by their public names.
+static_assert(RB_LIGHT_DIRECTIONAL == uint32_t(LightType::Directional));
+static_assert(RB_LIGHT_POINT == uint32_t(LightType::Point));
+static_assert(RB_LIGHT_SPOT == uint32_t(LightType::Spot));
+static_assert(RB_AO_BINARY == uint32_t(AoEstimator::Binary));
+static_assert(RB_AO_DISTANCE_WEIGHTED == uint32_t(AoEstimator::DistanceWeighted));
+static_assert(RB_CLUSTER_TRIANGLES == kRefitClusterTriangles);
 
 // Checks the description (names the offending field) and fills the camera and G-buffer part of `out`.
 // `passName` prefixes messages.
 Status fillGBufferConstants(const GBufferDesc& gbuffer, const TlasInfo& tlas, uint64_t frame, const char* passName,
-                            PassConstants& out);
+                            GBufferConstants& out);
 
 // The world-space camera position: GBufferDesc::cameraPosition, or the translation of inverse(view).
 void cameraPosition(const GBufferDesc& gbuffer, double out[3]);

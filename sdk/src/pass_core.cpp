@@ -17,7 +17,7 @@ Status PassCore::init(Context& ctx, const RayTracingPipelineDesc& desc) {
 
 void PassCore::retire(Context& ctx) {
   pipeline.retire(ctx);
-  ctx.impl().retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
+  internal::contextImpl(ctx).retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
   images.retire(ctx);
   metrics.retire(ctx);
 }
@@ -25,21 +25,21 @@ void PassCore::retire(Context& ctx) {
 std::vector<VkDescriptorSetLayoutBinding> PassCore::commonBindings() {
   const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
   return {
-      {0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, rg, nullptr},
-      {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
-      {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
-      {3, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
-      {4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr},
+      {RB_BINDING_TLAS, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, rg, nullptr},
+      {RB_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
+      {RB_BINDING_NORMAL, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
+      {RB_BINDING_GEOMETRIC_NORMAL, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
+      {RB_BINDING_RAY_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr},
   };
 }
 
 void PassCore::writeCommon(Context& ctx, DescriptorWrites& w, const GBufferDesc& g, const TlasInfo& tlas) const {
-  w.accelerationStructure(0, tlas.tlas);
-  w.sampledImage(1, g.depth.view, sampler, readLayout(g.depth));
-  w.sampledImage(2, g.normal.view, sampler, readLayout(g.normal));
+  w.accelerationStructure(RB_BINDING_TLAS, tlas.tlas);
+  w.sampledImage(RB_BINDING_DEPTH, g.depth.view, sampler, readLayout(g.depth));
+  w.sampledImage(RB_BINDING_NORMAL, g.normal.view, sampler, readLayout(g.normal));
   const GBufferImage& geo = g.geometricNormal.view ? g.geometricNormal : g.normal;
-  w.sampledImage(3, geo.view, sampler, readLayout(geo));
-  w.storageBuffer(4, metrics.counterBuffer(), metrics.counterOffset(ctx), metrics.counterBytes());
+  w.sampledImage(RB_BINDING_GEOMETRIC_NORMAL, geo.view, sampler, readLayout(geo));
+  w.storageBuffer(RB_BINDING_RAY_COUNTERS, metrics.counterBuffer(), metrics.counterOffset(ctx), metrics.counterBytes());
 }
 
 Status PassCore::begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
@@ -51,9 +51,9 @@ Status PassCore::begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
   return {};
 }
 
-void PassCore::traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const PassConstants& pc,
-                           const GBufferDesc& g) {
-  pipeline.bind(ctx, cmd, w.writes, &pc, sizeof pc);
+void PassCore::traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
+                           uint32_t constantBytes, const GBufferDesc& g) {
+  pipeline.bind(ctx, cmd, w.writes, constants, constantBytes);
   pipeline.trace(ctx, cmd, g.width, g.height);
   images.endWrite(ctx, cmd);
   metrics.writeEnd(ctx, cmd);

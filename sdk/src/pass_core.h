@@ -23,16 +23,22 @@ struct PassCore {
   // may be destroyed while frames that recorded it are still in flight.
   void retire(Context& ctx);
 
-  // The bindings every pass starts with: 0 TLAS, 1 depth, 2 normal, 3 geometric normal (or the normal),
-  // 4 ray counters. Pass-specific bindings follow from 5.
+  // The bindings every pass starts with (RB_BINDING_* in shaders/raybridge_shader_interface.glsl): TLAS, depth,
+  // normal, geometric normal (or the normal), ray counters. Pass-specific bindings follow.
   static std::vector<VkDescriptorSetLayoutBinding> commonBindings();
   void writeCommon(Context& ctx, DescriptorWrites& w, const GBufferDesc& g, const TlasInfo& tlas) const;
 
   // Ensures the outputs, starts the measurements and makes the outputs writable.
   Status begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const std::vector<PassImages::Spec>& outputs);
-  // Traces one ray generation invocation per G-buffer pixel, then makes the outputs readable.
-  void traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const PassConstants& pc,
-                   const GBufferDesc& g);
+  // Traces one ray generation invocation per G-buffer pixel with the pass's push constants (ShadowConstants,
+  // AoConstants, ...), then makes the outputs readable.
+  template <typename Constants>
+  void traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const Constants& pc,
+                   const GBufferDesc& g) {
+    traceAndEnd(ctx, cmd, w, &pc, sizeof pc, g);
+  }
+  void traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
+                   uint32_t constantBytes, const GBufferDesc& g);
 };
 
 }  // namespace rb

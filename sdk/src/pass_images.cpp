@@ -33,7 +33,7 @@ void transition(Context& ctx, VkCommandBuffer cmd, const std::vector<GpuImage>& 
   std::vector<VkImageMemoryBarrier> barriers;
   for (const GpuImage& img : images) barriers.push_back(colorImageBarrier(img.image, from, to, srcAccess, dstAccess));
   if (barriers.empty()) return;
-  ctx.vk().vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr,
+  internal::deviceFunctions(ctx).vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr,
                                 static_cast<uint32_t>(barriers.size()), barriers.data());
 }
 }  // namespace

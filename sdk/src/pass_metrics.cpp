@@ -8,7 +8,7 @@
 namespace rb {
 
 Status PassMetrics::init(Context& ctx, const char* passName) {
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   const uint32_t slots = c.desc.framesInFlight;
   Result<GpuBuffer> b = createBuffer(ctx, VkDeviceSize(slots) * kCounterSlots * sizeof(uint32_t),
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -29,7 +29,7 @@ Status PassMetrics::init(Context& ctx, const char* passName) {
 }
 
 void PassMetrics::retire(Context& ctx) {
-  ctx.impl().retireHandle(timestamps_, &DeviceFunctions::vkDestroyQueryPool);
+  internal::contextImpl(ctx).retireHandle(timestamps_, &DeviceFunctions::vkDestroyQueryPool);
   retireBuffer(ctx, counters_);
   recordedFrame_.assign(recordedFrame_.size(), UINT64_MAX);
 }
@@ -39,7 +39,7 @@ VkDeviceSize PassMetrics::counterOffset(Context& ctx) const {
 }
 
 void PassMetrics::collect(Context& ctx) {
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   for (uint32_t slot = 0; slot < recordedFrame_.size(); ++slot) {
     uint64_t f = recordedFrame_[slot];
     if (f == UINT64_MAX || !c.frameDone(f)) continue;
@@ -62,7 +62,7 @@ void PassMetrics::collect(Context& ctx) {
 
 void PassMetrics::beginRecording(Context& ctx, VkCommandBuffer cmd) {
   collect(ctx);
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   const uint32_t slot = static_cast<uint32_t>(c.frame % c.desc.framesInFlight);
   // The slot's previous frame is done (beginFrame contract), so the host may clear its counters now.
   std::memset(static_cast<uint8_t*>(counters_.mapped) + slot * counterBytes(), 0, counterBytes());
@@ -73,13 +73,14 @@ void PassMetrics::beginRecording(Context& ctx, VkCommandBuffer cmd) {
 void PassMetrics::writeStart(Context& ctx, VkCommandBuffer cmd) {
   if (!timing_) return;
   const uint32_t slot = static_cast<uint32_t>(ctx.frameIndex() % ctx.framesInFlight());
-  ctx.vk().vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps_, 2 * slot);
+  internal::deviceFunctions(ctx).vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps_, 2 * slot);
 }
 
 void PassMetrics::writeEnd(Context& ctx, VkCommandBuffer cmd) {
   if (!timing_) return;
   const uint32_t slot = static_cast<uint32_t>(ctx.frameIndex() % ctx.framesInFlight());
-  ctx.vk().vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps_, 2 * slot + 1);
+  internal::deviceFunctions(ctx).vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps_,
+                                                     2 * slot + 1);
 }
 
 }  // namespace rb

@@ -7,14 +7,15 @@
 #include <vector>
 
 #include "gpu_memory.h"
+#include "raybridge_shader_interface.glsl"
 
 namespace rb {
 
 class PassMetrics {
  public:
   // Rays are summed into 4096 counters, one per pixel of a 64x64 tile: neighbouring invocations (one warp or
-  // subgroup) never add to the same address, so the atomics do not serialise.
-  static constexpr uint32_t kCounterSlots = 4096;
+  // subgroup) never add to the same address, so the atomics do not serialise (shaders/ray_counters.glsl).
+  static constexpr uint32_t kCounterSlots = RB_RAY_COUNTER_SLOTS;
 
   Status init(Context& ctx, const char* passName);
   // Hands the counter buffer and the query pool to the context's deferred release (frames in flight may still

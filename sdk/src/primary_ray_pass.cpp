@@ -4,22 +4,13 @@
 #include <string>
 
 #include "context_impl.h"
+#include "pass_constants.h"
 #include "ray_tracing_pipeline.h"
 #include "raybridge_shaders.h"
 
 namespace rb {
 
 namespace {
-
-struct PrimaryConstants {
-  float eye[4];
-  float right[4];
-  float up[4];
-  float forward[4];
-  uint32_t size[2];
-  float tMin;
-  float tMax;
-};
 
 void cross(const float a[3], const float b[3], float out[3]) {
   out[0] = a[1] * b[2] - a[2] * b[1];
@@ -91,10 +82,11 @@ Result<std::unique_ptr<PrimaryRayPass>> PrimaryRayPass::create(Context& context)
   desc.raygen = SpirvModule::of(spirv::primary_rgen);
   desc.misses = {SpirvModule::of(spirv::primary_rmiss)};
   desc.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::primary_rchit), {}}};
+  const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
   desc.bindings = {
-      {0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr},
-      {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr},
-      {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr},
+      {RB_PRIMARY_BINDING_TLAS, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, rg, nullptr},
+      {RB_PRIMARY_BINDING_HIT_DISTANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr},
+      {RB_PRIMARY_BINDING_HIT_IDS, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr},
   };
   desc.pushConstantBytes = sizeof(PrimaryConstants);
   auto impl = std::make_unique<Impl>(context);
@@ -121,14 +113,14 @@ Status PrimaryRayPass::record(VkCommandBuffer cmd, VkAccelerationStructureKHR tl
     pc.up[i] = basis->up[i];
     pc.forward[i] = basis->forward[i];
   }
-  pc.size[0] = targets.width;
-  pc.size[1] = targets.height;
+  pc.width = targets.width;
+  pc.height = targets.height;
   pc.tMin = camera.tMin;
   pc.tMax = camera.tMax > 0.0f ? camera.tMax : 1e30f;
   DescriptorWrites w;
-  w.accelerationStructure(0, tlas);
-  w.storageImage(1, targets.hitDistance);
-  w.storageImage(2, targets.hitIds);
+  w.accelerationStructure(RB_PRIMARY_BINDING_TLAS, tlas);
+  w.storageImage(RB_PRIMARY_BINDING_HIT_DISTANCE, targets.hitDistance);
+  w.storageImage(RB_PRIMARY_BINDING_HIT_IDS, targets.hitIds);
   impl_->pipeline.bind(impl_->ctx, cmd, w.writes, &pc, sizeof(pc));
   impl_->pipeline.trace(impl_->ctx, cmd, targets.width, targets.height);
   return {};

@@ -24,7 +24,7 @@ Result<VkShaderModule> makeModule(Context::Impl& c, const SpirvModule& m, const 
 }  // namespace
 
 Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTracingPipelineDesc& desc) {
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   RayTracingPipeline p;
   VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   sl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
@@ -165,7 +165,7 @@ Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTra
 }
 
 void RayTracingPipeline::destroy(Context& ctx) {
-  Context::Impl& c = ctx.impl();
+  Context::Impl& c = internal::contextImpl(ctx);
   if (pipeline) c.vk.vkDestroyPipeline(c.desc.device, pipeline, c.allocator());
   if (layout) c.vk.vkDestroyPipelineLayout(c.desc.device, layout, c.allocator());
   if (setLayout) c.vk.vkDestroyDescriptorSetLayout(c.desc.device, setLayout, c.allocator());
@@ -180,12 +180,12 @@ void RayTracingPipeline::retire(Context& ctx) {
   RayTracingPipeline retired = *this;
   *this = RayTracingPipeline{};
   Context* context = &ctx;
-  ctx.impl().retire([context, retired]() mutable { retired.destroy(*context); });
+  internal::contextImpl(ctx).retire([context, retired]() mutable { retired.destroy(*context); });
 }
 
 void RayTracingPipeline::bind(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes,
                               const void* constants, uint32_t constantBytes) const {
-  const DeviceFunctions& vk = ctx.vk();
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipeline);
   vk.vkCmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, layout, 0,
                                static_cast<uint32_t>(writes.size()), writes.data());
@@ -194,7 +194,8 @@ void RayTracingPipeline::bind(Context& ctx, VkCommandBuffer cmd, std::span<const
 
 void RayTracingPipeline::trace(Context& ctx, VkCommandBuffer cmd, uint32_t width, uint32_t height,
                                uint32_t depth) const {
-  ctx.vk().vkCmdTraceRaysKHR(cmd, &raygenRegion, &missRegion, &hitRegion, &callableRegion, width, height, depth);
+  internal::deviceFunctions(ctx).vkCmdTraceRaysKHR(cmd, &raygenRegion, &missRegion, &hitRegion, &callableRegion, width,
+                                                    height, depth);
 }
 
 namespace {

@@ -38,7 +38,7 @@ struct ReflectionPass::Impl {
   ReflectionOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still trace with it and read its material table and texture set
-    Context::Impl& c = ctx.impl();
+    Context::Impl& c = internal::contextImpl(ctx);
     core.retire(ctx);
     retireBuffer(ctx, materials);
     c.retireHandle(pool, &DeviceFunctions::vkDestroyDescriptorPool);
@@ -51,7 +51,7 @@ ReflectionPass::ReflectionPass(std::unique_ptr<Impl> impl) : impl_(std::move(imp
 ReflectionPass::~ReflectionPass() = default;
 
 Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context) {
-  Context::Impl& c = context.impl();
+  Context::Impl& c = internal::contextImpl(context);
   if (c.info.maxRayRecursionDepth < 2) {
     return Error{ErrorCode::MissingFeature, VK_SUCCESS,
                  "ReflectionPass needs a ray recursion depth of 2 (a shadow ray from each hit); the device allows " +
@@ -89,14 +89,16 @@ Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context)
   const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
   const VkShaderStageFlags hit = VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR;
   p.bindings = PassCore::commonBindings();
-  p.bindings[0].stageFlags |= hit;  // shadow rays from hits
-  p.bindings[4].stageFlags |= hit;  // and their count
-  p.bindings.push_back({5, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
-  p.bindings.push_back({6, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
-  p.bindings.push_back({7, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit, nullptr});
-  p.bindings.push_back({8, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit, nullptr});
+  p.bindings[RB_BINDING_TLAS].stageFlags |= hit;          // shadow rays from hits
+  p.bindings[RB_BINDING_RAY_COUNTERS].stageFlags |= hit;  // and their count
+  p.bindings.push_back({RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg,
+                        nullptr});
+  p.bindings.push_back({RB_REFLECTION_BINDING_RADIANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
+  p.bindings.push_back({RB_REFLECTION_BINDING_SHADING_RECORDS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit, nullptr});
+  p.bindings.push_back({RB_REFLECTION_BINDING_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit, nullptr});
+  static_assert(RB_REFLECTION_SET_TEXTURES == 1, "the texture set is the first extra set");
   p.extraSetLayouts = {impl->textureLayout};
-  p.pushConstantBytes = sizeof(PassConstants);
+  p.pushConstantBytes = sizeof(ReflectionConstants);
   if (Status s = impl->core.init(context, p); !s) return s.error();
   // An empty table until the engine gives its own: every instance then shades with material 0, white.
   std::unique_ptr<ReflectionPass> pass(new ReflectionPass(std::move(impl)));
@@ -107,7 +109,7 @@ Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context)
 
 Status ReflectionPass::setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures) {
   Impl& s = *impl_;
-  Context::Impl& c = s.ctx.impl();
+  Context::Impl& c = internal::contextImpl(s.ctx);
   auto invalid = [](const std::string& m) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ReflectionPass::setMaterials: " + m};
   };
@@ -204,37 +206,44 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   if (!g.roughnessInNormalW && !g.roughnessMetalness.view) {
     return invalid("the G-buffer has no roughness: set GBufferDesc::roughnessInNormalW or roughnessMetalness");
   }
-  float threshold = settings.roughnessThreshold == 0.0f ? 0.3f : settings.roughnessThreshold;
+  float threshold = settings.roughnessThreshold == 0.0f ? kDefaultReflectionRoughnessThreshold : settings.roughnessThreshold;
   if (!(threshold > 0.0f && threshold <= 1.0f)) {
     return invalid("ReflectionSettings::roughnessThreshold " + std::to_string(threshold) + " is outside (0, 1]");
   }
   if (settings.raysPerPixel > 64) return invalid("ReflectionSettings::raysPerPixel exceeds 64");
-  float sunLen = std::sqrt(settings.sunDirection[0] * settings.sunDirection[0] +
-                           settings.sunDirection[1] * settings.sunDirection[1] +
-                           settings.sunDirection[2] * settings.sunDirection[2]);
-  if (!(sunLen > 0.0f) || !std::isfinite(sunLen)) return invalid("ReflectionSettings::sunDirection must be non-zero");
-  PassConstants pc{};
-  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ReflectionPass", pc); !st) return st;
+  const bool sunUnset = settings.sunDirection[0] == 0.0f && settings.sunDirection[1] == 0.0f && settings.sunDirection[2] == 0.0f;
+  const float sunDirection[3] = {settings.sunDirection[0], sunUnset ? 1.0f : settings.sunDirection[1], settings.sunDirection[2]};
+  float sunLen = std::sqrt(sunDirection[0] * sunDirection[0] + sunDirection[1] * sunDirection[1] +
+                           sunDirection[2] * sunDirection[2]);
+  if (!std::isfinite(sunLen)) return invalid("ReflectionSettings::sunDirection must be finite");
+  // Zero means the default, unless the engine says its zeros are meant (a black sky, no sky light).
+  const bool explicitLighting = (settings.flags & kReflectionExplicitLighting) != 0;
+  auto isZero = [](const float c[3]) { return c[0] == 0.0f && c[1] == 0.0f && c[2] == 0.0f; };
+  const bool defaultSun = !explicitLighting && isZero(settings.sunRadiance);
+  const bool defaultSky = !explicitLighting && isZero(settings.skyRadiance);
+  ReflectionConstants pc{};
+  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ReflectionPass", pc.gbuffer); !st) return st;
   for (int i = 0; i < 3; ++i) {
-    pc.p0[i] = settings.sunDirection[i] / sunLen;
-    pc.p1[i] = settings.sunRadiance[i];
-    pc.p2[i] = settings.skyRadiance[i];
+    pc.sunDirection[i] = sunDirection[i] / sunLen;
+    pc.sunRadiance[i] = defaultSun ? kDefaultSunRadiance : settings.sunRadiance[i];
+    pc.skyRadiance[i] = defaultSky ? kDefaultSkyRadiance[i] : settings.skyRadiance[i];
   }
-  pc.p0[3] = threshold;
-  pc.p2[3] = settings.ambientIntensity == 0.0f ? 0.4f : settings.ambientIntensity;
-  pc.u0[0] = settings.raysPerPixel ? settings.raysPerPixel : 1u;
+  pc.roughnessThreshold = threshold;
+  pc.ambientIntensity = settings.ambientIntensity == 0.0f && !explicitLighting ? kDefaultAmbientIntensity : settings.ambientIntensity;
+  pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultReflectionRays;
 
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16G16B16A16_SFLOAT, "reflection radiance"}}); !st) return st;
   DescriptorWrites w;
   s.core.writeCommon(s.ctx, w, g, tlas);
   const GBufferImage& rm = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
-  w.sampledImage(5, rm.view, s.core.sampler, readLayout(rm));
-  w.storageImage(6, s.core.images[0].view);
-  w.storageBuffer(7, tlas.shadingRecords, 0, tlas.shadingRecordsBytes);
-  w.storageBuffer(8, s.materials.buffer, 0, s.materials.size);
+  w.sampledImage(RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, rm.view, s.core.sampler, readLayout(rm));
+  w.storageImage(RB_REFLECTION_BINDING_RADIANCE, s.core.images[0].view);
+  w.storageBuffer(RB_REFLECTION_BINDING_SHADING_RECORDS, tlas.shadingRecords, 0, tlas.shadingRecordsBytes);
+  w.storageBuffer(RB_REFLECTION_BINDING_MATERIALS, s.materials.buffer, 0, s.materials.size);
   s.core.pipeline.bind(s.ctx, cmd, w.writes, &pc, sizeof pc);
-  s.ctx.vk().vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, s.core.pipeline.layout, 1, 1,
-                                     &s.textureSet, 0, nullptr);
+  internal::deviceFunctions(s.ctx).vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR,
+                                                          s.core.pipeline.layout, RB_REFLECTION_SET_TEXTURES, 1,
+                                                          &s.textureSet, 0, nullptr);
   s.core.pipeline.trace(s.ctx, cmd, g.width, g.height);
   s.core.images.endWrite(s.ctx, cmd);
   s.core.metrics.writeEnd(s.ctx, cmd);

@@ -37,9 +37,11 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
   p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::occlusion_rchit), {}}};
   const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
   p.bindings = PassCore::commonBindings();
-  p.bindings.push_back({5, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
-  if (desc.outputHitDistance) p.bindings.push_back({6, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
-  p.pushConstantBytes = sizeof(PassConstants);
+  p.bindings.push_back({RB_SHADOW_BINDING_VISIBILITY, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
+  if (desc.outputHitDistance) {
+    p.bindings.push_back({RB_SHADOW_BINDING_HIT_DISTANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
+  }
+  p.pushConstantBytes = sizeof(ShadowConstants);
   if (Status s = impl->core.init(context, p); !s) return s.error();
   return std::unique_ptr<ShadowPass>(new ShadowPass(std::move(impl)));
 }
@@ -49,8 +51,8 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   Impl& s = *impl_;
   auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ShadowPass: " + m}; };
   if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
-  PassConstants pc{};
-  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ShadowPass", pc); !st) return st;
+  ShadowConstants pc{};
+  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ShadowPass", pc.gbuffer); !st) return st;
 
   // Light parameters in the TLAS's space.
   float dir[3] = {light.direction[0], light.direction[1], light.direction[2]};
@@ -64,9 +66,9 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
         return invalid("Light::angularRadiusDegrees " + std::to_string(light.angularRadiusDegrees) +
                        " is outside [0, 45)");
       }
-      for (int i = 0; i < 3; ++i) pc.p0[i] = dir[i];
-      pc.p0[3] = 0.0f;
-      pc.p1[0] = std::tan(light.angularRadiusDegrees * kDegrees);
+      for (int i = 0; i < 3; ++i) pc.lightDirection[i] = dir[i];
+      pc.lightType = RB_LIGHT_DIRECTIONAL;
+      pc.tanAngularRadius = std::tan(light.angularRadiusDegrees * kDegrees);
       soft = light.angularRadiusDegrees > 0.0f;
       break;
     }
@@ -75,16 +77,16 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
       if (!(light.radius >= 0.0f) || !(light.range >= 0.0f)) {
         return invalid("Light::radius and Light::range must be >= 0");
       }
-      for (int i = 0; i < 3; ++i) pc.p0[i] = static_cast<float>(light.position[i] - tlas.originOffset[i]);
-      pc.p0[3] = light.type == LightType::Point ? 1.0f : 2.0f;
-      pc.p1[0] = light.radius;
-      pc.p1[1] = light.range;
+      for (int i = 0; i < 3; ++i) pc.lightPosition[i] = static_cast<float>(light.position[i] - tlas.originOffset[i]);
+      pc.lightType = light.type == LightType::Point ? RB_LIGHT_POINT : RB_LIGHT_SPOT;
+      pc.lightRadius = light.radius;
+      pc.range = light.range;
       float outer = light.spotOuterAngleDegrees == 0.0f ? 45.0f : light.spotOuterAngleDegrees;
       if (light.type == LightType::Spot && !(outer > 0.0f && outer <= 90.0f)) {
         return invalid("Light::spotOuterAngleDegrees " + std::to_string(outer) + " is outside (0, 90]");
       }
-      pc.p1[2] = std::cos(outer * kDegrees);
-      for (int i = 0; i < 3; ++i) pc.p2[i] = dir[i];
+      pc.cosSpotOuterAngle = std::cos(outer * kDegrees);
+      for (int i = 0; i < 3; ++i) pc.spotDirection[i] = dir[i];
       soft = light.radius > 0.0f;
       break;
     }
@@ -93,7 +95,7 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   if (settings.raysPerPixel > 4096) {
     return invalid("ShadowSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " exceeds 4096");
   }
-  pc.u0[0] = soft ? (settings.raysPerPixel ? settings.raysPerPixel : 4u) : 1u;
+  pc.raysPerPixel = soft ? (settings.raysPerPixel ? settings.raysPerPixel : kDefaultSoftShadowRays) : 1u;
 
   std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16_SFLOAT, "shadow visibility"}};
   if (s.desc.outputHitDistance) specs.push_back({VK_FORMAT_R32_SFLOAT, "shadow hit distance"});
@@ -101,8 +103,8 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   const PassImages& images = s.core.images;
   DescriptorWrites w;
   s.core.writeCommon(s.ctx, w, g, tlas);
-  w.storageImage(5, images[0].view);
-  if (s.desc.outputHitDistance) w.storageImage(6, images[1].view);
+  w.storageImage(RB_SHADOW_BINDING_VISIBILITY, images[0].view);
+  if (s.desc.outputHitDistance) w.storageImage(RB_SHADOW_BINDING_HIT_DISTANCE, images[1].view);
   s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
 
   ShadowOutputs& o = s.outputs;

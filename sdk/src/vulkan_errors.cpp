@@ -1,6 +1,6 @@
 #include <string>
 
-#include "context_impl.h"
+#include "vulkan_errors.h"
 
 namespace rb {
 

@@ -1,4 +1,5 @@
 // Links against the installed SDK, creates a headless device and a context, and builds one BLAS.
+#include <raybridge/headless_device.h>
 #include <raybridge/raybridge.h>
 
 #include <cstdio>

@@ -1,6 +1,7 @@
 // Builds against Raybridge added with add_subdirectory, creates a headless device, a context and the primary
 // ray pass (its pipeline is made from the embedded SPIR-V). The unused variable is deliberate: the host
 // compiles with warnings on and no -Werror, so the build must still succeed if Raybridge leaks none.
+#include <raybridge/headless_device.h>
 #include <raybridge/raybridge.h>
 
 #include <cstdio>

@@ -11,7 +11,7 @@ layout(set = 0, binding = 0) uniform FrameUniforms {
   vec4 sunRadiance;   // rgb: color * intensity
   vec4 sky;           // rgb: sky radiance (background), w: ambient intensity
   vec4 viewport;      // width, height, 1/width, 1/height
-  vec4 shadow;        // x: 1/map size, y: PCF taps per axis, z: normal offset (world units)
+  vec4 shadow;        // x: 1/map size, y: PCF taps per axis (0 = no shadow map), z: normal offset (world)
   uvec4 inputs;       // x: sun visibility image, y: AO image (external or SSAO), z: external reflection (1 = bound)
   mat4 invProj;
   vec4 probe;         // x: 1 = sample the reflection probe, y: its last mip level

@@ -89,6 +89,7 @@ Engine::Impl::~Impl() {
     vkDeviceWaitIdle(ctx.device);
     destroySwapchain(true);
     destroyTargets();
+    destroyOverlay();
     gpu.destroy(targets.shadowMap);
     if (sceneLoaded) destroyScene(gpu, scene);
     deformer.destroy();
@@ -148,6 +149,7 @@ Bounds Engine::sceneBounds() const { return impl_->scene.bounds; }
 VkExtent2D Engine::renderSize() const { return impl_->targets.extent; }
 void Engine::setPrepassHook(PrepassHook hook) { impl_->hook = std::move(hook); }
 PassTimings Engine::lastTimings() const { return impl_->timings; }
+ShadowMapStats Engine::lastShadowMapStats() const { return impl_->shadowStats; }
 uint64_t Engine::frameNumber() const { return impl_->frameCounter; }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -211,6 +213,7 @@ void Engine::Impl::destroyTargets() {
   for (Image* i : {&targets.depth, &targets.normalRoughness, &targets.geometricNormal, &targets.hdr, &targets.ldr,
                    &targets.ssaoRaw, &targets.ssao, &targets.shadowVisibility})
     gpu.destroy(*i);
+  destroyOverlayFramebuffer();
   ssaoRendered = shadowVisibilityRendered = false;
   targets.extent = {};
 }

@@ -51,6 +51,8 @@ struct FrameResources {
 // submission order on one queue and each frame's first barrier waits for the previous frame's use.
 struct RenderTargets {
   detail::Image depth, normalRoughness, geometricNormal, hdr, ldr;
+  // The sun's depth map, targets.shadowMapSize texels square; a 1x1 placeholder (never rendered, only bound)
+  // while the shadow map is disabled.
   detail::Image shadowMap;
   // Effect images (kEffectFormat, left in SHADER_READ_ONLY_OPTIMAL), created on first use at this extent.
   detail::Image ssaoRaw, ssao, shadowVisibility;
@@ -85,6 +87,9 @@ struct Engine::Impl {
   RenderTargets targets;
   Swapchain swapchain;
   PrepassHook hook;
+  OverlayHook overlayHook;
+  VkRenderPass overlayRenderPass = VK_NULL_HANDLE;    // created with the first overlay hook (swapchain.cpp)
+  VkFramebuffer overlayFramebuffer = VK_NULL_HANDLE;  // targets.ldr in overlayRenderPass; dies with the targets
   uint32_t currentFrame = 0;
   uint64_t frameCounter = 0;
   bool frameRendered = false;  // targets hold a finished frame (for readback)
@@ -92,6 +97,7 @@ struct Engine::Impl {
   bool shadowVisibilityRendered = false;
   std::optional<uint32_t> lastSubmittedSlot;
   PassTimings timings;
+  ShadowMapStats shadowStats;  // of the last submitted frame
   uint64_t timingsFrameNumber = 0;
 
   ~Impl();
@@ -116,6 +122,11 @@ struct Engine::Impl {
   // swapchain.cpp
   std::string createSwapchain(uint32_t width, uint32_t height);
   void destroySwapchain(bool destroySurface);
+  // swapchain.cpp: the overlay hook's render pass / framebuffer, and its call after the tonemap pass.
+  std::string prepareOverlay();
+  void recordOverlay(FrameResources& frame, std::optional<uint32_t> swapchainImage);
+  void destroyOverlayFramebuffer();
+  void destroyOverlay();
 };
 
 }  // namespace sample_engine

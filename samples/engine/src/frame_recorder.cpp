@@ -36,15 +36,21 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   static const Scene kNoScene;
   if (Status s = checkPlayback(sceneLoaded ? scene.cpu : kNoScene, params.time, params.animations); !s)
     return "renderFrame: " + s.error;
-  const uint32_t shadowSize = std::clamp(params.shadow.mapSize, 1024u, 8192u);
+  // Without a shadow map a 1x1 placeholder stays bound (the shaders skip it: 0 PCF taps), so every
+  // pipeline's descriptor sets keep their layout and the big map's memory is released.
+  const bool shadowsOn = params.shadow.enabled;
+  const uint32_t shadowSize =
+      shadowsOn ? std::clamp(params.shadow.mapSize, kMinShadowMapSize, kMaxShadowMapSize) : 1u;
+  const uint32_t taps = shadowsOn ? std::clamp(params.shadow.pcfKernelSize, 1u, kMaxShadowPcfKernel) : 0u;
   if (shadowSize != targets.shadowMapSize) {
-    vkDeviceWaitIdle(ctx.device);
+    vkDeviceWaitIdle(ctx.device);  // frames in flight may still sample the old map
     if (std::string e = createShadowMap(shadowSize); !e.empty()) return "shadow map: " + e;
   }
   const uint32_t probeResolution = ReflectionProbe::clampResolution(params.reflectionProbe.resolution);
   if (params.reflectionProbe.enabled)
     if (std::string e = probe.prepare(probeResolution); !e.empty()) return "reflection probe: " + e;
   if (std::string e = ensureEffectImages(params); !e.empty()) return "effect images: " + e;
+  if (std::string e = prepareOverlay(); !e.empty()) return "overlay: " + e;
   const uint32_t slot = currentFrame;
   FrameResources& frame = frames[slot];
   if (std::string e = waitFrame(frame); !e.empty()) return e;
@@ -85,9 +91,11 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   u.sunRadiance = glm::vec4(params.sun.color * params.sun.intensity, 0.0f);
   u.sky = glm::vec4(params.skyColor, params.ambientIntensity);
   u.viewport = glm::vec4(extent.width, extent.height, 1.0f / extent.width, 1.0f / extent.height);
-  const uint32_t taps = std::clamp(params.shadow.pcfKernelSize | 1u, 1u, 9u);
+  // The normal offset grows by the kernel's reach ((taps - 1) / 2 texels): on a slope facing the sun at an
+  // angle, the outer taps of a wide kernel would otherwise compare against the receiver's own depth.
+  const float normalOffsetTexels = params.shadow.normalOffset + 0.5f * float(std::max(taps, 1u) - 1u);
   u.shadow = glm::vec4(1.0f / float(shadowSize), float(taps),
-                       params.shadow.normalOffset * 2.0f * lightRadius / float(shadowSize), 0.0f);
+                       shadowsOn ? normalOffsetTexels * 2.0f * lightRadius / float(shadowSize) : 0.0f, 0.0f);
   u.invProj = glm::inverse(u.proj);
   // inputs and probe are filled after the hook; the uniform buffer is written before submission.
 
@@ -156,6 +164,7 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   frameRendered = true;
   ssaoRendered = params.ssao.enabled;
   shadowVisibilityRendered = params.outputShadowVisibility;
+  shadowStats = ShadowMapStats{shadowsOn, shadowsOn ? shadowSize : 0u, taps, frame.frameNumber};
 
   if (imageIndex) {
     VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
@@ -186,12 +195,16 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
                           nullptr);
 
   // (1) Shadow map. Previous contents are discarded (UNDEFINED); the barrier also orders this write after
-  // the previous frame's sampling.
-  imageBarrier(cmd, targets.shadowMap.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-               VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
-               VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
-  {
+  // the previous frame's sampling. Without a shadow map only the placeholder's layout is set for binding.
+  if (!params.shadow.enabled) {
+    imageBarrier(cmd, targets.shadowMap.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED, kReadLayout,
+                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+  } else {
+    imageBarrier(cmd, targets.shadowMap.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
+                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
     VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
     depth.imageView = targets.shadowMap.view;
     depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
@@ -203,11 +216,11 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     vkCmdSetDepthBias(cmd, params.shadow.depthBiasConstant, 0.0f, params.shadow.depthBiasSlope);
     if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Shadow);
     vkCmdEndRendering(cmd);
+    imageBarrier(cmd, targets.shadowMap.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                 kReadLayout, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
   }
-  imageBarrier(cmd, targets.shadowMap.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-               kReadLayout, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-               VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
   timestamp(kTsShadowEnd);
 
   // (1b) Reflection probe: six forward-shaded faces + mips, only when its inputs changed. It uses this
@@ -283,6 +296,9 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     info.invViewProj = uniformsIn.invViewProj;
     info.cameraPosition = params.camera.eye;
     info.sunDirection = glm::vec3(uniformsIn.sunDirection);
+    info.sunRadiance = glm::vec3(uniformsIn.sunRadiance);
+    info.skyColor = glm::vec3(uniformsIn.sky);
+    info.ambientIntensity = uniformsIn.sky.w;
     if (haveScene) info.instanceTransforms = scene.instanceTransforms;
     info.deformedInstances = deformer.instances();
     info.deformSemaphore = deformer.semaphore();
@@ -361,6 +377,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
                VK_ACCESS_2_TRANSFER_READ_BIT);
   timestamp(kTsTonemapEnd);
+  if (overlayHook) recordOverlay(frame, swapchainImage);  // swapchain.cpp: UI on top of the tonemapped frame
 
   // (6) Present path: blit (with channel swizzle if the swapchain is BGRA) into the acquired image.
   if (swapchainImage) {

@@ -1,4 +1,5 @@
-// Presentation: the frame is rendered offscreen as usual and blitted into the acquired swapchain image.
+// Presentation: the frame is rendered offscreen as usual and blitted into the acquired swapchain image; the
+// overlay hook draws onto the tonemapped image first.
 #include <algorithm>
 
 #include "engine_impl.h"
@@ -77,6 +78,90 @@ void Engine::Impl::destroySwapchain(bool destroySurface) {
     vkDestroySurfaceKHR(ctx.instance, swapchain.surface, nullptr);
     swapchain.surface = VK_NULL_HANDLE;
   }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Overlay hook
+
+void Engine::setOverlayHook(OverlayHook hook) { impl_->overlayHook = std::move(hook); }
+
+std::string Engine::Impl::prepareOverlay() {
+  if (!overlayHook) return {};
+  if (!overlayRenderPass) {
+    VkAttachmentDescription color{};
+    color.format = kLdrFormat;
+    color.samples = VK_SAMPLE_COUNT_1_BIT;
+    color.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+    color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    color.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+    color.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    color.initialLayout = color.finalLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    VkAttachmentReference ref{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+    VkSubpassDescription subpass{};
+    subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    subpass.colorAttachmentCount = 1;
+    subpass.pColorAttachments = &ref;
+    VkRenderPassCreateInfo ci{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+    ci.attachmentCount = 1;
+    ci.pAttachments = &color;
+    ci.subpassCount = 1;
+    ci.pSubpasses = &subpass;
+    SE_VK_TRY(vkCreateRenderPass(ctx.device, &ci, nullptr, &overlayRenderPass));
+  }
+  if (!overlayFramebuffer) {  // destroyed with the targets it shows
+    VkFramebufferCreateInfo ci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+    ci.renderPass = overlayRenderPass;
+    ci.attachmentCount = 1;
+    ci.pAttachments = &targets.ldr.view;
+    ci.width = targets.extent.width;
+    ci.height = targets.extent.height;
+    ci.layers = 1;
+    SE_VK_TRY(vkCreateFramebuffer(ctx.device, &ci, nullptr, &overlayFramebuffer));
+  }
+  return {};
+}
+
+// The tonemap pass left targets.ldr in TRANSFER_SRC_OPTIMAL; the hook gets it as a colour attachment and the
+// blit / readback get it back in TRANSFER_SRC_OPTIMAL.
+void Engine::Impl::recordOverlay(FrameResources& frame, std::optional<uint32_t> swapchainImage) {
+  VkCommandBuffer cmd = frame.cmd;
+  imageBarrier(cmd, targets.ldr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+               VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+               VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+  OverlayHookInfo info;
+  info.commandBuffer = cmd;
+  info.frameIndex = uint32_t(&frame - frames.data());
+  info.frameNumber = frame.frameNumber;
+  info.target = {targets.ldr.image, targets.ldr.view, kLdrFormat, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+  info.extent = targets.extent;
+  info.renderPass = overlayRenderPass;
+  info.framebuffer = overlayFramebuffer;
+  info.swapchainImageCount = swapchainImage ? uint32_t(swapchain.images.size()) : 0u;
+  info.instance = ctx.instance;
+  info.physicalDevice = ctx.physicalDevice;
+  info.device = ctx.device;
+  info.queue = ctx.queue;
+  info.queueFamily = ctx.queueFamily;
+  info.getInstanceProcAddr = &vkGetInstanceProcAddr;
+  info.apiVersion = VK_API_VERSION_1_3;
+  overlayHook(info);
+  imageBarrier(cmd, targets.ldr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+               VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+               VK_ACCESS_2_TRANSFER_READ_BIT);
+}
+
+void Engine::Impl::destroyOverlayFramebuffer() {
+  if (overlayFramebuffer) vkDestroyFramebuffer(ctx.device, overlayFramebuffer, nullptr);
+  overlayFramebuffer = VK_NULL_HANDLE;
+}
+
+void Engine::Impl::destroyOverlay() {
+  destroyOverlayFramebuffer();
+  if (overlayRenderPass) vkDestroyRenderPass(ctx.device, overlayRenderPass, nullptr);
+  overlayRenderPass = VK_NULL_HANDLE;
 }
 
 Status Engine::attachSurface(VkSurfaceKHR surface, uint32_t width, uint32_t height) {

@@ -169,6 +169,12 @@ struct Instance {
   uint32_t sbtRecordOffset = 0;
   VkGeometryInstanceFlagsKHR flags = 0;
   uint32_t material = 0;  // index into ReflectionPass::setMaterials(); read only by passes that shade hits
+
+  // Sets `transform` from a column-major 4x4 matrix (GLM's and most engines' layout); the last row is ignored.
+  void setTransformColumnMajor(const float m[16]) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) transform[r * 4 + c] = m[c * 4 + r];
+  }
 };
 
 enum class TlasBuildMode : uint8_t {
@@ -333,6 +339,11 @@ class AccelerationStructureService {
   // The wait the engine's next write to the vertex buffers of dynamic meshes needs: the value of the latest
   // submission that read them, stage ALL_COMMANDS. Returns false and leaves `out` alone when none is needed.
   bool fillVertexReuseWait(VkSemaphoreSubmitInfo& out) const;
+  // The four calls above in one, for the usual frame: updateMesh() for each of `meshes`, submitDynamicWork(ready),
+  // then the waits appended to the engine's lists (either may be nullptr when the engine has no such list).
+  Status updateDynamicMeshes(std::span<const MeshHandle> meshes, const AsyncBuildWait& ready,
+                             std::vector<VkSemaphoreSubmitInfo>* tlasWaits,
+                             std::vector<VkSemaphoreSubmitInfo>* vertexReuseWaits);
 
   // Records compaction copies and queued builds into `cmd` within the scratch budget, followed by a barrier that
   // makes them visible to TLAS builds; in DynamicBuildMode::InFrame and the async fallback also the frame's

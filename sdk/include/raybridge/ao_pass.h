@@ -24,9 +24,12 @@ enum class AoEstimator : uint8_t {
   DistanceWeighted,  // a hit at distance t counts t / range open; rays find the nearest hit
 };
 
+inline constexpr uint32_t kDefaultAoRays = 4;
+inline constexpr float kDefaultAoRange = 1.0f;  // world units
+
 struct AoSettings {
-  uint32_t raysPerPixel = 0;  // 0 = 4
-  float range = 0.0f;         // world units; 0 = 1.0. Use a large value (e.g. 1e6) for unlimited range.
+  uint32_t raysPerPixel = 0;  // 0 = kDefaultAoRays
+  float range = 0.0f;         // world units; 0 = kDefaultAoRange. Use a large value (e.g. 1e6) for unlimited range.
   AoEstimator estimator = AoEstimator::Binary;
 };
 

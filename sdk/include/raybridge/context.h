@@ -23,7 +23,9 @@
 
 namespace rb {
 
-struct DeviceFunctions;
+namespace internal {
+struct ContextAccess;  // the SDK's own way in (sdk/src/context_access.h); not part of the API
+}
 
 // What the engine hands over. A zero-initialised ContextDesc is invalid only because the four handles below
 // are required; every other field's zero value is a documented default.
@@ -141,12 +143,10 @@ class Context {
   VkPhysicalDevice physicalDevice() const;
   MemoryStats memoryStats() const;
 
-  // Internal: the per-context function table and shared machinery used by the services and passes.
-  struct Impl;
-  Impl& impl() { return *impl_; }
-  const DeviceFunctions& vk() const;
+  struct Impl;  // opaque
 
  private:
+  friend struct internal::ContextAccess;
   explicit Context(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

@@ -1,4 +1,6 @@
 // Raybridge: ray-traced effects for rasterizing Vulkan engines. Include this or the individual headers.
+// The headless device helper of the samples and tests is not part of it: <raybridge/headless_device.h>, in the
+// separate library Raybridge::headless.
 #pragma once
 
 #include <raybridge/acceleration_structures.h>
@@ -7,7 +9,8 @@
 #include <raybridge/denoiser.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
-#include <raybridge/headless_device.h>
+#include <raybridge/hybrid_effects.h>
+#include <raybridge/presets.h>
 #include <raybridge/primary_ray_pass.h>
 #include <raybridge/reflection_pass.h>
 #include <raybridge/result.h>

@@ -37,13 +37,28 @@ struct Material {
   uint32_t metallicRoughnessTexture = kNoTexture;  // glTF layout: G = roughness, B = metallic
 };
 
+// Defaults of ReflectionSettings (what a zero field means).
+inline constexpr float kDefaultReflectionRoughnessThreshold = 0.3f;
+inline constexpr uint32_t kDefaultReflectionRays = 1;
+inline constexpr float kDefaultSunRadiance = 3.0f;  // per channel
+inline constexpr float kDefaultSkyRadiance[3] = {0.45f, 0.62f, 0.9f};
+inline constexpr float kDefaultAmbientIntensity = 0.4f;
+
+enum ReflectionFlags : uint32_t {
+  // Take sunRadiance, skyRadiance and ambientIntensity as given, zeros included (a black sky, no sky light).
+  // Without it an all-zero colour or a zero intensity means its default constant.
+  kReflectionExplicitLighting = 1u << 0,
+};
+
+// A zero-initialised ReflectionSettings is valid: every zero field means the default constant above.
 struct ReflectionSettings {
-  float roughnessThreshold = 0.0f;  // 0 = 0.3: rougher surfaces trace no reflection ray
-  uint32_t raysPerPixel = 0;        // glossy pixels; 0 = 1 (noisy: denoise or accumulate). Mirrors trace one.
-  float sunDirection[3] = {0.0f, 1.0f, 0.0f};  // towards the sun
-  float sunRadiance[3] = {3.0f, 3.0f, 3.0f};   // linear, the sun's colour times intensity
-  float skyRadiance[3] = {0.45f, 0.62f, 0.9f}; // linear, returned by rays that escape
-  float ambientIntensity = 0.0f;               // 0 = 0.4: sky light on hit surfaces, times skyRadiance
+  float roughnessThreshold = 0.0f;  // 0 = kDefaultReflectionRoughnessThreshold: rougher surfaces trace nothing
+  uint32_t raysPerPixel = 0;        // glossy pixels; 0 = kDefaultReflectionRays (noisy: denoise or accumulate)
+  float sunDirection[3] = {0.0f, 0.0f, 0.0f};  // towards the sun; all zero = straight up (0, 1, 0)
+  float sunRadiance[3] = {0.0f, 0.0f, 0.0f};   // linear, the sun's colour times intensity; 0 = kDefaultSunRadiance
+  float skyRadiance[3] = {0.0f, 0.0f, 0.0f};   // linear, returned by rays that escape; 0 = kDefaultSkyRadiance
+  float ambientIntensity = 0.0f;  // sky light on hit surfaces, times skyRadiance; 0 = kDefaultAmbientIntensity
+  uint32_t flags = 0;             // ReflectionFlags
 };
 
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().

@@ -27,8 +27,11 @@ struct ShadowPassDesc {
   bool outputHitDistance = false;
 };
 
+inline constexpr uint32_t kDefaultSoftShadowRays = 4;
+
 struct ShadowSettings {
-  // Rays per pixel for a soft light (angular radius or radius > 0); 0 = 4. A hard light always uses one.
+  // Rays per pixel for a soft light (angular radius or radius > 0); 0 = kDefaultSoftShadowRays. A hard light
+  // always uses one.
   uint32_t raysPerPixel = 0;
 };
 

@@ -8,10 +8,11 @@
 // morphed) instances, a compute submission writes each one's deformed vertex buffers and signals a timeline
 // semaphore to the frame number; the main submission waits on it. Static scenes skip both.
 //
-// Add-ons (e.g. a ray-tracing adapter) plug in through three small things:
+// Add-ons (e.g. a ray-tracing adapter) plug in through four small things:
 //   * EngineConfig: extra device extensions / feature chain, so they can share the engine's device;
 //   * setPrepassHook(): called with the frame's command buffer between the pre-pass and the lighting pass;
 //   * LightingInputs: external sun-visibility / AO / reflection images the lighting pass samples.
+//   * setOverlayHook(): called with the frame's command buffer after the tonemap pass, to draw a UI on top.
 //
 // Thread safety: Engine is not thread-safe; call it from one thread at a time (the hook runs on the thread
 // that called renderFrame()). The spans it returns stay valid until the next loadScene() / destruction.
@@ -84,13 +85,37 @@ struct EngineConfig {
   std::string applicationName = "raybridge-sample-engine";
 };
 
-// Shadow-map settings; changing the size between frames recreates the map.
+// Limits of ShadowSettings (see there).
+inline constexpr uint32_t kMinShadowMapSize = 1024;
+inline constexpr uint32_t kMaxShadowMapSize = 8192;
+inline constexpr uint32_t kMaxShadowPcfKernel = 9;
+
+// Shadow-map settings; changing the size (or enabling/disabling the map) between frames recreates the map,
+// waiting for the GPU first. Engine::lastShadowMapStats() reports what a frame actually used.
 struct ShadowSettings {
-  uint32_t mapSize = 2048;      // clamped to [1024, 8192]
-  uint32_t pcfKernelSize = 3;   // odd, 1..9: taps per axis (each tap is a 2x2 hardware-filtered compare)
+  // false: no shadow map at all: no shadow-map pass is recorded, the map's memory is released (a 1x1
+  // placeholder stays bound) and the sun is unshadowed, except where LightingInputs::sunVisibility is given.
+  // The reflection probe and the shadow-visibility output then see an unshadowed sun too.
+  bool enabled = true;
+  uint32_t mapSize = 2048;  // texels per side, clamped to [kMinShadowMapSize, kMaxShadowMapSize]
+  // PCF taps per axis, clamped to [1, kMaxShadowPcfKernel]; 0 = 1 (a single tap). Each tap is a 2x2
+  // hardware-filtered depth compare; the n x n taps sit one texel apart at offsets -(n-1)/2 .. +(n-1)/2
+  // texels around the lookup, so an even kernel (e.g. 4 or 8) is centred too, its taps at half-texel
+  // offsets. The filtered penumbra is about n texels wide.
+  uint32_t pcfKernelSize = 3;
   float depthBiasConstant = 1.5f;
   float depthBiasSlope = 2.0f;
-  float normalOffset = 1.5f;    // world offset along the normal, in shadow-map texels
+  // Lookup offset along the geometric normal, in shadow-map texels; the engine adds (kernel - 1) / 2 texels
+  // so that the outer taps of a wide kernel do not shadow the receiver's own slope.
+  float normalOffset = 1.5f;
+};
+
+// The shadow map a rendered frame actually used: ShadowSettings after clamping (Engine::lastShadowMapStats()).
+struct ShadowMapStats {
+  bool enabled = false;      // false: no shadow map (ShadowSettings::enabled off, or no frame rendered yet)
+  uint32_t mapSize = 0;      // texels per side, in [kMinShadowMapSize, kMaxShadowMapSize]; 0 when not enabled
+  uint32_t pcfKernel = 0;    // PCF taps per axis, in [1, kMaxShadowPcfKernel]; 0 when not enabled
+  uint64_t frameNumber = 0;  // Engine::frameNumber() of that frame; 0 before the first frame
 };
 
 // The engine's own screen-space ambient occlusion (Crytek / LearnOpenGL hemisphere kernel with range check),
@@ -202,6 +227,10 @@ struct PrepassHookInfo {
   glm::mat4 invView{1.0f}, invProj{1.0f}, invViewProj{1.0f};
   glm::vec3 cameraPosition{0.0f};
   glm::vec3 sunDirection{0.0f, 1.0f, 0.0f};  // towards the sun, normalized
+  // The frame's lighting (FrameParams): sun colour * intensity, sky colour and ambient intensity.
+  glm::vec3 sunRadiance{0.0f};
+  glm::vec3 skyColor{0.0f};
+  float ambientIntensity = 0.0f;
   // This frame's world transform per Scene::instances entry (node animation applied).
   std::span<const glm::mat4> instanceTransforms;
   // The deforming instances; this frame's deformation submission rewrites their buffers. Empty for a
@@ -225,6 +254,46 @@ struct PrepassHookInfo {
 // Images it writes and passes in `inputs` must be in SHADER_READ_ONLY_OPTIMAL at the end of the hook;
 // the engine then adds a full memory barrier (all commands -> fragment shader reads).
 using PrepassHook = std::function<void(const PrepassHookInfo& info, LightingInputs& inputs)>;
+
+// --- Overlay hook ------------------------------------------------------------------------------------------
+// Lets an add-on (a debug UI such as Dear ImGui, a frame counter) draw on top of the finished, tonemapped frame.
+// Called once per frame after the tonemap pass, before the frame is blitted to the swapchain, so what it draws
+// is presented and also appears in readbackLdr(); headless frames call it too. Everything a renderer backend
+// needs to initialise itself lazily on the first call is in the info.
+struct OverlayHookInfo {
+  VkCommandBuffer commandBuffer = VK_NULL_HANDLE;  // recording, outside any render pass or rendering scope
+  uint32_t frameIndex = 0;                         // frame in flight, 0..framesInFlight-1
+  // Frames in flight (kFramesInFlight, >= 2): per-frame data the add-on writes must be ring-buffered over at
+  // least this many. When the hook runs for frame N, every frame up to N - framesInFlight has finished on the GPU.
+  uint32_t framesInFlight = kFramesInFlight;
+  uint64_t frameNumber = 0;  // increments every rendered frame (Engine::frameNumber() once renderFrame returns)
+  // The tonemapped colour target, extent x extent: R8G8B8A8_SRGB (blending is linear, so colours authored in
+  // sRGB, like ImGui's, look lighter unless linearised), COLOR_ATTACHMENT_OPTIMAL with the tonemap's writes
+  // visible. Use it only as a colour attachment and leave it in that layout; the engine then makes the writes
+  // visible to its blit / readback.
+  PassImage target;
+  VkExtent2D extent{};
+  // A render pass whose single subpass has target's format as its only colour attachment (1 sample,
+  // LOAD_OP_LOAD, STORE_OP_STORE, initial and final layout COLOR_ATTACHMENT_OPTIMAL), for pipelines built
+  // against a VkRenderPass; the same handle every frame, valid until the engine is destroyed. framebuffer is
+  // target in that pass, valid during this call only (it changes on resize). Dynamic-rendering pipelines use
+  // vkCmdBeginRendering with target.view / target.format instead.
+  VkRenderPass renderPass = VK_NULL_HANDLE;
+  VkFramebuffer framebuffer = VK_NULL_HANDLE;
+  uint32_t swapchainImageCount = 0;  // images of the swapchain the frame goes to; 0 when headless
+  // The engine's Vulkan objects (as Engine's accessors), so a backend can initialise on the first call.
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;  // the engine submits commandBuffer here; do not submit to it from the hook
+  uint32_t queueFamily = 0;
+  PFN_vkGetInstanceProcAddr getInstanceProcAddr = nullptr;
+  uint32_t apiVersion = 0;
+};
+
+// Records the overlay's draws into info.commandBuffer (see OverlayHookInfo). Runs on the thread that called
+// renderFrame(), after the pre-pass hook of the same frame. Costs nothing when no hook is set.
+using OverlayHook = std::function<void(const OverlayHookInfo& info)>;
 
 struct PassTimings {
   double shadowMs = 0.0;
@@ -335,11 +404,15 @@ class Engine {
 
   // --- Frame ---
   void setPrepassHook(PrepassHook hook);
+  // Replaces the overlay hook; an empty function removes it. Its GPU time is not part of PassTimings.
+  void setOverlayHook(OverlayHook hook);
   // Records and submits one frame (and presents when a swapchain is attached). Does not wait for it.
   Status renderFrame(const FrameParams& params);
   // Waits until the GPU is idle; afterwards lastTimings() covers the last submitted frame.
   Status waitIdle();
   PassTimings lastTimings() const;
+  // The shadow map the last submitted frame used (known at submission, no wait).
+  ShadowMapStats lastShadowMapStats() const;
   uint64_t frameNumber() const;
 
   // Read the last rendered frame back (waits for it): tonemapped sRGB RGBA8, and linear HDR.

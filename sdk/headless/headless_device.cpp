@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "context_impl.h"
+#include "vulkan_errors.h"
 
 namespace rb {
 

@@ -1,6 +1,7 @@
 // A headless Vulkan device for Raybridge's samples, tests and benchmarks: it plays the engine's part
 // (instance, device, queue, an optional async compute queue, one-shot submissions). Engines that have their own
-// device do not need it.
+// device do not need it. It is its own library, Raybridge::headless (target raybridge_headless): the core
+// Raybridge library never creates a device, submits, waits or opens the loader.
 //
 // Device choice: a GPU with ray tracing pipelines if there is one, otherwise a CPU implementation (lavapipe).
 // `HeadlessDeviceDesc::deviceNameFilter` or the environment variable RAYBRIDGE_DEVICE (a case-insensitive

@@ -1,0 +1,187 @@
+// The effects front end: one object that turns an effect set (or a preset) into passes and denoisers, records
+// them in order into the engine's command buffer each frame and hands back the images the engine's lighting
+// samples. Engines that want the passes one by one still use ShadowPass, AoPass, ReflectionPass and Denoiser
+// directly; this object only composes them.
+//
+//   auto fx = rb::HybridEffects::create(context, &service, rb::withPreset({}, rb::Preset::High)).value();
+//   fx->setMaterials(materials, textureViews);          // once per scene, for reflection hits
+//   // each frame, after ctx.beginFrame() and the G-buffer pass:
+//   rb::HybridFrame frame;
+//   frame.gbuffer = gbuffer;                            // the engine's pre-pass (gbuffer.h)
+//   frame.instances = instances;                        // or frame.tlas = the engine's own TLAS
+//   frame.light = sun;                                  // the light the shadow effect shadows
+//   fx->record(cmd, frame);                             // BLAS work, TLAS, shadows, AO, reflections, denoising
+//   fx->outputs().shadow.view ...                       // SHADER_READ_ONLY_OPTIMAL, readable by fragment and
+//                                                       // compute shaders
+//
+// Order inside record(): pending BLAS work and the TLAS (when it builds one) -> shadows [-> denoiser] -> AO
+// [-> denoiser] -> reflections. Only what the description enables exists: a disabled effect has no pass,
+// no denoiser, no image and traces no ray; hard shadows (one ray) are never denoised.
+//
+// Lifetime: setDesc()/applyPreset() and the destructor retire passes to the Context's deferred release (see
+// context.h), so switching effects mid-run needs no wait-idle. Destroy it before its Context and before the
+// AccelerationStructureService it was given.
+//
+// Thread safety: externally synchronised, like the Context it was created from.
+#pragma once
+
+#include <raybridge/acceleration_structures.h>
+#include <raybridge/ao_pass.h>
+#include <raybridge/denoiser.h>
+#include <raybridge/effects.h>
+#include <raybridge/gbuffer.h>
+#include <raybridge/presets.h>
+#include <raybridge/reflection_pass.h>
+#include <raybridge/shadow_pass.h>
+
+#include <memory>
+#include <span>
+
+namespace rb {
+
+// Defaults of the settings below (what a zero field means): kDefaultSoftShadowRays (shadow_pass.h),
+// kDefaultAoRays and kDefaultAoRange (ao_pass.h), kDefaultReflectionRoughnessThreshold, kDefaultReflectionRays,
+// kDefaultSunRadiance, kDefaultSkyRadiance and kDefaultAmbientIntensity (reflection_pass.h), and:
+// Angular radius given to a directional light without one when more than one shadow ray is asked for: the
+// sun's apparent size (0.27 degrees) widened a little, as games do to read as a soft sun.
+inline constexpr float kDefaultSoftLightAngularRadiusDegrees = 0.5f;
+
+struct ShadowEffectSettings {
+  // 0 = the light decides: kDefaultSoftShadowRays for a light with a size, one ray (hard) for one without.
+  // 1 = hard shadows whatever the light's size (the presets' "1 ray"), unless softAngularRadiusDegrees is set:
+  //     then one stochastic ray over that disk per pixel.
+  // N > 1 = N rays over the light's disk; a directional light without a size gets softAngularRadiusDegrees, or
+  //     kDefaultSoftLightAngularRadiusDegrees; a point or spot light without a radius stays hard.
+  uint32_t raysPerPixel = 0;
+  // Directional lights: the angular radius to use instead of the light's own. 0 = the light's own.
+  float softAngularRadiusDegrees = 0.0f;
+  bool disableDenoiser = false;  // false = soft shadows are denoised (hard shadows never are)
+};
+
+struct AoEffectSettings {
+  uint32_t raysPerPixel = 0;  // 0 = kDefaultAoRays
+  float range = 0.0f;         // 0 = kDefaultAoRange
+  AoEstimator estimator = AoEstimator::Binary;
+  bool disableDenoiser = false;  // false = denoised
+};
+
+struct ReflectionEffectSettings {
+  float roughnessThreshold = 0.0f;  // 0 = kDefaultReflectionRoughnessThreshold: rougher pixels trace nothing
+  uint32_t raysPerPixel = 0;        // glossy pixels; 0 = kDefaultReflectionRays (mirrors trace one)
+};
+
+// What runs. A zero-initialised description is valid: no effect, nothing allocated, nothing traced.
+struct HybridEffectsDesc {
+  EffectSet effects = 0;
+  ShadowEffectSettings shadows;
+  AoEffectSettings ao;
+  ReflectionEffectSettings reflections;
+  DenoiseSettings denoiser;  // shared by the shadow and AO denoisers (raysPerPixel is filled in per signal)
+  // Build the TLAS with camera-relative origin (TlasBuildOptions::originOffset = the G-buffer's camera
+  // position), so precision holds far from the world origin. Only used when record() builds the TLAS.
+  bool worldSpaceTlas = false;  // false = camera-relative (recommended)
+};
+
+// `base` with the preset's effect set and ray counts (every other field is kept).
+HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset);
+
+// Flags of HybridFrame::flags.
+enum HybridFrameFlags : uint32_t {
+  // Take lightRadiance, skyRadiance and ambientIntensity as given, zeros included (a black sky, no ambient).
+  // Without it a zero field means its default constant.
+  kFrameExplicitLighting = 1u << 0,
+};
+
+// One frame's inputs. gbuffer is required; the scene comes from `tlas` or `instances`.
+struct HybridFrame {
+  GBufferDesc gbuffer;
+  // Optional G-buffer with the shading normal and roughness for reflections, when `gbuffer` uses another
+  // normal (e.g. geometric normals for conformance checks). nullptr = gbuffer.
+  const GBufferDesc* reflectionGBuffer = nullptr;
+  // The engine's TLAS (tlas->tlas != VK_NULL_HANDLE): used as is; with reflections it must carry shading
+  // records. nullptr = record() records the service's pending work and builds a TLAS over `instances`.
+  const TlasInfo* tlas = nullptr;
+  std::span<const Instance> instances;
+  Light light;  // the light the shadow effect shadows and reflection hits are lit by (default: the sun, up)
+  // Lighting of reflection hits: the light's radiance (colour * intensity), the sky's radiance returned by
+  // escaping rays, and the sky light on hit surfaces (ambientIntensity * skyRadiance). Zero = the default
+  // constants above unless kFrameExplicitLighting.
+  float lightRadiance[3] = {0.0f, 0.0f, 0.0f};
+  float skyRadiance[3] = {0.0f, 0.0f, 0.0f};
+  float ambientIntensity = 0.0f;
+  uint32_t flags = 0;  // HybridFrameFlags
+};
+
+// An image the front end owns: left in `layout` after record(), readable by fragment and compute shaders.
+struct EffectImage {
+  VkImage image = VK_NULL_HANDLE;  // VK_NULL_HANDLE = not produced this frame
+  VkImageView view = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  uint32_t width = 0, height = 0;
+};
+
+// What the latest record() produced. `shadow` and `ao` are what the engine's lighting should sample (denoised
+// where a denoiser ran, else raw); the raw images stay available.
+struct HybridOutputs {
+  EffectImage shadow, shadowRaw;  // R16_SFLOAT visibility, 1 = lit
+  EffectImage ao, aoRaw;          // R16_SFLOAT open fraction, 1 = open
+  EffectImage reflection;         // R16G16B16A16_SFLOAT radiance, a = 1 where rays were traced
+};
+
+// Per-pass measurements of the latest recordings whose frames have finished (zero for what does not exist).
+struct HybridStats {
+  PassStats shadow, shadowDenoise, ao, aoDenoise, reflection;
+  double totalGpuMs() const { return shadow.gpuMs + shadowDenoise.gpuMs + ao.gpuMs + aoDenoise.gpuMs + reflection.gpuMs; }
+  uint64_t totalRays() const { return shadow.rays + ao.rays + reflection.rays; }
+};
+
+class HybridEffects {
+ public:
+  // `service` builds the TLAS when a frame gives instances instead of a TLAS; nullptr = every frame brings
+  // its own TLAS. The description's passes are created now (their images follow on the first record()).
+  static Result<std::unique_ptr<HybridEffects>> create(Context& context, AccelerationStructureService* service,
+                                                       const HybridEffectsDesc& desc = {});
+  ~HybridEffects();
+  HybridEffects(const HybridEffects&) = delete;
+  HybridEffects& operator=(const HybridEffects&) = delete;
+
+  // Switches effects and settings between frames: passes of newly enabled effects are created now, those of
+  // disabled effects retired (see Lifetime). Validated first: on an error nothing changes.
+  Status setDesc(const HybridEffectsDesc& desc);
+  Status applyPreset(Preset preset) { return setDesc(withPreset(desc(), preset)); }
+  const HybridEffectsDesc& desc() const;
+
+  // The engine's materials and texture views for reflection hits (see ReflectionPass::setMaterials). Kept
+  // and handed to the reflection pass whenever it exists; the views must stay valid until the next call.
+  Status setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures);
+
+  // Records the enabled effects (see Order above). On an error, outputs() names no image of this frame and
+  // the engine should keep its own lighting terms.
+  Status record(VkCommandBuffer cmd, const HybridFrame& frame);
+  const HybridOutputs& outputs() const;
+  const TlasInfo& lastTlas() const;  // the TLAS the latest record() traced
+  // Forget the denoisers' history (camera cut, scene change).
+  void resetHistory();
+
+  HybridStats stats() const;
+  // Device memory of the Context's pass categories (ShaderTables, PassImages, PassBuffers; the other
+  // categories are 0): this object's passes and denoisers, plus any pass the engine created itself on the same
+  // Context. `allocations` counts the whole Context's.
+  MemoryStats memoryStats() const;
+
+  // The passes, for tools that want more than outputs() (nullptr where the effect is off).
+  const ShadowPass* shadowPass() const;
+  const AoPass* aoPass() const;
+  const ReflectionPass* reflectionPass() const;
+  const Denoiser* shadowDenoiser() const;
+  const Denoiser* aoDenoiser() const;
+
+  struct Impl;
+
+ private:
+  explicit HybridEffects(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rb

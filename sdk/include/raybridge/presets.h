@@ -1,0 +1,78 @@
+// Quality presets: the thesis's table of effect sets and ray counts, with the raster counterpart an engine
+// draws when it renders without Raybridge (its shadow-map size and PCF kernel), so both modes of one preset
+// can be compared.
+//
+//   preset          shadow rays  AO rays  reflections  raster shadow map, PCF
+//   none                 0          0         no        none
+//   hard-shadows         1          0         no        2048
+//   ao                   0          4         no        none
+//   ao16                 0         16         no        none
+//   reflections          0          0         yes       none
+//   soft-shadows         4          0         no        4096, PCF 4
+//   soft-shadows8        8          0         no        8192, PCF 8
+//   low                  1          4         no        2048
+//   medium               4          4         no        4096, PCF 4
+//   high                 4          4         yes       4096, PCF 4
+//   ultra                8         16         yes       8192, PCF 8
+//
+// One shadow ray means hard shadows (towards the light's centre); more rays sample the light's disk.
+//
+// Thread safety: plain data and pure functions.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace rb {
+
+// The effects a HybridEffects object runs (see hybrid_effects.h). An effect not in the set has no pass, no
+// denoiser and no memory.
+enum EffectBits : uint32_t {
+  kEffectShadows = 1u << 0,      // ShadowPass: visibility of the frame's light
+  kEffectAo = 1u << 1,           // AoPass: ambient occlusion
+  kEffectReflections = 1u << 2,  // ReflectionPass: mirror and glossy reflections
+};
+using EffectSet = uint32_t;
+inline constexpr EffectSet kAllEffects = kEffectShadows | kEffectAo | kEffectReflections;
+
+enum class Preset : uint8_t {
+  None = 0,  // default: no effect
+  HardShadows,
+  Ao,
+  Ao16,
+  Reflections,
+  SoftShadows,
+  SoftShadows8,
+  Low,
+  Medium,
+  High,
+  Ultra,
+  Count
+};
+inline constexpr uint32_t kPresetCount = uint32_t(Preset::Count);
+
+// The raster counterpart of a preset: a shadow map of mapSize texels squared filtered by a PCF kernel of
+// pcfKernel x pcfKernel taps (0 = one hardware-filtered tap), or no shadow map at all (mapSize 0).
+struct RasterShadowDesc {
+  uint32_t mapSize = 0;    // 0 = the preset has no shadow map: the raster mode draws the sun unshadowed
+  uint32_t pcfKernel = 0;  // taps per axis; 0 = a single 2x2 hardware compare
+};
+
+struct PresetDesc {
+  EffectSet effects = 0;
+  uint32_t shadowRaysPerPixel = 0;  // 0 when the preset has no shadows; 1 = hard shadows
+  uint32_t aoRaysPerPixel = 0;      // 0 when the preset has no AO
+  RasterShadowDesc raster;
+};
+
+PresetDesc presetDesc(Preset preset);
+// "none", "hard-shadows", "ao", "ao16", "reflections", "soft-shadows", "soft-shadows8", "low", "medium", "high",
+// "ultra".
+const char* toString(Preset preset);
+// The names above, and the names of earlier releases: "shadows" (= soft-shadows).
+std::optional<Preset> parsePreset(std::string_view name);
+// "none, hard-shadows, ao, ..." for help texts and error messages.
+const char* presetNames();
+
+}  // namespace rb

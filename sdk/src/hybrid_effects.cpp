@@ -1,0 +1,286 @@
+// The effects front end (hybrid_effects.h): passes and denoisers of the enabled effects, recorded in order.
+#include <raybridge/hybrid_effects.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace rb {
+
+namespace {
+
+Error invalid(std::string message) { return {ErrorCode::InvalidArgument, VK_SUCCESS, "HybridEffects: " + std::move(message)}; }
+
+Error wrap(const char* what, const Error& e) {
+  Error out = e;
+  out.message = std::string("HybridEffects: ") + what + ": " + e.message;
+  return out;
+}
+
+Status validate(const HybridEffectsDesc& d) {
+  if (d.effects & ~kAllEffects) return invalid("effects has unknown bits " + std::to_string(d.effects & ~kAllEffects));
+  if (d.shadows.raysPerPixel > 4096) return invalid("shadows.raysPerPixel " + std::to_string(d.shadows.raysPerPixel) + " exceeds 4096");
+  if (!(d.shadows.softAngularRadiusDegrees >= 0.0f && d.shadows.softAngularRadiusDegrees < 45.0f))
+    return invalid("shadows.softAngularRadiusDegrees " + std::to_string(d.shadows.softAngularRadiusDegrees) + " is outside [0, 45)");
+  if (d.ao.raysPerPixel > 4096) return invalid("ao.raysPerPixel " + std::to_string(d.ao.raysPerPixel) + " exceeds 4096");
+  if (!(d.ao.range >= 0.0f) || !std::isfinite(d.ao.range)) return invalid("ao.range " + std::to_string(d.ao.range) + " must be >= 0 and finite");
+  if (!(d.reflections.roughnessThreshold >= 0.0f && d.reflections.roughnessThreshold <= 1.0f))
+    return invalid("reflections.roughnessThreshold " + std::to_string(d.reflections.roughnessThreshold) + " is outside [0, 1]");
+  if (d.reflections.raysPerPixel > 64) return invalid("reflections.raysPerPixel " + std::to_string(d.reflections.raysPerPixel) + " exceeds 64");
+  return {};
+}
+
+bool hasSize(const Light& l) { return l.type == LightType::Directional ? l.angularRadiusDegrees > 0.0f : l.radius > 0.0f; }
+
+// The light as the shadow pass traces it and the rays per pixel (see ShadowEffectSettings).
+struct ShadowPlan {
+  Light light;
+  uint32_t rays = 1;
+  bool soft = false;  // rays sample the light's disk (noisy: denoised)
+};
+
+ShadowPlan planShadows(const ShadowEffectSettings& s, const Light& frameLight) {
+  ShadowPlan p{frameLight, 1, false};
+  const bool directional = frameLight.type == LightType::Directional;
+  if (directional && s.softAngularRadiusDegrees > 0.0f) p.light.angularRadiusDegrees = s.softAngularRadiusDegrees;
+  uint32_t rays = s.raysPerPixel ? s.raysPerPixel : (hasSize(p.light) ? kDefaultSoftShadowRays : 1u);
+  if (rays == 1 && !(directional && s.softAngularRadiusDegrees > 0.0f)) {
+    p.light.angularRadiusDegrees = 0.0f, p.light.radius = 0.0f;  // one ray = hard, unless a disk is asked for
+  } else if (rays > 1 && !hasSize(p.light)) {
+    if (directional) p.light.angularRadiusDegrees = kDefaultSoftLightAngularRadiusDegrees;
+    else rays = 1;  // a point or spot light without a radius stays hard
+  }
+  p.rays = rays;
+  p.soft = hasSize(p.light);
+  return p;
+}
+
+EffectImage image(VkImage i, VkImageView v, VkFormat f, VkImageLayout layout, uint32_t w, uint32_t h) {
+  return {i, v, f, layout, w, h};
+}
+
+template <typename T>
+PassStats statsOf(const std::unique_ptr<T>& p) { return p ? p->stats() : PassStats{}; }
+
+// Creates `slot` when wanted and missing, retires it (deferred release) when not wanted.
+template <typename T, typename Create>
+Status ensure(std::unique_ptr<T>& slot, bool wanted, const char* what, Create create) {
+  if (!wanted) {
+    slot.reset();
+    return {};
+  }
+  if (slot) return {};
+  auto made = create();
+  if (!made) return wrap(what, made.error());
+  slot = std::move(made.value());
+  return {};
+}
+
+}  // namespace
+
+HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset) {
+  const PresetDesc p = presetDesc(preset);
+  base.effects = p.effects;
+  if (p.effects & kEffectShadows) base.shadows.raysPerPixel = p.shadowRaysPerPixel;
+  if (p.effects & kEffectAo) base.ao.raysPerPixel = p.aoRaysPerPixel;
+  return base;
+}
+
+struct HybridEffects::Impl {
+  Context& ctx;
+  AccelerationStructureService* service = nullptr;
+  HybridEffectsDesc desc;
+  std::unique_ptr<ShadowPass> shadow;
+  std::unique_ptr<Denoiser> shadowDenoiser;
+  std::unique_ptr<AoPass> ao;
+  std::unique_ptr<Denoiser> aoDenoiser;
+  std::unique_ptr<ReflectionPass> reflection;
+  std::vector<Material> materials;
+  std::vector<VkImageView> textures;
+  bool materialsDirty = false;  // the reflection pass has not seen the latest setMaterials
+  HybridOutputs outputs;
+  TlasInfo tlas;
+
+  Impl(Context& c, AccelerationStructureService* s) : ctx(c), service(s) {}
+
+  // Passes follow the effect set; denoisers are decided per frame (hard shadows need none).
+  Status applyDesc() {
+    const EffectSet e = desc.effects;
+    if (Status s = ensure(shadow, e & kEffectShadows, "ShadowPass::create", [&] { return ShadowPass::create(ctx); }); !s) return s;
+    if (Status s = ensure(ao, e & kEffectAo, "AoPass::create", [&] { return AoPass::create(ctx); }); !s) return s;
+    const bool hadReflection = reflection != nullptr;
+    if (Status s = ensure(reflection, e & kEffectReflections, "ReflectionPass::create", [&] { return ReflectionPass::create(ctx); }); !s)
+      return s;
+    if (reflection && !hadReflection) materialsDirty = true;
+    if (!shadow || desc.shadows.disableDenoiser) shadowDenoiser.reset();
+    if (!ao || desc.ao.disableDenoiser) aoDenoiser.reset();
+    return {};
+  }
+
+  Status recordShadows(VkCommandBuffer cmd, const HybridFrame& f);
+  Status recordAo(VkCommandBuffer cmd, const HybridFrame& f);
+  Status recordReflections(VkCommandBuffer cmd, const HybridFrame& f);
+};
+
+Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame& f) {
+  const ShadowPlan plan = planShadows(desc.shadows, f.light);
+  ShadowSettings s;
+  s.raysPerPixel = plan.rays;
+  if (Status st = shadow->record(cmd, f.gbuffer, tlas, plan.light, s); !st) return wrap("ShadowPass::record", st.error());
+  const ShadowOutputs& o = shadow->outputs();
+  outputs.shadowRaw = outputs.shadow = image(o.visibility, o.visibilityView, VK_FORMAT_R16_SFLOAT, o.layout, o.width, o.height);
+  const bool denoise = plan.soft && !desc.shadows.disableDenoiser;
+  if (Status st = ensure(shadowDenoiser, denoise, "Denoiser::create (shadows)", [&] { return Denoiser::create(ctx); }); !st) return st;
+  if (!shadowDenoiser) return {};
+  DenoiseSettings d = desc.denoiser;
+  d.raysPerPixel = plan.rays;  // the visibility is a fraction of this many binary rays
+  if (Status st = shadowDenoiser->record(cmd, f.gbuffer, o.visibilityView, d); !st) return wrap("Denoiser::record (shadows)", st.error());
+  const DenoiseOutputs& dn = shadowDenoiser->outputs();
+  outputs.shadow = image(dn.denoised, dn.denoisedView, VK_FORMAT_R16_SFLOAT, dn.layout, dn.width, dn.height);
+  return {};
+}
+
+Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) {
+  AoSettings s;
+  s.raysPerPixel = desc.ao.raysPerPixel;
+  s.range = desc.ao.range;
+  s.estimator = desc.ao.estimator;
+  if (Status st = ao->record(cmd, f.gbuffer, tlas, s); !st) return wrap("AoPass::record", st.error());
+  const AoOutputs& o = ao->outputs();
+  outputs.aoRaw = outputs.ao = image(o.ao, o.aoView, VK_FORMAT_R16_SFLOAT, o.layout, o.width, o.height);
+  if (Status st = ensure(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser::create (AO)", [&] { return Denoiser::create(ctx); }); !st) return st;
+  if (!aoDenoiser) return {};
+  DenoiseSettings d = desc.denoiser;
+  // Binary AO is a fraction of binary rays; distance-weighted AO is not, so its noise is estimated.
+  d.raysPerPixel = s.estimator == AoEstimator::Binary ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays) : 0u;
+  if (Status st = aoDenoiser->record(cmd, f.gbuffer, o.aoView, d); !st) return wrap("Denoiser::record (AO)", st.error());
+  const DenoiseOutputs& dn = aoDenoiser->outputs();
+  outputs.ao = image(dn.denoised, dn.denoisedView, VK_FORMAT_R16_SFLOAT, dn.layout, dn.width, dn.height);
+  return {};
+}
+
+Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
+  if (materialsDirty) {
+    if (Status st = reflection->setMaterials(materials, textures); !st) return wrap("ReflectionPass::setMaterials", st.error());
+    materialsDirty = false;
+  }
+  ReflectionSettings s;
+  s.roughnessThreshold = desc.reflections.roughnessThreshold;
+  s.raysPerPixel = desc.reflections.raysPerPixel;
+  s.flags = (f.flags & kFrameExplicitLighting) ? kReflectionExplicitLighting : 0u;
+  for (int i = 0; i < 3; ++i) {
+    s.sunRadiance[i] = f.lightRadiance[i];
+    s.skyRadiance[i] = f.skyRadiance[i];
+  }
+  s.ambientIntensity = f.ambientIntensity;
+  if (f.light.type == LightType::Directional) {
+    for (int i = 0; i < 3; ++i) s.sunDirection[i] = f.light.direction[i];
+  } else {
+    // The reflection pass lights hits by one directional light: a local light leaves them to the sky alone.
+    if (!(s.flags & kReflectionExplicitLighting)) {
+      const bool skyUnset = s.skyRadiance[0] == 0.0f && s.skyRadiance[1] == 0.0f && s.skyRadiance[2] == 0.0f;
+      for (int i = 0; i < 3; ++i) s.skyRadiance[i] = skyUnset ? kDefaultSkyRadiance[i] : s.skyRadiance[i];
+      if (s.ambientIntensity == 0.0f) s.ambientIntensity = kDefaultAmbientIntensity;
+      s.flags |= kReflectionExplicitLighting;
+    }
+    for (float& c : s.sunRadiance) c = 0.0f;
+  }
+  const GBufferDesc& g = f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer;
+  if (Status st = reflection->record(cmd, g, tlas, s); !st) return wrap("ReflectionPass::record", st.error());
+  const ReflectionOutputs& o = reflection->outputs();
+  outputs.reflection = image(o.radiance, o.radianceView, VK_FORMAT_R16G16B16A16_SFLOAT, o.layout, o.width, o.height);
+  return {};
+}
+
+Result<std::unique_ptr<HybridEffects>> HybridEffects::create(Context& context, AccelerationStructureService* service,
+                                                             const HybridEffectsDesc& desc) {
+  if (Status s = validate(desc); !s) return s.error();
+  std::unique_ptr<HybridEffects> fx(new HybridEffects(std::make_unique<Impl>(context, service)));
+  fx->impl_->desc = desc;
+  if (Status s = fx->impl_->applyDesc(); !s) return s.error();
+  return fx;
+}
+
+HybridEffects::HybridEffects(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+HybridEffects::~HybridEffects() = default;  // the passes retire their objects to the Context
+
+Status HybridEffects::setDesc(const HybridEffectsDesc& desc) {
+  if (Status s = validate(desc); !s) return s;
+  impl_->desc = desc;
+  return impl_->applyDesc();
+}
+
+const HybridEffectsDesc& HybridEffects::desc() const { return impl_->desc; }
+
+Status HybridEffects::setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures) {
+  Impl& a = *impl_;
+  a.materials.assign(materials.begin(), materials.end());
+  a.textures.assign(textures.begin(), textures.end());
+  a.materialsDirty = true;
+  if (!a.reflection) return {};
+  // Validate now, so a bad table is reported by the call that brought it.
+  if (Status st = a.reflection->setMaterials(a.materials, a.textures); !st) return wrap("ReflectionPass::setMaterials", st.error());
+  a.materialsDirty = false;
+  return {};
+}
+
+Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
+  Impl& a = *impl_;
+  a.outputs = {};
+  if (a.desc.effects == 0) return {};  // nothing enabled: no TLAS, no rays
+  if (!cmd) return invalid("record: cmd is VK_NULL_HANDLE");
+  if (frame.tlas && frame.tlas->tlas) {
+    a.tlas = *frame.tlas;
+  } else {
+    if (!a.service)
+      return invalid("record: the frame brings no TLAS (HybridFrame::tlas) and no AccelerationStructureService was given "
+                     "to create() to build one over HybridFrame::instances");
+    if (auto pending = a.service->recordPendingWork(cmd); !pending) return wrap("recordPendingWork", pending.error());
+    TlasBuildOptions options;
+    if (!a.desc.worldSpaceTlas) {
+      // Camera-relative: precision holds far from the origin (gbuffer.h). The passes read the offset back from
+      // TlasInfo, so a G-buffer without cameraPosition (all zero) simply gets a world-space TLAS.
+      for (int i = 0; i < 3; ++i) options.originOffset[i] = frame.gbuffer.cameraPosition[i];
+    }
+    options.writeShadingRecords = a.reflection != nullptr;  // vertex data + material per instance, for hits
+    auto tlas = a.service->recordTlasBuild(cmd, frame.instances, options);
+    if (!tlas) return wrap("recordTlasBuild", tlas.error());
+    a.tlas = tlas.value();
+  }
+  Status st;
+  if (a.shadow) st = a.recordShadows(cmd, frame);
+  if (st && a.ao) st = a.recordAo(cmd, frame);
+  if (st && a.reflection) st = a.recordReflections(cmd, frame);
+  if (!st) a.outputs = {};
+  return st;
+}
+
+const HybridOutputs& HybridEffects::outputs() const { return impl_->outputs; }
+const TlasInfo& HybridEffects::lastTlas() const { return impl_->tlas; }
+
+void HybridEffects::resetHistory() {
+  if (impl_->shadowDenoiser) impl_->shadowDenoiser->resetHistory();
+  if (impl_->aoDenoiser) impl_->aoDenoiser->resetHistory();
+}
+
+HybridStats HybridEffects::stats() const {
+  const Impl& a = *impl_;
+  return {statsOf(a.shadow), statsOf(a.shadowDenoiser), statsOf(a.ao), statsOf(a.aoDenoiser), statsOf(a.reflection)};
+}
+
+MemoryStats HybridEffects::memoryStats() const {
+  MemoryStats all = impl_->ctx.memoryStats();
+  MemoryStats passes;
+  for (MemoryCategory c : {MemoryCategory::ShaderTables, MemoryCategory::PassImages, MemoryCategory::PassBuffers})
+    passes.bytes[size_t(c)] = all.of(c);
+  passes.allocations = all.allocations;
+  return passes;
+}
+
+const ShadowPass* HybridEffects::shadowPass() const { return impl_->shadow.get(); }
+const AoPass* HybridEffects::aoPass() const { return impl_->ao.get(); }
+const ReflectionPass* HybridEffects::reflectionPass() const { return impl_->reflection.get(); }
+const Denoiser* HybridEffects::shadowDenoiser() const { return impl_->shadowDenoiser.get(); }
+const Denoiser* HybridEffects::aoDenoiser() const { return impl_->aoDenoiser.get(); }
+
+}  // namespace rb

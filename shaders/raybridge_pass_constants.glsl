@@ -1,0 +1,103 @@
+// The push constants of every SDK pass, one struct per pass. Each is mirrored field by field by the struct of the
+// same name in sdk/src/pass_constants.h, which static_asserts the size and every offset written here (std430,
+// the layout of push constants). A shader declares its pass's block as
+//   layout(push_constant) uniform ShadowPushConstants { ShadowConstants pc; };
+// All fit the 256 bytes every device allows.
+#ifndef RAYBRIDGE_PASS_CONSTANTS_GLSL
+#define RAYBRIDGE_PASS_CONSTANTS_GLSL
+
+#include "raybridge_shader_interface.glsl"
+
+// The camera and the G-buffer's layout, shared by the G-buffer passes (shadow, AO, reflection). 160 bytes.
+struct GBufferConstants {
+  mat4 inverseProjection;  //   0
+  mat3 viewToWorld;        //  64: rotation part of inverse(view), normalised columns (16 bytes apart)
+  vec3 cameraToTlas;       // 112: the camera position in the TLAS's space
+  float depthQuantum;      // 124: one step of the stored depth value; 0 = float depth (one ulp, in the shader)
+  uvec2 size;              // 128: width, height in pixels
+  uint flags;              // 136: RB_GB_*
+  uint frameIndex;         // 140: the noise seed
+  float wAtDepthOne;       // 144: w of inverse(projection) * (x, y, 1, 1), formed in double on the host
+  uint pad0;               // 148
+  uint pad1;               // 152
+  uint pad2;               // 156
+};
+
+// ShadowPass. 224 bytes.
+struct ShadowConstants {
+  GBufferConstants gbuffer;  //   0
+  vec3 lightDirection;       // 160: towards a directional light, unit length
+  uint lightType;            // 172: RB_LIGHT_*
+  vec3 lightPosition;        // 176: of a point or spot light, in the TLAS's space
+  float lightRadius;         // 188: of a point or spot light's sphere; 0 = hard shadows
+  vec3 spotDirection;        // 192: from a spot light along its axis, unit length
+  float cosSpotOuterAngle;   // 204
+  float tanAngularRadius;    // 208: of a directional light's disk; 0 = hard shadows
+  float range;               // 212: of a point or spot light; 0 = unlimited
+  uint raysPerPixel;         // 216
+  uint pad0;                 // 220
+};
+
+// AoPass. 176 bytes.
+struct AoConstants {
+  GBufferConstants gbuffer;  //   0
+  float range;               // 160: occluders further than this do not count
+  uint raysPerPixel;         // 164
+  uint estimator;            // 168: RB_AO_*
+  uint pad0;                 // 172
+};
+
+// ReflectionPass. 208 bytes.
+struct ReflectionConstants {
+  GBufferConstants gbuffer;  //   0
+  vec3 sunDirection;         // 160: towards the sun, unit length
+  float roughnessThreshold;  // 172: rougher surfaces get no reflection rays
+  vec3 sunRadiance;          // 176
+  float ambientIntensity;    // 188: scales skyRadiance as the ambient light of hit points
+  vec3 skyRadiance;          // 192: what rays that escape see
+  uint raysPerPixel;         // 204
+};
+
+// PrimaryRayPass. 64 bytes. The ray through pixel (x, y) counted from the top-left, through the pixel centre:
+//   dir = normalize(forward + ndcX * right - ndcY * up), ndc in [-1, 1].
+struct PrimaryConstants {
+  vec3 eye;      //   0
+  float tMin;    //  12
+  vec3 right;    //  16: pre-scaled by tan(fovY / 2) * aspect ratio
+  float tMax;    //  28
+  vec3 up;       //  32: pre-scaled by tan(fovY / 2)
+  uint width;    //  44
+  vec3 forward;  //  48: unit length
+  uint height;   //  60
+};
+
+// The denoiser's temporal and a-trous passes. 224 bytes.
+struct DenoiseConstants {
+  mat4 inverseProjection;       //   0
+  mat3 viewToWorld;             //  64: as GBufferConstants::viewToWorld
+  mat4 previousViewProjection;  // 112: previous frame: camera-relative world -> clip (rotation-only view)
+  vec3 cameraDelta;             // 176: current camera position - previous camera position
+  float depthSigma;             // 188
+  uvec2 size;                   // 192: width, height in pixels
+  uint flags;                   // 200: RB_DN_*
+  uint atrousStep;              // 204: a-trous: the spacing of the kernel's taps in pixels
+  uint maxHistoryFrames;        // 208: temporal: the most frames accumulated
+  float wAtDepthOne;            // 212: as GBufferConstants::wAtDepthOne
+  float normalPower;            // 216
+  float signalRaysPerPixel;     // 220: rays per pixel of the noisy signal; 0 = unknown
+};
+
+// The refit-quality measure of dynamic BLASes (blas_cluster_bounds.comp). 48 bytes.
+struct ClusterBoundsConstants {
+  uvec2 positions;      //  0: device address of vertex 0's position
+  uvec2 indices;        //  8: device address of the first index (4-byte aligned); unused for RB_INDEX_NONE
+  uvec2 clusterAreas;   // 16: device address of this dispatch's first output float
+  uint positionStride;  // 24: bytes, a multiple of 4
+  uint positionFormat;  // 28: RB_POSITION_*
+  uint indexType;       // 32: RB_INDEX_*
+  uint triangleCount;   // 36: of the whole mesh
+  uint firstCluster;    // 40: of this dispatch (dispatches are split at the workgroup count limit)
+  uint pad0;            // 44
+};
+
+#endif

@@ -1,0 +1,85 @@
+// The numbers the SDK's C++ and its GLSL must agree on: descriptor bindings, flag bits, enumerations and the ray
+// counters. Only #defines, so the one file is included by both (sdk/src/pass_constants.h and the shaders); the
+// C++ side static_asserts the enumerations against the public enums.
+#ifndef RAYBRIDGE_SHADER_INTERFACE_GLSL
+#define RAYBRIDGE_SHADER_INTERFACE_GLSL
+
+// Set 0 of every G-buffer ray tracing pass (shadow, AO, reflection) starts with these (PassCore::commonBindings).
+#define RB_BINDING_TLAS 0
+#define RB_BINDING_DEPTH 1
+#define RB_BINDING_NORMAL 2
+#define RB_BINDING_GEOMETRIC_NORMAL 3  // the normal image again when the G-buffer has no geometric normal
+#define RB_BINDING_RAY_COUNTERS 4
+// Pass-specific bindings of set 0.
+#define RB_SHADOW_BINDING_VISIBILITY 5
+#define RB_SHADOW_BINDING_HIT_DISTANCE 6  // only in the module that writes it (shadow_distance.rgen)
+#define RB_AO_BINDING_OUTPUT 5
+#define RB_REFLECTION_BINDING_ROUGHNESS_METALNESS 5  // the normal image again when roughness is in normal.w
+#define RB_REFLECTION_BINDING_RADIANCE 6
+#define RB_REFLECTION_BINDING_SHADING_RECORDS 7
+#define RB_REFLECTION_BINDING_MATERIALS 8
+#define RB_REFLECTION_SET_TEXTURES 1  // binding 0: the engine's textures, bindless
+// The primary-ray (first trace) pass.
+#define RB_PRIMARY_BINDING_TLAS 0
+#define RB_PRIMARY_BINDING_HIT_DISTANCE 1
+#define RB_PRIMARY_BINDING_HIT_IDS 2
+// The denoiser's temporal pass.
+#define RB_TEMPORAL_BINDING_DEPTH 0
+#define RB_TEMPORAL_BINDING_MOTION 1  // the depth image again without motion vectors
+#define RB_TEMPORAL_BINDING_SIGNAL 2
+#define RB_TEMPORAL_BINDING_HISTORY_IN 3
+#define RB_TEMPORAL_BINDING_DISTANCE_IN 4
+#define RB_TEMPORAL_BINDING_HISTORY_OUT 5
+#define RB_TEMPORAL_BINDING_DISTANCE_OUT 6
+#define RB_TEMPORAL_BINDING_VALUE_OUT 7
+// The denoiser's a-trous pass.
+#define RB_ATROUS_BINDING_DEPTH 0
+#define RB_ATROUS_BINDING_NORMAL 1
+#define RB_ATROUS_BINDING_SIGNAL_IN 2
+#define RB_ATROUS_BINDING_SIGNAL_OUT 3
+
+// GBufferConstants::flags: what the G-buffer description says.
+#define RB_GB_REVERSED_Z 1u
+#define RB_GB_OCTAHEDRAL 2u
+#define RB_GB_GEOMETRIC_NORMAL 4u
+#define RB_GB_ROUGHNESS_IN_NORMAL_W 8u
+#define RB_GB_ROUGHNESS_IMAGE 16u
+#define RB_GB_ALBEDO_IMAGE 32u
+
+// ShadowConstants::lightType: the values of rb::LightType.
+#define RB_LIGHT_DIRECTIONAL 0u
+#define RB_LIGHT_POINT 1u
+#define RB_LIGHT_SPOT 2u
+
+// AoConstants::estimator: the values of rb::AoEstimator.
+#define RB_AO_BINARY 0u
+#define RB_AO_DISTANCE_WEIGHTED 1u
+
+// DenoiseConstants::flags.
+#define RB_DN_REVERSED_Z 1u
+#define RB_DN_OCTAHEDRAL 2u
+#define RB_DN_HISTORY 4u  // last frame's history is valid (temporal pass)
+#define RB_DN_MOTION 8u   // the G-buffer has motion vectors (temporal pass)
+
+// ClusterBoundsConstants::positionFormat.
+#define RB_POSITION_RGB32F 0u
+#define RB_POSITION_RG32F 1u
+#define RB_POSITION_RGBA32F 2u
+#define RB_POSITION_RGBA16F 3u
+#define RB_POSITION_RG16F 4u
+#define RB_POSITION_RGBA16_SNORM 5u
+#define RB_POSITION_RG16_SNORM 6u
+#define RB_POSITION_RGBA8_SNORM 7u
+// ClusterBoundsConstants::indexType.
+#define RB_INDEX_U32 0u
+#define RB_INDEX_U16 1u
+#define RB_INDEX_NONE 2u
+// Triangles per cluster, the workgroup size of blas_cluster_bounds.comp (rb::kRefitClusterTriangles).
+#define RB_CLUSTER_TRIANGLES 64
+
+// Rays are counted into RB_RAY_COUNTER_SLOTS counters, one per pixel of a 64x64 tile: neighbouring invocations
+// (one warp or subgroup) never add to the same address, so the atomics do not serialise (PassMetrics).
+#define RB_RAY_COUNTER_SLOTS 4096
+#define RB_RAY_COUNTER_SLOT(x, y) (((x) & 63u) | (((y) & 63u) << 6))
+
+#endif
