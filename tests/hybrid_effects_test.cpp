@@ -116,6 +116,7 @@ TEST_CASE("the front end's hard shadows and AO equal the passes recorded one by 
   frame.gbuffer = gbuffer.desc();
   frame.tlas = &built.tlas;  // the engine's own TLAS: the front end builds none
   frame.light.direction[0] = 0.4f;
+  frame.light.direction[1] = 1.0f;
   frame.light.direction[2] = 0.3f;
   frame.light.angularRadiusDegrees = 3.0f;  // ignored: one ray per pixel is hard shadows
   auto cmd = fx.device().beginCommands();

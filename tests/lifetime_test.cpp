@@ -195,6 +195,7 @@ TEST_CASE("effects front ends created and destroyed every frame, cycling all pre
   frame.gbuffer = gbuffer.desc();
   frame.instances = built.instances;  // the front end records the service's pending work and builds the TLAS
   frame.light.direction[0] = 0.4f;
+  frame.light.direction[1] = 1.0f;
   frame.light.direction[2] = 0.3f;
   const rb::Material material;  // reflection hits need a material table
 

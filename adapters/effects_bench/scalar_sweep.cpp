@@ -183,8 +183,8 @@ se::Result<EffectResult> runShadowSweep(FrameDriver& driver, const SweepPlan& pl
   fx.rays = plan.shadowRays;
   fx.referenceRays = plan.referenceShadows;
   fx.tracedParams = driver.baseParams();
-  // The engine renders its shadow map in every frame; traced rows do not read it, so keep it at its cheapest.
-  fx.tracedParams.shadow.mapSize = 1024;
+  // Traced rows do not read the engine's shadow map, so it draws none.
+  fx.tracedParams.shadow.enabled = false;
   for (auto [size, pcf] : plan.shadowMaps) {
     RasterSetting rs;
     rs.setting = "map " + std::to_string(size) + ", PCF " + std::to_string(pcf);

@@ -162,6 +162,9 @@ int main(int argc, char** argv) {
     auto a = rbAdapter::Adapter::create(engine, ac);
     if (!a) return fail("adapter: " + a.error);
     adapter = std::move(a.value);
+    // Traced shadows replace the shadow map, and a preset without shadows has none in either mode: nothing
+    // samples the map, so the engine draws none.
+    params.shadow.enabled = false;
   } else {
     // The engine's own counterparts of the effects: the preset's shadow map and PCF, SSAO, the probe.
     params.shadow.enabled = fx.raster.mapSize > 0;

@@ -169,7 +169,8 @@ if want render; then
   : >"$OUT/render_gpu.log"
   RENDER="$RT/bin/raybridge-render"
   RDIR="$(mktemp -d)"
-  for variant in "raster|--mode raster" "hybrid|--mode hybrid" "hybrid_soft|--mode hybrid --sun-radius 0.5 --shadow-rays 8"; do
+  for variant in "raster|--mode raster" "hybrid|--mode hybrid" "raster_ultra|--mode raster --preset ultra" \
+                 "hybrid_ultra|--mode hybrid --preset ultra" "hybrid_low|--mode hybrid --preset low"; do
     name="${variant%%|*}"
     read -r -a vargs <<<"${variant#*|}"
     RAYBRIDGE_VALIDATION=0 step "render $name" 60 "$OUT/render_gpu.log" \

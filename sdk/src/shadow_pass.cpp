@@ -56,8 +56,9 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
 
   // Light parameters in the TLAS's space.
   float dir[3] = {light.direction[0], light.direction[1], light.direction[2]};
+  if (dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) dir[1] = light.type == LightType::Spot ? -1.0f : 1.0f;
   float len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-  if (!(len > 0.0f) || !std::isfinite(len)) return invalid("Light::direction must be a finite, non-zero vector");
+  if (!(len > 0.0f) || !std::isfinite(len)) return invalid("Light::direction must be a finite vector");
   for (float& d : dir) d /= len;
   bool soft;
   switch (light.type) {

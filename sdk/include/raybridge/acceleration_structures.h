@@ -300,9 +300,9 @@ class AccelerationStructureService {
  public:
   static Result<std::unique_ptr<AccelerationStructureService>> create(Context& context,
                                                                       const AsServiceDesc& desc = {});
-  // Waits (on the host) for the SDK's own timeline semaphore to reach its last submission's value, never on
-  // the engine's queues; contract otherwise as for the Context: the GPU is done with the engine's frames that
-  // used this service. The engine must have submitted the signals of the `ready` values it passed.
+  // Never waits. Contract, as for the Context: the GPU is done with the engine's frames that used this service
+  // and with the SDK's submissions on the async queue (the engine's vkDeviceWaitIdle, or a wait on that queue
+  // or on the SDK's timeline), and the engine has submitted the signals of the `ready` values it passed.
   // Unlike the passes it does not defer: it destroys its TLASes and BLASes at once, and it releases every
   // object retired to the context so far (its retired BLASes live in its storage blocks), those of destroyed
   // passes included. Destroy it at shutdown (or after a wait-idle), not in the middle of a run.

@@ -16,7 +16,8 @@ enum class LightType : uint8_t {
 struct Light {
   LightType type = LightType::Directional;
   // Directional: direction towards the light (need not be normalised). Spot: the direction the spot shines.
-  float direction[3] = {0.0f, 1.0f, 0.0f};
+  // All zero = the default: a sun straight overhead (0, 1, 0), a spot shining straight down (0, -1, 0).
+  float direction[3] = {0.0f, 0.0f, 0.0f};
   double position[3] = {0.0, 0.0, 0.0};  // point and spot: world-space position
   // Directional: angular radius of the light's disk in degrees; 0 = hard shadows (one ray, no noise).
   float angularRadiusDegrees = 0.0f;
