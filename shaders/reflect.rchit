@@ -75,5 +75,7 @@ void main() {
   // Direct sun: diffuse, plus a broad specular approximation so metals are not black under the sun.
   vec3 direct = (diffuse + specularColour / RB_PI) * pc.sunRadiance * max(nDotL, 0.0) * sunVisible;
   vec3 ambient = (base.rgb * (1.0 - metallic) + specularColour * metallic) * pc.skyRadiance * pc.ambientIntensity;
-  payload.radiance = direct + ambient + m.emissive.rgb;
+  vec3 emissive = m.emissive;
+  if (m.emissiveTexture != 0xFFFFFFFFu) emissive *= textureLod(textures[nonuniformEXT(m.emissiveTexture)], uv, 0.0).rgb;
+  payload.radiance = direct + ambient + emissive;
 }

@@ -35,7 +35,8 @@ struct GpuMaterial {
   float roughness;
   uint baseColorTexture;  // 0xFFFFFFFF = none
   uint metallicRoughnessTexture;
-  vec4 emissive;
+  vec3 emissive;
+  uint emissiveTexture;  // 0xFFFFFFFF = none
 };
 
 layout(set = 0, binding = RB_REFLECTION_BINDING_SHADING_RECORDS, std430) readonly buffer ShadingRecords {

@@ -35,7 +35,8 @@ std::vector<double> referenceAo(const EmbreeScene& embree, const CpuGBuffer& g, 
   for (size_t i = 0; i < g.hit.size(); ++i) {
     if (!g.hit[i]) continue;
     glm::dvec3 n(g.normal[i]);
-    glm::dvec3 t = glm::normalize(std::fabs(n.x) > 0.5 ? glm::cross(n, glm::dvec3(0, 1, 0)) : glm::cross(n, glm::dvec3(1, 0, 0)));
+    glm::dvec3 t = glm::normalize(std::fabs(n.x) > 0.5 ? glm::cross(n, glm::dvec3(0, 1, 0))
+                                                       : glm::cross(n, glm::dvec3(1, 0, 0)));
     glm::dvec3 b = glm::cross(n, t);
     glm::dvec3 o = g.position[i] + n * 1e-4;
     float of[3] = {float(o.x), float(o.y), float(o.z)};
@@ -108,8 +109,8 @@ TEST_CASE("AO with unlimited range matches analytic open fractions", "[ao][analy
   // a grid of 1 m cells: a triangle whose vertices are kilometres away is intersected with an absolute error
   // of millimetres on NVIDIA (its vertices are float), more than any origin offset allows for.
   const float big = 2e4f;
-  const float wallXMin[3] = {-1.0f, -1.0f, -big}, wallXMax[3] = {0.0f, big, big};   // the plane x = 0
-  const float wallZMin[3] = {-big, -1.0f, -1.0f}, wallZMax[3] = {big, big, 0.0f};   // the plane z = 0
+  const float wallXMin[3] = {-1.0f, -1.0f, -big}, wallXMax[3] = {0.0f, big, big};  // the plane x = 0
+  const float wallZMin[3] = {-big, -1.0f, -1.0f}, wallZMax[3] = {big, big, 0.0f};  // the plane z = 0
   auto check = [&](const TestScene& scene, double expected, glm::dvec3 eye, glm::dvec3 target) {
     EmbreeScene embree;
     addToEmbree(embree, scene);

@@ -103,7 +103,8 @@ TEST_CASE("dynamic BLAS builds on a second queue trace the same-frame and one-fr
       t = dyn.frame(instances);
     }
     CHECK(service.stats().staleBlas == (late ? 2u : 0u));
-    checkDeformedTraceAgreement(compareFirstTrace(fx, sceneOf(pose(base, late ? last - 1 : last)), t.tlas, cam, 64, 48));
+    checkDeformedTraceAgreement(
+        compareFirstTrace(fx, sceneOf(pose(base, late ? last - 1 : last)), t.tlas, cam, 64, 48));
     // No update: both modes trace the newest pose.
     t = dyn.frame(instances);
     CHECK(service.stats().staleBlas == 0);

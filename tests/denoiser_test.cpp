@@ -82,7 +82,8 @@ TEST_CASE("denoised 4-ray AO beats raw 4-ray AO and matches raw 16-ray AO", "[de
   rb::DenoiseSettings spatialOnly;
   spatialOnly.disableTemporal = true;
   std::vector<float> denoised4 = runFrames(fx, s, {g}, 4, true, spatialOnly);
-  double eRaw4 = rmse(raw4, reference, g), eRaw16 = rmse(raw16, reference, g), eDenoised = rmse(denoised4, reference, g);
+  double eRaw4 = rmse(raw4, reference, g), eRaw16 = rmse(raw16, reference, g),
+         eDenoised = rmse(denoised4, reference, g);
   INFO("RMSE raw 4: " << eRaw4 << ", raw 16: " << eRaw16 << ", denoised 4 (one frame, spatial): " << eDenoised);
   CHECK(eDenoised < eRaw4);
   CHECK(eDenoised <= eRaw16);

@@ -102,7 +102,7 @@ TEST_CASE("a refit after a deformation traces like Embree on the deformed mesh",
 
 TEST_CASE("the adaptive policy rebuilds once the cluster measure passes its threshold", "[dynamic][policy]") {
   GpuFixture fx;
-  auto service = makeService(fx, {});  // Adaptive, kDefaultMaxAreaGrowth
+  auto service = makeService(fx, {});                                        // Adaptive, kDefaultMaxAreaGrowth
   const rbsamples::CpuMesh grid = rbsamples::makeBumpyGrid(4.0f, 16, 0.1f);  // 512 triangles, 8 clusters
   DynamicScene dyn(fx, *service);
   const uint32_t m = dyn.add(grid);
@@ -391,8 +391,8 @@ TEST_CASE("updateMesh with new counts needs forceRebuild, then traces the new me
   GpuFixture fx;
   auto service = makeService(fx, {});
   DynamicScene dyn(fx, *service);
-  const rbsamples::CpuMesh small = rbsamples::makeGrid(3.0f, 8);                // 81 vertices, 128 triangles
-  const rbsamples::CpuMesh large = rbsamples::makeBumpyGrid(3.0f, 12, 0.4f);    // 169 vertices, 288 triangles
+  const rbsamples::CpuMesh small = rbsamples::makeGrid(3.0f, 8);              // 81 vertices, 128 triangles
+  const rbsamples::CpuMesh large = rbsamples::makeBumpyGrid(3.0f, 12, 0.4f);  // 169 vertices, 288 triangles
   const uint32_t m = dyn.add(small, "cloth");
   const std::vector<rb::Instance> instances = {instanceOf(dyn.handle(m), translation(0, 0, 0), 0)};
   dyn.frame(instances);
@@ -418,9 +418,8 @@ TEST_CASE("updateMesh with new counts needs forceRebuild, then traces the new me
   checkDeformedTraceAgreement(compareFirstTrace(fx, scene, tlas.tlas, cam, 64, 64));
 
   // New buffers with the same counts: refit from them, no rebuild needed.
-  const rbsamples::CpuMesh lifted = withPositions(large, deformed(large, [](uint32_t, int axis, const float*) {
-                                                    return axis == 1 ? 0.5f : 0.0f;
-                                                  }));
+  const rbsamples::CpuMesh lifted =
+      withPositions(large, deformed(large, [](uint32_t, int axis, const float*) { return axis == 1 ? 0.5f : 0.0f; }));
   RB_REQUIRE_OK(dyn.replace(m, lifted, false));
   tlas = dyn.frame(instances);
   CHECK(service->stats().refits == 1);

@@ -57,8 +57,7 @@ class DynamicScene {
 };
 
 // The mesh's positions, each coordinate moved by offset(vertex index, axis, original position).
-std::vector<float> deformed(const rbsamples::CpuMesh& mesh,
-                            float (*offset)(uint32_t vertex, int axis, const float* p));
+std::vector<float> deformed(const rbsamples::CpuMesh& mesh, float (*offset)(uint32_t vertex, int axis, const float* p));
 
 // The dynamic tests' bar for a trace of a deformed mesh against Embree: at least 300 hits compared, hit/miss and
 // distance agreeing on 99.5% of the rays.

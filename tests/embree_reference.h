@@ -12,7 +12,7 @@ struct ReferenceHit {
   bool hit = false;
   float t = 0.0f;
   uint32_t primitiveId = 0xFFFFFFFFu;
-  uint32_t instanceId = 0xFFFFFFFFu;  // the id passed to addInstance
+  uint32_t instanceId = 0xFFFFFFFFu;     // the id passed to addInstance
   float geometricNormal[3] = {0, 0, 0};  // world space, unnormalised
 };
 

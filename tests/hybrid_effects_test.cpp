@@ -44,7 +44,8 @@ TEST_CASE("preset names round-trip and the table matches the thesis", "[presets]
   CHECK(low.reflections.roughnessThreshold == 0.7f);
 }
 
-TEST_CASE("the front end rejects bad descriptions and frames by name and keeps its state", "[hybrid_effects][bad-input]") {
+TEST_CASE("the front end rejects bad descriptions and frames by name and keeps its state",
+          "[hybrid_effects][bad-input]") {
   GpuFixture fx;
   auto created = rb::HybridEffects::create(fx.ctx(), nullptr, rb::withPreset({}, rb::Preset::HardShadows));
   RB_REQUIRE_OK(created);
@@ -57,7 +58,8 @@ TEST_CASE("the front end rejects bad descriptions and frames by name and keeps i
   const Case cases[] = {
       {"effects", [](rb::HybridEffectsDesc& d) { d.effects = 1u << 7; }},
       {"shadows.raysPerPixel", [](rb::HybridEffectsDesc& d) { d.shadows.raysPerPixel = 5000; }},
-      {"shadows.softAngularRadiusDegrees", [](rb::HybridEffectsDesc& d) { d.shadows.softAngularRadiusDegrees = -1.0f; }},
+      {"shadows.softAngularRadiusDegrees",
+       [](rb::HybridEffectsDesc& d) { d.shadows.softAngularRadiusDegrees = -1.0f; }},
       {"ao.raysPerPixel", [](rb::HybridEffectsDesc& d) { d.ao.raysPerPixel = 4097; }},
       {"ao.range", [](rb::HybridEffectsDesc& d) { d.ao.range = std::numeric_limits<float>::infinity(); }},
       {"reflections.roughnessThreshold", [](rb::HybridEffectsDesc& d) { d.reflections.roughnessThreshold = 2.0f; }},

@@ -103,8 +103,7 @@ VkDeviceSize passBytes(const rb::MemoryStats& m) {
 
 }  // namespace
 
-TEST_CASE("passes and denoisers destroyed while their frame is in flight are released by the context",
-          "[lifetime]") {
+TEST_CASE("passes and denoisers destroyed while their frame is in flight are released by the context", "[lifetime]") {
   GpuFixture fx;
   const uint32_t framesInFlight = fx.ctx().framesInFlight();
   const uint32_t frames = 100;

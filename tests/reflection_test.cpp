@@ -74,7 +74,8 @@ TEST_CASE("a mirror reflects a coloured box where Embree says it should", "[refl
   settings.sunDirection[1] = 1.0f;
   settings.sunDirection[2] = 0.6f;
   // Explicit lighting, so the reference below reads the same values the pass shades with.
-  for (int i = 0; i < 3; ++i) settings.sunRadiance[i] = rb::kDefaultSunRadiance, settings.skyRadiance[i] = rb::kDefaultSkyRadiance[i];
+  for (int i = 0; i < 3; ++i)
+    settings.sunRadiance[i] = rb::kDefaultSunRadiance, settings.skyRadiance[i] = rb::kDefaultSkyRadiance[i];
   settings.ambientIntensity = rb::kDefaultAmbientIntensity;
 
   SECTION("mirror floor") {
@@ -130,8 +131,8 @@ TEST_CASE("a mirror reflects a coloured box where Embree says it should", "[refl
     // Rays are counted: one reflection ray per mirror pixel (every floor pixel, no box pixel), plus a shadow
     // ray where a reflection ray hits a box face that faces the sun.
     uint64_t tracedPixels = 0, allFloor = 0, shadowRays = 0;
-    const glm::dvec3 toSun = glm::normalize(glm::dvec3(settings.sunDirection[0], settings.sunDirection[1],
-                                                       settings.sunDirection[2]));
+    const glm::dvec3 toSun = glm::normalize(
+        glm::dvec3(settings.sunDirection[0], settings.sunDirection[1], settings.sunDirection[2]));
     for (size_t i = 0; i < run.radiance.size(); ++i) {
       tracedPixels += run.radiance[i].a != 0.0f;
       if (!cpu.hit[i] || cpu.instance[i] != 0) continue;

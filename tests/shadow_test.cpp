@@ -200,7 +200,7 @@ TEST_CASE("grazing light shows no self-shadowing and a 1 cm gap still casts a sh
                   << planeShadowAgree << ")");
       REQUIRE(planeLit > 300);
       REQUIRE(planeShadow > 30);
-      CHECK(planeLitAgree == planeLit);                  // no acne anywhere on the open plane
+      CHECK(planeLitAgree == planeLit);                       // no acne anywhere on the open plane
       CHECK(double(planeShadowAgree) / planeShadow >= 0.99);  // the 1 cm gap does not leak light
     }
   }

@@ -24,8 +24,7 @@ CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& v, const
   const glm::dvec3 forward = glm::normalize(v.target - v.eye);
   g.viewMatrix = glm::mat4(glm::lookAtRH(glm::dvec3(0.0), forward, v.up));
   double aspect = double(v.width) / double(v.height);
-  glm::dmat4 proj = glm::perspectiveRH_ZO(glm::radians(v.fovYDegrees), aspect, double(v.nearPlane),
-                                          double(v.farPlane));
+  glm::dmat4 proj = glm::perspectiveRH_ZO(glm::radians(v.fovYDegrees), aspect, double(v.nearPlane), double(v.farPlane));
   if (v.reversedZ) {
     // Reversed-Z: map near to 1 and far to 0.
     glm::dmat4 flip(1.0);
@@ -83,8 +82,8 @@ GpuGBuffer::Image GpuGBuffer::upload(VkFormat format, VkImageAspectFlags aspect,
   vk.vkGetImageMemoryRequirements(device, img.image, &req);
   VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mai.allocationSize = req.size;
-  mai.memoryTypeIndex =
-      uint32_t(rb::internal::contextImpl(fx_.ctx()).findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0));
+  mai.memoryTypeIndex = uint32_t(
+      rb::internal::contextImpl(fx_.ctx()).findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0));
   REQUIRE(vk.vkAllocateMemory(device, &mai, nullptr, &img.memory) == VK_SUCCESS);
   vk.vkBindImageMemory(device, img.image, img.memory, 0);
   VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
@@ -105,19 +104,18 @@ GpuGBuffer::Image GpuGBuffer::upload(VkFormat format, VkImageAspectFlags aspect,
   b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = img.image;
   b.subresourceRange = {aspect, 0, 1, 0, 1};
-  vk.vkCmdPipelineBarrier(cmd.value(), VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
-                          nullptr, 0, nullptr, 1, &b);
+  vk.vkCmdPipelineBarrier(cmd.value(), VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
+                          0, nullptr, 1, &b);
   VkBufferImageCopy region{};
   region.imageSubresource = {aspect, 0, 0, 1};
   region.imageExtent = {desc_.width, desc_.height, 1};
-  vk.vkCmdCopyBufferToImage(cmd.value(), staging->buffer, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
-                            &region);
+  vk.vkCmdCopyBufferToImage(cmd.value(), staging->buffer, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
   b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
   b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
   b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
   b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-  vk.vkCmdPipelineBarrier(cmd.value(), VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR,
-                          0, 0, nullptr, 0, nullptr, 1, &b);
+  vk.vkCmdPipelineBarrier(cmd.value(), VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, 0,
+                          0, nullptr, 0, nullptr, 1, &b);
   RB_REQUIRE_OK(fx_.device().submitAndWait(cmd.value()));
   fx_.device().destroyBuffer(staging.value());
   return img;
@@ -127,8 +125,7 @@ GpuGBuffer::GpuGBuffer(GpuFixture& fx, const CpuGBuffer& cpu) : fx_(fx) {
   desc_.width = cpu.view.width;
   desc_.height = cpu.view.height;
   depth_ = upload(VK_FORMAT_D32_SFLOAT, VK_IMAGE_ASPECT_DEPTH_BIT, cpu.depth.data(), cpu.depth.size() * 4);
-  normal_ = upload(VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_ASPECT_COLOR_BIT, cpu.normal.data(),
-                   cpu.normal.size() * 16);
+  normal_ = upload(VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_ASPECT_COLOR_BIT, cpu.normal.data(), cpu.normal.size() * 16);
   desc_.depth = {depth_.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   desc_.depthConvention = cpu.view.reversedZ ? rb::DepthConvention::ReversedZ : rb::DepthConvention::Standard;
   desc_.normal = {normal_.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
@@ -174,8 +171,10 @@ float halfToFloat(uint16_t h) {
   uint32_t sign = (h >> 15) & 1, exp = (h >> 10) & 31, mant = h & 1023;
   float v;
   if (exp == 0) v = std::ldexp(float(mant), -24);
-  else if (exp == 31) v = mant ? NAN : INFINITY;
-  else v = std::ldexp(float(mant | 1024), int(exp) - 25);
+  else if (exp == 31)
+    v = mant ? NAN : INFINITY;
+  else
+    v = std::ldexp(float(mant | 1024), int(exp) - 25);
   return sign ? -v : v;
 }
 }  // namespace

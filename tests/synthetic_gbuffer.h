@@ -43,8 +43,7 @@ struct CpuGBuffer {
 
 // Traces the primary rays with Embree over `scene` (instances given in world space). `roughness`, indexed by
 // instance, goes to the normal image's w (GBufferDesc::roughnessInNormalW); empty = 0 everywhere.
-CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& view,
-                        const std::vector<float>& roughness = {});
+CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& view, const std::vector<float>& roughness = {});
 
 // The G-buffer uploaded: D32 depth and RGBA32F normal images in SHADER_READ_ONLY_OPTIMAL.
 class GpuGBuffer {

@@ -58,11 +58,11 @@ class GpuFixture {
 };
 
 // Asserts a result is ok and prints its message otherwise.
-#define RB_REQUIRE_OK(expr)                                                        \
-  do {                                                                             \
-    auto&& rb_result_ = (expr);                                                    \
-    INFO((rb_result_.ok() ? std::string() : rb_result_.error().message));         \
-    REQUIRE(rb_result_.ok());                                                      \
+#define RB_REQUIRE_OK(expr)                                               \
+  do {                                                                    \
+    auto&& rb_result_ = (expr);                                           \
+    INFO((rb_result_.ok() ? std::string() : rb_result_.error().message)); \
+    REQUIRE(rb_result_.ok());                                             \
   } while (0)
 
 std::string sharedScenesDir();  // ../shared/scenes relative to the source tree

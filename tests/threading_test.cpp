@@ -140,8 +140,7 @@ TEST_CASE("meshes registered and released on other threads while frames are reco
   for (std::thread& t : threads) t.join();
   INFO(firstError);
   REQUIRE(firstError.empty());
-  INFO("frames " << frames << ", TLAS instances " << tlasInstances << ", out of budget "
-                  << outOfBudget.load());
+  INFO("frames " << frames << ", TLAS instances " << tlasInstances << ", out of budget " << outOfBudget.load());
 
   rb::AsStats st = s.stats();
   CHECK(registered.load() == uint32_t(kThreads * kRegistrationsPerThread));

@@ -232,9 +232,11 @@ se::Result<json> runMode(se::Engine& engine, const rbAnimated::AnimatedScene& sc
   r["async"] = as.async;
   r["async_queue_family"] = as.async ? json(as.asyncQueueFamily) : json(nullptr);
   r["async_fallback_reason"] = as.asyncFallbackReason;
-  r["graphics_ms"] = {{"p50", percentile(s.graphicsMs, 0.5)}, {"p99", percentile(s.graphicsMs, 0.99)},
+  r["graphics_ms"] = {{"p50", percentile(s.graphicsMs, 0.5)},
+                      {"p99", percentile(s.graphicsMs, 0.99)},
                       {"mean", mean(s.graphicsMs)}};
-  r["frame_interval_ms"] = {{"p50", percentile(s.intervalMs, 0.5)}, {"p99", percentile(s.intervalMs, 0.99)},
+  r["frame_interval_ms"] = {{"p50", percentile(s.intervalMs, 0.5)},
+                            {"p99", percentile(s.intervalMs, 0.99)},
                             {"mean", mean(s.intervalMs)}};
   r["hook_ms_mean"] = mean(s.hookMs);
   r["deform_ms_mean"] = mean(s.deformMs);
@@ -248,9 +250,9 @@ se::Result<json> runMode(se::Engine& engine, const rbAnimated::AnimatedScene& sc
   r["rebuilds"] = as.rebuilds;
   r["memory_bytes"] = mem.total();
   r["dynamic_blas_bytes"] = as.dynamicBlasBytes;
-  r["frames"] = {{"graphics_ms", s.graphicsMs}, {"interval_ms", s.intervalMs}, {"async_ms", s.asyncMs},
-                 {"shadow_ms", s.shadowMs},     {"refit_triangles", s.refitTriangles},
-                 {"rebuild_triangles", s.rebuildTriangles}};
+  r["frames"] = {
+      {"graphics_ms", s.graphicsMs}, {"interval_ms", s.intervalMs},         {"async_ms", s.asyncMs},
+      {"shadow_ms", s.shadowMs},     {"refit_triangles", s.refitTriangles}, {"rebuild_triangles", s.rebuildTriangles}};
   return R::success(std::move(r));
 }
 
@@ -278,12 +280,13 @@ int main(int argc, char** argv) {
   auto created = se::Engine::create(config);
   if (!created) return std::fprintf(stderr, "engine: %s\n", created.error.c_str()), 1;
   se::Engine& engine = *created.value;
-  if (se::Status s = engine.setRenderSize(o.width, o.height); !s) return std::fprintf(stderr, "%s\n", s.error.c_str()), 1;
+  if (se::Status s = engine.setRenderSize(o.width, o.height); !s)
+    return std::fprintf(stderr, "%s\n", s.error.c_str()), 1;
 
   json report;
   report["device"] = engine.deviceInfo().name;
-  report["async_compute_queue_family"] =
-      engine.asyncComputeQueue() ? json(engine.asyncComputeQueueFamily()) : json(nullptr);
+  report["async_compute_queue_family"] = engine.asyncComputeQueue() ? json(engine.asyncComputeQueueFamily())
+                                                                    : json(nullptr);
   report["width"] = o.width;
   report["height"] = o.height;
   report["frames"] = o.frames;
@@ -293,8 +296,10 @@ int main(int argc, char** argv) {
   std::printf("device %s, %ux%u, %u frames per run (after %u warm-up), async compute family %s\n",
               engine.deviceInfo().name.c_str(), o.width, o.height, o.frames, o.warmup,
               engine.asyncComputeQueue() ? std::to_string(engine.asyncComputeQueueFamily()).c_str() : "none");
-  std::printf("| characters | mode | graphics p50 ms | p99 ms | interval p50 ms | p99 ms | async ms | BLAS ms | shadow ms | "
-              "refit tris/frame | rebuild tris/frame | stale | memory MiB |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| characters | mode | graphics p50 ms | p99 ms | interval p50 ms | p99 ms | async ms | BLAS ms | shadow ms | "
+      "refit tris/frame | rebuild tris/frame | stale | memory MiB "
+      "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (uint32_t k : o.characters) {
     auto scene = rbAnimated::makeAnimatedScene(o.scenes, k);
     if (!scene) return std::fprintf(stderr, "%s\n", scene.error.c_str()), 1;
@@ -310,9 +315,9 @@ int main(int argc, char** argv) {
                   m.name, run["graphics_ms"]["p50"].get<double>(), run["graphics_ms"]["p99"].get<double>(),
                   run["frame_interval_ms"]["p50"].get<double>(), run["frame_interval_ms"]["p99"].get<double>(),
                   run["async_ms_mean"].get<double>(), run["blas_gpu_ms_per_frame"].get<double>(),
-                  run["shadow_ms_mean"].get<double>(),
-                  run["refit_triangles_per_frame"].get<double>(), run["rebuild_triangles_per_frame"].get<double>(),
-                  run["stale_blas_mean"].get<double>(), run["memory_bytes"].get<double>() / 1048576.0);
+                  run["shadow_ms_mean"].get<double>(), run["refit_triangles_per_frame"].get<double>(),
+                  run["rebuild_triangles_per_frame"].get<double>(), run["stale_blas_mean"].get<double>(),
+                  run["memory_bytes"].get<double>() / 1048576.0);
       std::fflush(stdout);
       report["runs"].push_back(std::move(run));
     }

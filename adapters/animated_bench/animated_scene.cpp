@@ -17,7 +17,7 @@ namespace se = sample_engine;
 namespace {
 
 constexpr float kCharacterSize = 1.7f;  // metres: a model's largest extent (a person's height, the fox's length)
-constexpr float kSpacing = 1.6f;          // metres between neighbouring characters on the grid
+constexpr float kSpacing = 1.6f;        // metres between neighbouring characters on the grid
 
 }  // namespace
 
@@ -72,7 +72,8 @@ se::Result<AnimatedScene> makeAnimatedScene(const std::string& scenesDir, uint32
                                 glm::rotate(glm::mat4(1.0f), yaw, glm::vec3(0, 1, 0)) * m.normalize;
     const size_t firstMesh = out.scene.meshes.size();
     const uint32_t animation = se::appendScene(out.scene, m.scene, placement);
-    for (size_t i = firstMesh; i < out.scene.meshes.size(); ++i) out.characterTriangles += out.scene.meshes[i].triangleCount();
+    for (size_t i = firstMesh; i < out.scene.meshes.size(); ++i)
+      out.characterTriangles += out.scene.meshes[i].triangleCount();
     // Offsets spread the characters over their cycles, so no two share a pose.
     out.playbacks.push_back({animation, 0.37 * double(k)});
     out.characterNames.push_back(m.name);

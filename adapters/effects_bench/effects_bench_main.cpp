@@ -85,8 +85,9 @@ int main(int argc, char** argv) {
     RawRate r;
     rawRateError = readRawRate(o.rawRateJson, r);
     if (rawRateError.empty()) raw = r;
-    else std::fprintf(stderr, "raybridge-effects-bench: warning: %s; rays/s are reported without fractions\n",
-                      rawRateError.c_str());
+    else
+      std::fprintf(stderr, "raybridge-effects-bench: warning: %s; rays/s are reported without fractions\n",
+                   rawRateError.c_str());
   }
   const auto start = std::chrono::steady_clock::now();
 
@@ -110,8 +111,8 @@ int main(int argc, char** argv) {
   std::vector<EffectResult> results;
   using Sweep = se::Result<EffectResult> (*)(FrameDriver&, const SweepPlan&);
   const std::pair<rb::EffectBits, Sweep> sweeps[] = {{rb::kEffectShadows, runShadowSweep},
-                                                        {rb::kEffectAo, runAoSweep},
-                                                        {rb::kEffectReflections, runReflectionSweep}};
+                                                     {rb::kEffectAo, runAoSweep},
+                                                     {rb::kEffectReflections, runReflectionSweep}};
   for (auto [flag, sweep] : sweeps) {
     if (!(o.effects & flag)) continue;
     auto r = sweep(driver, plan);
@@ -159,11 +160,13 @@ int main(int argc, char** argv) {
   doc["timing"] = {{"warmup_frames", plan.warmupFrames},
                    {"timed_frames", plan.timedFrames},
                    {"statistic", "median"},
-                   {"source", "GPU timestamps: SDK PassStats (traced passes), engine PassTimings (raster passes, frame)"},
+                   {"source",
+                    "GPU timestamps: SDK PassStats (traced passes), engine PassTimings (raster passes, frame)"},
                    {"frame_ms", "sum of the engine's passes (shadow map, pre-pass, SSAO, hook, lighting, tonemap); "
                                 "without the probe capture and the shadow-visibility readback pass"}};
   if (raw) doc["raw_rate"] = {{"source", raw->source}, {"stress_grays_per_second", raw->graysPerSecond}};
-  else if (!rawRateError.empty()) doc["raw_rate"] = {{"source", o.rawRateJson}, {"error", rawRateError}};
+  else if (!rawRateError.empty())
+    doc["raw_rate"] = {{"source", o.rawRateJson}, {"error", rawRateError}};
   doc["effects"] = nlohmann::json::object();
   bool checksPassed = true;
   for (const EffectResult& r : results) {

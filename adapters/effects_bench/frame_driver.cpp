@@ -41,8 +41,10 @@ se::Result<std::unique_ptr<FrameDriver>> FrameDriver::create(const Config& confi
     if (!self->captureNext_) return;
     self->captureNext_ = false;
     const rb::HybridOutputs& fo = self->adapter_->effects().outputs();
-    const std::vector<rbRender::CaptureImage> images = {{"shadow_raw", fo.shadowRaw.image, 1}, {"shadow", fo.shadow.image, 1},
-                                                        {"ao_raw", fo.aoRaw.image, 1},         {"ao", fo.ao.image, 1},
+    const std::vector<rbRender::CaptureImage> images = {{"shadow_raw", fo.shadowRaw.image, 1},
+                                                        {"shadow", fo.shadow.image, 1},
+                                                        {"ao_raw", fo.aoRaw.image, 1},
+                                                        {"ao", fo.ao.image, 1},
                                                         {"reflection", fo.reflection.image, 4}};
     if (se::Status s = self->capture_->record(info, info.normalRoughness, images); !s) self->captureError_ = s.error;
   });

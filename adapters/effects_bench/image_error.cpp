@@ -93,7 +93,8 @@ se::ImageRGBA8 image(uint32_t width, uint32_t height) {
 se::Status writeGreyPng(const std::string& path, const std::vector<float>& values, uint32_t width, uint32_t height) {
   if (values.size() != size_t(width) * height) return se::Status::failure(path + ": image size mismatch");
   se::ImageRGBA8 img = image(width, height);
-  for (size_t i = 0; i < values.size(); ++i) img.pixels[i * 4] = img.pixels[i * 4 + 1] = img.pixels[i * 4 + 2] = srgb8(values[i]);
+  for (size_t i = 0; i < values.size(); ++i)
+    img.pixels[i * 4] = img.pixels[i * 4 + 1] = img.pixels[i * 4 + 2] = srgb8(values[i]);
   return se::writePng(path, img);
 }
 

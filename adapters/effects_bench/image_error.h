@@ -28,7 +28,7 @@ class Accumulator {
  public:
   void add(const std::vector<float>& frame);
   uint32_t frames() const { return frames_[0] + frames_[1]; }
-  std::vector<float> mean() const;          // over every frame
+  std::vector<float> mean() const;              // over every frame
   std::vector<float> halfMean(int half) const;  // over the even (0) or odd (1) frames
 
  private:

@@ -65,7 +65,9 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
   auto refImage = writeImage(plan, "reflections", "reference", png(ref.value.values));
   if (!refImage) return R::failure(refImage.error);
   result.reference.image = refImage.value;
-  if (auto m = writeImage(plan, "reflections", "mask", [&](const std::string& p) { return writeMaskPng(p, mask, w, h); }); !m)
+  if (auto m = writeImage(plan, "reflections", "mask",
+                          [&](const std::string& p) { return writeMaskPng(p, mask, w, h); });
+      !m)
     return R::failure(m.error);
   progress("reflections: reference done in %.1f s (halves RMSE %.5f)", result.reference.seconds,
            result.reference.halvesRmse);

@@ -13,7 +13,8 @@ std::string readRawRate(const std::string& path, RawRate& out) {
   if (doc.is_discarded()) return "--raw-rate-json: '" + path + "' is not valid JSON";
   const nlohmann::json::json_pointer ptr("/scenarios/gigarays/summary/stressGRaysPerSecond");
   if (!doc.contains(ptr) || !doc[ptr].is_number())
-    return "--raw-rate-json: '" + path + "' has no scenarios.gigarays.summary.stressGRaysPerSecond (run "
+    return "--raw-rate-json: '" + path +
+           "' has no scenarios.gigarays.summary.stressGRaysPerSecond (run "
            "raybridge-bench --scenario gigarays)";
   out.source = path;
   out.graysPerSecond = doc[ptr].get<double>();
@@ -70,8 +71,8 @@ nlohmann::json toJson(const EffectResult& r, const std::optional<RawRate>& raw) 
 void printTables(const std::vector<EffectResult>& results, const std::optional<RawRate>& raw) {
   for (const EffectResult& r : results) {
     std::printf("\n== %s: error on the %s; reference %u rays per pixel (%u frames), noise RMSE ~%.5f\n",
-                r.effect.c_str(), r.compared.c_str(), r.reference.raysPerFrame * r.reference.frames,
-                r.reference.frames, r.reference.noiseRmse());
+                r.effect.c_str(), r.compared.c_str(), r.reference.raysPerFrame * r.reference.frames, r.reference.frames,
+                r.reference.noiseRmse());
     std::printf("%-16s %-18s %10s %10s %10s %10s  %s\n", "method", "setting", "effect ms", "frame ms", "RMSE", "bias",
                 "effect ms of");
     for (const Row& row : r.rows)

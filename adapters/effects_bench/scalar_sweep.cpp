@@ -27,7 +27,7 @@ struct ScalarEffect {
   const char* denoiseName = "";
   rb::PassStats Stats::*pass = nullptr;
   rb::PassStats Stats::*denoise = nullptr;
-  const char* rawImage = "";       // capture names (FrameDriver::capture)
+  const char* rawImage = "";  // capture names (FrameDriver::capture)
   const char* denoisedImage = "";
   std::function<void(rb::HybridEffectsDesc&, uint32_t)> setRays;
   std::vector<uint32_t> rays;
@@ -42,7 +42,8 @@ struct ScalarEffect {
 
 se::Result<std::vector<float>> named(const rbRender::CapturedFrame& f, const char* name) {
   auto it = f.images.find(name);
-  if (it == f.images.end()) return se::Result<std::vector<float>>::failure(std::string("no captured '") + name + "' image");
+  if (it == f.images.end())
+    return se::Result<std::vector<float>>::failure(std::string("no captured '") + name + "' image");
   return se::Result<std::vector<float>>::success(it->second);
 }
 
@@ -64,7 +65,9 @@ se::Result<EffectResult> runScalarSweep(FrameDriver& driver, const SweepPlan& pl
     return st ? se::Status::success() : se::Status::failure("HybridEffects::setDesc: " + st.error().message);
   };
   const uint32_t w = plan.width, h = plan.height;
-  auto grey = [&](const std::vector<float>& v) { return [&v, w, h](const std::string& p) { return writeGreyPng(p, v, w, h); }; };
+  auto grey = [&](const std::vector<float>& v) {
+    return [&v, w, h](const std::string& p) { return writeGreyPng(p, v, w, h); };
+  };
 
   // Reference: the raw traced buffer, many rays per frame, no denoiser, averaged over frames.
   s.enabled = true;
@@ -73,9 +76,9 @@ se::Result<EffectResult> runScalarSweep(FrameDriver& driver, const SweepPlan& pl
   result.reference.raysPerFrame = perFrame;
   progress("%s: reference, %u rays per pixel (%u frames of %u)", fx.name.c_str(), fx.referenceRays,
            (fx.referenceRays + perFrame - 1) / perFrame, perFrame);
-  auto ref = traceReference(driver, fx.tracedParams, (fx.referenceRays + perFrame - 1) / perFrame, 1,
-                            [&](const rbRender::CapturedFrame& f) { return named(f, fx.rawImage); }, fx.pass,
-                            result.reference);
+  auto ref = traceReference(
+      driver, fx.tracedParams, (fx.referenceRays + perFrame - 1) / perFrame, 1,
+      [&](const rbRender::CapturedFrame& f) { return named(f, fx.rawImage); }, fx.pass, result.reference);
   if (!ref) return R::failure(fx.name + " reference: " + ref.error);
   const std::vector<uint8_t>& mask = ref.value.mask;
   result.surfacePixels = countSet(mask);

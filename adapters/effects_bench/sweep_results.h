@@ -22,13 +22,13 @@ struct Row {
   std::string setting;  // human-readable, e.g. "8 rays", "map 2048, PCF 3", "probe 128"
   std::string id;       // file-name friendly, unique within the effect (the PNG's stem)
   nlohmann::json params;
-  double effectMs = 0.0;     // GPU ms of the effect's own passes (what the plots put on x)
-  std::string effectMsOf;    // which passes effectMs sums
-  double frameMs = 0.0;      // GPU ms of the whole frame (engine passes, hook included)
-  nlohmann::json engineMs;   // medians of each engine pass
+  double effectMs = 0.0;           // GPU ms of the effect's own passes (what the plots put on x)
+  std::string effectMsOf;          // which passes effectMs sums
+  double frameMs = 0.0;            // GPU ms of the whole frame (engine passes, hook included)
+  nlohmann::json engineMs;         // medians of each engine pass
   std::vector<PassResult> passes;  // SDK passes (traced rows only)
   double rmse = 0.0, bias = 0.0;
-  std::string image;         // PNG, relative to --images ("" when not written)
+  std::string image;  // PNG, relative to --images ("" when not written)
 };
 
 struct Reference {

@@ -21,7 +21,8 @@ float halfToFloat(uint16_t h) {
   const uint32_t sign = uint32_t(h >> 15) << 31, exp = (h >> 10) & 0x1f, mant = h & 0x3ff;
   float magnitude;
   if (exp == 0) magnitude = float(mant) * (1.0f / 16777216.0f);  // subnormal: mant * 2^-24
-  else if (exp == 31) magnitude = mant ? __builtin_nanf("") : __builtin_inff();
+  else if (exp == 31)
+    magnitude = mant ? __builtin_nanf("") : __builtin_inff();
   else {
     uint32_t bits = ((exp + 112) << 23) | (mant << 13);
     std::memcpy(&magnitude, &bits, 4);
@@ -79,7 +80,8 @@ std::string FrameCapture::Impl::ensure(HostBuffer& b, VkDeviceSize size) {
   ai.allocationSize = req.size;
   ai.memoryTypeIndex = UINT32_MAX;
   for (uint32_t i = 0; i < memory.memoryTypeCount && ai.memoryTypeIndex == UINT32_MAX; ++i) {
-    if ((req.memoryTypeBits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & want) == want) ai.memoryTypeIndex = i;
+    if ((req.memoryTypeBits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & want) == want)
+      ai.memoryTypeIndex = i;
   }
   if (ai.memoryTypeIndex == UINT32_MAX) return "no host-visible coherent memory type";
   if (allocate(device, &ai, nullptr, &b.memory) != VK_SUCCESS) return "vkAllocateMemory failed";
@@ -135,7 +137,8 @@ se::Status FrameCapture::record(const se::PrepassHookInfo& info, const se::PassI
     c.names.push_back({img.name, k, img.channels});
   }
   if (c.extra.size() < distinct.size()) c.extra.resize(distinct.size());
-  for (size_t k = 0; k < distinct.size() && e.empty(); ++k) e = c.ensure(c.extra[k], pixels * 2 * distinct[k]->channels);
+  for (size_t k = 0; k < distinct.size() && e.empty(); ++k)
+    e = c.ensure(c.extra[k], pixels * 2 * distinct[k]->channels);
   if (!e.empty()) return se::Status::failure("frame capture: " + e);
 
   struct Target {
@@ -144,11 +147,11 @@ se::Status FrameCapture::record(const se::PrepassHookInfo& info, const se::PassI
     VkImageLayout layout;
     VkBuffer buffer;
   };
-  std::vector<Target> targets = {
-      {info.depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, info.depth.layout, c.depth.buffer},
-      {normal.image, VK_IMAGE_ASPECT_COLOR_BIT, normal.layout, c.normal.buffer}};
+  std::vector<Target> targets = {{info.depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, info.depth.layout, c.depth.buffer},
+                                 {normal.image, VK_IMAGE_ASPECT_COLOR_BIT, normal.layout, c.normal.buffer}};
   for (size_t k = 0; k < distinct.size(); ++k)
-    targets.push_back({distinct[k]->image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.extra[k].buffer});
+    targets.push_back(
+        {distinct[k]->image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.extra[k].buffer});
 
   auto transition = [&](bool toTransfer) {
     std::vector<VkImageMemoryBarrier> barriers;
@@ -156,7 +159,8 @@ se::Status FrameCapture::record(const se::PrepassHookInfo& info, const se::PassI
       VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
       b.srcAccessMask = toTransfer ? VK_ACCESS_MEMORY_WRITE_BIT : 0;
       b.dstAccessMask = toTransfer ? VK_ACCESS_TRANSFER_READ_BIT : VK_ACCESS_SHADER_READ_BIT;
-      if (!toTransfer && t.aspect == VK_IMAGE_ASPECT_DEPTH_BIT) b.dstAccessMask |= VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT;
+      if (!toTransfer && t.aspect == VK_IMAGE_ASPECT_DEPTH_BIT)
+        b.dstAccessMask |= VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT;
       b.oldLayout = toTransfer ? t.layout : VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
       b.newLayout = toTransfer ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : t.layout;
       b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;

@@ -1,6 +1,7 @@
 // raybridge-render only: copies the pre-pass depth, the normal the passes used and the effect images (sun
-// visibility, AO, reflection; raw and denoised) of one frame into host memory, recorded from inside the pre-pass hook (the engine reads back only its
-// final images). Vulkan functions come from the engine's vkGetInstanceProcAddr, like the SDK's.
+// visibility, AO, reflection; raw and denoised) of one frame into host memory, recorded from inside the pre-pass hook
+// (the engine reads back only its final images). Vulkan functions come from the engine's vkGetInstanceProcAddr, like
+// the SDK's.
 #pragma once
 
 #include <cstdint>
@@ -15,8 +16,8 @@ namespace rbRender {
 
 struct CapturedFrame {
   uint32_t width = 0, height = 0;
-  std::vector<float> depth;       // D32 depth buffer values, rows from the top
-  std::vector<float> normal;      // RGBA per pixel (xyz = world normal, w = roughness or metallic)
+  std::vector<float> depth;                          // D32 depth buffer values, rows from the top
+  std::vector<float> normal;                         // RGBA per pixel (xyz = world normal, w = roughness or metallic)
   std::map<std::string, std::vector<float>> images;  // by name: `channels` floats per pixel
 };
 

@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
   const bool hybrid = o.mode == Mode::Hybrid;
 
   std::vector<se::AnimationPlayback> characterPlaybacks;  // --characters: one animation per character
-  auto scene = loadScene(o, characterPlaybacks);  // before any Vulkan work, so bad input fails fast
+  auto scene = loadScene(o, characterPlaybacks);          // before any Vulkan work, so bad input fails fast
   if (!scene) return fail(scene.error);
 
   // The same device in both modes (Raybridge's extensions enabled), so raster and hybrid compare like for like.
@@ -146,7 +146,8 @@ int main(int argc, char** argv) {
   std::string cameraSource;
   params.camera = chooseCamera(o, engine.scene(), engine.sceneBounds(), cameraSource);
   if (o.sun) params.sun.direction = glm::normalize(*o.sun);
-  else if (engine.scene().sun) params.sun = *engine.scene().sun;
+  else if (engine.scene().sun)
+    params.sun = *engine.scene().sun;
   params.sun.direction = glm::normalize(params.sun.direction);
 
   const ResolvedEffects fx = resolve(o);
@@ -193,7 +194,9 @@ int main(int argc, char** argv) {
     std::vector<CaptureImage> images;
     if (adapter) {
       const rb::HybridOutputs& fo = adapter->effects().outputs();
-      images = {{"shadow", fo.shadow.image, 1}, {"ao", fo.ao.image, 1}, {"ao_raw", fo.aoRaw.image, 1},
+      images = {{"shadow", fo.shadow.image, 1},
+                {"ao", fo.ao.image, 1},
+                {"ao_raw", fo.aoRaw.image, 1},
                 {"reflection", fo.reflection.image, 4}};
       if (fo.shadowRaw.image != fo.shadow.image) images.push_back({"shadow_raw", fo.shadowRaw.image, 1});  // denoised
     }
@@ -250,12 +253,16 @@ int main(int argc, char** argv) {
                         {"name", animation >= 0 ? engine.scene().animations[size_t(animation)].name : ""},
                         {"deformed_instances", engine.deformedInstances().size()}};
   stats["gbuffer_normals"] = o.geometricNormals ? "geometric" : "shading";
-  stats["scene"] = o.characters ? "procedural demo scene with " + std::to_string(o.characters) + " characters"
-                  : o.scene.empty() ? "procedural demo scene" : o.scene;
+  stats["scene"] = o.characters      ? "procedural demo scene with " + std::to_string(o.characters) + " characters"
+                   : o.scene.empty() ? "procedural demo scene"
+                                     : o.scene;
   stats["device"] = {{"name", engine.deviceInfo().name}};
-  stats["camera"] = {{"eye", vec(params.camera.eye)},     {"target", vec(params.camera.target)},
-                     {"fovy_degrees", params.camera.fovYDegrees}, {"z_near", params.camera.zNear},
-                     {"z_far", params.camera.zFar},        {"source", cameraSource}};
+  stats["camera"] = {{"eye", vec(params.camera.eye)},
+                     {"target", vec(params.camera.target)},
+                     {"fovy_degrees", params.camera.fovYDegrees},
+                     {"z_near", params.camera.zNear},
+                     {"z_far", params.camera.zFar},
+                     {"source", cameraSource}};
   const rb::HybridEffectsDesc& hd = fx.hybrid;
   const uint32_t shadowRays = hd.shadows.raysPerPixel ? hd.shadows.raysPerPixel : 1u;  // the engine's sun has no size
   stats["sun"] = {{"direction", vec(params.sun.direction)},
@@ -268,27 +275,32 @@ int main(int argc, char** argv) {
       {"ao_rays_per_pixel", wantAo ? (hd.ao.raysPerPixel ? hd.ao.raysPerPixel : rb::kDefaultAoRays) : 0u},
       {"ao_range", hd.ao.range ? hd.ao.range : rb::kDefaultAoRange},
       {"ao_estimator", hd.ao.estimator == rb::AoEstimator::Binary ? "binary" : "distance"},
-      {"reflection_roughness_threshold",
-       hd.reflections.roughnessThreshold ? hd.reflections.roughnessThreshold : rb::kDefaultReflectionRoughnessThreshold},
+      {"reflection_roughness_threshold", hd.reflections.roughnessThreshold ? hd.reflections.roughnessThreshold
+                                                                           : rb::kDefaultReflectionRoughnessThreshold},
       {"reflection_rays_per_pixel",
-       wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays) : 0u}};
+       wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays)
+                       : 0u}};
   if (!hybrid) {
     const se::ShadowMapStats sm = engine.lastShadowMapStats();
-    stats["effects"]["raster_counterparts"] = {
-        {"shadows", sm.enabled ? "shadow map" : "none (unshadowed sun)"},
-        {"shadow_map_size", sm.enabled ? sm.mapSize : 0u},
-        {"pcf_kernel", sm.enabled ? sm.pcfKernel : 0u},
-        {"ao", wantAo ? "SSAO" : "off"},
-        {"reflections", wantReflections ? "reflection probe" : "constant sky"}};
+    stats["effects"]["raster_counterparts"] = {{"shadows", sm.enabled ? "shadow map" : "none (unshadowed sun)"},
+                                               {"shadow_map_size", sm.enabled ? sm.mapSize : 0u},
+                                               {"pcf_kernel", sm.enabled ? sm.pcfKernel : 0u},
+                                               {"ao", wantAo ? "SSAO" : "off"},
+                                               {"reflections", wantReflections ? "reflection probe" : "constant sky"}};
   }
-  stats["engine_gpu_ms"] = {{"valid", timings.valid},         {"shadow_map", timings.shadowMs},
-                            {"probe", timings.probeMs},       {"ssao", timings.ssaoMs},
+  stats["engine_gpu_ms"] = {{"valid", timings.valid},
+                            {"shadow_map", timings.shadowMs},
+                            {"probe", timings.probeMs},
+                            {"ssao", timings.ssaoMs},
                             {"shadow_visibility_output", timings.shadowVisibilityMs},
-                            {"prepass", timings.prepassMs},   {"hook", timings.hookMs},
-                            {"lighting", timings.lightingMs}, {"tonemap", timings.tonemapMs},
+                            {"prepass", timings.prepassMs},
+                            {"hook", timings.hookMs},
+                            {"lighting", timings.lightingMs},
+                            {"tonemap", timings.tonemapMs},
                             {"frame_total", engineTotal}};
   uint64_t sceneTriangles = 0;
-  for (const se::Instance& inst : engine.scene().instances) sceneTriangles += engine.scene().meshes[inst.mesh].triangleCount();
+  for (const se::Instance& inst : engine.scene().instances)
+    sceneTriangles += engine.scene().meshes[inst.mesh].triangleCount();
   stats["triangles"] = sceneTriangles;
   stats["instances"] = engine.scene().instances.size();
   stats["rays_traced"] = 0;
@@ -317,7 +329,8 @@ int main(int argc, char** argv) {
     std::printf("Raybridge (%s):", effectSetToString(effects).c_str());
     for (const auto& [name, p] : all) {
       if (!p) continue;
-      passes[name] = {{"gpu_ms", p->gpuMs}, {"rays", p->rays}, {"rays_per_second", p->raysPerSecond()}, {"frame", p->frame}};
+      passes[name] = {
+          {"gpu_ms", p->gpuMs}, {"rays", p->rays}, {"rays_per_second", p->raysPerSecond()}, {"frame", p->frame}};
       rays += p->rays;
       std::printf(" %s %.1f ms", name, p->gpuMs);
       if (p->rays) std::printf(" %.2f Mrays (%.1f Mrays/s)", p->rays * 1e-6, p->raysPerSecond() * 1e-6);
@@ -328,18 +341,28 @@ int main(int argc, char** argv) {
     stats["raybridge"] = {
         {"passes", passes},
         {"acceleration_structures",
-         {{"blas_build_gpu_ms", buildMs}, {"build_batches", as.batches.size()}, {"blas_count", as.blasCount},
-          {"blas_triangles", as.triangles}, {"blas_bytes", as.blasBytes}, {"tlas_bytes", as.tlasBytes},
-          {"scratch_bytes", as.scratchBytes}, {"storage_block_bytes", as.storageBlockBytes},
-          {"dedup_hits", as.dedupHits}, {"tlas_instances", fxo.lastTlas().instanceCount},
+         {{"blas_build_gpu_ms", buildMs},
+          {"build_batches", as.batches.size()},
+          {"blas_count", as.blasCount},
+          {"blas_triangles", as.triangles},
+          {"blas_bytes", as.blasBytes},
+          {"tlas_bytes", as.tlasBytes},
+          {"scratch_bytes", as.scratchBytes},
+          {"storage_block_bytes", as.storageBlockBytes},
+          {"dedup_hits", as.dedupHits},
+          {"tlas_instances", fxo.lastTlas().instanceCount},
           {"tlas_skipped_instances", fxo.lastTlas().skippedInstances},
           {"dynamic_builds", o.dynamicMode == rb::DynamicBuildMode::InFrame          ? "in-frame"
                              : o.dynamicMode == rb::DynamicBuildMode::AsyncSameFrame ? "async"
                                                                                      : "async-late"},
-          {"refits", as.refits}, {"rebuilds", as.rebuilds}, {"async", as.async},
+          {"refits", as.refits},
+          {"rebuilds", as.rebuilds},
+          {"async", as.async},
           {"async_queue_family", as.async ? nlohmann::json(as.asyncQueueFamily) : nlohmann::json(nullptr)},
-          {"async_fallback_reason", as.asyncFallbackReason}, {"stale_blas", as.staleBlas},
-          {"async_gpu_ms", as.lastAsyncGpuMs}, {"dynamic_blas_bytes", as.dynamicBlasBytes}}},
+          {"async_fallback_reason", as.asyncFallbackReason},
+          {"stale_blas", as.staleBlas},
+          {"async_gpu_ms", as.lastAsyncGpuMs},
+          {"dynamic_blas_bytes", as.dynamicBlasBytes}}},
         {"memory_bytes", memory}};
   }
   std::printf("engine GPU ms: shadow map %.2f  probe %.2f  prepass %.2f  ssao %.2f  hook %.2f  lighting %.2f  tonemap "
@@ -373,11 +396,13 @@ int main(int argc, char** argv) {
     if (e.empty() && !hybrid) {
       auto visibility = engine.readbackShadowVisibility();
       if (!visibility) e = visibility.error;
-      else e = write("shadow.exr", toExr(f, visibility.value, 1)), written.push_back("shadow.exr");
+      else
+        e = write("shadow.exr", toExr(f, visibility.value, 1)), written.push_back("shadow.exr");
       if (e.empty() && wantAo) {
         auto ssao = engine.readbackSsao();
         if (!ssao) e = ssao.error;
-        else e = write("ao.exr", toExr(f, ssao.value, 1)), written.push_back("ao.exr");
+        else
+          e = write("ao.exr", toExr(f, ssao.value, 1)), written.push_back("ao.exr");
       }
     }
     if (!e.empty()) return fail(e);

@@ -2,28 +2,20 @@
 #include "raybridge_sample_engine_adapter.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
 
 namespace rbAdapter {
 namespace se = sample_engine;
 namespace {
 
-std::string message(const char* what, const rb::Error& e) { return std::string(what) + ": " + rb::toString(e.code) + ": " + e.message; }
-se::Status failure(const char* what, const rb::Error& e) { return se::Status::failure(message(what, e)); }
-
-// rb::Material has no emissive texture: it is folded into the factor as its average texel (decoded from sRGB),
-// so a mostly black emissive mask does not make the whole surface glow in reflections.
-glm::vec3 averageSrgbDecoded(const se::TextureData& t) {
-  const size_t pixels = size_t(t.width) * t.height;
-  glm::dvec3 sum(0.0);
-  for (size_t i = 0; i < pixels * 4 && t.rgba8.size() >= pixels * 4; ++i)
-    if (const double c = t.rgba8[i] / 255.0; i % 4 < 3) sum[int(i % 4)] += c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-  return pixels && t.rgba8.size() >= pixels * 4 ? glm::vec3(sum / double(pixels)) : glm::vec3(1.0f);
+std::string message(const char* what, const rb::Error& e) {
+  return std::string(what) + ": " + rb::toString(e.code) + ": " + e.message;
 }
+se::Status failure(const char* what, const rb::Error& e) { return se::Status::failure(message(what, e)); }
+void keepFirst(std::string& error, std::string message) { error = error.empty() ? std::move(message) : error; }
 
-// The engine's materials as reflection hits shade them, and the texture table they index: base colour as the
-// engine's sRGB views, metallic-roughness as its UNORM views (G = roughness, B = metallic), each view once.
+// The engine's materials as reflection hits shade them, and the texture table they index: base colour and
+// emissive as the engine's sRGB views, metallic-roughness as its UNORM views (G = roughness, B = metallic).
 void convertMaterials(const se::Scene& scene, std::span<const se::GpuTexture> gpu, std::vector<rb::Material>& out,
                       std::vector<VkImageView>& views) {
   out.clear(), views.clear();
@@ -41,10 +33,8 @@ void convertMaterials(const se::Scene& scene, std::span<const se::GpuTexture> gp
     r.roughness = std::clamp(m.roughnessFactor, 0.0f, 1.0f);
     r.baseColorTexture = slot(m.baseColorTexture, true);
     r.metallicRoughnessTexture = slot(m.metallicRoughnessTexture, false);
-    glm::vec3 emissive = m.emissiveFactor;
-    if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < scene.textures.size())
-      emissive *= averageSrgbDecoded(scene.textures[size_t(m.emissiveTexture)]);
-    std::memcpy(r.emissive, &emissive[0], sizeof(r.emissive));
+    r.emissiveTexture = slot(m.emissiveTexture, true);
+    std::memcpy(r.emissive, &m.emissiveFactor[0], sizeof(r.emissive));
     out.push_back(r);
   }
   if (out.empty()) out.emplace_back();
@@ -70,7 +60,7 @@ rb::MeshDesc describeMesh(VkDeviceAddress positions, uint32_t positionStride, ui
 
 void configureEngine(se::EngineConfig& config, rb::RequiredFeatures& features) {
   for (const char* name : rb::requiredDeviceExtensions())
-    if (std::find(config.deviceExtensions.begin(), config.deviceExtensions.end(), name) == config.deviceExtensions.end())
+    if (std::ranges::find(config.deviceExtensions, name) == config.deviceExtensions.end())
       config.deviceExtensions.emplace_back(name);
   // The engine builds the core feature structs itself and takes the others as a chain, as the SDK splits them.
   features.mergeVulkan12Into(config.extraFeatures12);
@@ -102,9 +92,8 @@ se::Result<std::unique_ptr<Adapter>> Adapter::create(se::Engine& engine, const A
   using R = se::Result<std::unique_ptr<Adapter>>;
   auto impl = std::make_unique<Impl>(engine);
   impl->config = config;
-  auto ctx = rb::Context::create({.instance = engine.instance(), .physicalDevice = engine.physicalDevice(),
-                                  .device = engine.device(), .getInstanceProcAddr = engine.getInstanceProcAddr(),
-                                  .framesInFlight = se::kFramesInFlight, .mainQueueFamily = engine.queueFamily()});
+  auto ctx = rb::Context::create({engine.instance(), engine.physicalDevice(), engine.device(),
+                                  engine.getInstanceProcAddr(), se::kFramesInFlight, nullptr, engine.queueFamily()});
   if (!ctx) return R::failure(message("rb::Context::create", ctx.error()));
   impl->ctx = std::move(ctx.value());
   rb::AsServiceDesc asDesc = config.accelerationStructures;
@@ -113,8 +102,8 @@ se::Result<std::unique_ptr<Adapter>> Adapter::create(se::Engine& engine, const A
   auto as = rb::AccelerationStructureService::create(*impl->ctx, asDesc);
   if (!as) return R::failure(message("rb::AccelerationStructureService::create", as.error()));
   impl->as = std::move(as.value());
-  const rb::HybridEffectsDesc fxDesc =
-      config.preset == rb::Preset::None ? config.effects : rb::withPreset(config.effects, config.preset);
+  rb::HybridEffectsDesc fxDesc = config.effects;
+  if (config.preset != rb::Preset::None) fxDesc = rb::withPreset(fxDesc, config.preset);
   auto fx = rb::HybridEffects::create(*impl->ctx, impl->as.get(), fxDesc);
   if (!fx) return R::failure(message("rb::HybridEffects::create", fx.error()));
   impl->fx = std::move(fx.value());
@@ -135,11 +124,13 @@ se::Status Adapter::syncScene() {
     a.meshes.emplace_back();
     if ((m.indexCount ? m.indexCount : m.vertexCount) / 3 == 0) continue;
     if (m.positionAddress == 0)
-      return se::Status::failure("mesh " + std::to_string(i) + " has no device address: create the engine with "
+      return se::Status::failure("mesh " + std::to_string(i) +
+                                 " has no device address: create the engine with "
                                  "EngineConfig::enableRayTracingInputs and rbAdapter::configureEngine()");
-    rb::MeshDesc d = describeMesh(m.positionAddress, m.positionStride, m.vertexCount, m, m.attributeAddress, m.attributeStride);
-    if (m.cpu)  // content-hash dedup of identical static meshes
-      d.hostVertices = m.cpu->positions.data(), d.hostIndices = m.cpu->indices.empty() ? nullptr : m.cpu->indices.data();
+    rb::MeshDesc d = describeMesh(m.positionAddress, m.positionStride, m.vertexCount, m, m.attributeAddress,
+                                  m.attributeStride);
+    if (m.cpu) d.hostVertices = m.cpu->positions.data();  // content-hash dedup of identical static meshes
+    if (m.cpu && !m.cpu->indices.empty()) d.hostIndices = m.cpu->indices.data();
     auto handle = a.as->registerMesh(d);
     if (!handle) return failure("registerMesh", handle.error());
     a.meshes.back() = handle.value();
@@ -175,13 +166,14 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   Impl& a = *impl_;
   a.ctx->beginFrame();  // every frame, so deferred releases and statistics keep pace with the engine
   if (!a.settings.enabled || a.fx->desc().effects == 0) return;
-  auto fail = [&](std::string message) { if (a.error.empty()) a.error = std::move(message); };
   // This frame's node animation moves instances; deformation rewrote the deformed buffers.
   if (info.instanceTransforms.size() == a.engine.scene().instances.size())
-    for (size_t k = 0; k < a.instances.size(); ++k) a.instances[k].setTransformColumnMajor(&info.instanceTransforms[a.instanceSource[k]][0][0]);
+    for (size_t k = 0; k < a.instances.size(); ++k)
+      a.instances[k].setTransformColumnMajor(&info.instanceTransforms[a.instanceSource[k]][0][0]);
+  const rb::AsyncBuildWait ready{info.deformSemaphore, info.deformValue};  // this frame's deformation
   if (!a.deformed.empty() && a.settings.updateDeformedMeshes)
-    if (rb::Status s = a.as->updateDynamicMeshes(a.deformed, {info.deformSemaphore, info.deformValue}, info.submitWaits, info.deformWaits); !s)
-      return fail(message("updateDynamicMeshes", s.error()));
+    if (rb::Status s = a.as->updateDynamicMeshes(a.deformed, ready, info.submitWaits, info.deformWaits); !s)
+      return keepFirst(a.error, message("updateDynamicMeshes", s.error()));
   rb::HybridFrame f;
   rb::GBufferDesc& g = f.gbuffer;
   g.width = info.extent.width, g.height = info.extent.height;
@@ -192,17 +184,23 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   std::memcpy(g.projection, &info.proj[0][0], sizeof(g.projection));
   for (int i = 0; i < 3; ++i) g.cameraPosition[i] = info.cameraPosition[i];  // camera-relative TLAS and rays
   rb::GBufferDesc shading = g;  // roughness lives in normalRoughness.w: reflections read the shading normals
-  shading.normal = {info.normalRoughness.view, info.normalRoughness.layout}, shading.roughnessInNormalW = true;
-  if (!a.config.geometricNormals) g = shading;
-  else g.normal = g.geometricNormal, f.reflectionGBuffer = &shading;
+  shading.normal = {info.normalRoughness.view, info.normalRoughness.layout};
+  shading.roughnessInNormalW = true;
+  g.normal = a.config.geometricNormals ? g.geometricNormal : shading.normal;
+  g.roughnessInNormalW = !a.config.geometricNormals;
+  f.reflectionGBuffer = &shading;
   f.instances = a.instances;
-  for (int i = 0; i < 3; ++i)
-    f.light.direction[i] = info.sunDirection[i], f.lightRadiance[i] = info.sunRadiance[i], f.skyRadiance[i] = info.skyColor[i];
+  std::copy_n(&info.sunDirection[0], 3, f.light.direction);
+  std::copy_n(&info.sunRadiance[0], 3, f.lightRadiance);
+  std::copy_n(&info.skyColor[0], 3, f.skyRadiance);
   f.ambientIntensity = info.ambientIntensity;
   f.flags = rb::kFrameExplicitLighting;  // the engine's own values, zeros included
-  if (rb::Status s = a.fx->record(info.commandBuffer, f); !s) return fail(message("HybridEffects::record", s.error()));
+  if (rb::Status s = a.fx->record(info.commandBuffer, f); !s)
+    return keepFirst(a.error, message("HybridEffects::record", s.error()));
   const rb::HybridOutputs& out = a.fx->outputs();  // SHADER_READ_ONLY_OPTIMAL, as LightingInputs requires
-  inputs.sunVisibility = out.shadow.view, inputs.ambientOcclusion = out.ao.view, inputs.reflection = out.reflection.view;
+  inputs.sunVisibility = out.shadow.view;
+  inputs.ambientOcclusion = out.ao.view;
+  inputs.reflection = out.reflection.view;
 }
 
 se::PrepassHook Adapter::prepassHook() {

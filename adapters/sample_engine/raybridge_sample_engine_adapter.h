@@ -36,8 +36,8 @@ struct AdapterConfig {
   rb::AsServiceDesc accelerationStructures;
 };
 
-struct FrameSettings {  // change them between frames through Adapter::settings()
-  bool enabled = true;  // false = record nothing: the engine uses its own lighting terms
+struct FrameSettings {               // change them between frames through Adapter::settings()
+  bool enabled = true;               // false = record nothing: the engine uses its own lighting terms
   bool updateDeformedMeshes = true;  // false = deforming BLASes keep their pose (a paused animation costs nothing)
 };
 

@@ -12,8 +12,8 @@
 #include <catch2/catch_test_macros.hpp>
 #include <nlohmann/json.hpp>
 
-#include "render_command_support.h"
 #include "raybridge_sample_engine_adapter.h"
+#include "render_command_support.h"
 #include "sample_engine/procedural.h"
 
 namespace fs = std::filesystem;
@@ -140,8 +140,8 @@ TEST_CASE("raybridge-render: --preset high --dump writes every effect image and 
   const RunResult r = runRender("--preset high --width 160 --height 96 --dump --out " + dir.string());
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
-  for (const char* name : {"final.png", "final.exr", "depth.exr", "normal.exr", "shadow.exr", "shadow_raw.exr", "ao.exr",
-                           "ao_raw.exr", "reflection.exr", "stats.json"}) {
+  for (const char* name : {"final.png", "final.exr", "depth.exr", "normal.exr", "shadow.exr", "shadow_raw.exr",
+                           "ao.exr", "ao_raw.exr", "reflection.exr", "stats.json"}) {
     INFO(name);
     CHECK(fs::file_size(dir / name) > 0);
   }
@@ -252,7 +252,7 @@ TEST_CASE("hybrid and raster shadow the same ground regions of the demo scene", 
   }
   INFO("ground " << ground << " shadowed in both " << both << ", hybrid only " << hybridOnly << ", raster only "
                  << rasterOnly);
-  CHECK(both > ground / 50);                  // there are shadows on the ground in both modes
+  CHECK(both > ground / 50);                   // there are shadows on the ground in both modes
   CHECK(double(both) / double(either) > 0.7);  // and they overlap substantially
   engine->setPrepassHook({});
   adapter.value.reset();
@@ -405,12 +405,14 @@ TEST_CASE("all eleven presets render in both modes; raster mode follows the pres
       if (want.effects & rb::kEffectShadows) CHECK(stats["sun"]["rays_per_pixel"] == want.shadowRaysPerPixel);
       if (want.effects & rb::kEffectAo) CHECK(stats["effects"]["ao_rays_per_pixel"] == want.aoRaysPerPixel);
       if (want.effects == 0) CHECK(stats["rays_traced"] == 0);
-      else CHECK(stats["rays_traced"].get<uint64_t>() > 0);
+      else
+        CHECK(stats["rays_traced"].get<uint64_t>() > 0);
     }
   }
 }
 
-TEST_CASE("raybridge-render --mode raster uses the engine's shadow map, SSAO and reflection probe", "[render][raster]") {
+TEST_CASE("raybridge-render --mode raster uses the engine's shadow map, SSAO and reflection probe",
+          "[render][raster]") {
   const fs::path dir = tempDir("raster");
   const RunResult r = runRender("--mode raster --preset high --width 96 --height 64 --dump --out " + dir.string());
   INFO(r.output);

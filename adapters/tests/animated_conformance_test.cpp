@@ -18,9 +18,9 @@
 #include <nlohmann/json.hpp>
 
 #include "embree_reference.h"
-#include "render_command_support.h"
 #include "gltf_fixtures.h"
 #include "gltf_pose_reference.h"
+#include "render_command_support.h"
 
 namespace fs = std::filesystem;
 using rbRenderTest::readExrRed;
@@ -69,9 +69,9 @@ Agreement compareAt(const std::string& model, double time, const std::string& ex
   std::snprintf(timeText, sizeof timeText, "%.9g", time);
   fs::remove_all(dir);
   REQUIRE(rbRenderTest::runRender("--scene \"" + model + "\" --time " + timeText + " --mode hybrid --effects shadows " +
-                    "--gbuffer-normals geometric --sun-radius 0 --dump --width " + std::to_string(W) + " --height " +
-                    std::to_string(H) + " --camera " + camera + " --sun " + sun + " --out \"" + dir.string() + "\" " +
-                    extraArgs) == 0);
+                                  "--gbuffer-normals geometric --sun-radius 0 --dump --width " + std::to_string(W) +
+                                  " --height " + std::to_string(H) + " --camera " + camera + " --sun " + sun +
+                                  " --out \"" + dir.string() + "\" " + extraArgs) == 0);
   int w = 0, h = 0;
   const std::vector<float> depth = readExrRed(dir / "depth.exr", w, h);
   REQUIRE((w == int(W) && h == int(H)));
@@ -90,7 +90,8 @@ Agreement compareAt(const std::string& model, double time, const std::string& ex
       const size_t i = size_t(y) * W + x;
       hits[i] = embree.intersect(&eye.x, &d.x, 0.0f, 1e30f);
       if (!hits[i].hit) continue;
-      glm::vec3 n = glm::normalize(glm::vec3(hits[i].geometricNormal[0], hits[i].geometricNormal[1], hits[i].geometricNormal[2]));
+      glm::vec3 n = glm::normalize(
+          glm::vec3(hits[i].geometricNormal[0], hits[i].geometricNormal[1], hits[i].geometricNormal[2]));
       if (glm::dot(n, d) > 0) n = -n;
       if (glm::dot(n, toSun) <= 0.0f) {
         visible[i] = 0;
@@ -143,7 +144,8 @@ fs::path tempDir(const std::string& name) { return fs::temp_directory_path() / (
 
 }  // namespace
 
-TEST_CASE("animated render: the skinned strip at two times matches Embree on the CPU pose", "[render][animation][embree]") {
+TEST_CASE("animated render: the skinned strip at two times matches Embree on the CPU pose",
+          "[render][animation][embree]") {
   const fs::path model = tempDir("strip_model") / "strip.gltf";
   fs::create_directories(model.parent_path());
   REQUIRE(pose_reference::writeSkinnedStrip(model.string()).empty());
@@ -213,16 +215,17 @@ TEST_CASE("raybridge-render rejects bad animation options, naming the value", "[
   }
 }
 
-TEST_CASE("raybridge-render's stats.json reports the dynamic BLAS work of an animated scene", "[render][animation][stats]") {
+TEST_CASE("raybridge-render's stats.json reports the dynamic BLAS work of an animated scene",
+          "[render][animation][stats]") {
   const fs::path model = tempDir("strip_model") / "strip.gltf";
   fs::create_directories(model.parent_path());
   REQUIRE(pose_reference::writeSkinnedStrip(model.string()).empty());
   auto statsOf = [&](const std::string& mode) {
     const fs::path dir = tempDir("stats_" + mode);
     fs::remove_all(dir);
-    REQUIRE(rbRenderTest::runRender("--scene \"" + model.string() + "\" --time 0.6 --fps 30 --frames 4 --effects shadows " +
-                                    "--width 48 --height 48 --dump --dynamic-builds " + mode + " --out \"" +
-                                    dir.string() + "\"") == 0);
+    REQUIRE(rbRenderTest::runRender(
+                "--scene \"" + model.string() + "\" --time 0.6 --fps 30 --frames 4 --effects shadows " +
+                "--width 48 --height 48 --dump --dynamic-builds " + mode + " --out \"" + dir.string() + "\"") == 0);
     std::ifstream in(dir / "stats.json");
     return nlohmann::json::parse(in);
   };

@@ -2,10 +2,10 @@
 // the path, e.g. on the GPU machine) and reading the red channel of the EXR images it dumps.
 #pragma once
 
+#include <ImathBox.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
-#include <ImathBox.h>
 
 #include <cstdlib>
 #include <filesystem>

@@ -30,7 +30,8 @@ TEST_CASE("raybridge-render's depth and hard shadows match Embree on the demo sc
   char camera[256], sun[128];
   std::snprintf(camera, sizeof camera, "%g,%g,%g,%g,%g,%g,%g", eye.x, eye.y, eye.z, target.x, target.y, target.z, fovy);
   std::snprintf(sun, sizeof sun, "%g,%g,%g", toSun.x, toSun.y, toSun.z);
-  REQUIRE(rbRenderTest::runRender("--mode hybrid --effects shadows --gbuffer-normals geometric --sun-radius 0 --dump --width " +
+  REQUIRE(rbRenderTest::runRender(
+              "--mode hybrid --effects shadows --gbuffer-normals geometric --sun-radius 0 --dump --width " +
               std::to_string(W) + " --height " + std::to_string(H) + " --camera " + camera + " --sun " + sun +
               " --out " + dir.string()) == 0);
   int w = 0, h = 0;
@@ -78,7 +79,8 @@ TEST_CASE("raybridge-render's depth and hard shadows match Embree on the demo sc
       Ref& r = ref[size_t(y) * W + x];
       r.hit = embree.intersect(&eye.x, &d.x, 0.0f, 1e30f);
       if (!r.hit.hit) continue;
-      glm::vec3 n = glm::normalize(glm::vec3(r.hit.geometricNormal[0], r.hit.geometricNormal[1], r.hit.geometricNormal[2]));
+      glm::vec3 n = glm::normalize(
+          glm::vec3(r.hit.geometricNormal[0], r.hit.geometricNormal[1], r.hit.geometricNormal[2]));
       if (glm::dot(n, d) > 0) n = -n;
       if (glm::dot(n, toSun) <= 0.0f) {
         r.visible = 0;

@@ -57,8 +57,12 @@ int parse(int argc, char** argv, Options& o, bool& exitNow) {
   app.add_option("--scene", o.scene, "glTF scene to show (default: the engine's procedural demo scene)")
       ->type_name("FILE.gltf|.glb")
       ->check(rbCli::nonEmpty("file name"));
-  app.add_option("--width", o.width, "window width (default 1280)")->type_name("W")->check(rbCli::wholeNumber(1, 16384));
-  app.add_option("--height", o.height, "window height (default 720)")->type_name("H")->check(rbCli::wholeNumber(1, 16384));
+  app.add_option("--width", o.width, "window width (default 1280)")
+      ->type_name("W")
+      ->check(rbCli::wholeNumber(1, 16384));
+  app.add_option("--height", o.height, "window height (default 720)")
+      ->type_name("H")
+      ->check(rbCli::wholeNumber(1, 16384));
   app.add_option("--frames", o.frames, "quit after N frames (default 0 = run until the window is closed)")
       ->type_name("N")
       ->check(rbCli::wholeNumber(0, 100000000));
@@ -78,11 +82,12 @@ int parse(int argc, char** argv, Options& o, bool& exitNow) {
   app.add_flag("--validation", o.validation,
                "enable the Vulkan validation layer; exit code 3 when it reported errors\n"
                "(also RAYBRIDGE_VALIDATION=1)");
-  app.add_flag_callback("--no-overlay", [&o] { o.overlay = false; },
-                        "start with the overlay hidden (F1 shows it; default: shown)");
-  app.add_flag_callback("--no-screenshot-overlay", [&o] { o.screenshotOverlay = false; },
-                        "keep the overlay out of --screenshot: one more frame is rendered without it\n"
-                        "(default: the screenshot shows what the window shows, overlay included)");
+  app.add_flag_callback(
+      "--no-overlay", [&o] { o.overlay = false; }, "start with the overlay hidden (F1 shows it; default: shown)");
+  app.add_flag_callback(
+      "--no-screenshot-overlay", [&o] { o.screenshotOverlay = false; },
+      "keep the overlay out of --screenshot: one more frame is rendered without it\n"
+      "(default: the screenshot shows what the window shows, overlay included)");
   bool help = false;
   if (std::string e = rbCli::parse(app, argc, argv, help); !e.empty()) {
     std::fprintf(stderr, "raybridge-viewer: error: %s\nRun with --help for the options.\n", e.c_str());
@@ -107,7 +112,8 @@ struct Orbit {
   }
   void apply(se::Camera& c) const {
     c.target = target;
-    c.eye = target + glm::vec3(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw)) * distance;
+    c.eye = target +
+            glm::vec3(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw)) * distance;
   }
 };
 
@@ -210,7 +216,7 @@ int main(int argc, char** argv) {
   auto last = std::chrono::steady_clock::now();
   double frameMs = 0.0;
   uint32_t frames = 0;
-  bool paused = false;  // the animation clock (real time) stops while paused
+  bool paused = false;        // the animation clock (real time) stops while paused
   bool overlayDrawn = false;  // the last rendered frame has the overlay in it
 
   auto printState = [&] {

@@ -37,8 +37,8 @@ struct ImGuiOverlay::Impl {
   GLFWwindow* window = nullptr;
   bool glfwBackend = false;
   bool vulkanBackend = false;
-  bool uiReady = false;           // endFrame() since the last recorded frame
-  uint64_t fontUploadFrame = 0;   // frame whose command buffer uploaded the fonts; 0 = none pending
+  bool uiReady = false;          // endFrame() since the last recorded frame
+  uint64_t fontUploadFrame = 0;  // frame whose command buffer uploaded the fonts; 0 = none pending
   std::string error;
 
   // What the first hook call brought, and the few functions the overlay calls itself.
@@ -70,8 +70,10 @@ bool ImGuiOverlay::Impl::startVulkan(const se::OverlayHookInfo& info) {
   getInstanceProcAddr = info.getInstanceProcAddr;
   getDeviceProcAddr = reinterpret_cast<PFN_vkGetDeviceProcAddr>(getInstanceProcAddr(instance, "vkGetDeviceProcAddr"));
   if (!getDeviceProcAddr) return error = "vkGetDeviceProcAddr not found", false;
-  createDescriptorPool = reinterpret_cast<PFN_vkCreateDescriptorPool>(getDeviceProcAddr(device, "vkCreateDescriptorPool"));
-  destroyDescriptorPool = reinterpret_cast<PFN_vkDestroyDescriptorPool>(getDeviceProcAddr(device, "vkDestroyDescriptorPool"));
+  createDescriptorPool = reinterpret_cast<PFN_vkCreateDescriptorPool>(
+      getDeviceProcAddr(device, "vkCreateDescriptorPool"));
+  destroyDescriptorPool = reinterpret_cast<PFN_vkDestroyDescriptorPool>(
+      getDeviceProcAddr(device, "vkDestroyDescriptorPool"));
   cmdBeginRenderPass = reinterpret_cast<PFN_vkCmdBeginRenderPass>(getDeviceProcAddr(device, "vkCmdBeginRenderPass"));
   cmdEndRenderPass = reinterpret_cast<PFN_vkCmdEndRenderPass>(getDeviceProcAddr(device, "vkCmdEndRenderPass"));
   if (!createDescriptorPool || !destroyDescriptorPool || !cmdBeginRenderPass || !cmdEndRenderPass)

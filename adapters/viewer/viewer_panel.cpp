@@ -22,8 +22,10 @@ void passRow(const char* name, double ms, const rb::PassStats* rays = nullptr) {
   // Grays/s on GPUs, Mrays/s on software rasterisers (lavapipe), so the value never reads as 0.000.
   const double perSecond = rays ? rays->raysPerSecond() : 0.0;
   if (perSecond >= 1e8) ImGui::Text("%7.2f G", perSecond * 1e-9);
-  else if (perSecond > 0.0) ImGui::Text("%7.2f M", perSecond * 1e-6);
-  else ImGui::TextDisabled("-");
+  else if (perSecond > 0.0)
+    ImGui::Text("%7.2f M", perSecond * 1e-6);
+  else
+    ImGui::TextDisabled("-");
 }
 
 void effectToggle(const char* label, rb::EffectBits bit, const PanelModel& m, PanelRequests& r) {
@@ -67,8 +69,8 @@ PanelRequests drawPanel(const PanelModel& m) {
   ImGui::SameLine();
   bool denoise = m.denoise;
   if (ImGui::Checkbox("denoise (N)", &denoise)) r.toggleDenoise = true;
-  ImGui::Text("rays/pixel: shadows %u, AO %u   sun az %.0f el %.0f deg%s", m.shadowRays, m.aoRays,
-              m.sunAzimuthDegrees, m.sunElevationDegrees, m.paused ? "   (paused)" : "");
+  ImGui::Text("rays/pixel: shadows %u, AO %u   sun az %.0f el %.0f deg%s", m.shadowRays, m.aoRays, m.sunAzimuthDegrees,
+              m.sunElevationDegrees, m.paused ? "   (paused)" : "");
 
   // --- GPU time ---
   if (ImGui::CollapsingHeader("GPU passes", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -22,11 +22,11 @@ struct PanelModel {
   uint32_t shadowRays = 0, aoRays = 0;  // effective rays per pixel (1 shadow ray = hard shadows)
   bool paused = false;                  // animation clock
   float sunAzimuthDegrees = 0.0f, sunElevationDegrees = 0.0f;
-  double frameMs = 0.0;                 // CPU time between frames, smoothed
-  sample_engine::PassTimings engine;    // the engine's passes (hookMs holds everything Raybridge recorded)
-  rb::HybridStats effectStats;          // Raybridge's passes
+  double frameMs = 0.0;               // CPU time between frames, smoothed
+  sample_engine::PassTimings engine;  // the engine's passes (hookMs holds everything Raybridge recorded)
+  rb::HybridStats effectStats;        // Raybridge's passes
   rb::AsStats as;
-  rb::MemoryStats memory;               // the rb::Context's, every category
+  rb::MemoryStats memory;  // the rb::Context's, every category
 };
 
 // What the user changed this frame (nothing by default).

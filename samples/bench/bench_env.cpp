@@ -98,8 +98,7 @@ UploadedMesh BenchEnv::upload(const rbsamples::CpuMesh& mesh, const std::string&
   out.vertices = check(device_->createBuffer(mesh.positions.size() * sizeof(float), usage, false,
                                              mesh.positions.data()),
                        "uploading the vertices of " + name);
-  out.indices = check(device_->createBuffer(mesh.indices.size() * sizeof(uint32_t), usage, false,
-                                            mesh.indices.data()),
+  out.indices = check(device_->createBuffer(mesh.indices.size() * sizeof(uint32_t), usage, false, mesh.indices.data()),
                       "uploading the indices of " + name);
   out.desc.vertexAddress = out.vertices.address;
   out.desc.vertexBufferBytes = out.vertices.size;
@@ -155,9 +154,8 @@ void BenchEnv::recordTraceBarrier(VkCommandBuffer cmd, TraceTargets& t) {
     b[i].image = images[i];
     b[i].subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
   }
-  VkPipelineStageFlags src = t.inGeneral
-                                 ? VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_TRANSFER_BIT
-                                 : VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT;
+  VkPipelineStageFlags src = t.inGeneral ? VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_TRANSFER_BIT
+                                         : VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT;
   vk().vkCmdPipelineBarrier(cmd, src, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, 0, 0, nullptr, 0, nullptr, 2, b);
   t.inGeneral = true;
 }
@@ -165,8 +163,8 @@ void BenchEnv::recordTraceBarrier(VkCommandBuffer cmd, TraceTargets& t) {
 double BenchEnv::hitFraction(const TraceTargets& t) {
   const uint32_t w = t.distance.width, h = t.distance.height;
   const VkDeviceSize bytes = VkDeviceSize(w) * h * sizeof(float);
-  rb::HeadlessBuffer staging =
-      check(device_->createBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true), "creating a readback buffer");
+  rb::HeadlessBuffer staging = check(device_->createBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true),
+                                     "creating a readback buffer");
   VkCommandBuffer cmd = check(device_->beginCommands(), "beginning a readback");
   VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
   b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;

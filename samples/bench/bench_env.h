@@ -42,7 +42,7 @@ struct UploadedMesh {
 
 // Sizes and repeats picked from --quick/--full and the device kind.
 struct BenchSizes {
-  std::vector<uint64_t> buildTriangles;     // build and compaction sweeps
+  std::vector<uint64_t> buildTriangles;  // build and compaction sweeps
   uint32_t buildRepeats = 5;
   uint64_t duplicationTriangles = 0;        // triangles of the duplicated mesh
   std::vector<uint32_t> duplicationCopies;  // N
@@ -50,8 +50,8 @@ struct BenchSizes {
   uint32_t fastRepeats = 5;
   std::vector<uint32_t> tlasInstances;
   uint32_t tlasRepeats = 7;
-  uint64_t traceTriangles = 0;              // trace scenario ground
-  uint32_t traceRepeats = 5;                // timed traces per measurement
+  uint64_t traceTriangles = 0;  // trace scenario ground
+  uint32_t traceRepeats = 5;    // timed traces per measurement
   uint32_t width = 0, height = 0;
   bool gltfRepeatsOnce = false;
 };

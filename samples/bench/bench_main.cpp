@@ -31,9 +31,14 @@ nlohmann::json deviceJson(BenchEnv& env) {
   const rb::DeviceInfo& i = env.info();
   char vendor[16];
   std::snprintf(vendor, sizeof vendor, "0x%04x", i.vendorId);
-  return {{"name", i.deviceName},   {"driverName", i.driverName}, {"driverInfo", i.driverInfo},
-          {"vulkan", versionString(i.apiVersion)}, {"vendorId", vendor}, {"isCpu", i.isCpu},
-          {"timestampPeriodNs", i.timestampPeriodNs}, {"timestampValidBits", env.timestampValidBits()}};
+  return {{"name", i.deviceName},
+          {"driverName", i.driverName},
+          {"driverInfo", i.driverInfo},
+          {"vulkan", versionString(i.apiVersion)},
+          {"vendorId", vendor},
+          {"isCpu", i.isCpu},
+          {"timestampPeriodNs", i.timestampPeriodNs},
+          {"timestampValidBits", env.timestampValidBits()}};
 }
 
 int run(const BenchOptions& options) {
@@ -43,7 +48,10 @@ int run(const BenchOptions& options) {
   std::printf("raybridge-bench on %s (%s %s, Vulkan %s)%s, trace resolution %ux%u%s\n", info.deviceName.c_str(),
               info.driverName.c_str(), info.driverInfo.c_str(), versionString(info.apiVersion).c_str(),
               info.isCpu ? " [CPU device: compare ratios, not absolute times]" : "", env.sizes().width,
-              env.sizes().height, options.quick ? " [--quick]" : options.full ? " [--full]" : "");
+              env.sizes().height,
+              options.quick  ? " [--quick]"
+              : options.full ? " [--full]"
+                             : "");
   std::fflush(stdout);
 
   auto wanted = [&](const std::string& name) { return options.scenario == "all" || options.scenario == name; };
@@ -60,12 +68,18 @@ int run(const BenchOptions& options) {
   doc["date"] = utcNow();
   doc["commandLine"] = options.commandLine;
   doc["device"] = deviceJson(env);
-  doc["options"] = {{"scenario", options.scenario}, {"quick", options.quick}, {"full", options.full},
-                    {"width", env.sizes().width}, {"height", env.sizes().height},
-                    {"scenesDir", options.scenesDir}, {"framesInFlight", env.ctx().framesInFlight()}};
+  doc["options"] = {{"scenario", options.scenario},
+                    {"quick", options.quick},
+                    {"full", options.full},
+                    {"width", env.sizes().width},
+                    {"height", env.sizes().height},
+                    {"scenesDir", options.scenesDir},
+                    {"framesInFlight", env.ctx().framesInFlight()}};
   doc["gltfModels"] = nlohmann::json::array();
   for (const GltfModel& m : models) {
-    doc["gltfModels"].push_back({{"name", m.name}, {"meshes", m.meshes.size()}, {"instances", m.instances.size()},
+    doc["gltfModels"].push_back({{"name", m.name},
+                                 {"meshes", m.meshes.size()},
+                                 {"instances", m.instances.size()},
                                  {"uniqueTriangles", m.uniqueTriangles()}});
   }
   doc["messages"] = messages;
@@ -108,7 +122,8 @@ int run(const BenchOptions& options) {
 
   const uint32_t errors = env.device().validationErrorCount();
   doc["failures"] = failures;
-  doc["validation"] = {{"enabled", env.device().validationEnabled()}, {"errors", errors},
+  doc["validation"] = {{"enabled", env.device().validationEnabled()},
+                       {"errors", errors},
                        {"messages", env.device().validationErrors()}};
   doc["totalSeconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!options.outPath.empty()) {

@@ -29,14 +29,15 @@ void Table::print() const {
   for (const auto& row : rows_) {
     std::vector<std::string> line;
     for (size_t c = 0; c < columns_.size(); ++c) {
-      line.push_back(cell(row.contains(columns_[c].key) ? row[columns_[c].key] : nlohmann::json(),
-                          columns_[c].precision));
+      line.push_back(
+          cell(row.contains(columns_[c].key) ? row[columns_[c].key] : nlohmann::json(), columns_[c].precision));
       width[c] = std::max(width[c], line.back().size());
     }
     cells.push_back(std::move(line));
   }
   std::printf("\n== %s\n", title_.c_str());
-  for (size_t c = 0; c < columns_.size(); ++c) std::printf("%s%*s", c ? "  " : "", int(width[c]), columns_[c].header.c_str());
+  for (size_t c = 0; c < columns_.size(); ++c)
+    std::printf("%s%*s", c ? "  " : "", int(width[c]), columns_[c].header.c_str());
   std::printf("\n");
   for (const auto& line : cells) {
     for (size_t c = 0; c < line.size(); ++c) std::printf("%s%*s", c ? "  " : "", int(width[c]), line[c].c_str());

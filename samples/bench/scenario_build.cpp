@@ -22,7 +22,8 @@ BuildSample measure(BenchEnv& env, std::vector<UploadedMesh>& meshes, const std:
   BuildSample s;
   for (uint32_t r = 0; r < repeats; ++r) {
     auto service = check(rb::AccelerationStructureService::create(env.ctx()), "creating the AS service");
-    for (size_t i = 0; i < meshes.size(); ++i) registerOrThrow(*service, meshes[i].desc, name + "#" + std::to_string(i));
+    for (size_t i = 0; i < meshes.size(); ++i)
+      registerOrThrow(*service, meshes[i].desc, name + "#" + std::to_string(i));
     BatchSum sum = buildQueued(env, *service);
     s.ms.push_back(sum.gpuMs);
     s.triangles = sum.triangles;
@@ -55,8 +56,13 @@ nlohmann::json row(const std::string& name, uint32_t meshCount, const BuildSampl
 nlohmann::json runBuildScenario(BenchEnv& env, const std::vector<GltfModel>& models) {
   const BenchSizes& z = env.sizes();
   Table table("build: BLAS build GPU time (service timestamps; median of the repeats after the first)",
-              {{"mesh", "mesh"}, {"BLAS", "blas"}, {"triangles", "triangles"}, {"first ms", "firstMs", 3},
-               {"median ms", "medianMs", 3}, {"min ms", "minMs", 3}, {"Mtris/s", "mtrisPerSecond", 1},
+              {{"mesh", "mesh"},
+               {"BLAS", "blas"},
+               {"triangles", "triangles"},
+               {"first ms", "firstMs", 3},
+               {"median ms", "medianMs", 3},
+               {"min ms", "minMs", 3},
+               {"Mtris/s", "mtrisPerSecond", 1},
                {"first/median", "firstOverMedian", 2}});
   for (uint64_t target : z.buildTriangles) {
     const std::string name = "sphere " + humanCount(target);

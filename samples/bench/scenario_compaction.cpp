@@ -45,11 +45,17 @@ nlohmann::json measure(BenchEnv& env, std::vector<UploadedMesh>& meshes, const s
 
 nlohmann::json runCompactionScenario(BenchEnv& env, const std::vector<GltfModel>& models) {
   const BenchSizes& z = env.sizes();
-  Table table("compaction: BLAS bytes as built and after compaction",
-              {{"mesh", "mesh"}, {"BLAS", "blas"}, {"triangles", "triangles"}, {"built bytes", "bytesBuilt"},
-               {"after bytes", "bytesAfter"}, {"after/built", "afterOverBuilt", 3},
-               {"B/tri built", "bytesPerTriangleBuilt", 1}, {"B/tri after", "bytesPerTriangleAfter", 1},
-               {"compacted", "compacted"}, {"skipped", "skipped"}, {"copy frame ms", "copyFrameGpuMs", 3}});
+  Table table("compaction: BLAS bytes as built and after compaction", {{"mesh", "mesh"},
+                                                                       {"BLAS", "blas"},
+                                                                       {"triangles", "triangles"},
+                                                                       {"built bytes", "bytesBuilt"},
+                                                                       {"after bytes", "bytesAfter"},
+                                                                       {"after/built", "afterOverBuilt", 3},
+                                                                       {"B/tri built", "bytesPerTriangleBuilt", 1},
+                                                                       {"B/tri after", "bytesPerTriangleAfter", 1},
+                                                                       {"compacted", "compacted"},
+                                                                       {"skipped", "skipped"},
+                                                                       {"copy frame ms", "copyFrameGpuMs", 3}});
   for (uint64_t target : z.buildTriangles) {
     const std::string name = "sphere " + humanCount(target);
     env.progress("compaction: " + name);

@@ -3,8 +3,8 @@
 // instances). Memory, build, TLAS and trace cost of both.
 #include "gpu_timer.h"
 #include "report.h"
-#include "scene_meshes.h"
 #include "scenarios.h"
+#include "scene_meshes.h"
 #include "service_frames.h"
 #include "trace_timing.h"
 
@@ -74,8 +74,13 @@ nlohmann::json runDuplicationScenario(BenchEnv& env) {
   auto pass = check(rb::PrimaryRayPass::create(env.ctx()), "creating the primary ray pass");
   Table table("duplication: sphere of " + std::to_string(cpu.triangleCount()) + " triangles copied N times, " +
                   std::to_string(z.width) + "x" + std::to_string(z.height) + " primary rays",
-              {{"N", "copies"}, {"mode", "mode"}, {"BLAS", "blasCount"}, {"BLAS bytes", "blasBytes"},
-               {"build ms", "buildGpuMs", 3}, {"TLAS ms", "tlasGpuMs", 3}, {"trace ms", "traceMs", 3},
+              {{"N", "copies"},
+               {"mode", "mode"},
+               {"BLAS", "blasCount"},
+               {"BLAS bytes", "blasBytes"},
+               {"build ms", "buildGpuMs", 3},
+               {"TLAS ms", "tlasGpuMs", 3},
+               {"trace ms", "traceMs", 3},
                {"hits", "hitFraction", 2}});
   nlohmann::json ratios = nlohmann::json::array();
   for (uint32_t n : z.duplicationCopies) {
@@ -91,9 +96,11 @@ nlohmann::json runDuplicationScenario(BenchEnv& env) {
                       {"traceDistinctOverDedup", ratio(distinct["traceMs"], shared["traceMs"])}});
   }
   table.print();
-  Table ratioTable("duplication: distinct / dedup ratios (same run)",
-                   {{"N", "copies"}, {"bytes", "bytesDistinctOverDedup", 2}, {"build", "buildDistinctOverDedup", 2},
-                    {"TLAS", "tlasDistinctOverDedup", 2}, {"trace", "traceDistinctOverDedup", 2}});
+  Table ratioTable("duplication: distinct / dedup ratios (same run)", {{"N", "copies"},
+                                                                       {"bytes", "bytesDistinctOverDedup", 2},
+                                                                       {"build", "buildDistinctOverDedup", 2},
+                                                                       {"TLAS", "tlasDistinctOverDedup", 2},
+                                                                       {"trace", "traceDistinctOverDedup", 2}});
   for (const auto& r : ratios) ratioTable.add(r);
   ratioTable.print();
   env.destroy(mesh);

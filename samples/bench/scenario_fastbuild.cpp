@@ -3,8 +3,8 @@
 // bench's own timestamps around PrimaryRayPass::record.
 #include "gpu_timer.h"
 #include "report.h"
-#include "scene_meshes.h"
 #include "scenarios.h"
+#include "scene_meshes.h"
 #include "service_frames.h"
 #include "trace_timing.h"
 
@@ -31,8 +31,7 @@ nlohmann::json measure(BenchEnv& env, rb::PrimaryRayPass& pass, const UploadedMe
   rb::TlasInfo tlas;
   env.runFrame([&](VkCommandBuffer cmd) { tlas = check(service->recordTlasBuild(cmd, {&instance, 1}), "TLAS"); });
   env.settle();
-  TraceTiming trace = timeTraces(env, pass, tlas.tlas, cameraOverGround(kGroundSize),
-                                 env.sizes().traceRepeats);
+  TraceTiming trace = timeTraces(env, pass, tlas.tlas, cameraOverGround(kGroundSize), env.sizes().traceRepeats);
   rb::AsStats st = service->stats();
   const double med = warmMedian(ms);
   return {{"role", name},
@@ -61,9 +60,15 @@ nlohmann::json runFastBuildScenario(BenchEnv& env) {
   nlohmann::json fastBuild = measure(env, *pass, mesh, rb::MeshRole::Dynamic);
   Table table("fastbuild-vs-fasttrace: ground of " + std::to_string(cpu.triangleCount()) + " triangles, " +
                   std::to_string(z.width) + "x" + std::to_string(z.height) + " primary rays",
-              {{"role", "role"}, {"flags", "flags"}, {"build first ms", "buildFirstMs", 3},
-               {"build median ms", "buildMedianMs", 3}, {"Mtris/s", "mtrisPerSecond", 1}, {"BLAS bytes", "blasBytes"},
-               {"trace ms", "traceMedianMs", 3}, {"Mrays/s", "mraysPerSecond", 2}, {"hits", "hitFraction", 2}});
+              {{"role", "role"},
+               {"flags", "flags"},
+               {"build first ms", "buildFirstMs", 3},
+               {"build median ms", "buildMedianMs", 3},
+               {"Mtris/s", "mtrisPerSecond", 1},
+               {"BLAS bytes", "blasBytes"},
+               {"trace ms", "traceMedianMs", 3},
+               {"Mrays/s", "mraysPerSecond", 2},
+               {"hits", "hitFraction", 2}});
   table.add(fastTrace);
   table.add(fastBuild);
   table.print();

@@ -9,8 +9,8 @@
 #include "gpu_timer.h"
 #include "ray_tracing_pipeline.h"
 #include "report.h"
-#include "scene_meshes.h"
 #include "scenarios.h"
+#include "scene_meshes.h"
 #include "service_frames.h"
 #include "stress_shaders.h"
 
@@ -27,8 +27,8 @@ struct StressConstants {
 
 uint64_t sumHits(BenchEnv& env, const rb::GpuImage& image) {
   const VkDeviceSize bytes = VkDeviceSize(image.width) * image.height * 4;
-  rb::HeadlessBuffer staging =
-      check(env.device().createBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true), "creating a readback buffer");
+  rb::HeadlessBuffer staging = check(env.device().createBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true),
+                                     "creating a readback buffer");
   VkCommandBuffer cmd = check(env.device().beginCommands(), "beginning a readback");
   VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
   b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
@@ -65,7 +65,8 @@ nlohmann::json runGigaRaysScenario(BenchEnv& env) {
   instance.mesh = registerOrThrow(*service, mesh.desc, "stress ground");
   (void)buildQueued(env, *service);
   rb::TlasInfo tlas;
-  env.runFrame([&](VkCommandBuffer cmd) { tlas = check(service->recordTlasBuild(cmd, std::span(&instance, 1)), "TLAS"); });
+  env.runFrame(
+      [&](VkCommandBuffer cmd) { tlas = check(service->recordTlasBuild(cmd, std::span(&instance, 1)), "TLAS"); });
   env.settle();
 
   rb::RayTracingPipelineDesc desc;
@@ -76,7 +77,8 @@ nlohmann::json runGigaRaysScenario(BenchEnv& env) {
   desc.bindings = {{0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr},
                    {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr}};
   desc.pushConstantBytes = sizeof(StressConstants);
-  rb::RayTracingPipeline pipeline = check(rb::RayTracingPipeline::create(env.ctx(), desc), "creating the stress pipeline");
+  rb::RayTracingPipeline pipeline = check(rb::RayTracingPipeline::create(env.ctx(), desc),
+                                          "creating the stress pipeline");
   rb::GpuImage hits = check(rb::createStorageImage(env.ctx(), w, h, VK_FORMAT_R32_UINT, VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                                                    rb::MemoryCategory::PassImages, "stress hit counts"),
                             "creating the hit count image");
@@ -84,7 +86,10 @@ nlohmann::json runGigaRaysScenario(BenchEnv& env) {
   Table table("gigarays: " + std::to_string(raysPerPixel) + " rays per pixel at " + std::to_string(w) + "x" +
                   std::to_string(h) + " (thesis stress and miss scenarios), median of " +
                   std::to_string(z.traceRepeats),
-              {{"scenario", "scenario"}, {"rays", "rays"}, {"hit rays", "hitRays"}, {"median ms", "medianMs", 3},
+              {{"scenario", "scenario"},
+               {"rays", "rays"},
+               {"hit rays", "hitRays"},
+               {"median ms", "medianMs", 3},
                {"GRays/s", "graysPerSecond", 3}});
   rb::PrimaryRayCamera sky;
   sky.eye[1] = 20.0f;
@@ -119,7 +124,8 @@ nlohmann::json runGigaRaysScenario(BenchEnv& env) {
         b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
         b.image = hits.image;
         b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        env.vk().vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_TRANSFER_BIT,
+        env.vk().vkCmdPipelineBarrier(cmd,
+                                      VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_TRANSFER_BIT,
                                       VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, 0, 0, nullptr, 0, nullptr, 1, &b);
         inGeneral = true;
         pc.seed = i;

@@ -5,8 +5,8 @@
 
 #include "gpu_timer.h"
 #include "report.h"
-#include "scene_meshes.h"
 #include "scenarios.h"
+#include "scene_meshes.h"
 #include "service_frames.h"
 
 namespace rbbench {
@@ -27,8 +27,12 @@ nlohmann::json runTlasScenario(BenchEnv& env) {
 
   Table table("tlas: TLAS over many instances (" + std::to_string(cpu.size()) + " meshes; median of " +
                   std::to_string(z.tlasRepeats) + " frames)",
-              {{"instances", "instances"}, {"host ms", "hostMedianMs", 3}, {"host ms/1k", "hostMsPer1k", 4},
-               {"GPU ms", "gpuMedianMs", 3}, {"GPU ms/1k", "gpuMsPer1k", 4}, {"TLAS bytes", "tlasBytes"}});
+              {{"instances", "instances"},
+               {"host ms", "hostMedianMs", 3},
+               {"host ms/1k", "hostMsPer1k", 4},
+               {"GPU ms", "gpuMedianMs", 3},
+               {"GPU ms/1k", "gpuMsPer1k", 4},
+               {"TLAS bytes", "tlasBytes"}});
   GpuTimer timer(env, 2);
   for (uint32_t count : z.tlasInstances) {
     env.progress("tlas: " + humanCount(count) + " instances");

@@ -1,8 +1,8 @@
 // trace: raw primary-ray rate (one ray per pixel, closest hit) on a finely tessellated scene, a bumpy ground
 // with spheres standing on it, seen from above, and for reference rays that miss everything.
 #include "report.h"
-#include "scene_meshes.h"
 #include "scenarios.h"
+#include "scene_meshes.h"
 #include "service_frames.h"
 #include "trace_timing.h"
 
@@ -42,15 +42,20 @@ nlohmann::json runTraceScenario(BenchEnv& env) {
   auto pass = check(rb::PrimaryRayPass::create(env.ctx()), "creating the primary ray pass");
   Table table("trace: primary rays, " + std::to_string(z.width) + "x" + std::to_string(z.height) + ", median of " +
                   std::to_string(z.traceRepeats) + " traces",
-              {{"view", "view"}, {"triangles", "triangles"}, {"rays", "rays"}, {"median ms", "medianMs", 3},
-               {"min ms", "minMs", 3}, {"Mrays/s", "mraysPerSecond", 2}, {"GRays/s", "graysPerSecond", 4},
+              {{"view", "view"},
+               {"triangles", "triangles"},
+               {"rays", "rays"},
+               {"median ms", "medianMs", 3},
+               {"min ms", "minMs", 3},
+               {"Mrays/s", "mraysPerSecond", 2},
+               {"GRays/s", "graysPerSecond", 4},
                {"hits", "hitFraction", 3}});
   rb::PrimaryRayCamera sky;
   sky.eye[1] = 20.0f;
   sky.target[1] = 100.0f;
   sky.target[2] = -10.0f;
-  const std::pair<const char*, rb::PrimaryRayCamera> views[] = {
-      {"ground + spheres", cameraOverGround(size)}, {"sky (all miss)", sky}};
+  const std::pair<const char*, rb::PrimaryRayCamera> views[] = {{"ground + spheres", cameraOverGround(size)},
+                                                                {"sky (all miss)", sky}};
   for (const auto& [name, camera] : views) {
     env.progress(std::string("trace: ") + name);
     TraceTiming t = timeTraces(env, *pass, tlas.tlas, camera, z.traceRepeats);

@@ -13,7 +13,7 @@ struct TraceTiming {
   std::vector<double> ms;  // one per timed trace
   double medianMs = 0.0;
   double minMs = 0.0;
-  double hitFraction = 0.0;   // of the last trace's pixels
+  double hitFraction = 0.0;    // of the last trace's pixels
   double raysPerSecond = 0.0;  // width * height / median time
 };
 

@@ -8,9 +8,9 @@
 namespace rbsamples {
 
 struct CpuMesh {
-  std::vector<float> positions;  // xyz per vertex
-  std::vector<float> normals;    // xyz per vertex (smooth where the surface is smooth)
-  std::vector<uint32_t> indices; // three per triangle, counter-clockwise seen from outside
+  std::vector<float> positions;   // xyz per vertex
+  std::vector<float> normals;     // xyz per vertex (smooth where the surface is smooth)
+  std::vector<uint32_t> indices;  // three per triangle, counter-clockwise seen from outside
   uint32_t vertexCount() const { return static_cast<uint32_t>(positions.size() / 3); }
   uint32_t triangleCount() const { return static_cast<uint32_t>(indices.size() / 3); }
 };

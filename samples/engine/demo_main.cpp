@@ -26,14 +26,14 @@ struct Options {
   uint32_t width = 1280, height = 720;
   uint32_t shadowMapSize = 2048;
   uint32_t pcf = 3;
-  uint32_t ssaoKernel = 0;      // 0 = SSAO off
+  uint32_t ssaoKernel = 0;       // 0 = SSAO off
   uint32_t probeResolution = 0;  // 0 = constant-sky reflections
   std::string effectsPrefix;     // writes PREFIX_ssao.png / PREFIX_shadow.png
   bool window = false;
   bool validation = false;
-  int frames = 0;  // --window: close after this many frames (0 = run until closed); headless: frames to render
-  double time = 0.0;       // animation time of the (last) headless frame; the viewer starts there
-  std::string animation;   // index or name; empty = the scene's first
+  int frames = 0;         // --window: close after this many frames (0 = run until closed); headless: frames to render
+  double time = 0.0;      // animation time of the (last) headless frame; the viewer starts there
+  std::string animation;  // index or name; empty = the scene's first
   bool restPose = false;
 };
 
@@ -199,7 +199,8 @@ int runHeadless(const Options& o) {
   Scene scene;
   if (!loadScene(o, scene)) return 1;
   if (Status s = engine.loadScene(scene); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
-  if (Status s = engine.setRenderSize(o.width, o.height); !s) return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
+  if (Status s = engine.setRenderSize(o.width, o.height); !s)
+    return std::fprintf(stderr, "error: %s\n", s.error.c_str()), 1;
   FrameParams params = initialParams(o, engine);
   if (!pickAnimation(o, engine.scene(), params)) return 1;
   if (!engine.deformedInstances().empty())

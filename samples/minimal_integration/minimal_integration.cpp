@@ -91,8 +91,8 @@ Buffer makeBuffer(VkDeviceSize size, VkBufferUsageFlags usage, const void* data 
                                   VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT};
   const bool addressable = usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
   VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, addressable ? &flags : nullptr, req.size,
-                             memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                                                VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)};
+                             memoryType(req.memoryTypeBits,
+                                        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)};
   check(vkAllocateMemory(gDevice, &alloc, nullptr, &b.memory), "vkAllocateMemory");
   check(vkBindBufferMemory(gDevice, b.buffer, b.memory, 0), "vkBindBufferMemory");
   check(vkMapMemory(gDevice, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
@@ -146,8 +146,8 @@ Image makeImage(VkPhysicalDevice pd, uint32_t w, uint32_t h, VkFormat format, Vk
 }
 
 // Every barrier here waits for all earlier work: the program favours obviously correct over minimal.
-void transition(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout from,
-                VkImageLayout to, VkPipelineStageFlags dstStage, VkAccessFlags dstAccess) {
+void transition(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout from, VkImageLayout to,
+                VkPipelineStageFlags dstStage, VkAccessFlags dstAccess) {
   VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
                          nullptr,
                          VK_ACCESS_MEMORY_WRITE_BIT,
@@ -163,19 +163,15 @@ void transition(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, V
 
 float halfToFloat(uint16_t h) {
   const int e = (h >> 10) & 31, m = h & 1023;
-  const float v = e == 0    ? std::ldexp(float(m), -24)
-                  : e == 31 ? INFINITY
-                            : std::ldexp(float(m | 1024), e - 25);
+  const float v = e == 0 ? std::ldexp(float(m), -24) : e == 31 ? INFINITY : std::ldexp(float(m | 1024), e - 25);
   return (h & 0x8000) ? -v : v;
 }
 
-void writePfm(const std::filesystem::path& path, uint32_t w, uint32_t h, int channels,
-              const std::vector<float>& px) {
+void writePfm(const std::filesystem::path& path, uint32_t w, uint32_t h, int channels, const std::vector<float>& px) {
   FILE* f = std::fopen(path.string().c_str(), "wb");
   if (!f) fail("cannot write " + path.string());
   std::fprintf(f, "%s\n%u %u\n-1.0\n", channels == 3 ? "PF" : "Pf", w, h);
-  for (uint32_t y = h; y-- > 0;)
-    std::fwrite(&px[size_t(y) * w * channels], sizeof(float), size_t(w) * channels, f);
+  for (uint32_t y = h; y-- > 0;) std::fwrite(&px[size_t(y) * w * channels], sizeof(float), size_t(w) * channels, f);
   std::fclose(f);
 }
 
@@ -189,8 +185,7 @@ int main(int argc, char** argv) {
   cli.add_option("--out", outDir, "output folder");
   cli.add_option("--width", width)->check(CLI::Range(8u, 8192u));
   cli.add_option("--height", height)->check(CLI::Range(8u, 8192u));
-  cli.add_option("--frames", frames, "frames to render (the camera moves every frame)")
-      ->check(CLI::Range(1u, 1000u));
+  cli.add_option("--frames", frames, "frames to render (the camera moves every frame)")->check(CLI::Range(1u, 1000u));
   cli.add_flag("--validate", validate, "enable the validation layer (also RAYBRIDGE_VALIDATION=1)");
   CLI11_PARSE(cli, argc, argv);
   const char* env = std::getenv("RAYBRIDGE_VALIDATION");
@@ -202,13 +197,11 @@ int main(int argc, char** argv) {
       VK_STRUCTURE_TYPE_APPLICATION_INFO, nullptr, "minimal_integration", 1, nullptr, 0, VK_API_VERSION_1_3};
   VkDebugUtilsMessengerCreateInfoEXT messengerInfo{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
   messengerInfo.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  messengerInfo.messageType =
-      VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+  messengerInfo.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                              VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
   messengerInfo.pfnUserCallback = &onMessage;
-  const VkValidationFeatureEnableEXT syncValidation =
-      VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
-  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT, &messengerInfo, 1,
-                                   &syncValidation};
+  const VkValidationFeatureEnableEXT syncValidation = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT, &messengerInfo, 1, &syncValidation};
   const char* layer = "VK_LAYER_KHRONOS_validation";
   const char* debugUtils = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
   VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
@@ -224,8 +217,7 @@ int main(int argc, char** argv) {
         validate ? "vkCreateInstance with VK_LAYER_KHRONOS_validation" : "vkCreateInstance");
   volkLoadInstanceOnly(instance);
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
-  if (validate)
-    check(vkCreateDebugUtilsMessengerEXT(instance, &messengerInfo, nullptr, &messenger), "messenger");
+  if (validate) check(vkCreateDebugUtilsMessengerEXT(instance, &messengerInfo, nullptr, &messenger), "messenger");
 
   // The first device with Raybridge's extensions and a graphics queue.
   uint32_t count = 0;
@@ -240,8 +232,7 @@ int main(int argc, char** argv) {
     vkEnumerateDeviceExtensionProperties(candidate, nullptr, &count, exts.data());
     bool all = true;
     for (const char* name : rb::requiredDeviceExtensions()) {
-      all &= std::any_of(exts.begin(), exts.end(),
-                         [&](auto& e) { return std::strcmp(e.extensionName, name) == 0; });
+      all &= std::any_of(exts.begin(), exts.end(), [&](auto& e) { return std::strcmp(e.extensionName, name) == 0; });
     }
     vkGetPhysicalDeviceQueueFamilyProperties(candidate, &count, nullptr);
     std::vector<VkQueueFamilyProperties> families(count);
@@ -267,11 +258,10 @@ int main(int argc, char** argv) {
   vkGetDeviceQueue(gDevice, family, 0, &queue);
 
   // Raybridge adopts the device; the acceleration-structure service and the effects front end come from it.
-  auto ctx = check(
-      rb::Context::create({instance, pd, gDevice, vkGetInstanceProcAddr, kFramesInFlight, nullptr, family}),
-      "rb::Context::create");
-  auto service =
-      check(rb::AccelerationStructureService::create(*ctx), "rb::AccelerationStructureService::create");
+  auto ctx =
+      check(rb::Context::create({instance, pd, gDevice, vkGetInstanceProcAddr, kFramesInFlight, nullptr, family}),
+            "rb::Context::create");
+  auto service = check(rb::AccelerationStructureService::create(*ctx), "rb::AccelerationStructureService::create");
   auto effects = check(rb::HybridEffects::create(*ctx, service.get(), rb::withPreset({}, rb::Preset::Low)),
                        "rb::HybridEffects::create");
 
@@ -282,10 +272,8 @@ int main(int argc, char** argv) {
   const VkBufferUsageFlags geometry = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
                                       VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
   for (const minimal::Mesh& m : scene) {
-    const VkDeviceSize vBytes = m.positions.size() * sizeof(float),
-                       iBytes = m.indices.size() * sizeof(uint32_t);
-    vertexBuffers.push_back(
-        makeBuffer(vBytes, geometry | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, m.positions.data()));
+    const VkDeviceSize vBytes = m.positions.size() * sizeof(float), iBytes = m.indices.size() * sizeof(uint32_t);
+    vertexBuffers.push_back(makeBuffer(vBytes, geometry | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, m.positions.data()));
     indexBuffers.push_back(makeBuffer(iBytes, geometry | VK_BUFFER_USAGE_INDEX_BUFFER_BIT, m.indices.data()));
     rb::MeshDesc desc;
     desc.vertexAddress = vertexBuffers.back().address;
@@ -327,16 +315,16 @@ int main(int argc, char** argv) {
       VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO, nullptr, 0, 0, nullptr, 1, &pushRange};
   VkPipelineLayout layout;
   check(vkCreatePipelineLayout(gDevice, &layoutInfo, nullptr, &layout), "vkCreatePipelineLayout");
-  VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr,
-                                                0, VK_SHADER_STAGE_VERTEX_BIT, modules[0], "main"},
-                                               {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr,
-                                                0, VK_SHADER_STAGE_FRAGMENT_BIT, modules[1], "main"}};
+  VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
+                                                VK_SHADER_STAGE_VERTEX_BIT, modules[0], "main"},
+                                               {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
+                                                VK_SHADER_STAGE_FRAGMENT_BIT, modules[1], "main"}};
   VkVertexInputBindingDescription binding{0, 3 * sizeof(float), VK_VERTEX_INPUT_RATE_VERTEX};
   VkVertexInputAttributeDescription attribute{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0};
   VkPipelineVertexInputStateCreateInfo vertexInput{
       VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO, nullptr, 0, 1, &binding, 1, &attribute};
-  VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
-                                                  nullptr, 0, VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST};
+  VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO, nullptr,
+                                                  0, VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST};
   VkViewport viewport{0, 0, float(width), float(height), 0, 1};
   VkRect2D scissor{{0, 0}, {width, height}};
   VkPipelineViewportStateCreateInfo viewportState{
@@ -344,19 +332,17 @@ int main(int argc, char** argv) {
   VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
   raster.cullMode = VK_CULL_MODE_NONE;
   raster.lineWidth = 1.0f;
-  VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
-                                                   nullptr, 0, VK_SAMPLE_COUNT_1_BIT};
-  VkPipelineDepthStencilStateCreateInfo depthState{
-      .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
-      .depthTestEnable = VK_TRUE,
-      .depthWriteEnable = VK_TRUE,
-      .depthCompareOp = VK_COMPARE_OP_GREATER};  // reversed-Z
+  VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO, nullptr, 0,
+                                                   VK_SAMPLE_COUNT_1_BIT};
+  VkPipelineDepthStencilStateCreateInfo depthState{.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
+                                                   .depthTestEnable = VK_TRUE,
+                                                   .depthWriteEnable = VK_TRUE,
+                                                   .depthCompareOp = VK_COMPARE_OP_GREATER};  // reversed-Z
   VkPipelineColorBlendAttachmentState blend[2] = {{}, {}};
   blend[0].colorWriteMask = blend[1].colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT;
-  VkPipelineColorBlendStateCreateInfo blendState{
-      .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-      .attachmentCount = 2,
-      .pAttachments = blend};
+  VkPipelineColorBlendStateCreateInfo blendState{.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+                                                 .attachmentCount = 2,
+                                                 .pAttachments = blend};
   const VkFormat colorFormats[2] = {normalFormat, motionFormat};
   VkPipelineRenderingCreateInfo rendering{
       VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO, nullptr, 0, 2, colorFormats, depthFormat};
@@ -373,8 +359,7 @@ int main(int argc, char** argv) {
                                             .pColorBlendState = &blendState,
                                             .layout = layout};
   VkPipeline pipeline;
-  check(vkCreateGraphicsPipelines(gDevice, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline),
-        "G-buffer pipeline");
+  check(vkCreateGraphicsPipelines(gDevice, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline), "G-buffer pipeline");
 
   // Frame slots: a command buffer and a fence each.
   VkCommandPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO, nullptr,
@@ -391,15 +376,15 @@ int main(int argc, char** argv) {
     check(vkCreateFence(gDevice, &info, nullptr, &f), "vkCreateFence");
   }
   const size_t pixels = size_t(width) * height;
-  Buffer readback =
-      makeBuffer(pixels * (2 + 2 + 4 + 4), VK_BUFFER_USAGE_TRANSFER_DST_BIT);  // shadow, ao, depth, motion
+  Buffer readback = makeBuffer(pixels * (2 + 2 + 4 + 4),
+                               VK_BUFFER_USAGE_TRANSFER_DST_BIT);  // shadow, ao, depth, motion
 
-  const VkPipelineStageFlags passReaders =
-      VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  const VkPipelineStageFlags passReaders = VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR |
+                                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
   float view[16], projection[16], previousView[16];
   double eye[3], target[3];
-  minimal::reversedInfiniteProjection(minimal::kFovYDegrees, float(width) / float(height),
-                                      minimal::kNearPlane, projection);
+  minimal::reversedInfiniteProjection(minimal::kFovYDegrees, float(width) / float(height), minimal::kNearPlane,
+                                      projection);
   for (uint32_t frame = 0; frame < frames; ++frame) {
     VkCommandBuffer cmd = cmds[frame % kFramesInFlight];
     VkFence fence = fences[frame % kFramesInFlight];
@@ -423,14 +408,12 @@ int main(int argc, char** argv) {
     minimal::multiply(toPixels, previousClip, constants + 16);
 
     // The G-buffer pass; the previous frame's passes have read the images, their contents are discarded.
-    transition(cmd, depth.image, depth.aspect, VK_IMAGE_LAYOUT_UNDEFINED,
-               VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+    transition(cmd, depth.image, depth.aspect, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
                VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
     for (const Image* img : {&normal, &motion}) {
-      transition(cmd, img->image, img->aspect, VK_IMAGE_LAYOUT_UNDEFINED,
-                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                 VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
+      transition(cmd, img->image, img->aspect, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                 VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
     }
     VkRenderingAttachmentInfo colors[2] = {{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO},
                                            {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO}};
@@ -458,10 +441,9 @@ int main(int argc, char** argv) {
     }
     vkCmdEndRendering(cmd);
     for (const Image* img : {&depth, &normal, &motion}) {
-      transition(
-          cmd, img->image, img->aspect,
-          img == &depth ? VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-          VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, passReaders, VK_ACCESS_SHADER_READ_BIT);
+      transition(cmd, img->image, img->aspect,
+                 img == &depth ? VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, passReaders, VK_ACCESS_SHADER_READ_BIT);
     }
 
     // Raybridge: the G-buffer contract, the scene's instances and the sun; BLAS builds, TLAS, shadows, AO.
@@ -497,15 +479,14 @@ int main(int argc, char** argv) {
         transition(cmd, r.image, r.aspect, r.layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                    VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
         VkBufferImageCopy region{r.offset, 0, 0, {r.aspect, 0, 0, 1}, {0, 0, 0}, {width, height, 1}};
-        vkCmdCopyImageToBuffer(cmd, r.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1,
-                               &region);
+        vkCmdCopyImageToBuffer(cmd, r.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1, &region);
         transition(cmd, r.image, r.aspect, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, r.layout,
                    VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT);
       }
       VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_TRANSFER_WRITE_BIT,
                              VK_ACCESS_HOST_READ_BIT};
-      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0,
-                           nullptr, 0, nullptr);
+      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr,
+                           0, nullptr);
     }
     check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
     VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO, nullptr, 0, nullptr, nullptr, 1, &cmd};
@@ -517,8 +498,7 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(outDir);
   const auto* halfs = static_cast<const uint16_t*>(readback.mapped);
   const auto* floats = reinterpret_cast<const float*>(halfs + 2 * pixels);
-  std::vector<float> shadowPx(pixels), aoPx(pixels), depthPx(floats, floats + pixels),
-      motionPx(3 * pixels, 0.0f);
+  std::vector<float> shadowPx(pixels), aoPx(pixels), depthPx(floats, floats + pixels), motionPx(3 * pixels, 0.0f);
   std::vector<uint8_t> png(3 * pixels);
   const auto* motionHalfs = reinterpret_cast<const uint16_t*>(floats + pixels);
   for (size_t i = 0; i < pixels; ++i) {
@@ -535,13 +515,12 @@ int main(int argc, char** argv) {
   writePfm(dir / "ao.pfm", width, height, 1, aoPx);
   writePfm(dir / "depth.pfm", width, height, 1, depthPx);
   writePfm(dir / "motion.pfm", width, height, 3, motionPx);
-  stbi_write_png((dir / "composite.png").string().c_str(), int(width), int(height), 3, png.data(),
-                 int(width) * 3);
+  stbi_write_png((dir / "composite.png").string().c_str(), int(width), int(height), 3, png.data(), int(width) * 3);
   FILE* cam = std::fopen((dir / "camera.txt").string().c_str(), "w");
   if (!cam) fail("cannot write camera.txt");
   std::fprintf(cam, "width %u\nheight %u\neye %.17g %.17g %.17g\n", width, height, eye[0], eye[1], eye[2]);
-  for (const auto& [name, m] : {std::pair{"view", view}, std::pair{"projection", projection},
-                                std::pair{"previousView", previousView}}) {
+  for (const auto& [name, m] :
+       {std::pair{"view", view}, std::pair{"projection", projection}, std::pair{"previousView", previousView}}) {
     std::fprintf(cam, "%s", name);
     for (int i = 0; i < 16; ++i) std::fprintf(cam, " %.9g", m[i]);
     std::fprintf(cam, "\n");
@@ -571,7 +550,7 @@ int main(int argc, char** argv) {
   vkDestroyDevice(gDevice, nullptr);
   if (messenger) vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
   vkDestroyInstance(instance, nullptr);
-  std::printf("minimal_integration: %u frames of %ux%u written to %s; %u validation errors%s\n", frames,
-              width, height, outDir.c_str(), gValidationErrors, validate ? "" : " (validation off)");
+  std::printf("minimal_integration: %u frames of %ux%u written to %s; %u validation errors%s\n", frames, width, height,
+              outDir.c_str(), gValidationErrors, validate ? "" : " (validation off)");
   return gValidationErrors ? 2 : 0;
 }

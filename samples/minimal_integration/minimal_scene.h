@@ -15,8 +15,7 @@ struct Mesh {
   std::vector<uint32_t> indices;  // three per triangle
 };
 
-inline void addQuad(Mesh& m, const float (&a)[3], const float (&b)[3], const float (&c)[3],
-                    const float (&d)[3]) {
+inline void addQuad(Mesh& m, const float (&a)[3], const float (&b)[3], const float (&c)[3], const float (&d)[3]) {
   const uint32_t base = uint32_t(m.positions.size() / 3);
   for (const float* p : {a, b, c, d}) m.positions.insert(m.positions.end(), {p[0], p[1], p[2]});
   m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
@@ -33,16 +32,14 @@ inline Mesh box(const char* name, float x0, float y0, float z0, float x1, float 
   return m;
 }
 
-inline Mesh sphere(const char* name, float cx, float cy, float cz, float r, uint32_t slices,
-                   uint32_t stacks) {
+inline Mesh sphere(const char* name, float cx, float cy, float cz, float r, uint32_t slices, uint32_t stacks) {
   Mesh m{name, {}, {}};
   for (uint32_t i = 0; i <= stacks; ++i) {
     const float theta = 3.14159265f * float(i) / float(stacks);
     for (uint32_t j = 0; j <= slices; ++j) {
       const float phi = 2.0f * 3.14159265f * float(j) / float(slices);
-      m.positions.insert(m.positions.end(),
-                         {cx + r * std::sin(theta) * std::cos(phi), cy + r * std::cos(theta),
-                          cz - r * std::sin(theta) * std::sin(phi)});
+      m.positions.insert(m.positions.end(), {cx + r * std::sin(theta) * std::cos(phi), cy + r * std::cos(theta),
+                                             cz - r * std::sin(theta) * std::sin(phi)});
     }
   }
   for (uint32_t i = 0; i < stacks; ++i) {
@@ -88,10 +85,8 @@ inline void viewMatrix(const double eye[3], const double target[3], float m[16])
   for (double& c : s) c /= sl;
   const double u[3] = {s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0]};
   const double t[3] = {-(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]),
-                       -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]),
-                       f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2]};
-  const double cm[16] = {s[0], u[0], -f[0], 0, s[1], u[1], -f[1], 0,
-                         s[2], u[2], -f[2], 0, t[0], t[1], t[2],  1};
+                       -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]), f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2]};
+  const double cm[16] = {s[0], u[0], -f[0], 0, s[1], u[1], -f[1], 0, s[2], u[2], -f[2], 0, t[0], t[1], t[2], 1};
   for (int i = 0; i < 16; ++i) m[i] = float(cm[i]);
 }
 

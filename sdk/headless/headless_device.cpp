@@ -48,9 +48,13 @@ struct HeadlessDevice::Impl {
 
   PFN_vkGetDeviceProcAddr gdpa = nullptr;
   template <typename T>
-  T ip(const char* n) const { return reinterpret_cast<T>(gipa(instance, n)); }
+  T ip(const char* n) const {
+    return reinterpret_cast<T>(gipa(instance, n));
+  }
   template <typename T>
-  T dp(const char* n) const { return reinterpret_cast<T>(gdpa(device, n)); }
+  T dp(const char* n) const {
+    return reinterpret_cast<T>(gdpa(device, n));
+  }
 
   static VKAPI_ATTR VkBool32 VKAPI_CALL onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                   VkDebugUtilsMessageTypeFlagsEXT,
@@ -119,8 +123,8 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   }
   VkDebugUtilsMessengerCreateInfoEXT messengerInfo{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  messengerInfo.messageSeverity =
-      VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+  messengerInfo.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT |
+                                  VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
   messengerInfo.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
                               VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                               VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
@@ -141,7 +145,7 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
   if (r != VK_SUCCESS) return vulkanError(r, "vkCreateInstance");
   if (impl->validation) {
     impl->ip<PFN_vkCreateDebugUtilsMessengerEXT>("vkCreateDebugUtilsMessengerEXT")(impl->instance, &messengerInfo,
-                                                                                    nullptr, &impl->messenger);
+                                                                                   nullptr, &impl->messenger);
   }
 
   auto enumerateDevices = impl->ip<PFN_vkEnumeratePhysicalDevices>("vkEnumeratePhysicalDevices");
@@ -174,7 +178,7 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
     if (!hasAll) continue;
     int score = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU     ? 3
                 : p.deviceType == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU ? 2
-                                                                          : 1;
+                                                                         : 1;
     if (score > bestScore) {
       bestScore = score;
       impl->physicalDevice = pd;
@@ -189,8 +193,7 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
                      "). Install Mesa 25 lavapipe from bookworm-backports (scripts/setup.sh) or set RAYBRIDGE_DEVICE"};
   }
 
-  auto queueProps =
-      impl->ip<PFN_vkGetPhysicalDeviceQueueFamilyProperties>("vkGetPhysicalDeviceQueueFamilyProperties");
+  auto queueProps = impl->ip<PFN_vkGetPhysicalDeviceQueueFamilyProperties>("vkGetPhysicalDeviceQueueFamilyProperties");
   uint32_t familyCount = 0;
   queueProps(impl->physicalDevice, &familyCount, nullptr);
   std::vector<VkQueueFamilyProperties> families(familyCount);
@@ -212,8 +215,8 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
     for (uint32_t i = 0; i < familyCount; ++i) {
       const VkQueueFlags f = families[i].queueFlags;
       if (!(f & VK_QUEUE_COMPUTE_BIT) || (f & VK_QUEUE_GRAPHICS_BIT) || families[i].queueCount == 0) continue;
-      if (impl->asyncFamily == UINT32_MAX || (families[impl->asyncFamily].timestampValidBits == 0 &&
-                                              families[i].timestampValidBits != 0)) {
+      if (impl->asyncFamily == UINT32_MAX ||
+          (families[impl->asyncFamily].timestampValidBits == 0 && families[i].timestampValidBits != 0)) {
         impl->asyncFamily = i;
       }
     }
@@ -250,7 +253,7 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
     impl->bufferFamilies = {impl->queueFamily, impl->asyncFamily};
   }
   impl->ip<PFN_vkGetPhysicalDeviceMemoryProperties>("vkGetPhysicalDeviceMemoryProperties")(impl->physicalDevice,
-                                                                                          &impl->memoryProperties);
+                                                                                           &impl->memoryProperties);
 
   VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -271,9 +274,7 @@ uint32_t HeadlessDevice::queueFamily() const { return impl_->queueFamily; }
 VkQueue HeadlessDevice::asyncComputeQueue() const { return impl_->asyncQueue; }
 uint32_t HeadlessDevice::asyncComputeQueueFamily() const { return impl_->asyncFamily; }
 PFN_vkGetInstanceProcAddr HeadlessDevice::getInstanceProcAddr() const { return impl_->gipa; }
-PFN_vkVoidFunction HeadlessDevice::instanceProc(const char* name) const {
-  return impl_->gipa(impl_->instance, name);
-}
+PFN_vkVoidFunction HeadlessDevice::instanceProc(const char* name) const { return impl_->gipa(impl_->instance, name); }
 PFN_vkVoidFunction HeadlessDevice::deviceProc(const char* name) const { return impl_->gdpa(impl_->device, name); }
 std::string HeadlessDevice::deviceName() const { return impl_->name; }
 uint32_t HeadlessDevice::validationErrorCount() const { return static_cast<uint32_t>(impl_->errors.size()); }
@@ -375,9 +376,8 @@ Result<HeadlessBuffer> HeadlessDevice::createBuffer(VkDeviceSize size, VkBufferU
   if (r != VK_SUCCESS) return vulkanError(r, "vkCreateBuffer");
   VkMemoryRequirements req;
   d.dp<PFN_vkGetBufferMemoryRequirements>("vkGetBufferMemoryRequirements")(d.device, out.buffer, &req);
-  VkMemoryPropertyFlags want = hostVisible
-                                   ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
-                                   : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+  VkMemoryPropertyFlags want = hostVisible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                           : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
   uint32_t type = UINT32_MAX;
   for (uint32_t i = 0; i < d.memoryProperties.memoryTypeCount; ++i) {
     if ((req.memoryTypeBits & (1u << i)) && (d.memoryProperties.memoryTypes[i].propertyFlags & want) == want) {

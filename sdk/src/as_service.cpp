@@ -21,7 +21,8 @@ VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * 
 void recordAsBarrier(const DeviceFunctions& vk, VkCommandBuffer cmd, VkPipelineStageFlags dstStages) {
   VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   barrier.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
-  barrier.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
+  barrier.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR |
+                          VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
   vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, dstStages, 0, 1, &barrier, 0,
                           nullptr, 0, nullptr);
 }
@@ -34,7 +35,7 @@ AccelerationStructureService::Impl::Impl(Context& context, const AsServiceDesc& 
   if (desc.scratchBudgetBytes == 0) desc.scratchBudgetBytes = kDefaultScratchBudget;
   if (desc.storageBlockBytes == 0) desc.storageBlockBytes = kDefaultBlockBytes;
   tlasSlots.resize(c.desc.framesInFlight);
-  entries.emplace_back();        // index 0 is never used, so a zero handle is always the null handle
+  entries.emplace_back();  // index 0 is never used, so a zero handle is always the null handle
   registrations.emplace_back();
 }
 
@@ -127,7 +128,7 @@ Result<VkQueryPool> AccelerationStructureService::Impl::takeTimestampPool(std::v
 }
 
 void AccelerationStructureService::Impl::buildGeometry(const BlasEntry& e, VkAccelerationStructureGeometryKHR& g,
-                                                      VkAccelerationStructureBuildRangeInfoKHR& range) const {
+                                                       VkAccelerationStructureBuildRangeInfoKHR& range) const {
   const MeshDesc& m = e.mesh.desc;
   g = VkAccelerationStructureGeometryKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
   g.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
@@ -147,8 +148,8 @@ void AccelerationStructureService::Impl::buildGeometry(const BlasEntry& e, VkAcc
 }
 
 Result<VkAccelerationStructureKHR> AccelerationStructureService::Impl::createAs(VkAccelerationStructureTypeKHR type,
-                                                                              VkBuffer buffer, VkDeviceSize offset,
-                                                                              VkDeviceSize size) {
+                                                                                VkBuffer buffer, VkDeviceSize offset,
+                                                                                VkDeviceSize size) {
   VkAccelerationStructureCreateInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
   info.buffer = buffer;
   info.offset = offset;
@@ -238,7 +239,7 @@ AccelerationStructureService::AccelerationStructureService(std::unique_ptr<Impl>
 AccelerationStructureService::~AccelerationStructureService() = default;
 
 Result<std::unique_ptr<AccelerationStructureService>> AccelerationStructureService::create(Context& context,
-                                                                                          const AsServiceDesc& desc) {
+                                                                                           const AsServiceDesc& desc) {
   if (desc.storageBlockBytes != 0 && desc.storageBlockBytes < (1u << 16)) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
                  "AsServiceDesc::storageBlockBytes is " + std::to_string(desc.storageBlockBytes) +
@@ -255,9 +256,7 @@ namespace {
 // AccelerationStructureService::Impl::deferRetires).
 class RegistrationLock {
  public:
-  explicit RegistrationLock(AccelerationStructureService::Impl& s) : s_(s), lock_(s.mutex) {
-    s_.deferRetires = true;
-  }
+  explicit RegistrationLock(AccelerationStructureService::Impl& s) : s_(s), lock_(s.mutex) { s_.deferRetires = true; }
   ~RegistrationLock() { s_.deferRetires = false; }
   RegistrationLock(const RegistrationLock&) = delete;
   RegistrationLock& operator=(const RegistrationLock&) = delete;
@@ -390,8 +389,8 @@ void AccelerationStructureService::Impl::resolveBatches() {
     }
     if (b.timestamps) {
       uint64_t ticks[2] = {0, 0};
-      VkResult r = c.vk.vkGetQueryPoolResults(c.desc.device, b.timestamps, 0, 2, sizeof(ticks), ticks,
-                                              sizeof(uint64_t), VK_QUERY_RESULT_64_BIT);
+      VkResult r = c.vk.vkGetQueryPoolResults(c.desc.device, b.timestamps, 0, 2, sizeof(ticks), ticks, sizeof(uint64_t),
+                                              VK_QUERY_RESULT_64_BIT);
       if (r == VK_NOT_READY) {
         keep.push_back(b);
         continue;
@@ -404,9 +403,9 @@ void AccelerationStructureService::Impl::resolveBatches() {
     }
     if (b.compactedSizes) {
       std::vector<uint64_t> sizes(b.compactEntries.size(), 0);
-      VkResult r = c.vk.vkGetQueryPoolResults(c.desc.device, b.compactedSizes, 0,
-                                              static_cast<uint32_t>(sizes.size()), sizes.size() * sizeof(uint64_t),
-                                              sizes.data(), sizeof(uint64_t), VK_QUERY_RESULT_64_BIT);
+      VkResult r = c.vk.vkGetQueryPoolResults(c.desc.device, b.compactedSizes, 0, static_cast<uint32_t>(sizes.size()),
+                                              sizes.size() * sizeof(uint64_t), sizes.data(), sizeof(uint64_t),
+                                              VK_QUERY_RESULT_64_BIT);
       if (r == VK_SUCCESS) {
         for (size_t i = 0; i < sizes.size(); ++i) {
           BlasEntry& e = entries[b.compactEntries[i]];
@@ -471,7 +470,7 @@ Status AccelerationStructureService::Impl::recordCompactions(VkCommandBuffer cmd
 }
 
 Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd, std::vector<uint32_t>& batch,
-                                                           VkDeviceSize scratchBytes, bool& recordedAny) {
+                                                            VkDeviceSize scratchBytes, bool& recordedAny) {
   if (batch.empty()) return {};
   const VkDeviceSize align = scratchAlignment();
   // Scratch: the persistent buffer when the batch fits the budget, else transient scratch for this batch.
@@ -486,10 +485,9 @@ Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd,
     scratchBase = alignUp(transient.address, align);
   } else {
     if (!scratch.valid()) {
-      Result<GpuBuffer> t = createBuffer(
-          ctx, desc.scratchBudgetBytes + align,
-          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT, MemoryLocation::DeviceLocal,
-          MemoryCategory::Scratch, "BLAS build scratch");
+      Result<GpuBuffer> t = createBuffer(ctx, desc.scratchBudgetBytes + align,
+                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                                         MemoryLocation::DeviceLocal, MemoryCategory::Scratch, "BLAS build scratch");
       if (!t) return t.error();
       scratch = t.value();
     }
@@ -507,17 +505,16 @@ Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd,
     BlasEntry& e = entries[batch[i]];
     Result<StorageAllocation> alloc = storage.allocate(e.sizes.accelerationStructureSize);
     if (!alloc) return alloc.error();
-    Result<VkAccelerationStructureKHR> as =
-        createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, storage.buffer(alloc->block), alloc->offset,
-                 e.sizes.accelerationStructureSize);
+    Result<VkAccelerationStructureKHR> as = createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                     storage.buffer(alloc->block), alloc->offset,
+                                                     e.sizes.accelerationStructureSize);
     if (!as) {
       storage.free(alloc.value());
       return as.error();
     }
     e.as = as.value();
     e.storage = alloc.value();
-    VkAccelerationStructureDeviceAddressInfoKHR ai{
-        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
+    VkAccelerationStructureDeviceAddressInfoKHR ai{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
     ai.accelerationStructure = e.as;
     e.address = c.vk.vkGetAccelerationStructureDeviceAddressKHR(c.desc.device, &ai);
     e.builtSize = e.sizes.accelerationStructureSize;
@@ -525,7 +522,8 @@ Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd,
     buildGeometry(e, geometries[i], ranges[i]);
     rangePtrs[i] = &ranges[i];
     VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
-    info = VkAccelerationStructureBuildGeometryInfoKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+    info = VkAccelerationStructureBuildGeometryInfoKHR{
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
     info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
     info.flags = blasFlags(e);
     info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
@@ -568,14 +566,14 @@ Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd,
   if (record.timestamps) {
     c.vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, record.timestamps, 1);
   }
-  recordAsBarrier(c.vk, cmd,
-                  VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR);
+  recordAsBarrier(
+      c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR);
   if (record.compactedSizes) {
     std::vector<VkAccelerationStructureKHR> handles;
     for (uint32_t idx : record.compactEntries) handles.push_back(entries[idx].as);
     c.vk.vkCmdWriteAccelerationStructuresPropertiesKHR(cmd, static_cast<uint32_t>(handles.size()), handles.data(),
-                                                      VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR,
-                                                      record.compactedSizes, 0);
+                                                       VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR,
+                                                       record.compactedSizes, 0);
   }
   for (uint32_t idx : batch) entries[idx].state = BlasState::Built;
   if (transient.valid()) retireBuffer(ctx, transient);

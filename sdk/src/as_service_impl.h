@@ -25,9 +25,9 @@ namespace rb {
 constexpr size_t kMaxBatchTimings = 64;  // AsStats::batches keeps the most recent ones
 
 enum class BlasState : uint8_t {
-  Free,     // slot unused (its generation is bumped on reuse)
-  Queued,   // registered, build not yet recorded
-  Built,    // build recorded; usable by TLAS builds recorded after it
+  Free,    // slot unused (its generation is bumped on reuse)
+  Queued,  // registered, build not yet recorded
+  Built,   // build recorded; usable by TLAS builds recorded after it
 };
 
 // One copy of a dynamic BLAS; the copies of a mesh form a ring (see DynamicBuildMode).
@@ -51,8 +51,8 @@ struct DynamicBlas {
   uint64_t writes = 0;           // writes so far (BlasCopy::writeSerial)
   bool updatePending = false;    // updateMesh since the last refit or build
   bool forceRebuild = false;
-  bool resize = false;           // forceRebuild with new counts: the copies are re-created at the rebuild
-  uint64_t pose = 0;             // updateMesh calls so far: the pose the engine's buffers hold
+  bool resize = false;  // forceRebuild with new counts: the copies are re-created at the rebuild
+  uint64_t pose = 0;    // updateMesh calls so far: the pose the engine's buffers hold
   uint32_t refitsSinceBuild = 0;
   uint32_t buildGeneration = 0;  // full builds so far; measure samples carry it, so late ones are ignored
   double baselineArea = 0.0;     // refit-quality measure at the last full build (0 = not read back yet)
@@ -74,12 +74,12 @@ struct BlasEntry {
   VkAccelerationStructureKHR as = VK_NULL_HANDLE;
   StorageAllocation storage;
   VkDeviceAddress address = 0;
-  VkDeviceSize builtSize = 0;    // size of the original build (of one copy, for a dynamic BLAS)
-  VkDeviceSize currentSize = 0;  // size now (smaller once compacted)
-  VkDeviceSize reserved = 0;     // storage it holds against the budget (aligned, all copies)
-  DynamicBlas dyn;               // MeshRole::Dynamic only; `as` and `address` then mirror the newest copy
-  bool compactionPending = false;       // waiting for its compacted-size query
-  VkDeviceSize compactedSize = 0;       // known and worth a copy: copy queued
+  VkDeviceSize builtSize = 0;      // size of the original build (of one copy, for a dynamic BLAS)
+  VkDeviceSize currentSize = 0;    // size now (smaller once compacted)
+  VkDeviceSize reserved = 0;       // storage it holds against the budget (aligned, all copies)
+  DynamicBlas dyn;                 // MeshRole::Dynamic only; `as` and `address` then mirror the newest copy
+  bool compactionPending = false;  // waiting for its compacted-size query
+  VkDeviceSize compactedSize = 0;  // known and worth a copy: copy queued
   bool compacted = false;
   uint64_t lastUsedFrame = 0;   // frame of the last TLAS that referenced it
   uint64_t lastTlasSerial = 0;  // serial of the last TLAS that referenced it
@@ -147,7 +147,7 @@ struct TlasSlot {
   VkDeviceSize storageCapacity = 0;
   bool allowsUpdate = false;
   uint32_t builtInstanceCount = 0;
-  uint64_t blasSignature = 0;  // hash of the BLAS addresses in order, to decide if a refit is valid
+  uint64_t blasSignature = 0;          // hash of the BLAS addresses in order, to decide if a refit is valid
   uint64_t writtenFrame = UINT64_MAX;  // frame whose instances the buffer holds
 };
 
@@ -203,7 +203,7 @@ struct AccelerationStructureService::Impl {
   ClusterBoundsPass clusterBounds;
   bool clusterBoundsCreated = false;
   GpuBuffer asyncScratch;
-  uint64_t asyncTimestampMask = 0;  // 0 = no timestamps on the async queue
+  uint64_t asyncTimestampMask = 0;                    // 0 = no timestamps on the async queue
   std::vector<DynamicSubmission> dynamicSubmissions;  // in order
   std::vector<GpuBuffer> freeReadbacks;
   std::vector<VkQueryPool> freeAsyncTimestampPools;
@@ -228,8 +228,8 @@ struct AccelerationStructureService::Impl {
   Status recordCompactions(VkCommandBuffer cmd, bool& recordedAny);
   Status recordBuildBatch(VkCommandBuffer cmd, std::vector<uint32_t>& batch, VkDeviceSize scratchBytes,
                           bool& recordedAny);
-  Result<VkAccelerationStructureKHR> createAs(VkAccelerationStructureTypeKHR type, VkBuffer buffer,
-                                              VkDeviceSize offset, VkDeviceSize size);
+  Result<VkAccelerationStructureKHR> createAs(VkAccelerationStructureTypeKHR type, VkBuffer buffer, VkDeviceSize offset,
+                                              VkDeviceSize size);
   void buildGeometry(const BlasEntry& e, VkAccelerationStructureGeometryKHR& geometry,
                      VkAccelerationStructureBuildRangeInfoKHR& range) const;
   VkBuildAccelerationStructureFlagsKHR blasFlags(const BlasEntry& e) const;
@@ -257,8 +257,8 @@ struct AccelerationStructureService::Impl {
   // in-frame modes); `trianglesUsed` counts first builds against maxBuildTrianglesPerCall.
   Status recordDynamicWork(VkCommandBuffer cmd, uint64_t& trianglesUsed, bool& recordedAny);
   Result<std::vector<DynamicOp>> planDynamicWork(uint64_t& trianglesUsed);
-  Status recordDynamicOps(VkCommandBuffer cmd, std::vector<DynamicOp>& ops, bool onAsyncQueue,
-                          DynamicSubmission& sub, std::vector<GpuBuffer>& transientScratch);
+  Status recordDynamicOps(VkCommandBuffer cmd, std::vector<DynamicOp>& ops, bool onAsyncQueue, DynamicSubmission& sub,
+                          std::vector<GpuBuffer>& transientScratch);
   void commitDynamicOps(std::vector<DynamicOp>& ops, uint64_t signalValue);
 };
 

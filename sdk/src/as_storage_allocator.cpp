@@ -31,10 +31,9 @@ Result<StorageAllocation> AsStorageAllocator::allocate(VkDeviceSize size) {
     }
   }
   VkDeviceSize bytes = std::max(blockBytes_, need);
-  Result<GpuBuffer> buffer =
-      createBuffer(ctx_, bytes,
-                   VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                   MemoryLocation::DeviceLocal, MemoryCategory::BlasStorage, "BLAS storage block", sharedWith_);
+  Result<GpuBuffer> buffer = createBuffer(
+      ctx_, bytes, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+      MemoryLocation::DeviceLocal, MemoryCategory::BlasStorage, "BLAS storage block", sharedWith_);
   if (!buffer) return buffer.error();
   Block block;
   block.buffer = buffer.value();
@@ -78,8 +77,8 @@ void AsStorageAllocator::free(const StorageAllocation& a) {
 }
 
 uint32_t AsStorageAllocator::blockCount() const {
-  return static_cast<uint32_t>(std::count_if(blocks_.begin(), blocks_.end(),
-                                             [](const Block& b) { return b.buffer.valid(); }));
+  return static_cast<uint32_t>(
+      std::count_if(blocks_.begin(), blocks_.end(), [](const Block& b) { return b.buffer.valid(); }));
 }
 
 VkDeviceSize AsStorageAllocator::blockBytes() const {

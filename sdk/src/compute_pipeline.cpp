@@ -71,8 +71,7 @@ void ComputePipeline::retire(Context& ctx) {
 }
 
 void ComputePipeline::dispatch(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes,
-                               const void* constants, uint32_t constantBytes, uint32_t width,
-                               uint32_t height) const {
+                               const void* constants, uint32_t constantBytes, uint32_t width, uint32_t height) const {
   const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
   vk.vkCmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, static_cast<uint32_t>(writes.size()),

@@ -21,8 +21,8 @@ class ComputePipeline {
   // dispatch it); this object is left empty.
   void retire(Context& ctx);
   // Binds, pushes the descriptors and constants, and dispatches 8x8 groups over width x height.
-  void dispatch(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes,
-                const void* constants, uint32_t constantBytes, uint32_t width, uint32_t height) const;
+  void dispatch(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes, const void* constants,
+                uint32_t constantBytes, uint32_t width, uint32_t height) const;
 
   VkPipeline pipeline = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;

@@ -208,8 +208,8 @@ Result<std::unique_ptr<Context>> Context::create(const ContextDesc& desc) {
   std::vector<VkQueueFamilyProperties> families(familyCount);
   vk.vkGetPhysicalDeviceQueueFamilyProperties(desc.physicalDevice, &familyCount, families.data());
   if (desc.mainQueueFamily >= familyCount) {
-    return invalid("ContextDesc::mainQueueFamily " + std::to_string(desc.mainQueueFamily) + " is not a queue family of '" +
-                   info.deviceName + "' (it has " + std::to_string(familyCount) + ")");
+    return invalid("ContextDesc::mainQueueFamily " + std::to_string(desc.mainQueueFamily) +
+                   " is not a queue family of '" + info.deviceName + "' (it has " + std::to_string(familyCount) + ")");
   }
   info.timestampValidBits = families[desc.mainQueueFamily].timestampValidBits;
   info.timestampsSupported = info.timestampValidBits != 0 && props.properties.limits.timestampPeriod > 0.0f;

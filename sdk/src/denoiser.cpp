@@ -39,7 +39,7 @@ struct Denoiser::Impl {
   PassImages images;
   PassMetrics metrics;
   DenoiseOutputs outputs;
-  uint32_t parity = 0;       // which of each ping-pong pair this frame writes
+  uint32_t parity = 0;  // which of each ping-pong pair this frame writes
   bool historyValid = false;
   double previousViewProjection[16] = {};
   double previousCamera[3] = {};
@@ -65,22 +65,20 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context) {
   auto storage = [&](uint32_t b) {
     return VkDescriptorSetLayoutBinding{b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, nullptr};
   };
-  Result<ComputePipeline> t = ComputePipeline::create(
-      context, SpirvModule::of(spirv::denoise_temporal_comp),
-      {sampled(RB_TEMPORAL_BINDING_DEPTH), sampled(RB_TEMPORAL_BINDING_MOTION), sampled(RB_TEMPORAL_BINDING_SIGNAL),
-       sampled(RB_TEMPORAL_BINDING_HISTORY_IN), sampled(RB_TEMPORAL_BINDING_DISTANCE_IN),
-       storage(RB_TEMPORAL_BINDING_HISTORY_OUT), storage(RB_TEMPORAL_BINDING_DISTANCE_OUT),
-       storage(RB_TEMPORAL_BINDING_VALUE_OUT)},
-      sizeof(DenoiseConstants),
-      "denoiser temporal");
+  Result<ComputePipeline> t =
+      ComputePipeline::create(context, SpirvModule::of(spirv::denoise_temporal_comp),
+                              {sampled(RB_TEMPORAL_BINDING_DEPTH), sampled(RB_TEMPORAL_BINDING_MOTION),
+                               sampled(RB_TEMPORAL_BINDING_SIGNAL), sampled(RB_TEMPORAL_BINDING_HISTORY_IN),
+                               sampled(RB_TEMPORAL_BINDING_DISTANCE_IN), storage(RB_TEMPORAL_BINDING_HISTORY_OUT),
+                               storage(RB_TEMPORAL_BINDING_DISTANCE_OUT), storage(RB_TEMPORAL_BINDING_VALUE_OUT)},
+                              sizeof(DenoiseConstants), "denoiser temporal");
   if (!t) return t.error();
   impl->temporal = t.value();
   Result<ComputePipeline> a =
       ComputePipeline::create(context, SpirvModule::of(spirv::denoise_atrous_comp),
                               {sampled(RB_ATROUS_BINDING_DEPTH), sampled(RB_ATROUS_BINDING_NORMAL),
                                sampled(RB_ATROUS_BINDING_SIGNAL_IN), storage(RB_ATROUS_BINDING_SIGNAL_OUT)},
-                              sizeof(DenoiseConstants),
-                              "denoiser a-trous");
+                              sizeof(DenoiseConstants), "denoiser a-trous");
   if (!a) return a.error();
   impl->atrous = a.value();
   Result<VkSampler> s = createNearestSampler(context);
@@ -137,9 +135,9 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   multiply(proj, viewRot, viewProjection);
 
   std::vector<PassImages::Spec> specs = {
-      {VK_FORMAT_R16G16_SFLOAT, "denoiser history A"}, {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},
-      {VK_FORMAT_R32_SFLOAT, "denoiser distance A"},   {VK_FORMAT_R32_SFLOAT, "denoiser distance B"},
-      {VK_FORMAT_R16_SFLOAT, "denoiser spatial A"},    {VK_FORMAT_R16_SFLOAT, "denoiser spatial B"},
+      {VK_FORMAT_R16G16_SFLOAT, "denoiser history A"},   {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},
+      {VK_FORMAT_R32_SFLOAT, "denoiser distance A"},     {VK_FORMAT_R32_SFLOAT, "denoiser distance B"},
+      {VK_FORMAT_R16_SFLOAT, "denoiser spatial A"},      {VK_FORMAT_R16_SFLOAT, "denoiser spatial B"},
       {VK_FORMAT_R16_SFLOAT, "denoiser temporal result"}};
   bool resized = s.images.size() == 0 || s.images[0].width != g.width || s.images[0].height != g.height;
   if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;

@@ -19,7 +19,7 @@ std::string describe(const MeshDesc& m, uint32_t index) {
 
 const char* modeName(DynamicBuildMode m) {
   return m == DynamicBuildMode::AsyncSameFrame ? "DynamicBuildMode::AsyncSameFrame"
-                                                : "DynamicBuildMode::AsyncOneFrameLate";
+                                               : "DynamicBuildMode::AsyncOneFrameLate";
 }
 
 }  // namespace
@@ -131,10 +131,10 @@ Result<std::vector<BlasCopy>> AccelerationStructureService::Impl::createCopies(c
   AsStorageAllocator& pool = copyStorage();
   for (BlasCopy& cp : copies) {
     Result<StorageAllocation> alloc = pool.allocate(e.sizes.accelerationStructureSize);
-    Result<VkAccelerationStructureKHR> as =
-        alloc ? createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, pool.buffer(alloc->block), alloc->offset,
-                         e.sizes.accelerationStructureSize)
-              : Result<VkAccelerationStructureKHR>(alloc.error());
+    Result<VkAccelerationStructureKHR> as = alloc ? createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                             pool.buffer(alloc->block), alloc->offset,
+                                                             e.sizes.accelerationStructureSize)
+                                                  : Result<VkAccelerationStructureKHR>(alloc.error());
     if (!as) {
       if (alloc) pool.free(alloc.value());
       retireCopies(copies);
@@ -201,8 +201,9 @@ Status AccelerationStructureService::updateMesh(MeshHandle mesh, const MeshUpdat
     const MeshDesc& now = v->desc;
     if (now.role != MeshRole::Dynamic) {
       return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
-                   "updateMesh: MeshUpdate::desc of " + name + " has MeshRole::Static; a registered dynamic mesh "
-                   "stays dynamic (release it and register it again to make it static)"};
+                   "updateMesh: MeshUpdate::desc of " + name +
+                       " has MeshRole::Static; a registered dynamic mesh "
+                       "stays dynamic (release it and register it again to make it static)"};
     }
     std::string changes;
     auto change = [&](const char* field, const std::string& a, const std::string& b) {
@@ -296,8 +297,8 @@ Status AccelerationStructureService::submitDynamicWork(const AsyncBuildWait& rea
     return st;
   }
   // Builds read the vertex buffers (and the cluster measure reads them in compute shaders).
-  const VkPipelineStageFlags readers =
-      VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR |
+                                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
   Result<uint64_t> value = s.submitter.submit(cmd.value(), ready, readers);
   if (!value) {
     dropSubmission();

@@ -3,7 +3,8 @@
 
 namespace rb {
 
-Status AccelerationStructureService::updateDynamicMeshes(std::span<const MeshHandle> meshes, const AsyncBuildWait& ready,
+Status AccelerationStructureService::updateDynamicMeshes(std::span<const MeshHandle> meshes,
+                                                         const AsyncBuildWait& ready,
                                                          std::vector<VkSemaphoreSubmitInfo>* tlasWaits,
                                                          std::vector<VkSemaphoreSubmitInfo>* vertexReuseWaits) {
   for (MeshHandle mesh : meshes)

@@ -27,8 +27,8 @@ void recordDynamicStartBarrier(const DeviceFunctions& vk, VkCommandBuffer cmd, b
   b.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR | VK_ACCESS_SHADER_WRITE_BIT;
   b.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR |
                     VK_ACCESS_SHADER_WRITE_BIT;
-  VkPipelineStageFlags src =
-      VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  VkPipelineStageFlags src = VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR |
+                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
   if (!onAsyncQueue) src |= VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
   vk.vkCmdPipelineBarrier(cmd, src,
                           VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
@@ -208,8 +208,8 @@ Status AccelerationStructureService::Impl::recordDynamicOps(VkCommandBuffer cmd,
     VkDeviceSize bytes;
     VkDeviceAddress transientBase;  // 0 = the shared scratch
   };
-  const VkBufferUsageFlags scratchUsage =
-      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+  const VkBufferUsageFlags scratchUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                          VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
   std::vector<Batch> batches;
   VkDeviceSize largestShared = 0;
   for (size_t begin = 0; begin < ops.size();) {
@@ -262,8 +262,8 @@ Status AccelerationStructureService::Impl::recordDynamicOps(VkCommandBuffer cmd,
   batchRecord.frame = c.frame;
   VkQueryPool timestamps = VK_NULL_HANDLE;
   if (!desc.disableTimestamps && (onAsyncQueue ? asyncTimestampMask != 0 : c.info.timestampsSupported)) {
-    Result<VkQueryPool> pool =
-        takeTimestampPool(onAsyncQueue ? freeAsyncTimestampPools : freeTimestampPools, "dynamic BLAS timestamps");
+    Result<VkQueryPool> pool = takeTimestampPool(onAsyncQueue ? freeAsyncTimestampPools : freeTimestampPools,
+                                                 "dynamic BLAS timestamps");
     if (!pool) return pool.error();
     timestamps = pool.value();
     (onAsyncQueue ? sub.timestamps : batchRecord.timestamps) = timestamps;

@@ -27,8 +27,7 @@ Result<VkDeviceMemory> allocate(Context::Impl& c, const VkMemoryRequirements& re
   int32_t type = c.findMemoryType(req.memoryTypeBits, required, required);
   if (type < 0 && location == MemoryLocation::DeviceLocal) type = c.findMemoryType(req.memoryTypeBits, 0, 0);
   if (type < 0) {
-    return Error{ErrorCode::VulkanError, VK_ERROR_OUT_OF_DEVICE_MEMORY,
-                 std::string("no memory type fits ") + what};
+    return Error{ErrorCode::VulkanError, VK_ERROR_OUT_OF_DEVICE_MEMORY, std::string("no memory type fits ") + what};
   }
   VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
   flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;

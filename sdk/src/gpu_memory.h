@@ -8,8 +8,8 @@
 namespace rb {
 
 enum class MemoryLocation : uint8_t {
-  DeviceLocal,   // fastest for the GPU
-  HostVisible,   // host-visible and coherent, persistently mapped (upload rings, readback)
+  DeviceLocal,  // fastest for the GPU
+  HostVisible,  // host-visible and coherent, persistently mapped (upload rings, readback)
 };
 
 struct GpuBuffer {
@@ -37,8 +37,7 @@ struct GpuImage {
 // `sharedWith`: two or more queue families make the buffer VK_SHARING_MODE_CONCURRENT over them (a buffer both
 // the main and the async queue touch needs no ownership transfers); empty = exclusive.
 Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryLocation location,
-                               MemoryCategory category, const char* what,
-                               std::span<const uint32_t> sharedWith = {});
+                               MemoryCategory category, const char* what, std::span<const uint32_t> sharedWith = {});
 // Destroys now. Use retireBuffer() when the GPU may still read it.
 void destroyBuffer(Context& ctx, GpuBuffer& buffer);
 // Destroys once the frames in flight that may use it are done (Context::beginFrame contract).

@@ -9,7 +9,9 @@ namespace rb {
 
 namespace {
 
-Error invalid(std::string message) { return {ErrorCode::InvalidArgument, VK_SUCCESS, "HybridEffects: " + std::move(message)}; }
+Error invalid(std::string message) {
+  return {ErrorCode::InvalidArgument, VK_SUCCESS, "HybridEffects: " + std::move(message)};
+}
 
 Error wrap(const char* what, const Error& e) {
   Error out = e;
@@ -19,18 +21,26 @@ Error wrap(const char* what, const Error& e) {
 
 Status validate(const HybridEffectsDesc& d) {
   if (d.effects & ~kAllEffects) return invalid("effects has unknown bits " + std::to_string(d.effects & ~kAllEffects));
-  if (d.shadows.raysPerPixel > 4096) return invalid("shadows.raysPerPixel " + std::to_string(d.shadows.raysPerPixel) + " exceeds 4096");
+  if (d.shadows.raysPerPixel > 4096)
+    return invalid("shadows.raysPerPixel " + std::to_string(d.shadows.raysPerPixel) + " exceeds 4096");
   if (!(d.shadows.softAngularRadiusDegrees >= 0.0f && d.shadows.softAngularRadiusDegrees < 45.0f))
-    return invalid("shadows.softAngularRadiusDegrees " + std::to_string(d.shadows.softAngularRadiusDegrees) + " is outside [0, 45)");
-  if (d.ao.raysPerPixel > 4096) return invalid("ao.raysPerPixel " + std::to_string(d.ao.raysPerPixel) + " exceeds 4096");
-  if (!(d.ao.range >= 0.0f) || !std::isfinite(d.ao.range)) return invalid("ao.range " + std::to_string(d.ao.range) + " must be >= 0 and finite");
+    return invalid("shadows.softAngularRadiusDegrees " + std::to_string(d.shadows.softAngularRadiusDegrees) +
+                   " is outside [0, 45)");
+  if (d.ao.raysPerPixel > 4096)
+    return invalid("ao.raysPerPixel " + std::to_string(d.ao.raysPerPixel) + " exceeds 4096");
+  if (!(d.ao.range >= 0.0f) || !std::isfinite(d.ao.range))
+    return invalid("ao.range " + std::to_string(d.ao.range) + " must be >= 0 and finite");
   if (!(d.reflections.roughnessThreshold >= 0.0f && d.reflections.roughnessThreshold <= 1.0f))
-    return invalid("reflections.roughnessThreshold " + std::to_string(d.reflections.roughnessThreshold) + " is outside [0, 1]");
-  if (d.reflections.raysPerPixel > 64) return invalid("reflections.raysPerPixel " + std::to_string(d.reflections.raysPerPixel) + " exceeds 64");
+    return invalid("reflections.roughnessThreshold " + std::to_string(d.reflections.roughnessThreshold) +
+                   " is outside [0, 1]");
+  if (d.reflections.raysPerPixel > 64)
+    return invalid("reflections.raysPerPixel " + std::to_string(d.reflections.raysPerPixel) + " exceeds 64");
   return {};
 }
 
-bool hasSize(const Light& l) { return l.type == LightType::Directional ? l.angularRadiusDegrees > 0.0f : l.radius > 0.0f; }
+bool hasSize(const Light& l) {
+  return l.type == LightType::Directional ? l.angularRadiusDegrees > 0.0f : l.radius > 0.0f;
+}
 
 // The light as the shadow pass traces it and the rays per pixel (see ShadowEffectSettings).
 struct ShadowPlan {
@@ -48,7 +58,8 @@ ShadowPlan planShadows(const ShadowEffectSettings& s, const Light& frameLight) {
     p.light.angularRadiusDegrees = 0.0f, p.light.radius = 0.0f;  // one ray = hard, unless a disk is asked for
   } else if (rays > 1 && !hasSize(p.light)) {
     if (directional) p.light.angularRadiusDegrees = kDefaultSoftLightAngularRadiusDegrees;
-    else rays = 1;  // a point or spot light without a radius stays hard
+    else
+      rays = 1;  // a point or spot light without a radius stays hard
   }
   p.rays = rays;
   p.soft = hasSize(p.light);
@@ -60,7 +71,9 @@ EffectImage image(VkImage i, VkImageView v, VkFormat f, VkImageLayout layout, ui
 }
 
 template <typename T>
-PassStats statsOf(const std::unique_ptr<T>& p) { return p ? p->stats() : PassStats{}; }
+PassStats statsOf(const std::unique_ptr<T>& p) {
+  return p ? p->stats() : PassStats{};
+}
 
 // Creates `slot` when wanted and missing, retires it (deferred release) when not wanted.
 template <typename T, typename Create>
@@ -106,10 +119,14 @@ struct HybridEffects::Impl {
   // Passes follow the effect set; denoisers are decided per frame (hard shadows need none).
   Status applyDesc() {
     const EffectSet e = desc.effects;
-    if (Status s = ensure(shadow, e & kEffectShadows, "ShadowPass::create", [&] { return ShadowPass::create(ctx); }); !s) return s;
+    if (Status s = ensure(shadow, e & kEffectShadows, "ShadowPass::create", [&] { return ShadowPass::create(ctx); });
+        !s)
+      return s;
     if (Status s = ensure(ao, e & kEffectAo, "AoPass::create", [&] { return AoPass::create(ctx); }); !s) return s;
     const bool hadReflection = reflection != nullptr;
-    if (Status s = ensure(reflection, e & kEffectReflections, "ReflectionPass::create", [&] { return ReflectionPass::create(ctx); }); !s)
+    if (Status s = ensure(reflection, e & kEffectReflections, "ReflectionPass::create",
+                          [&] { return ReflectionPass::create(ctx); });
+        !s)
       return s;
     if (reflection && !hadReflection) materialsDirty = true;
     if (!shadow || desc.shadows.disableDenoiser) shadowDenoiser.reset();
@@ -126,15 +143,20 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   const ShadowPlan plan = planShadows(desc.shadows, f.light);
   ShadowSettings s;
   s.raysPerPixel = plan.rays;
-  if (Status st = shadow->record(cmd, f.gbuffer, tlas, plan.light, s); !st) return wrap("ShadowPass::record", st.error());
+  if (Status st = shadow->record(cmd, f.gbuffer, tlas, plan.light, s); !st)
+    return wrap("ShadowPass::record", st.error());
   const ShadowOutputs& o = shadow->outputs();
-  outputs.shadowRaw = outputs.shadow = image(o.visibility, o.visibilityView, VK_FORMAT_R16_SFLOAT, o.layout, o.width, o.height);
+  outputs.shadowRaw = outputs.shadow = image(o.visibility, o.visibilityView, VK_FORMAT_R16_SFLOAT, o.layout, o.width,
+                                             o.height);
   const bool denoise = plan.soft && !desc.shadows.disableDenoiser;
-  if (Status st = ensure(shadowDenoiser, denoise, "Denoiser::create (shadows)", [&] { return Denoiser::create(ctx); }); !st) return st;
+  if (Status st = ensure(shadowDenoiser, denoise, "Denoiser::create (shadows)", [&] { return Denoiser::create(ctx); });
+      !st)
+    return st;
   if (!shadowDenoiser) return {};
   DenoiseSettings d = desc.denoiser;
   d.raysPerPixel = plan.rays;  // the visibility is a fraction of this many binary rays
-  if (Status st = shadowDenoiser->record(cmd, f.gbuffer, o.visibilityView, d); !st) return wrap("Denoiser::record (shadows)", st.error());
+  if (Status st = shadowDenoiser->record(cmd, f.gbuffer, o.visibilityView, d); !st)
+    return wrap("Denoiser::record (shadows)", st.error());
   const DenoiseOutputs& dn = shadowDenoiser->outputs();
   outputs.shadow = image(dn.denoised, dn.denoisedView, VK_FORMAT_R16_SFLOAT, dn.layout, dn.width, dn.height);
   return {};
@@ -148,12 +170,16 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   if (Status st = ao->record(cmd, f.gbuffer, tlas, s); !st) return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
   outputs.aoRaw = outputs.ao = image(o.ao, o.aoView, VK_FORMAT_R16_SFLOAT, o.layout, o.width, o.height);
-  if (Status st = ensure(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser::create (AO)", [&] { return Denoiser::create(ctx); }); !st) return st;
+  if (Status st = ensure(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser::create (AO)",
+                         [&] { return Denoiser::create(ctx); });
+      !st)
+    return st;
   if (!aoDenoiser) return {};
   DenoiseSettings d = desc.denoiser;
   // Binary AO is a fraction of binary rays; distance-weighted AO is not, so its noise is estimated.
   d.raysPerPixel = s.estimator == AoEstimator::Binary ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays) : 0u;
-  if (Status st = aoDenoiser->record(cmd, f.gbuffer, o.aoView, d); !st) return wrap("Denoiser::record (AO)", st.error());
+  if (Status st = aoDenoiser->record(cmd, f.gbuffer, o.aoView, d); !st)
+    return wrap("Denoiser::record (AO)", st.error());
   const DenoiseOutputs& dn = aoDenoiser->outputs();
   outputs.ao = image(dn.denoised, dn.denoisedView, VK_FORMAT_R16_SFLOAT, dn.layout, dn.width, dn.height);
   return {};
@@ -161,7 +187,8 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
 
 Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
   if (materialsDirty) {
-    if (Status st = reflection->setMaterials(materials, textures); !st) return wrap("ReflectionPass::setMaterials", st.error());
+    if (Status st = reflection->setMaterials(materials, textures); !st)
+      return wrap("ReflectionPass::setMaterials", st.error());
     materialsDirty = false;
   }
   ReflectionSettings s;
@@ -219,7 +246,8 @@ Status HybridEffects::setMaterials(std::span<const Material> materials, std::spa
   a.materialsDirty = true;
   if (!a.reflection) return {};
   // Validate now, so a bad table is reported by the call that brought it.
-  if (Status st = a.reflection->setMaterials(a.materials, a.textures); !st) return wrap("ReflectionPass::setMaterials", st.error());
+  if (Status st = a.reflection->setMaterials(a.materials, a.textures); !st)
+    return wrap("ReflectionPass::setMaterials", st.error());
   a.materialsDirty = false;
   return {};
 }
@@ -233,8 +261,9 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
     a.tlas = *frame.tlas;
   } else {
     if (!a.service)
-      return invalid("record: the frame brings no TLAS (HybridFrame::tlas) and no AccelerationStructureService was given "
-                     "to create() to build one over HybridFrame::instances");
+      return invalid(
+          "record: the frame brings no TLAS (HybridFrame::tlas) and no AccelerationStructureService was given "
+          "to create() to build one over HybridFrame::instances");
     if (auto pending = a.service->recordPendingWork(cmd); !pending) return wrap("recordPendingWork", pending.error());
     TlasBuildOptions options;
     if (!a.desc.worldSpaceTlas) {

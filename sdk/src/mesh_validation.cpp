@@ -24,9 +24,7 @@ uint32_t vertexFormatSize(VkFormat format) {
 Result<ValidatedMesh> validateMesh(const MeshDesc& in, const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
                                    uint64_t maxPrimitiveCount) {
   std::string name = in.debugName ? std::string("mesh '") + in.debugName + "'" : std::string("mesh");
-  auto invalid = [&](const std::string& m) {
-    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, name + ": " + m};
-  };
+  auto invalid = [&](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, name + ": " + m}; };
   ValidatedMesh out;
   MeshDesc& d = out.desc;
   d = in;

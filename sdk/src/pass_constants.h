@@ -28,9 +28,9 @@ struct GBufferConstants {
   float cameraToTlas[3];    // camera position in the TLAS's space
   float depthQuantum;       // one step of the stored depth value; 0 = float depth
   uint32_t size[2];
-  uint32_t flags;           // RB_GB_*
+  uint32_t flags;  // RB_GB_*
   uint32_t frameIndex;
-  float wAtDepthOne;        // w of inverse(projection) * (x, y, 1, 1)
+  float wAtDepthOne;  // w of inverse(projection) * (x, y, 1, 1)
   uint32_t pad[3];
 };
 static_assert(sizeof(GBufferConstants) == 160);
@@ -51,8 +51,8 @@ struct ShadowConstants {
   float lightRadius;        // point and spot lights; 0 = hard shadows
   float spotDirection[3];   // from the light, unit length
   float cosSpotOuterAngle;
-  float tanAngularRadius;   // directional light; 0 = hard shadows
-  float range;              // point and spot lights; 0 = unlimited
+  float tanAngularRadius;  // directional light; 0 = hard shadows
+  float range;             // point and spot lights; 0 = unlimited
   uint32_t raysPerPixel;
   uint32_t pad0;
 };
@@ -104,7 +104,7 @@ struct PrimaryConstants {
   float tMin;
   float right[3];  // pre-scaled by tan(fovY / 2) * aspect ratio
   float tMax;
-  float up[3];     // pre-scaled by tan(fovY / 2)
+  float up[3];  // pre-scaled by tan(fovY / 2)
   uint32_t width;
   float forward[3];
   uint32_t height;
@@ -123,11 +123,11 @@ struct DenoiseConstants {
   float inverseProjection[16];
   float viewToWorld[3][4];  // as GBufferConstants::viewToWorld
   float previousViewProjection[16];
-  float cameraDelta[3];     // current camera position - previous camera position
+  float cameraDelta[3];  // current camera position - previous camera position
   float depthSigma;
   uint32_t size[2];
-  uint32_t flags;           // RB_DN_*
-  uint32_t atrousStep;      // a-trous pass
+  uint32_t flags;             // RB_DN_*
+  uint32_t atrousStep;        // a-trous pass
   uint32_t maxHistoryFrames;  // temporal pass
   float wAtDepthOne;
   float normalPower;

@@ -34,7 +34,7 @@ void transition(Context& ctx, VkCommandBuffer cmd, const std::vector<GpuImage>& 
   for (const GpuImage& img : images) barriers.push_back(colorImageBarrier(img.image, from, to, srcAccess, dstAccess));
   if (barriers.empty()) return;
   internal::deviceFunctions(ctx).vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr,
-                                static_cast<uint32_t>(barriers.size()), barriers.data());
+                                                      static_cast<uint32_t>(barriers.size()), barriers.data());
 }
 }  // namespace
 

@@ -76,12 +76,16 @@ Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTra
   };
   {
     Result<uint32_t> s = addStage(desc.raygen, VK_SHADER_STAGE_RAYGEN_BIT_KHR);
-    if (!s) status = s.error(); else groups.push_back(general(s.value()));
+    if (!s) status = s.error();
+    else
+      groups.push_back(general(s.value()));
   }
   for (const SpirvModule& miss : desc.misses) {
     if (!status) break;
     Result<uint32_t> s = addStage(miss, VK_SHADER_STAGE_MISS_BIT_KHR);
-    if (!s) status = s.error(); else groups.push_back(general(s.value()));
+    if (!s) status = s.error();
+    else
+      groups.push_back(general(s.value()));
   }
   for (const HitGroupDesc& hg : desc.hitGroups) {
     if (!status) break;
@@ -90,12 +94,18 @@ Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTra
     g.generalShader = g.closestHitShader = g.anyHitShader = g.intersectionShader = VK_SHADER_UNUSED_KHR;
     if (hg.closestHit.code) {
       Result<uint32_t> s = addStage(hg.closestHit, VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR);
-      if (!s) { status = s.error(); break; }
+      if (!s) {
+        status = s.error();
+        break;
+      }
       g.closestHitShader = s.value();
     }
     if (hg.anyHit.code) {
       Result<uint32_t> s = addStage(hg.anyHit, VK_SHADER_STAGE_ANY_HIT_BIT_KHR);
-      if (!s) { status = s.error(); break; }
+      if (!s) {
+        status = s.error();
+        break;
+      }
       g.anyHitShader = s.value();
     }
     groups.push_back(g);
@@ -137,10 +147,10 @@ Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTra
   VkDeviceSize raygenSize = alignUp(stride, base);
   VkDeviceSize missSize = alignUp(stride * missCount, base);
   VkDeviceSize hitSize = alignUp(stride * hitCount, base);
-  Result<GpuBuffer> sbt = createBuffer(
-      ctx, raygenSize + missSize + hitSize + base,
-      VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-      MemoryLocation::HostVisible, MemoryCategory::ShaderTables, "shader binding table");
+  Result<GpuBuffer> sbt =
+      createBuffer(ctx, raygenSize + missSize + hitSize + base,
+                   VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                   MemoryLocation::HostVisible, MemoryCategory::ShaderTables, "shader binding table");
   if (!sbt) {
     p.destroy(ctx);
     return sbt.error();
@@ -195,7 +205,7 @@ void RayTracingPipeline::bind(Context& ctx, VkCommandBuffer cmd, std::span<const
 void RayTracingPipeline::trace(Context& ctx, VkCommandBuffer cmd, uint32_t width, uint32_t height,
                                uint32_t depth) const {
   internal::deviceFunctions(ctx).vkCmdTraceRaysKHR(cmd, &raygenRegion, &missRegion, &hitRegion, &callableRegion, width,
-                                                    height, depth);
+                                                   height, depth);
 }
 
 namespace {

@@ -15,7 +15,9 @@ struct SpirvModule {
   const uint32_t* code = nullptr;
   size_t bytes = 0;
   template <size_t N>
-  static SpirvModule of(const uint32_t (&words)[N]) { return {words, N * sizeof(uint32_t)}; }
+  static SpirvModule of(const uint32_t (&words)[N]) {
+    return {words, N * sizeof(uint32_t)};
+  }
 };
 
 struct HitGroupDesc {
@@ -28,7 +30,7 @@ struct RayTracingPipelineDesc {
   std::vector<SpirvModule> misses;
   std::vector<HitGroupDesc> hitGroups;
   std::vector<VkDescriptorSetLayoutBinding> bindings;  // set 0, pushed with vkCmdPushDescriptorSetKHR
-  std::vector<VkDescriptorSetLayout> extraSetLayouts;   // sets 1.. (owned by the caller), bound by the caller
+  std::vector<VkDescriptorSetLayout> extraSetLayouts;  // sets 1.. (owned by the caller), bound by the caller
   uint32_t pushConstantBytes = 0;
   uint32_t maxRecursionDepth = 1;
   const char* name = "ray tracing pipeline";

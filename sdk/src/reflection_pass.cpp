@@ -19,7 +19,8 @@ struct GpuMaterial {
   float baseColor[4];
   float metallic, roughness;
   uint32_t baseColorTexture, metallicRoughnessTexture;
-  float emissive[4];
+  float emissive[3];
+  uint32_t emissiveTexture;
 };
 static_assert(sizeof(GpuMaterial) == 48, "must match shaders/reflection_common.glsl");
 
@@ -62,9 +63,10 @@ Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context)
   // to kMaxTextures (none included) fits one layout.
   VkDescriptorSetLayoutBinding textures{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kMaxTextures,
                                         VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR, nullptr};
-  VkDescriptorBindingFlags flags =
-      VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT | VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT;
-  VkDescriptorSetLayoutBindingFlagsCreateInfo flagsInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO};
+  VkDescriptorBindingFlags flags = VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT |
+                                   VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT;
+  VkDescriptorSetLayoutBindingFlagsCreateInfo flagsInfo{
+      VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO};
   flagsInfo.bindingCount = 1;
   flagsInfo.pBindingFlags = &flags;
   VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, &flagsInfo};
@@ -91,8 +93,8 @@ Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context)
   p.bindings = PassCore::commonBindings();
   p.bindings[RB_BINDING_TLAS].stageFlags |= hit;          // shadow rays from hits
   p.bindings[RB_BINDING_RAY_COUNTERS].stageFlags |= hit;  // and their count
-  p.bindings.push_back({RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg,
-                        nullptr});
+  p.bindings.push_back(
+      {RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
   p.bindings.push_back({RB_REFLECTION_BINDING_RADIANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
   p.bindings.push_back({RB_REFLECTION_BINDING_SHADING_RECORDS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit, nullptr});
   p.bindings.push_back({RB_REFLECTION_BINDING_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit, nullptr});
@@ -118,7 +120,8 @@ Status ReflectionPass::setMaterials(std::span<const Material> materials, std::sp
     return invalid(std::to_string(textures.size()) + " textures exceed the limit of " + std::to_string(kMaxTextures));
   }
   for (size_t i = 0; i < materials.size(); ++i) {
-    for (uint32_t t : {materials[i].baseColorTexture, materials[i].metallicRoughnessTexture}) {
+    for (uint32_t t :
+         {materials[i].baseColorTexture, materials[i].metallicRoughnessTexture, materials[i].emissiveTexture}) {
       if (t != kNoTexture && t >= textures.size()) {
         return invalid("materials[" + std::to_string(i) + "] uses texture " + std::to_string(t) + " but only " +
                        std::to_string(textures.size()) + " textures were given");
@@ -128,8 +131,9 @@ Status ReflectionPass::setMaterials(std::span<const Material> materials, std::sp
   for (size_t i = 0; i < textures.size(); ++i) {
     if (!textures[i]) return invalid("textures[" + std::to_string(i) + "] is VK_NULL_HANDLE");
   }
-  Result<GpuBuffer> buffer = createBuffer(s.ctx, materials.size() * sizeof(GpuMaterial), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                          MemoryLocation::HostVisible, MemoryCategory::PassBuffers, "material table");
+  Result<GpuBuffer> buffer = createBuffer(s.ctx, materials.size() * sizeof(GpuMaterial),
+                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryLocation::HostVisible,
+                                          MemoryCategory::PassBuffers, "material table");
   if (!buffer) return buffer.error();
   auto* out = static_cast<GpuMaterial*>(buffer->mapped);
   for (size_t i = 0; i < materials.size(); ++i) {
@@ -141,6 +145,7 @@ Status ReflectionPass::setMaterials(std::span<const Material> materials, std::sp
     g.baseColorTexture = m.baseColorTexture;
     g.metallicRoughnessTexture = m.metallicRoughnessTexture;
     std::memcpy(g.emissive, m.emissive, sizeof m.emissive);
+    g.emissiveTexture = m.emissiveTexture;
     out[i] = g;
   }
   const uint32_t count = static_cast<uint32_t>(textures.size());
@@ -206,13 +211,16 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   if (!g.roughnessInNormalW && !g.roughnessMetalness.view) {
     return invalid("the G-buffer has no roughness: set GBufferDesc::roughnessInNormalW or roughnessMetalness");
   }
-  float threshold = settings.roughnessThreshold == 0.0f ? kDefaultReflectionRoughnessThreshold : settings.roughnessThreshold;
+  float threshold = settings.roughnessThreshold == 0.0f ? kDefaultReflectionRoughnessThreshold
+                                                        : settings.roughnessThreshold;
   if (!(threshold > 0.0f && threshold <= 1.0f)) {
     return invalid("ReflectionSettings::roughnessThreshold " + std::to_string(threshold) + " is outside (0, 1]");
   }
   if (settings.raysPerPixel > 64) return invalid("ReflectionSettings::raysPerPixel exceeds 64");
-  const bool sunUnset = settings.sunDirection[0] == 0.0f && settings.sunDirection[1] == 0.0f && settings.sunDirection[2] == 0.0f;
-  const float sunDirection[3] = {settings.sunDirection[0], sunUnset ? 1.0f : settings.sunDirection[1], settings.sunDirection[2]};
+  const bool sunUnset = settings.sunDirection[0] == 0.0f && settings.sunDirection[1] == 0.0f &&
+                        settings.sunDirection[2] == 0.0f;
+  const float sunDirection[3] = {settings.sunDirection[0], sunUnset ? 1.0f : settings.sunDirection[1],
+                                 settings.sunDirection[2]};
   float sunLen = std::sqrt(sunDirection[0] * sunDirection[0] + sunDirection[1] * sunDirection[1] +
                            sunDirection[2] * sunDirection[2]);
   if (!std::isfinite(sunLen)) return invalid("ReflectionSettings::sunDirection must be finite");
@@ -229,7 +237,8 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
     pc.skyRadiance[i] = defaultSky ? kDefaultSkyRadiance[i] : settings.skyRadiance[i];
   }
   pc.roughnessThreshold = threshold;
-  pc.ambientIntensity = settings.ambientIntensity == 0.0f && !explicitLighting ? kDefaultAmbientIntensity : settings.ambientIntensity;
+  pc.ambientIntensity = settings.ambientIntensity == 0.0f && !explicitLighting ? kDefaultAmbientIntensity
+                                                                               : settings.ambientIntensity;
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultReflectionRays;
 
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16G16B16A16_SFLOAT, "reflection radiance"}}); !st) return st;
@@ -242,8 +251,8 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   w.storageBuffer(RB_REFLECTION_BINDING_MATERIALS, s.materials.buffer, 0, s.materials.size);
   s.core.pipeline.bind(s.ctx, cmd, w.writes, &pc, sizeof pc);
   internal::deviceFunctions(s.ctx).vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR,
-                                                          s.core.pipeline.layout, RB_REFLECTION_SET_TEXTURES, 1,
-                                                          &s.textureSet, 0, nullptr);
+                                                           s.core.pipeline.layout, RB_REFLECTION_SET_TEXTURES, 1,
+                                                           &s.textureSet, 0, nullptr);
   s.core.pipeline.trace(s.ctx, cmd, g.width, g.height);
   s.core.images.endWrite(s.ctx, cmd);
   s.core.metrics.writeEnd(s.ctx, cmd);

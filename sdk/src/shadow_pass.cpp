@@ -30,7 +30,8 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
   impl->desc = desc;
   RayTracingPipelineDesc p;
   p.name = "shadow pass";
-  p.raygen = desc.outputHitDistance ? SpirvModule::of(spirv::shadow_distance_rgen) : SpirvModule::of(spirv::shadow_rgen);
+  p.raygen = desc.outputHitDistance ? SpirvModule::of(spirv::shadow_distance_rgen)
+                                    : SpirvModule::of(spirv::shadow_rgen);
   p.misses = {SpirvModule::of(spirv::occlusion_rmiss)};
   // The closest-hit shader runs only when the occluder distance is wanted; otherwise rays skip it by flag.
   // (A hit group without shaders would do, but crashes validation layer 1.3.239 in vkCmdTraceRaysKHR.)

@@ -26,8 +26,7 @@ Status ensureBuffer(Context& ctx, GpuBuffer& buffer, VkDeviceSize bytes, VkBuffe
 
 }  // namespace
 
-Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer cmd,
-                                                               std::span<const Instance> instances,
+Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer cmd, std::span<const Instance> instances,
                                                                const TlasBuildOptions& options) {
   Impl& s = *impl_;
   Context::Impl& c = s.c;
@@ -83,7 +82,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
                    "recordTlasBuild: instances[" + std::to_string(i) + "] refers to " +
                        (h.isNull() ? std::string("the null mesh handle")
                                    : "mesh handle {index " + std::to_string(h.index) + ", generation " +
-                                         std::to_string(h.generation) + "}, which was released, evicted or never "
+                                         std::to_string(h.generation) +
+                                         "}, which was released, evicted or never "
                                          "registered")};
     }
     if (in.customIndex > 0xFFFFFFu) {
@@ -103,7 +103,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   auto* records = options.writeShadingRecords ? static_cast<ShadingRecord*>(slot.shading.mapped) : nullptr;
   uint32_t written = 0, skipped = 0, stale = 0;
   uint64_t signature = 0;
-  const bool rebase = options.originOffset[0] != 0.0 || options.originOffset[1] != 0.0 || options.originOffset[2] != 0.0;
+  const bool rebase = options.originOffset[0] != 0.0 || options.originOffset[1] != 0.0 ||
+                      options.originOffset[2] != 0.0;
   for (uint32_t i = 0; i < count; ++i) {
     const Instance& in = instances[i];
     const Registration& reg = s.registrations[in.mesh.index];
@@ -130,8 +131,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     std::memcpy(&inst.transform, in.transform, sizeof(inst.transform));
     if (rebase) {
       for (int row = 0; row < 3; ++row) {
-        inst.transform.matrix[row][3] =
-            static_cast<float>(static_cast<double>(in.transform[row * 4 + 3]) - options.originOffset[row]);
+        inst.transform.matrix[row][3] = static_cast<float>(static_cast<double>(in.transform[row * 4 + 3]) -
+                                                           options.originOffset[row]);
       }
     }
     inst.instanceCustomIndex = in.customIndex;
@@ -240,8 +241,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   // Earlier BLAS builds and this slot's previous use of its scratch must be complete.
   recordAsBarrier(c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
   c.vk.vkCmdBuildAccelerationStructuresKHR(cmd, 1, &info, &rangePtr);
-  recordAsBarrier(c.vk, cmd,
-                  VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
+  recordAsBarrier(
+      c.vk, cmd, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
 
   slot.builtInstanceCount = written;
   slot.blasSignature = signature;

@@ -34,8 +34,8 @@ const char* toString(VkResult result) {
 }
 
 Error vulkanError(VkResult result, const std::string& what) {
-  return Error{ErrorCode::VulkanError, result, what + " failed: " + toString(result) + " (" +
-                                                   std::to_string(static_cast<int>(result)) + ")"};
+  return Error{ErrorCode::VulkanError, result,
+               what + " failed: " + toString(result) + " (" + std::to_string(static_cast<int>(result)) + ")"};
 }
 
 const char* formatName(VkFormat format) {

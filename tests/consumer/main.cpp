@@ -19,8 +19,8 @@ int main() {
   if (!service) return 1;
   const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   const uint32_t indices[3] = {0, 1, 2};
-  const VkBufferUsageFlags usage =
-      VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
+                                   VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
   auto vb = device.value()->createBuffer(sizeof positions, usage, true, positions);
   auto ib = device.value()->createBuffer(sizeof indices, usage, true, indices);
   if (!vb || !ib) return 1;

@@ -84,8 +84,7 @@ std::string checkMeshDeformation(const Scene& scene, uint32_t m, const Instance&
       }
     }
     if (!(sum > 1e-6))
-      return where + ", vertex " + std::to_string(v) + ": skin weights sum to " + number(sum) +
-             "; they must sum to 1";
+      return where + ", vertex " + std::to_string(v) + ": skin weights sum to " + number(sum) + "; they must sum to 1";
   }
   return {};
 }
@@ -172,8 +171,8 @@ Status ScenePose::reset(const Scene& scene) {
       if (smp.times.empty()) return Status::failure(where + ", sampler " + std::to_string(s) + ": no keys");
       for (size_t k = 0; k < smp.times.size(); ++k)
         if (!std::isfinite(smp.times[k]) || (k > 0 && smp.times[k] < smp.times[k - 1]))
-          return Status::failure(where + ", sampler " + std::to_string(s) + ": key time " + std::to_string(k) +
-                                 " = " + number(smp.times[k]) + " is not finite or decreases");
+          return Status::failure(where + ", sampler " + std::to_string(s) + ": key time " + std::to_string(k) + " = " +
+                                 number(smp.times[k]) + " is not finite or decreases");
       maxTime = std::max(maxTime, double(smp.times.back()));
     }
     for (size_t c = 0; c < anim.channels.size(); ++c) {
@@ -391,8 +390,8 @@ Status ScenePose::evaluate(const Scene& scene, double time, std::span<const Anim
   for (const JointGroup& g : jointGroups_) {
     const Instance& inst = scene.instances[g.instance];
     const Skin& skin = scene.skins[size_t(inst.skin)];
-    const glm::dmat4 toLocal =
-        glm::inverse(inst.node >= 0 ? nodeWorld_[size_t(inst.node)] : glm::dmat4(inst.transform));
+    const glm::dmat4 toLocal = glm::inverse(inst.node >= 0 ? nodeWorld_[size_t(inst.node)]
+                                                           : glm::dmat4(inst.transform));
     for (size_t j = 0; j < skin.joints.size(); ++j) {
       glm::dmat4 m = toLocal * nodeWorld_[skin.joints[j]];
       if (!skin.inverseBindMatrices.empty()) m = m * glm::dmat4(skin.inverseBindMatrices[j]);
@@ -409,8 +408,7 @@ Status ScenePose::evaluate(const Scene& scene, double time, std::span<const Anim
       const MeshData& mesh = scene.meshes[inst.mesh];
       float* out = weights_.data() + r.weightOffset;
       for (uint32_t k = 0; k < r.weightCount; ++k) {
-        if (inst.node >= 0)
-          out[k] = float(nodeWeights_[nodeWeightOffset_[size_t(inst.node)] + k]);
+        if (inst.node >= 0) out[k] = float(nodeWeights_[nodeWeightOffset_[size_t(inst.node)] + k]);
         else
           out[k] = k < mesh.morphWeights.size() ? mesh.morphWeights[k] : 0.0f;
       }

@@ -76,8 +76,13 @@ std::string Deformer::create(Gpu& gpu, const VulkanContext& ctx) {
   VkShaderModule module = VK_NULL_HANDLE;
   SE_VK_TRY(vkCreateShaderModule(dev, &mci, nullptr, &module));
   VkComputePipelineCreateInfo pci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  pci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT, module,
-               "main", nullptr};
+  pci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+               nullptr,
+               0,
+               VK_SHADER_STAGE_COMPUTE_BIT,
+               module,
+               "main",
+               nullptr};
   pci.layout = layout_;
   VkResult r = vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &pci, nullptr, &pipeline_);
   vkDestroyShaderModule(dev, module, nullptr);
@@ -159,8 +164,8 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   if (ctx_->accelerationStructureEnabled)
     outputUsage |= VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
-  const VkBufferUsageFlags tableUsage =
-      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  const VkBufferUsageFlags tableUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
+                                        VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   sources_.resize(s.meshes.size());
   outputs_.resize(deforming.size() * 2);
   std::vector<SourceLayout> layouts(s.meshes.size());
@@ -214,8 +219,13 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
     job.vertexCount = uint32_t(mesh.positions.size());
     job.jointOffset = job.influences ? pose.jointOffset(i) : 0;
     job.weightOffset = job.targetCount ? pose.weightOffset(i) : 0;
-    instances_[k] = {i, inst.mesh, outputs_[2 * k].buffer, outputs_[2 * k].address, outputs_[2 * k + 1].buffer,
-                     outputs_[2 * k + 1].address, job.vertexCount};
+    instances_[k] = {i,
+                     inst.mesh,
+                     outputs_[2 * k].buffer,
+                     outputs_[2 * k].address,
+                     outputs_[2 * k + 1].buffer,
+                     outputs_[2 * k + 1].address,
+                     job.vertexCount};
     scene.instanceVertices[i] = {outputs_[2 * k].buffer, outputs_[2 * k + 1].buffer};
   }
   Buffer staging;
@@ -250,7 +260,8 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
     // The deformed buffers start as the bind pose, so they are valid before the first frame.
     for (const DeformedInstance& d : instances_) {
       const MeshBuffers& b = scene.buffers[d.mesh];
-      VkBufferCopy positions{0, 0, VkDeviceSize(d.vertexCount) * 12}, attributes{0, 0, VkDeviceSize(d.vertexCount) * 36};
+      VkBufferCopy positions{0, 0, VkDeviceSize(d.vertexCount) * 12},
+          attributes{0, 0, VkDeviceSize(d.vertexCount) * 36};
       vkCmdCopyBuffer(cmd, b.positions.buffer, d.positionBuffer, 1, &positions);
       vkCmdCopyBuffer(cmd, b.attributes.buffer, d.attributeBuffer, 1, &attributes);
     }

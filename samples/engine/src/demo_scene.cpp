@@ -20,8 +20,7 @@ TextureData makeChecker(uint32_t size, uint32_t checks, uint8_t light, uint8_t d
   return t;
 }
 
-uint32_t addMaterial(Scene& s, const char* name, glm::vec3 color, float metallic, float roughness,
-                     int texture = -1) {
+uint32_t addMaterial(Scene& s, const char* name, glm::vec3 color, float metallic, float roughness, int texture = -1) {
   s.materials.push_back(Material{.name = name,
                                  .baseColorFactor = glm::vec4(color, 1.0f),
                                  .metallicFactor = metallic,
@@ -88,8 +87,8 @@ Scene makeDefaultDemoScene() {
   // Mirror patch lying on the ground in front of the objects (a thin box so it has real thickness).
   place(s, addMesh(s, makeBox({3.0f, 0.02f, 1.8f}, 1), mirror), {0.0f, 0.01f, 4.2f});
 
-  s.camera = Camera{.eye = {0.0f, 4.2f, 12.5f}, .target = {0.0f, 1.2f, 0.0f}, .fovYDegrees = 50.0f,
-                    .zNear = 0.1f, .zFar = 200.0f};
+  s.camera = Camera{
+      .eye = {0.0f, 4.2f, 12.5f}, .target = {0.0f, 1.2f, 0.0f}, .fovYDegrees = 50.0f, .zNear = 0.1f, .zFar = 200.0f};
   s.sun = Sun{};
   return s;
 }

@@ -52,7 +52,7 @@ std::string Engine::Impl::init(const EngineConfig& config) {
                                          f.uniforms);
         !e.empty())
       return e;
-    VkDescriptorSetLayout layouts[kSetsPerFrame] = {pipelines.frameSetLayout,  pipelines.lightingSetLayout,
+    VkDescriptorSetLayout layouts[kSetsPerFrame] = {pipelines.frameSetLayout,   pipelines.lightingSetLayout,
                                                     pipelines.tonemapSetLayout, pipelines.screenSetLayout,
                                                     pipelines.screenSetLayout,  pipelines.screenSetLayout};
     VkDescriptorSet sets[kSetsPerFrame];
@@ -186,13 +186,15 @@ std::string Engine::Impl::createTargets(VkExtent2D extent) {
   destroyTargets();
   targets.extent = extent;
   const VkImageUsageFlags readable = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-  std::string e = gpu.createImage(
-      {kDepthFormat, extent, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | readable, VK_IMAGE_ASPECT_DEPTH_BIT},
-      targets.depth);
+  std::string e = gpu.createImage({kDepthFormat, extent, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | readable,
+                                   VK_IMAGE_ASPECT_DEPTH_BIT},
+                                  targets.depth);
   if (e.empty())
-    e = gpu.createImage({kNormalFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | readable}, targets.normalRoughness);
+    e = gpu.createImage({kNormalFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | readable},
+                        targets.normalRoughness);
   if (e.empty())
-    e = gpu.createImage({kNormalFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | readable}, targets.geometricNormal);
+    e = gpu.createImage({kNormalFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | readable},
+                        targets.geometricNormal);
   if (e.empty()) e = gpu.createImage({kHdrFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | readable}, targets.hdr);
   if (e.empty())
     e = gpu.createImage({kLdrFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT},
@@ -204,7 +206,9 @@ std::string Engine::Impl::createTargets(VkExtent2D extent) {
 std::string Engine::Impl::createShadowMap(uint32_t size) {
   gpu.destroy(targets.shadowMap);
   targets.shadowMapSize = size;
-  return gpu.createImage({kDepthFormat, {size, size}, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+  return gpu.createImage({kDepthFormat,
+                          {size, size},
+                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
                           VK_IMAGE_ASPECT_DEPTH_BIT},
                          targets.shadowMap);
 }
@@ -303,8 +307,10 @@ float halfToFloat(uint16_t h) {
       }
       bits = sign | (exp << 23) | ((mant & 0x3ff) << 13);
     }
-  } else if (exp == 31) bits = sign | 0x7f800000u | (mant << 13);
-  else bits = sign | ((exp + 127 - 15) << 23) | (mant << 13);
+  } else if (exp == 31)
+    bits = sign | 0x7f800000u | (mant << 13);
+  else
+    bits = sign | ((exp + 127 - 15) << 23) | (mant << 13);
   float f;
   std::memcpy(&f, &bits, 4);
   return f;
@@ -364,7 +370,8 @@ Result<ImageRGBA32F> Engine::readbackHdr() {
   if (Status s = waitIdle(); !s) return R::failure(s.error);
   if (!impl_->frameRendered) return R::failure("readbackHdr: no frame has been rendered");
   std::vector<uint8_t> raw;
-  if (std::string e = readImage(*impl_, impl_->targets.hdr, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 8, raw); !e.empty())
+  if (std::string e = readImage(*impl_, impl_->targets.hdr, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 8, raw);
+      !e.empty())
     return R::failure("readbackHdr: " + e);
   ImageRGBA32F img;
   img.width = impl_->targets.extent.width;

@@ -32,18 +32,18 @@ enum TimestampSlot : uint32_t {
 struct FrameResources {
   VkCommandPool pool = VK_NULL_HANDLE;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;           // signaled when the frame's GPU work is done
+  VkFence fence = VK_NULL_HANDLE;  // signaled when the frame's GPU work is done
   VkSemaphore imageAcquired = VK_NULL_HANDLE;
-  detail::Buffer uniforms;                  // FrameUniforms, host visible
+  detail::Buffer uniforms;  // FrameUniforms, host visible
   VkDescriptorSet frameSet = VK_NULL_HANDLE;
   VkDescriptorSet lightingSet = VK_NULL_HANDLE;
   VkDescriptorSet tonemapSet = VK_NULL_HANDLE;
-  VkDescriptorSet ssaoSet = VK_NULL_HANDLE;             // screen-pass inputs (Pipelines::screenSetLayout)
+  VkDescriptorSet ssaoSet = VK_NULL_HANDLE;  // screen-pass inputs (Pipelines::screenSetLayout)
   VkDescriptorSet ssaoBlurSet = VK_NULL_HANDLE;
   VkDescriptorSet shadowVisibilitySet = VK_NULL_HANDLE;
   VkQueryPool timestamps = VK_NULL_HANDLE;
-  bool timingsPending = false;              // submitted with timestamps, not read back yet
-  bool probeCaptured = false;               // this frame recorded a probe capture
+  bool timingsPending = false;  // submitted with timestamps, not read back yet
+  bool probeCaptured = false;   // this frame recorded a probe capture
   uint64_t frameNumber = 0;
 };
 
@@ -75,8 +75,8 @@ struct Engine::Impl {
   detail::Pipelines pipelines;
   detail::DefaultImages defaults;
   detail::GpuScene scene;
-  ScenePose pose;             // the loaded scene's, evaluated every frame
-  detail::Deformer deformer;  // skinning / morphing of the loaded scene's deforming instances
+  ScenePose pose;                                  // the loaded scene's, evaluated every frame
+  detail::Deformer deformer;                       // skinning / morphing of the loaded scene's deforming instances
   std::vector<VkSemaphoreSubmitInfo> submitWaits;  // the hook's additions to this frame's main submission
   std::vector<VkSemaphoreSubmitInfo> mainWaits;    // reused: all waits of the main submission
   bool sceneLoaded = false;

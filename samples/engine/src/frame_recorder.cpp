@@ -39,8 +39,7 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   // Without a shadow map a 1x1 placeholder stays bound (the shaders skip it: 0 PCF taps), so every
   // pipeline's descriptor sets keep their layout and the big map's memory is released.
   const bool shadowsOn = params.shadow.enabled;
-  const uint32_t shadowSize =
-      shadowsOn ? std::clamp(params.shadow.mapSize, kMinShadowMapSize, kMaxShadowMapSize) : 1u;
+  const uint32_t shadowSize = shadowsOn ? std::clamp(params.shadow.mapSize, kMinShadowMapSize, kMaxShadowMapSize) : 1u;
   const uint32_t taps = shadowsOn ? std::clamp(params.shadow.pcfKernelSize, 1u, kMaxShadowPcfKernel) : 0u;
   if (shadowSize != targets.shadowMapSize) {
     vkDeviceWaitIdle(ctx.device);  // frames in flight may still sample the old map
@@ -58,8 +57,8 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   std::optional<uint32_t> imageIndex;
   if (swapchain.swapchain) {
     uint32_t index = 0;
-    VkResult r = vkAcquireNextImageKHR(ctx.device, swapchain.swapchain, UINT64_MAX, frame.imageAcquired,
-                                       VK_NULL_HANDLE, &index);
+    VkResult r = vkAcquireNextImageKHR(ctx.device, swapchain.swapchain, UINT64_MAX, frame.imageAcquired, VK_NULL_HANDLE,
+                                       &index);
     if (r == VK_ERROR_OUT_OF_DATE_KHR) return createSwapchain(swapchain.extent.width, swapchain.extent.height);
     if (r != VK_SUCCESS && r != VK_SUBOPTIMAL_KHR) return vkFailure("vkAcquireNextImageKHR", r);
     imageIndex = index;
@@ -251,9 +250,9 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
     depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
     depth.clearValue.depthStencil = {1.0f, 0};
-    beginRendering(cmd, extent,
-                   {colorAttachment(targets.normalRoughness.view, {}), colorAttachment(targets.geometricNormal.view, {})},
-                   &depth);
+    beginRendering(
+        cmd, extent,
+        {colorAttachment(targets.normalRoughness.view, {}), colorAttachment(targets.geometricNormal.view, {})}, &depth);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.prepass);
     if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Prepass);
     vkCmdEndRendering(cmd);
@@ -262,7 +261,8 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
   imageBarrier(cmd, targets.depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                kDepthReadLayout, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-               VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+               VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                   VK_ACCESS_2_TRANSFER_READ_BIT);
   for (const Image* img : {&targets.normalRoughness, &targets.geometricNormal})
     imageBarrier(cmd, img->image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, kReadLayout,
                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
@@ -316,7 +316,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
   // External inputs win over the engine's own SSAO; the probe stays bound under an external reflection, as
   // the environment term where the reflection's alpha (coverage) is below 1.
   const VkImageView ao = inputs.ambientOcclusion ? inputs.ambientOcclusion
-                          : params.ssao.enabled  ? targets.ssao.view
+                         : params.ssao.enabled   ? targets.ssao.view
                                                  : VK_NULL_HANDLE;
   const bool useProbe = params.reflectionProbe.enabled && probe.captured();
   FrameUniforms u = uniformsIn;
@@ -357,8 +357,8 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
   timestamp(kTsLightingEnd);
 
   // (5) Tonemap into the 8-bit sRGB target, left in TRANSFER_SRC_OPTIMAL for readback / swapchain blit.
-  imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-               kReadLayout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+  imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, kReadLayout,
+               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
                VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
   imageBarrier(cmd, targets.ldr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,

@@ -73,8 +73,9 @@ std::string read(const tinygltf::Model& model, int accessorIndex, int components
   out.assign(acc.count * size_t(components), 0.0f);
   const size_t elementSize = size_t(compSize) * size_t(have);
   if (acc.bufferView >= 0) {  // without one, the base values are zeros (glTF)
-    const tinygltf::BufferView* view =
-        acc.bufferView < int(model.bufferViews.size()) ? &model.bufferViews[size_t(acc.bufferView)] : nullptr;
+    const tinygltf::BufferView* view = acc.bufferView < int(model.bufferViews.size())
+                                           ? &model.bufferViews[size_t(acc.bufferView)]
+                                           : nullptr;
     const size_t stride = view && view->byteStride ? view->byteStride : elementSize;
     const uint8_t* data = nullptr;
     if (std::string e = viewData(model, acc.bufferView, acc.byteOffset, acc.count, elementSize, stride, data);
@@ -82,8 +83,8 @@ std::string read(const tinygltf::Model& model, int accessorIndex, int components
       return name + ": " + e;
     for (size_t i = 0; i < acc.count; ++i)
       for (int c = 0; c < components; ++c)
-        out[i * size_t(components) + size_t(c)] =
-            readComponent(data + i * stride + size_t(c) * size_t(compSize), acc.componentType, acc.normalized);
+        out[i * size_t(components) + size_t(c)] = readComponent(data + i * stride + size_t(c) * size_t(compSize),
+                                                                acc.componentType, acc.normalized);
   }
   if (acc.sparse.isSparse) {
     const size_t count = size_t(std::max(acc.sparse.count, 0));
@@ -106,7 +107,8 @@ std::string read(const tinygltf::Model& model, int accessorIndex, int components
         uint16_t v;
         std::memcpy(&v, indices + i * 2, 2);
         index = v;
-      } else std::memcpy(&index, indices + i * 4, 4);
+      } else
+        std::memcpy(&index, indices + i * 4, 4);
       if (index >= acc.count)
         return name + ": sparse index " + std::to_string(index) + " is out of range (count " +
                std::to_string(acc.count) + ")";
@@ -143,11 +145,13 @@ std::string readIndices(const tinygltf::Model& model, int accessorIndex, std::ve
     for (size_t i = 0; i < f.size(); ++i) out[i] = uint32_t(f[i]);
     return {};
   }
-  const tinygltf::BufferView* view =
-      acc.bufferView < int(model.bufferViews.size()) ? &model.bufferViews[size_t(acc.bufferView)] : nullptr;
+  const tinygltf::BufferView* view = acc.bufferView < int(model.bufferViews.size())
+                                         ? &model.bufferViews[size_t(acc.bufferView)]
+                                         : nullptr;
   const size_t stride = view && view->byteStride ? view->byteStride : size_t(size);
   const uint8_t* data = nullptr;
-  if (std::string e = viewData(model, acc.bufferView, acc.byteOffset, acc.count, size_t(size), stride, data); !e.empty())
+  if (std::string e = viewData(model, acc.bufferView, acc.byteOffset, acc.count, size_t(size), stride, data);
+      !e.empty())
     return "index accessor " + std::to_string(accessorIndex) + ": " + e;
   out.resize(acc.count);
   for (size_t i = 0; i < acc.count; ++i) {
@@ -157,7 +161,8 @@ std::string readIndices(const tinygltf::Model& model, int accessorIndex, std::ve
       uint16_t v;
       std::memcpy(&v, p, 2);
       out[i] = v;
-    } else std::memcpy(&out[i], p, 4);
+    } else
+      std::memcpy(&out[i], p, 4);
   }
   return {};
 }

@@ -27,12 +27,15 @@ std::string convertNodes(const tinygltf::Model& model, Scene& scene) {
       for (int k = 0; k < 16; ++k) glm::value_ptr(m)[k] = float(in.matrix[size_t(k)]);  // column-major
       out.matrix = m;
     }
-    if (in.translation.size() == 3) out.translation = glm::vec3(in.translation[0], in.translation[1], in.translation[2]);
+    if (in.translation.size() == 3)
+      out.translation = glm::vec3(in.translation[0], in.translation[1], in.translation[2]);
     if (in.rotation.size() == 4)  // glTF stores x, y, z, w
-      out.rotation = glm::quat(float(in.rotation[3]), float(in.rotation[0]), float(in.rotation[1]), float(in.rotation[2]));
+      out.rotation = glm::quat(float(in.rotation[3]), float(in.rotation[0]), float(in.rotation[1]),
+                               float(in.rotation[2]));
     if (in.scale.size() == 3) out.scale = glm::vec3(in.scale[0], in.scale[1], in.scale[2]);
     const std::vector<double>* weights = &in.weights;
-    if (weights->empty() && in.mesh >= 0 && in.mesh < int(model.meshes.size())) weights = &model.meshes[size_t(in.mesh)].weights;
+    if (weights->empty() && in.mesh >= 0 && in.mesh < int(model.meshes.size()))
+      weights = &model.meshes[size_t(in.mesh)].weights;
     for (double w : *weights) out.weights.push_back(float(w));
   }
   for (int p = 0; p < count; ++p)
@@ -88,9 +91,12 @@ std::string convertAnimations(const tinygltf::Model& model, Scene& scene, std::v
       const std::string at = where + ", sampler " + std::to_string(s);
       AnimationSampler o;
       if (smp.interpolation == "LINEAR" || smp.interpolation.empty()) o.interpolation = AnimationInterpolation::Linear;
-      else if (smp.interpolation == "STEP") o.interpolation = AnimationInterpolation::Step;
-      else if (smp.interpolation == "CUBICSPLINE") o.interpolation = AnimationInterpolation::CubicSpline;
-      else return at + ": unknown interpolation '" + smp.interpolation + "' (LINEAR, STEP or CUBICSPLINE)";
+      else if (smp.interpolation == "STEP")
+        o.interpolation = AnimationInterpolation::Step;
+      else if (smp.interpolation == "CUBICSPLINE")
+        o.interpolation = AnimationInterpolation::CubicSpline;
+      else
+        return at + ": unknown interpolation '" + smp.interpolation + "' (LINEAR, STEP or CUBICSPLINE)";
       if (std::string e = readFloats(model, smp.input, 1, o.times); !e.empty()) return at + ", input: " + e;
       if (o.times.empty()) return at + ": input accessor " + std::to_string(smp.input) + " has no keys";
       int components = 0;
@@ -122,9 +128,12 @@ std::string convertAnimations(const tinygltf::Model& model, Scene& scene, std::v
       o.node = uint32_t(ch.target_node);
       int expected = 1;
       if (ch.target_path == "translation") o.path = AnimationPath::Translation, expected = 3;
-      else if (ch.target_path == "rotation") o.path = AnimationPath::Rotation, expected = 4;
-      else if (ch.target_path == "scale") o.path = AnimationPath::Scale, expected = 3;
-      else if (ch.target_path == "weights") o.path = AnimationPath::Weights, expected = 1;
+      else if (ch.target_path == "rotation")
+        o.path = AnimationPath::Rotation, expected = 4;
+      else if (ch.target_path == "scale")
+        o.path = AnimationPath::Scale, expected = 3;
+      else if (ch.target_path == "weights")
+        o.path = AnimationPath::Weights, expected = 1;
       else {
         warnings.push_back(at + ": path '" + ch.target_path + "' is not supported; ignored");
         continue;

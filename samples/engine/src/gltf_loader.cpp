@@ -49,8 +49,8 @@ struct Loader {
   SceneLoadResult& result;
   std::map<int, std::vector<uint32_t>> meshPrimitives;  // glTF mesh -> Scene mesh indices
   std::vector<std::pair<int, int>> meshOrigin;          // Scene mesh -> glTF (mesh, primitive)
-  std::set<std::pair<int, uint32_t>> checkedSkins;       // (skin, Scene mesh) pairs already validated
-  std::string error;                                     // the first fatal problem
+  std::set<std::pair<int, uint32_t>> checkedSkins;      // (skin, Scene mesh) pairs already validated
+  std::string error;                                    // the first fatal problem
 
   void fail(std::string message) {
     if (error.empty()) error = std::move(message);
@@ -146,7 +146,8 @@ struct Loader {
   }
 
   // Reads a required per-vertex attribute of `comps` floats; a problem is fatal (the mesh could not animate).
-  bool readVertexAttribute(int accessor, const std::string& what, int comps, size_t vertexCount, std::vector<float>& f) {
+  bool readVertexAttribute(int accessor, const std::string& what, int comps, size_t vertexCount,
+                           std::vector<float>& f) {
     if (std::string e = readFloats(model, accessor, comps, f); !e.empty()) {
       fail(what + ": " + e);
       return false;
@@ -206,8 +207,8 @@ struct Loader {
     const MeshData& mesh = result.scene.meshes[m];
     const std::string skinName = "skin " + std::to_string(skinIndex) + " '" + skin.name + "'";
     const auto [gltfMesh, primitive] = meshOrigin[m];
-    const std::string where =
-        "mesh " + std::to_string(gltfMesh) + " '" + model.meshes[size_t(gltfMesh)].name + "' primitive " + std::to_string(primitive);
+    const std::string where = "mesh " + std::to_string(gltfMesh) + " '" + model.meshes[size_t(gltfMesh)].name +
+                              "' primitive " + std::to_string(primitive);
     const size_t jointCount = skin.joints.size();
     for (size_t v = 0; v < mesh.positions.size(); ++v) {
       float sum = 0.0f;
@@ -248,7 +249,8 @@ struct Loader {
     if (nodeIndex < 0 || nodeIndex >= int(model.nodes.size()))
       return fail("scene node " + std::to_string(nodeIndex) + " is out of range (the file has " +
                   std::to_string(model.nodes.size()) + " nodes)");
-    if (depth > 1024) return fail("node " + std::to_string(nodeIndex) + ": the hierarchy is deeper than 1024 (a cycle?)");
+    if (depth > 1024)
+      return fail("node " + std::to_string(nodeIndex) + ": the hierarchy is deeper than 1024 (a cycle?)");
     const tinygltf::Node& node = model.nodes[size_t(nodeIndex)];
     glm::mat4 world = parent * result.scene.nodes[size_t(nodeIndex)].localTransform();
     const std::string name = "node " + std::to_string(nodeIndex) + " '" + node.name + "'";
@@ -357,7 +359,8 @@ SceneLoadResult loadGltf(const std::string& path) {
     }
     if (result.scene.instances.empty()) result.error = "glTF '" + path + "' contains no renderable triangles";
     // Whatever the checks above did not name in glTF terms (e.g. a cycle among unvisited nodes).
-    else if (Status s = ScenePose().reset(result.scene); !s) result.error = "glTF '" + path + "': " + s.error;
+    else if (Status s = ScenePose().reset(result.scene); !s)
+      result.error = "glTF '" + path + "': " + s.error;
   } catch (const std::exception& e) {
     result.error = std::string("glTF loading failed: ") + e.what();
   }

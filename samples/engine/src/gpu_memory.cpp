@@ -26,8 +26,7 @@ uint32_t Gpu::memoryType(uint32_t bits, VkMemoryPropertyFlags props) const {
   return UINT32_MAX;
 }
 
-std::string Gpu::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags props,
-                              Buffer& out) {
+std::string Gpu::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags props, Buffer& out) {
   out = {};
   out.size = size;
   VkBufferCreateInfo ci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
@@ -46,7 +45,8 @@ std::string Gpu::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMem
   if (ai.memoryTypeIndex == UINT32_MAX) return "no memory type for buffer";
   SE_VK_TRY(vkAllocateMemory(device_, &ai, nullptr, &out.memory));
   SE_VK_TRY(vkBindBufferMemory(device_, out.buffer, out.memory, 0));
-  if (props & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) SE_VK_TRY(vkMapMemory(device_, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped));
+  if (props & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)
+    SE_VK_TRY(vkMapMemory(device_, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped));
   if (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) {
     VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
     info.buffer = out.buffer;

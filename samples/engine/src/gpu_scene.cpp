@@ -108,9 +108,11 @@ std::string uploadTextures(Gpu& gpu, bool mips, std::vector<std::pair<Image*, co
   VkDeviceSize offset = 0;
   std::string e;
   for (auto& [img, data] : textures) {
-    ImageDesc desc{VK_FORMAT_R8G8B8A8_UNORM, {data->width, data->height},
+    ImageDesc desc{VK_FORMAT_R8G8B8A8_UNORM,
+                   {data->width, data->height},
                    VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                   VK_IMAGE_ASPECT_COLOR_BIT, mips ? mipCount(data->width, data->height) : 1u,
+                   VK_IMAGE_ASPECT_COLOR_BIT,
+                   mips ? mipCount(data->width, data->height) : 1u,
                    VK_FORMAT_R8G8B8A8_SRGB};
     if (e = gpu.createImage(desc, *img); !e.empty()) break;
     std::memcpy(static_cast<char*>(staging.mapped) + offset, data->rgba8.data(), data->rgba8.size());
@@ -128,8 +130,8 @@ std::string uploadTextures(Gpu& gpu, bool mips, std::vector<std::pair<Image*, co
 bool canBlitMips(VkPhysicalDevice pd) {
   VkFormatProperties p;
   vkGetPhysicalDeviceFormatProperties(pd, VK_FORMAT_R8G8B8A8_UNORM, &p);
-  const VkFormatFeatureFlags need =
-      VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
+  const VkFormatFeatureFlags need = VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT |
+                                    VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
   return (p.optimalTilingFeatures & need) == need;
 }
 
@@ -152,8 +154,8 @@ bool deforms(const Scene& scene, const Instance& instance) {
   return instance.skin >= 0 || scene.meshes[instance.mesh].morphed();
 }
 
-std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pipelines,
-                        const DefaultImages& defaults, const Scene& scene, ScenePose& pose, GpuScene& out) {
+std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pipelines, const DefaultImages& defaults,
+                        const Scene& scene, ScenePose& pose, GpuScene& out) {
   out.cpu = scene;
   finalizeScene(out.cpu);
   const Scene& s = out.cpu;
@@ -164,7 +166,8 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
   VkBufferUsageFlags rtUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   if (ctx.info.bufferDeviceAddress) {
     rtUsage |= VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
-    if (ctx.accelerationStructureEnabled) rtUsage |= VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
+    if (ctx.accelerationStructureEnabled)
+      rtUsage |= VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
   }
   // The deformation pass reads the bind pose of deforming meshes by device address, and the deformed buffers
   // start as copies of it.
@@ -184,9 +187,9 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     for (size_t v = 0; v < mesh.positions.size(); ++v)
       attributes[m][v] = {mesh.normals[v], mesh.uvs[v], mesh.tangents[v]};
     stagingSize += mesh.positions.size() * 12 + attributes[m].size() * 36 + mesh.indices.size() * 4;
-    const VkBufferUsageFlags vertexUsage =
-        VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | rtUsage |
-        (deformedMesh[m] ? VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT : 0);
+    const VkBufferUsageFlags vertexUsage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                           VK_BUFFER_USAGE_TRANSFER_SRC_BIT | rtUsage |
+                                           (deformedMesh[m] ? VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT : 0);
     MeshBuffers& b = out.buffers[m];
     if (!mesh.positions.empty()) {
       requests.push_back({mesh.positions.size() * 12, vertexUsage, &b.positions, {}});
@@ -291,15 +294,15 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
       if (texture < 0 || !out.textures[texture].image) return fallback.view;
       return srgb ? out.textures[texture].altView : out.textures[texture].view;
     };
-    VkDescriptorImageInfo infos[4] = {
-        {pipelines.materialSampler, view(mat.baseColorTexture, defaults.white, true),
-         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-        {pipelines.materialSampler, view(mat.metallicRoughnessTexture, defaults.white, false),
-         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-        {pipelines.materialSampler, view(mat.normalTexture, defaults.flatNormal, false),
-         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-        {pipelines.materialSampler, view(mat.emissiveTexture, defaults.white, true),
-         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
+    VkDescriptorImageInfo infos[4] = {{pipelines.materialSampler, view(mat.baseColorTexture, defaults.white, true),
+                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                                      {pipelines.materialSampler,
+                                       view(mat.metallicRoughnessTexture, defaults.white, false),
+                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                                      {pipelines.materialSampler, view(mat.normalTexture, defaults.flatNormal, false),
+                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                                      {pipelines.materialSampler, view(mat.emissiveTexture, defaults.white, true),
+                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     w.dstSet = out.materialSets[m];
     w.descriptorCount = 4;

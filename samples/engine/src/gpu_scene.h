@@ -15,9 +15,9 @@ namespace sample_engine::detail {
 
 // 1x1 fallback textures bound where a material or lighting input has nothing.
 struct DefaultImages {
-  Image white;      // RGBA8 UNORM (1,1,1,1): base color, metallic-roughness, visibility, AO
-  Image black;      // RGBA8 UNORM (0,0,0,0): reflection
-  Image flatNormal; // RGBA8 UNORM (0.5,0.5,1): tangent-space +Z
+  Image white;       // RGBA8 UNORM (1,1,1,1): base color, metallic-roughness, visibility, AO
+  Image black;       // RGBA8 UNORM (0,0,0,0): reflection
+  Image flatNormal;  // RGBA8 UNORM (0.5,0.5,1): tangent-space +Z
   std::string create(Gpu& gpu);
   void destroy(Gpu& gpu);
 };
@@ -27,7 +27,7 @@ struct MeshBuffers {
 };
 
 struct GpuScene {
-  Scene cpu;  // finalized copy; GpuMesh::cpu points into it
+  Scene cpu;                         // finalized copy; GpuMesh::cpu points into it
   std::vector<MeshBuffers> buffers;  // bound into memoryBlocks
   std::vector<VkDeviceMemory> memoryBlocks;
   std::vector<GpuMesh> meshes;
@@ -48,8 +48,8 @@ bool deforms(const Scene& scene, const Instance& instance);
 
 // Copies and finalizes `scene`, checks its animation data with pose.reset() (nothing is uploaded when that
 // fails), then uploads it.
-std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pipelines,
-                        const DefaultImages& defaults, const Scene& scene, ScenePose& pose, GpuScene& out);
+std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pipelines, const DefaultImages& defaults,
+                        const Scene& scene, ScenePose& pose, GpuScene& out);
 void destroyScene(Gpu& gpu, GpuScene& scene);
 
 }  // namespace sample_engine::detail

@@ -19,8 +19,7 @@ namespace sample_engine {
 Status writePng(const std::string& path, const ImageRGBA8& image) {
   if (image.width == 0 || image.height == 0 || image.pixels.size() != size_t(image.width) * image.height * 4)
     return Status::failure("writePng: empty or inconsistent image");
-  if (!stbi_write_png(path.c_str(), int(image.width), int(image.height), 4, image.pixels.data(),
-                      int(image.width * 4)))
+  if (!stbi_write_png(path.c_str(), int(image.width), int(image.height), 4, image.pixels.data(), int(image.width * 4)))
     return Status::failure("writePng: cannot write " + path);
   return Status::success();
 }
@@ -46,8 +45,8 @@ Status writeExr(const std::string& path, const ImageRGBA32F& image, bool halfFlo
       Imf::FrameBuffer fb;
       char* base = reinterpret_cast<char*>(const_cast<float*>(image.pixels.data()));
       for (int c = 0; c < 4; ++c)
-        fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 4 * sizeof(float),
-                                       4 * sizeof(float) * size_t(w)));
+        fb.insert(names[c],
+                  Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 4 * sizeof(float), 4 * sizeof(float) * size_t(w)));
       file.setFrameBuffer(fb);
       file.writePixels(h);
     }

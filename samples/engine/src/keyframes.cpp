@@ -68,8 +68,7 @@ void sample(const AnimationSampler& smp, uint32_t width, bool rotation, const Ke
     const float* a1 = &smp.values[k1 * stride];
     const double s2 = s * s, s3 = s2 * s;
     const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
-    for (uint32_t c = 0; c < width; ++c)
-      out[c] = h00 * v0[c] + td * h10 * b0[c] + h01 * v1[c] + td * h11 * a1[c];
+    for (uint32_t c = 0; c < width; ++c) out[c] = h00 * v0[c] + td * h10 * b0[c] + h01 * v1[c] + td * h11 * a1[c];
     if (rotation) {
       const double len = std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2] + out[3] * out[3]);
       if (len > 0.0)

@@ -45,11 +45,11 @@ struct PipelineDesc {
 
 std::string makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out) {
   std::vector<VkPipelineShaderStageCreateInfo> stages;
-  stages.push_back({VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT,
-                    d.vert, "main", nullptr});
+  stages.push_back({VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT, d.vert,
+                    "main", nullptr});
   if (d.frag)
-    stages.push_back({VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
-                      VK_SHADER_STAGE_FRAGMENT_BIT, d.frag, "main", nullptr});
+    stages.push_back({VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT,
+                      d.frag, "main", nullptr});
   std::vector<VkVertexInputBindingDescription> bindings;
   std::vector<VkVertexInputAttributeDescription> attributes;
   if (d.sceneVertices || d.positionsOnly) {
@@ -153,8 +153,7 @@ std::string Pipelines::create(VkDevice device) {
                       screenSetLayout));
   if (!e.empty()) return e;
 
-  VkPushConstantRange drawRange{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                                sizeof(DrawConstants)};
+  VkPushConstantRange drawRange{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(DrawConstants)};
   VkDescriptorSetLayout sets[3] = {frameSetLayout, materialSetLayout, lightingSetLayout};
   VkPipelineLayoutCreateInfo lci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   lci.setLayoutCount = 3;
@@ -240,8 +239,8 @@ std::string Pipelines::create(VkDevice device) {
     if (m) vkDestroyShaderModule(device, m, nullptr);
   if (!e.empty()) return e;
 
-  check(makeSampler(device, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, false, VK_LOD_CLAMP_NONE,
-                    materialSampler));
+  check(
+      makeSampler(device, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, false, VK_LOD_CLAMP_NONE, materialSampler));
   check(makeSampler(device, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, 0.0f, screenSampler));
   check(makeSampler(device, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER, true, 0.0f, shadowSampler));
   check(makeSampler(device, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, 0.0f, nearestSampler));

@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include <glm/glm.hpp>
 #include <vulkan/vulkan.h>
+#include <glm/glm.hpp>
 
 namespace sample_engine::detail {
 
@@ -67,7 +67,7 @@ struct Pipelines {
   VkSampler screenSampler = VK_NULL_HANDLE;    // bilinear, clamp: external screen-space inputs
   VkSampler shadowSampler = VK_NULL_HANDLE;    // comparison LESS_OR_EQUAL, bilinear PCF
   VkSampler nearestSampler = VK_NULL_HANDLE;
-  VkSampler cubeSampler = VK_NULL_HANDLE;      // trilinear, clamp: reflection probe
+  VkSampler cubeSampler = VK_NULL_HANDLE;  // trilinear, clamp: reflection probe
 
   std::string create(VkDevice device);
   void destroy(VkDevice device);

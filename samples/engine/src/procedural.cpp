@@ -65,9 +65,9 @@ MeshData makeBox(const glm::vec3& size, uint32_t segments) {
     glm::vec3 n, u, v;
   };
   // cross(u, v) = n for every face, so the grid pattern winds outward.
-  const Face faces[6] = {{{1, 0, 0}, {0, 0, -1}, {0, 1, 0}},  {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
-                         {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}},  {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
-                         {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},   {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}}};
+  const Face faces[6] = {{{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
+                         {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
+                         {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}}};
   Builder b;
   b.mesh.name = "box";
   const glm::vec3 half = size * 0.5f;
@@ -149,15 +149,15 @@ MeshData makeCylinder(float radius, float height, uint32_t slices, uint32_t heig
       }
       for (uint32_t i = 0; i < slices; ++i) {
         if (top) b.tri(center, center + 1 + i, center + 2 + i);
-        else b.tri(center, center + 2 + i, center + 1 + i);
+        else
+          b.tri(center, center + 2 + i, center + 1 + i);
       }
     }
   }
   return b.mesh;
 }
 
-MeshData makeArch(float majorRadius, float minorRadius, float arcRadians, uint32_t arcSegments,
-                  uint32_t tubeSegments) {
+MeshData makeArch(float majorRadius, float minorRadius, float arcRadians, uint32_t arcSegments, uint32_t tubeSegments) {
   arcSegments = std::max(arcSegments, 1u);
   tubeSegments = std::max(tubeSegments, 3u);
   Builder b;

@@ -98,9 +98,13 @@ std::string ReflectionProbe::create(Gpu& gpu, const VulkanContext& ctx, const Pi
     }
   }
 
-  if (std::string e = gpu.createImage({VK_FORMAT_R8G8B8A8_UNORM, {1, 1},
+  if (std::string e = gpu.createImage({VK_FORMAT_R8G8B8A8_UNORM,
+                                       {1, 1},
                                        VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                                       VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_FORMAT_UNDEFINED, true},
+                                       VK_IMAGE_ASPECT_COLOR_BIT,
+                                       1,
+                                       VK_FORMAT_UNDEFINED,
+                                       true},
                                       fallback_);
       !e.empty())
     return e;
@@ -143,13 +147,19 @@ std::string ReflectionProbe::prepare(uint32_t resolution) {
   if (cube_.image) vkDeviceWaitIdle(device_);
   destroyCube();
   const uint32_t mips = uint32_t(std::bit_width(resolution));  // down to 1x1
-  std::string e = gpu_->createImage({kHdrFormat, {resolution, resolution},
+  std::string e = gpu_->createImage({kHdrFormat,
+                                     {resolution, resolution},
                                      VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
                                          VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                                     VK_IMAGE_ASPECT_COLOR_BIT, mips, VK_FORMAT_UNDEFINED, true},
+                                     VK_IMAGE_ASPECT_COLOR_BIT,
+                                     mips,
+                                     VK_FORMAT_UNDEFINED,
+                                     true},
                                     cube_);
   if (e.empty())
-    e = gpu_->createImage({kDepthFormat, {resolution, resolution}, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
+    e = gpu_->createImage({kDepthFormat,
+                           {resolution, resolution},
+                           VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
                            VK_IMAGE_ASPECT_DEPTH_BIT},
                           depth_);
   for (uint32_t f = 0; f < 6 && e.empty(); ++f) {
@@ -165,9 +175,8 @@ std::string ReflectionProbe::prepare(uint32_t resolution) {
   return e;
 }
 
-void ReflectionProbe::recordCapture(VkCommandBuffer cmd, uint32_t slot, const FrameUniforms& base,
-                                    const ProbeKey& key, const GpuScene* scene, VkImageView shadowMap,
-                                    const DefaultImages& defaults) {
+void ReflectionProbe::recordCapture(VkCommandBuffer cmd, uint32_t slot, const FrameUniforms& base, const ProbeKey& key,
+                                    const GpuScene* scene, VkImageView shadowMap, const DefaultImages& defaults) {
   const Pipelines& p = *pipelines_;
   SlotResources& res = slots_[slot];
   const uint32_t size = cube_.extent.width;
@@ -236,7 +245,8 @@ void ReflectionProbe::recordCapture(VkCommandBuffer cmd, uint32_t slot, const Fr
   // Mip chain by successive 2x box blits of all six faces: roughness picks the mip in the lighting pass.
   imageBarrier(cmd, cube_.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_BLIT_BIT, VK_ACCESS_2_TRANSFER_READ_BIT, 0, 1);
+               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_BLIT_BIT, VK_ACCESS_2_TRANSFER_READ_BIT, 0,
+               1);
   for (uint32_t level = 1; level < cube_.mipLevels; ++level) {
     const int32_t src = int32_t(std::max(size >> (level - 1), 1u)), dst = int32_t(std::max(size >> level, 1u));
     VkImageBlit blit{};

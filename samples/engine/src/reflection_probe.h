@@ -68,10 +68,10 @@ class ReflectionProbe {
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDeviceSize uniformStride_ = 0;
   std::array<SlotResources, kFramesInFlight> slots_;
-  Image fallback_;  // 1x1 black cube
-  Image cube_;      // RGBA16F cube with mips
+  Image fallback_;                          // 1x1 black cube
+  Image cube_;                              // RGBA16F cube with mips
   std::array<VkImageView, 6> faceViews_{};  // mip 0 of each face, render targets
-  Image depth_;     // one face's depth, reused by every face
+  Image depth_;                             // one face's depth, reused by every face
   bool captured_ = false;
   ProbeKey key_;
 };

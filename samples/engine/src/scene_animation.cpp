@@ -10,8 +10,7 @@ namespace sample_engine {
 
 glm::mat4 Node::localTransform() const {
   if (matrix) return *matrix;
-  return glm::translate(glm::mat4(1.0f), translation) * glm::mat4_cast(rotation) *
-         glm::scale(glm::mat4(1.0f), scale);
+  return glm::translate(glm::mat4(1.0f), translation) * glm::mat4_cast(rotation) * glm::scale(glm::mat4(1.0f), scale);
 }
 
 std::optional<uint32_t> Scene::animationIndex(std::string_view nameOrNumber) const {

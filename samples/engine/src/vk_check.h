@@ -14,8 +14,8 @@ inline std::string vkFailure(const char* what, VkResult r) { return std::string(
 }  // namespace sample_engine::detail
 
 // Evaluates a Vulkan call; on failure returns (from the enclosing function) an error string or Status.
-#define SE_VK_TRY(call)                                                            \
-  do {                                                                             \
-    VkResult se_vk_result_ = (call);                                               \
+#define SE_VK_TRY(call)                                                                               \
+  do {                                                                                                \
+    VkResult se_vk_result_ = (call);                                                                  \
     if (se_vk_result_ != VK_SUCCESS) return ::sample_engine::detail::vkFailure(#call, se_vk_result_); \
   } while (0)

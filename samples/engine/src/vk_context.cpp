@@ -16,13 +16,24 @@ std::string vkResultName(VkResult r) {
   switch (r) {
 #define SE_CASE(x) \
   case x: return #x;
-    SE_CASE(VK_SUCCESS) SE_CASE(VK_NOT_READY) SE_CASE(VK_TIMEOUT) SE_CASE(VK_INCOMPLETE)
-    SE_CASE(VK_SUBOPTIMAL_KHR) SE_CASE(VK_ERROR_OUT_OF_HOST_MEMORY) SE_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
-    SE_CASE(VK_ERROR_INITIALIZATION_FAILED) SE_CASE(VK_ERROR_DEVICE_LOST) SE_CASE(VK_ERROR_MEMORY_MAP_FAILED)
-    SE_CASE(VK_ERROR_LAYER_NOT_PRESENT) SE_CASE(VK_ERROR_EXTENSION_NOT_PRESENT)
-    SE_CASE(VK_ERROR_FEATURE_NOT_PRESENT) SE_CASE(VK_ERROR_INCOMPATIBLE_DRIVER)
-    SE_CASE(VK_ERROR_TOO_MANY_OBJECTS) SE_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED)
-    SE_CASE(VK_ERROR_SURFACE_LOST_KHR) SE_CASE(VK_ERROR_OUT_OF_DATE_KHR)
+    SE_CASE(VK_SUCCESS)
+    SE_CASE(VK_NOT_READY)
+    SE_CASE(VK_TIMEOUT)
+    SE_CASE(VK_INCOMPLETE)
+    SE_CASE(VK_SUBOPTIMAL_KHR)
+    SE_CASE(VK_ERROR_OUT_OF_HOST_MEMORY)
+    SE_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
+    SE_CASE(VK_ERROR_INITIALIZATION_FAILED)
+    SE_CASE(VK_ERROR_DEVICE_LOST)
+    SE_CASE(VK_ERROR_MEMORY_MAP_FAILED)
+    SE_CASE(VK_ERROR_LAYER_NOT_PRESENT)
+    SE_CASE(VK_ERROR_EXTENSION_NOT_PRESENT)
+    SE_CASE(VK_ERROR_FEATURE_NOT_PRESENT)
+    SE_CASE(VK_ERROR_INCOMPATIBLE_DRIVER)
+    SE_CASE(VK_ERROR_TOO_MANY_OBJECTS)
+    SE_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED)
+    SE_CASE(VK_ERROR_SURFACE_LOST_KHR)
+    SE_CASE(VK_ERROR_OUT_OF_DATE_KHR)
     SE_CASE(VK_ERROR_NATIVE_WINDOW_IN_USE_KHR)
 #undef SE_CASE
     default: return "VkResult(" + std::to_string(int(r)) + ")";
@@ -100,8 +111,8 @@ std::string VulkanContext::create(const EngineConfig& config) {
   app.pEngineName = "raybridge-sample-engine";
   app.apiVersion = VK_API_VERSION_1_3;
   VkDebugUtilsMessengerCreateInfoEXT messengerInfo{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  messengerInfo.messageSeverity =
-      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  messengerInfo.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                                  VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
   messengerInfo.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
                               VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                               VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
@@ -181,7 +192,8 @@ std::string VulkanContext::create(const EngineConfig& config) {
     }
     candidates.push_back(c);
   }
-  if (candidates.empty()) return "no suitable Vulkan 1.3 device found:" + (rejected.empty() ? std::string(" none enumerated") : rejected);
+  if (candidates.empty())
+    return "no suitable Vulkan 1.3 device found:" + (rejected.empty() ? std::string(" none enumerated") : rejected);
   auto chosen = std::find_if(candidates.begin(), candidates.end(), [](const Candidate& c) {
     return c.props.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU;
   });
@@ -213,7 +225,7 @@ std::string VulkanContext::create(const EngineConfig& config) {
   f13.dynamicRendering = VK_TRUE;
   f13.synchronization2 = VK_TRUE;
   f12.separateDepthStencilLayouts = VK_TRUE;  // lets the pre-pass depth sit in DEPTH_READ_ONLY_OPTIMAL
-  f12.timelineSemaphore = VK_TRUE;  // the deformation submission signals a timeline semaphore per frame
+  f12.timelineSemaphore = VK_TRUE;            // the deformation submission signals a timeline semaphore per frame
   // Required by Vulkan 1.3, so always on: the deformation pass reads and writes vertex buffers through
   // device addresses. Scene buffers expose addresses only with enableRayTracingInputs (info.bufferDeviceAddress).
   f12.bufferDeviceAddress = supported12.bufferDeviceAddress;

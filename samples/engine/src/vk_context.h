@@ -22,10 +22,10 @@ struct VulkanContext {
   VkDevice device = VK_NULL_HANDLE;
   VkQueue queue = VK_NULL_HANDLE;
   uint32_t queueFamily = 0;
-  VkQueue asyncComputeQueue = VK_NULL_HANDLE;   // EngineConfig::requestAsyncComputeQueue and the device has one
-  uint32_t asyncComputeFamily = UINT32_MAX;     // a COMPUTE family without GRAPHICS
-  bool bufferDeviceAddressFeature = false;      // enabled (the deformation pass needs it), whatever
-                                                // info.bufferDeviceAddress says about scene buffers
+  VkQueue asyncComputeQueue = VK_NULL_HANDLE;  // EngineConfig::requestAsyncComputeQueue and the device has one
+  uint32_t asyncComputeFamily = UINT32_MAX;    // a COMPUTE family without GRAPHICS
+  bool bufferDeviceAddressFeature = false;     // enabled (the deformation pass needs it), whatever
+                                               // info.bufferDeviceAddress says about scene buffers
   DeviceInfo info;
   std::vector<std::string> deviceExtensions;
   bool swapchainEnabled = false;

@@ -52,14 +52,17 @@ std::vector<std::string> Window::requiredInstanceExtensions() const {
 Result<VkSurfaceKHR> Window::createSurface(VkInstance instance) const {
   VkSurfaceKHR surface = VK_NULL_HANDLE;
   VkResult r = glfwCreateWindowSurface(instance, handle(window_), nullptr, &surface);
-  if (r != VK_SUCCESS) return Result<VkSurfaceKHR>::failure("glfwCreateWindowSurface failed: " + std::to_string(int(r)));
+  if (r != VK_SUCCESS)
+    return Result<VkSurfaceKHR>::failure("glfwCreateWindowSurface failed: " + std::to_string(int(r)));
   return Result<VkSurfaceKHR>::success(surface);
 }
 
 bool Window::shouldClose() const { return glfwWindowShouldClose(handle(window_)); }
 void Window::requestClose() { glfwSetWindowShouldClose(handle(window_), GLFW_TRUE); }
 void Window::pollEvents() { glfwPollEvents(); }
-void Window::framebufferSize(int& width, int& height) const { glfwGetFramebufferSize(handle(window_), &width, &height); }
+void Window::framebufferSize(int& width, int& height) const {
+  glfwGetFramebufferSize(handle(window_), &width, &height);
+}
 
 
 bool Window::keyDown(Key key) const {

@@ -200,8 +200,8 @@ TEST_CASE("an async compute queue is a compute family without graphics, or none"
 
 TEST_CASE("bad animation input fails with messages naming the value", "[animation][errors]") {
   SECTION("a joint index beyond the skin's joints") {
-    SceneLoadResult r =
-        loadGltf(writeFixture("sample_engine_bad_joint.gltf", pose_reference::writeSkinnedStripBadJoint));
+    SceneLoadResult r = loadGltf(
+        writeFixture("sample_engine_bad_joint.gltf", pose_reference::writeSkinnedStripBadJoint));
     INFO(r.error);
     REQUIRE_FALSE(r.ok());
     CHECK(r.error.find("vertex 7") != std::string::npos);
@@ -211,8 +211,8 @@ TEST_CASE("bad animation input fails with messages naming the value", "[animatio
     CHECK(r.error.find("skin 0") != std::string::npos);
   }
   SECTION("a skinned vertex whose weights sum to zero") {
-    SceneLoadResult r =
-        loadGltf(writeFixture("sample_engine_zero_weights.gltf", pose_reference::writeSkinnedStripZeroWeights));
+    SceneLoadResult r = loadGltf(
+        writeFixture("sample_engine_zero_weights.gltf", pose_reference::writeSkinnedStripZeroWeights));
     INFO(r.error);
     REQUIRE_FALSE(r.ok());
     CHECK(r.error.find("vertex 5") != std::string::npos);
@@ -220,7 +220,8 @@ TEST_CASE("bad animation input fails with messages naming the value", "[animatio
   }
   SECTION("renderFrame: bad times and animation indices") {
     auto engine = makeEngine();
-    REQUIRE(engine->loadScene(
+    REQUIRE(engine
+                ->loadScene(
                     loadGltfScene(writeFixture("sample_engine_skinned_strip.gltf", pose_reference::writeSkinnedStrip)))
                 .ok());
     REQUIRE(engine->setRenderSize(kSize, kSize).ok());
@@ -366,8 +367,8 @@ TEST_CASE("many animated characters: timings", "[.perf][animation]") {
   REQUIRE(pose.reset(engine->scene()).ok());
   const auto e0 = std::chrono::steady_clock::now();
   for (uint32_t f = 0; f < frames; ++f) REQUIRE(pose.evaluate(engine->scene(), f / 30.0, playbacks, false).ok());
-  const double evaluateMs =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - e0).count() / std::max(frames, 1u);
+  const double evaluateMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - e0).count() /
+                            std::max(frames, 1u);
   size_t vertices = 0;
   for (const DeformedInstance& d : engine->deformedInstances()) vertices += d.vertexCount;
   std::printf("%u characters, %zu deformed instances, %zu deformed vertices, %ux%u on %s (async compute family %d, "
@@ -376,14 +377,15 @@ TEST_CASE("many animated characters: timings", "[.perf][animation]") {
               "GPU deform %.3f ms, shadow %.3f, prepass %.3f, lighting %.3f\n",
               characters, engine->deformedInstances().size(), vertices, width, height,
               engine->deviceInfo().name.c_str(), int(engine->asyncComputeQueueFamily()), validation ? "on" : "off",
-              timed, evaluateMs,
-              pose.packedJointMatrices().size(), cpuMs / std::max(timed, 1u), deformMs / std::max(timed, 1u), shadowMs / std::max(timed, 1u),
-              prepassMs / std::max(timed, 1u), lightingMs / std::max(timed, 1u));
+              timed, evaluateMs, pose.packedJointMatrices().size(), cpuMs / std::max(timed, 1u),
+              deformMs / std::max(timed, 1u), shadowMs / std::max(timed, 1u), prepassMs / std::max(timed, 1u),
+              lightingMs / std::max(timed, 1u));
   // The last frame's poses of one copy of each model.
   for (size_t m = 0; m < models.size() && m < characters; ++m) {
     INFO("character " << m << " (" << paths[m] << ")");
     const double t = params.time + playbacks[m].timeOffset;
-    const glm::mat4 placement = glm::translate(glm::mat4(1.0f), glm::vec3(-12.0f + 24.0f * float(m) / float(columns), 0.0f, -12.0f)) *
+    const glm::mat4 placement = glm::translate(glm::mat4(1.0f),
+                                               glm::vec3(-12.0f + 24.0f * float(m) / float(columns), 0.0f, -12.0f)) *
                                 glm::scale(glm::mat4(1.0f), glm::vec3(scales[m]));
     CHECK(compareWithReference(*engine, reference(paths[m], 0, t), firstInstance[m], int(firstNode[m]),
                                glm::dmat4(placement)) > 0);

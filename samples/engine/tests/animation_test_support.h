@@ -20,7 +20,7 @@ namespace animation_test {
 
 using namespace sample_engine;
 
-constexpr uint32_t kSize = 64;          // lavapipe is slow; the pixels are not what these tests look at
+constexpr uint32_t kSize = 64;               // lavapipe is slow; the pixels are not what these tests look at
 constexpr double kRelativeTolerance = 1e-5;  // of the model's bounding-box diagonal
 
 // Writes a generated fixture into the temp directory and returns its path.
@@ -70,14 +70,16 @@ inline void render(Engine& engine, FrameParams params) {
 // is what appendScene put above the reference's roots; `firstInstance` skips instances of other copies.
 // Returns how many deformed instances were compared.
 inline size_t compareWithReference(Engine& engine, const std::vector<pose_reference::PosedPrimitive>& ref,
-                            uint32_t firstInstance = 0, int nodeOffset = 0, const glm::dmat4& placement = glm::dmat4(1.0)) {
+                                   uint32_t firstInstance = 0, int nodeOffset = 0,
+                                   const glm::dmat4& placement = glm::dmat4(1.0)) {
   const Scene& scene = engine.scene();
   const double tolerance = kRelativeTolerance * diagonal(ref);
   std::map<int, std::vector<const pose_reference::PosedPrimitive*>> refByNode;
   for (const auto& p : ref) refByNode[p.node].push_back(&p);
   std::map<int, size_t> seen;  // per reference node: instances matched so far
   std::map<uint32_t, uint32_t> deformedOf;
-  for (uint32_t d = 0; d < engine.deformedInstances().size(); ++d) deformedOf[engine.deformedInstances()[d].instance] = d;
+  for (uint32_t d = 0; d < engine.deformedInstances().size(); ++d)
+    deformedOf[engine.deformedInstances()[d].instance] = d;
   size_t compared = 0;
   for (uint32_t i = firstInstance; i < firstInstance + ref.size(); ++i) {
     const Instance& inst = scene.instances.at(i);
@@ -110,7 +112,7 @@ inline size_t compareWithReference(Engine& engine, const std::vector<pose_refere
 
 // Largest distance between two poses of the reference: a comparison is only meaningful if the poses differ.
 inline double poseDifference(const std::vector<pose_reference::PosedPrimitive>& a,
-                      const std::vector<pose_reference::PosedPrimitive>& b) {
+                             const std::vector<pose_reference::PosedPrimitive>& b) {
   double d = 0.0;
   for (size_t p = 0; p < a.size(); ++p)
     for (size_t v = 0; v < a[p].localPositions.size(); ++v)

@@ -49,7 +49,8 @@ void checkSharedModel(const char* name) {
 
 }  // namespace
 
-TEST_CASE("skinned strip (8 influences): deformed vertices and transforms match the reference", "[animation][skinning]") {
+TEST_CASE("skinned strip (8 influences): deformed vertices and transforms match the reference",
+          "[animation][skinning]") {
   const std::string path = writeFixture("sample_engine_skinned_strip.gltf", pose_reference::writeSkinnedStrip);
   const Scene scene = loadGltfScene(path);
   REQUIRE(scene.animations.size() == 1);
@@ -130,8 +131,10 @@ TEST_CASE("two appendScene copies at different time offsets get their own buffer
   params.time = 0.5;
   params.animations = {{a, 0.25}, {b, 0.7}};  // copy A at 0.75 s (rotation), copy B at 1.2 s (STEP translation)
   render(*engine, params);
-  CHECK(compareWithReference(*engine, reference(path, 0, 0.75), staticInstances, int(nodesA), glm::dmat4(placementA)) == 1);
-  CHECK(compareWithReference(*engine, reference(path, 0, 1.2), staticInstances + 1, int(nodesB), glm::dmat4(placementB)) == 1);
+  CHECK(compareWithReference(*engine, reference(path, 0, 0.75), staticInstances, int(nodesA), glm::dmat4(placementA)) ==
+        1);
+  CHECK(compareWithReference(*engine, reference(path, 0, 1.2), staticInstances + 1, int(nodesB),
+                             glm::dmat4(placementB)) == 1);
   // The static demo instances keep their transforms.
   for (uint32_t i = 0; i < staticInstances; ++i) CHECK(engine->instanceTransforms()[i] == scene.instances[i].transform);
   REQUIRE(engine->waitIdle().ok());
@@ -141,8 +144,9 @@ TEST_CASE("two appendScene copies at different time offsets get their own buffer
 TEST_CASE("shared model CesiumMan is skinned like the reference", "[animation][skinning][samples]") {
   checkSharedModel("CesiumMan");
 }
-TEST_CASE("shared model Fox is skinned like the reference", "[animation][skinning][samples]") { checkSharedModel("Fox"); }
+TEST_CASE("shared model Fox is skinned like the reference", "[animation][skinning][samples]") {
+  checkSharedModel("Fox");
+}
 TEST_CASE("shared model BrainStem is skinned like the reference", "[animation][skinning][samples]") {
   checkSharedModel("BrainStem");
 }
-

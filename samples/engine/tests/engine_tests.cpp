@@ -62,8 +62,7 @@ struct ExternalMask {
   VkDeviceMemory memory = VK_NULL_HANDLE;
   VkImageView view = VK_NULL_HANDLE;
 
-  ExternalMask(Engine& engine, uint32_t w, uint32_t h, VkFormat format = VK_FORMAT_R8_UNORM)
-      : device(engine.device()) {
+  ExternalMask(Engine& engine, uint32_t w, uint32_t h, VkFormat format = VK_FORMAT_R8_UNORM) : device(engine.device()) {
     VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     ci.imageType = VK_IMAGE_TYPE_2D;
     ci.format = format;
@@ -265,7 +264,8 @@ TEST_CASE("glTF loader reports errors instead of throwing", "[gltf]") {
 }
 
 TEST_CASE("glTF Box sample loads and renders", "[gltf][render]") {
-  const std::filesystem::path box = std::filesystem::path(RAYBRIDGE_SOURCE_DIR) / ".." / "shared" / "scenes" / "Box" / "Box.gltf";
+  const std::filesystem::path box = std::filesystem::path(RAYBRIDGE_SOURCE_DIR) / ".." / "shared" / "scenes" / "Box" /
+                                    "Box.gltf";
   if (!std::filesystem::exists(box)) SKIP("glTF sample not present: " + box.string());
   SceneLoadResult r = loadGltf(box.string());
   INFO(r.error);
@@ -286,8 +286,8 @@ TEST_CASE("glTF Box sample loads and renders", "[gltf][render]") {
 }
 
 TEST_CASE("scene textures are exposed as read-only views, parallel to Scene::textures", "[gltf][textures]") {
-  const std::filesystem::path path =
-      std::filesystem::path(RAYBRIDGE_SOURCE_DIR) / ".." / "shared" / "scenes" / "BoxTextured" / "BoxTextured.gltf";
+  const std::filesystem::path path = std::filesystem::path(RAYBRIDGE_SOURCE_DIR) / ".." / "shared" / "scenes" /
+                                     "BoxTextured" / "BoxTextured.gltf";
   if (!std::filesystem::exists(path)) SKIP("glTF sample not present: " + path.string());
   SceneLoadResult r = loadGltf(path.string());
   INFO(r.error);
@@ -336,12 +336,18 @@ constexpr uint32_t kFxWidth = 320, kFxHeight = 240;
 // comes from +x at 45 degrees, so the box's shadow covers the ground around (-5, 0, 0).
 Scene makeEffectsScene() {
   Scene s;
-  s.materials.push_back(Material{.name = "rough ground", .baseColorFactor = {0.7f, 0.7f, 0.7f, 1.0f},
-                                 .metallicFactor = 0.0f, .roughnessFactor = 0.8f});
-  s.materials.push_back(Material{.name = "matte box", .baseColorFactor = {0.2f, 0.3f, 0.7f, 1.0f},
-                                 .metallicFactor = 0.0f, .roughnessFactor = 0.8f});
-  s.materials.push_back(Material{.name = "polished metal", .baseColorFactor = {0.95f, 0.95f, 0.95f, 1.0f},
-                                 .metallicFactor = 1.0f, .roughnessFactor = 0.05f});
+  s.materials.push_back(Material{.name = "rough ground",
+                                 .baseColorFactor = {0.7f, 0.7f, 0.7f, 1.0f},
+                                 .metallicFactor = 0.0f,
+                                 .roughnessFactor = 0.8f});
+  s.materials.push_back(Material{.name = "matte box",
+                                 .baseColorFactor = {0.2f, 0.3f, 0.7f, 1.0f},
+                                 .metallicFactor = 0.0f,
+                                 .roughnessFactor = 0.8f});
+  s.materials.push_back(Material{.name = "polished metal",
+                                 .baseColorFactor = {0.95f, 0.95f, 0.95f, 1.0f},
+                                 .metallicFactor = 1.0f,
+                                 .roughnessFactor = 0.05f});
   auto add = [&](MeshData mesh, uint32_t material, glm::vec3 at) {
     mesh.material = material;
     s.meshes.push_back(std::move(mesh));
@@ -352,8 +358,8 @@ Scene makeEffectsScene() {
   add(makePlane(40.0f, 40.0f, 8, 8), 0, {0, 0, 0});
   add(makeBox({2.0f, 2.0f, 2.0f}, 2), 1, {-3, 1, 0});
   add(makeSphere(1.0f, 64, 32), 2, {3, 1, 0});
-  s.camera = Camera{.eye = {0.0f, 5.0f, 10.0f}, .target = {0.0f, 0.5f, 0.0f}, .fovYDegrees = 50.0f,
-                    .zNear = 0.1f, .zFar = 100.0f};
+  s.camera = Camera{
+      .eye = {0.0f, 5.0f, 10.0f}, .target = {0.0f, 0.5f, 0.0f}, .fovYDegrees = 50.0f, .zNear = 0.1f, .zFar = 100.0f};
   s.sun = Sun{.direction = glm::normalize(glm::vec3(1.0f, 1.0f, 0.0f)), .color = {1, 1, 1}, .intensity = 3.0f};
   return s;
 }
@@ -595,7 +601,8 @@ TEST_CASE("an external reflection replaces the environment term by its alpha (co
 
     value = glm::vec4(8.0f, 8.0f, 8.0f, 1.0f);  // alpha 1: a bright environment brightens the metal
     ImageRGBA32F bright = renderHdr(*f.engine, f.params);
-    INFO("metal: own " << windowLuminance(ownHdr, sphere, 1) << ", external bright " << windowLuminance(bright, sphere, 1));
+    INFO("metal: own " << windowLuminance(ownHdr, sphere, 1) << ", external bright "
+                       << windowLuminance(bright, sphere, 1));
     CHECK(windowLuminance(bright, sphere, 1) > 2.0f * windowLuminance(ownHdr, sphere, 1));
   }
 

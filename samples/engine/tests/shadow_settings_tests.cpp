@@ -18,8 +18,8 @@ namespace {
 // grid (the light's horizontal axis is world z), unstretched by the sun's slant.
 Scene makeShadowEdgeScene() {
   Scene s;
-  s.materials.push_back(Material{.name = "ground", .baseColorFactor = {0.7f, 0.7f, 0.7f, 1.0f},
-                                 .metallicFactor = 0.0f, .roughnessFactor = 0.9f});
+  s.materials.push_back(Material{
+      .name = "ground", .baseColorFactor = {0.7f, 0.7f, 0.7f, 1.0f}, .metallicFactor = 0.0f, .roughnessFactor = 0.9f});
   auto add = [&](MeshData mesh, glm::vec3 at) {
     mesh.material = 0;
     s.meshes.push_back(std::move(mesh));
@@ -41,8 +41,10 @@ constexpr float kEdgeView = 0.16f;
 constexpr float kEdgeHeight = 2.0f;
 
 Camera edgeCamera() {
-  return Camera{.eye = {-1.0f, kEdgeHeight, kEdgeZ}, .target = {-1.0f, 0.0f, kEdgeZ},
-                .fovYDegrees = glm::degrees(2.0f * std::atan(0.5f * kEdgeView / kEdgeHeight)), .zNear = 0.5f,
+  return Camera{.eye = {-1.0f, kEdgeHeight, kEdgeZ},
+                .target = {-1.0f, 0.0f, kEdgeZ},
+                .fovYDegrees = glm::degrees(2.0f * std::atan(0.5f * kEdgeView / kEdgeHeight)),
+                .zNear = 0.5f,
                 .zFar = 5.0f};
 }
 
@@ -126,8 +128,7 @@ float luminance(const glm::vec4& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0
 
 // The pixel that shows world point `p`, at least one pixel away from the image border.
 glm::ivec2 pixelOf(const Camera& camera, glm::vec3 p, uint32_t width, uint32_t height) {
-  const glm::vec4 c =
-      projectionMatrix(camera, float(width) / float(height)) * viewMatrix(camera) * glm::vec4(p, 1.0f);
+  const glm::vec4 c = projectionMatrix(camera, float(width) / float(height)) * viewMatrix(camera) * glm::vec4(p, 1.0f);
   const glm::ivec2 at = glm::ivec2((glm::vec2(c) / c.w * 0.5f + 0.5f) * glm::vec2(width, height));
   REQUIRE((c.w > 0.0f && at.x >= 1 && at.y >= 1 && at.x + 1 < int(width) && at.y + 1 < int(height)));
   return at;
@@ -164,9 +165,12 @@ TEST_CASE("the engine reports the shadow-map size and PCF kernel it drew with", 
   // The raster counterparts of the quality presets (none | 2048 | 4096 PCF 4 | 8192 PCF 8), PCF 0 and 1
   // (one tap), and clamping. The 8192 map (256 MiB of D32) is drawn once, at this small resolution.
   const Case cases[] = {
-      {true, 2048, 0, {true, 2048, 1, 0}},  {true, 2048, 1, {true, 2048, 1, 0}},
-      {true, 4096, 4, {true, 4096, 4, 0}},  {true, 8192, 8, {true, 8192, 8, 0}},
-      {false, 4096, 4, {false, 0, 0, 0}},   {true, 100, 30, {true, kMinShadowMapSize, kMaxShadowPcfKernel, 0}},
+      {true, 2048, 0, {true, 2048, 1, 0}},
+      {true, 2048, 1, {true, 2048, 1, 0}},
+      {true, 4096, 4, {true, 4096, 4, 0}},
+      {true, 8192, 8, {true, 8192, 8, 0}},
+      {false, 4096, 4, {false, 0, 0, 0}},
+      {true, 100, 30, {true, kMinShadowMapSize, kMaxShadowPcfKernel, 0}},
       {true, 1u << 20, 2, {true, kMaxShadowMapSize, 2, 0}},
   };
   for (const Case& c : cases) {
@@ -183,8 +187,8 @@ TEST_CASE("the engine reports the shadow-map size and PCF kernel it drew with", 
 
 TEST_CASE("without a shadow map the sun is unshadowed, and the map comes back when re-enabled", "[shadow]") {
   ShadowFixture f;
-  const Camera overview{.eye = {0.0f, 4.0f, 4.0f}, .target = {-1.0f, 0.0f, 0.0f}, .fovYDegrees = 50.0f,
-                        .zNear = 0.1f, .zFar = 20.0f};
+  const Camera overview{
+      .eye = {0.0f, 4.0f, 4.0f}, .target = {-1.0f, 0.0f, 0.0f}, .fovYDegrees = 50.0f, .zNear = 0.1f, .zFar = 20.0f};
   f.setView(overview, 96, 72);
   const glm::vec3 underBox{-1.0f, 0.0f, 0.0f}, open{-1.0f, 0.0f, 1.5f};
   f.params.shadow.mapSize = 2048;
@@ -234,15 +238,15 @@ TEST_CASE("PCF kernels: more taps widen the penumbra, even kernels stay centred"
   const float pixel = kEdgeView / float(kEdgeSize);
   REQUIRE(pixel < 0.5f * texel);  // the penumbra of one tap (1 texel, a bilinear ramp) spans several pixels
 
-  const EdgeProfile one = f.edge(kSize, 1), three = f.edge(kSize, 3), four = f.edge(kSize, 4),
-                    five = f.edge(kSize, 5), eight = f.edge(kSize, 8), nine = f.edge(kSize, 9);
+  const EdgeProfile one = f.edge(kSize, 1), three = f.edge(kSize, 3), four = f.edge(kSize, 4), five = f.edge(kSize, 5),
+                    eight = f.edge(kSize, 8), nine = f.edge(kSize, 9);
   // Penumbra of n taps: about n texels.
   INFO("penumbra pixels: 1 -> " << one.penumbraPixels << ", 3 -> " << three.penumbraPixels << ", 4 -> "
                                 << four.penumbraPixels << ", 5 -> " << five.penumbraPixels << ", 8 -> "
                                 << eight.penumbraPixels << ", 9 -> " << nine.penumbraPixels);
   CHECK(one.penumbraPixels > 0);
   CHECK(float(four.penumbraPixels) > 2.0f * float(one.penumbraPixels));  // "PCF 4 is softer than PCF 1"
-  CHECK(three.penumbraPixels < four.penumbraPixels);  // 4 is its own kernel, not rounded to 3 or 5
+  CHECK(three.penumbraPixels < four.penumbraPixels);                     // 4 is its own kernel, not rounded to 3 or 5
   CHECK(four.penumbraPixels < five.penumbraPixels);
   CHECK(four.penumbraPixels < eight.penumbraPixels);
   CHECK(eight.penumbraPixels < nine.penumbraPixels);
@@ -254,7 +258,8 @@ TEST_CASE("PCF kernels: more taps widen the penumbra, even kernels stay centred"
                               << ", 5 -> " << (five.edgeZ - kEdgeZ) / texel << ", 8 -> "
                               << (eight.edgeZ - kEdgeZ) / texel << ", 9 -> " << (nine.edgeZ - kEdgeZ) / texel);
   CHECK(std::abs(one.edgeZ - kEdgeZ) < 1.0f * texel);  // the map's rasterised edge is within a texel
-  for (const EdgeProfile* e : {&three, &four, &five, &eight, &nine}) CHECK(std::abs(e->edgeZ - one.edgeZ) < 0.2f * texel);
+  for (const EdgeProfile* e : {&three, &four, &five, &eight, &nine})
+    CHECK(std::abs(e->edgeZ - one.edgeZ) < 0.2f * texel);
   CHECK(std::abs(four.edgeZ - 0.5f * (three.edgeZ + five.edgeZ)) < 0.15f * texel);
 
   // A bigger map draws the same kernel's penumbra narrower on the ground.

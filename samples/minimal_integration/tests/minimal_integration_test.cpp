@@ -90,9 +90,8 @@ TEST_CASE("minimal integration: hard shadows match Embree, AO and motion vectors
   const int W = 192, H = 128;
   const fs::path dir = fs::temp_directory_path() / "raybridge_minimal_integration";
   fs::remove_all(dir);
-  const std::string command = std::string("\"") + MINIMAL_INTEGRATION_EXE +
-                              "\" --validate --frames 4 --width " + std::to_string(W) + " --height " +
-                              std::to_string(H) + " --out \"" + dir.string() + "\"";
+  const std::string command = std::string("\"") + MINIMAL_INTEGRATION_EXE + "\" --validate --frames 4 --width " +
+                              std::to_string(W) + " --height " + std::to_string(H) + " --out \"" + dir.string() + "\"";
   // Non-zero on any Vulkan or Raybridge error and on any validation error (synchronization validation
   // included).
   REQUIRE(std::system(command.c_str()) == 0);
@@ -121,13 +120,11 @@ TEST_CASE("minimal integration: hard shadows match Embree, AO and motion vectors
     embree.addInstance(mesh, identity, i);
   }
   embree.commit();
-  const glm::dvec3 toSun =
-      glm::normalize(glm::dvec3(minimal::kToSun[0], minimal::kToSun[1], minimal::kToSun[2]));
+  const glm::dvec3 toSun = glm::normalize(glm::dvec3(minimal::kToSun[0], minimal::kToSun[1], minimal::kToSun[2]));
   const glm::vec3 toSunF(toSun);
 
   auto unproject = [&](int x, int y, double z) {
-    glm::dvec4 p =
-        inverseViewProjection * glm::dvec4((x + 0.5) / W * 2.0 - 1.0, (y + 0.5) / H * 2.0 - 1.0, z, 1.0);
+    glm::dvec4 p = inverseViewProjection * glm::dvec4((x + 0.5) / W * 2.0 - 1.0, (y + 0.5) / H * 2.0 - 1.0, z, 1.0);
     return glm::dvec3(p) / p.w;
   };
   std::vector<Pixel> px(size_t(W) * H);
@@ -135,8 +132,7 @@ TEST_CASE("minimal integration: hard shadows match Embree, AO and motion vectors
   for (int y = 0; y < H; ++y) {
     for (int x = 0; x < W; ++x) {
       Pixel& p = px[size_t(y) * W + x];
-      const glm::vec3 origin(eye),
-          direction(glm::normalize(unproject(x, y, 1.0) - eye));  // depth 1 = near plane
+      const glm::vec3 origin(eye), direction(glm::normalize(unproject(x, y, 1.0) - eye));  // depth 1 = near plane
       const rbtest::ReferenceHit hit = embree.intersect(&origin.x, &direction.x, 0.0f, 1e30f);
       const float d = depth[size_t(y) * W + x];
       skyMismatch += hit.hit != (d != 0.0f);
@@ -145,8 +141,7 @@ TEST_CASE("minimal integration: hard shadows match Embree, AO and motion vectors
       p.instance = hit.instanceId;
       p.distance = hit.t;
       p.position = unproject(x, y, d);  // the program's reversed-Z depth, through its own camera
-      p.normal =
-          glm::normalize(glm::dvec3(hit.geometricNormal[0], hit.geometricNormal[1], hit.geometricNormal[2]));
+      p.normal = glm::normalize(glm::dvec3(hit.geometricNormal[0], hit.geometricNormal[1], hit.geometricNormal[2]));
       if (glm::dot(p.normal, glm::dvec3(direction)) > 0.0) p.normal = -p.normal;
       if (glm::dot(p.normal, toSun) <= 0.0) {
         p.visible = 0;
@@ -172,21 +167,20 @@ TEST_CASE("minimal integration: hard shadows match Embree, AO and motion vectors
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           const Pixel& n = px[size_t(y + dy) * W + size_t(x + dx)];
-          edge |= n.sky || n.instance != p.instance || n.visible != p.visible ||
-                  glm::dot(n.normal, p.normal) < 0.9 || std::fabs(n.distance - p.distance) > 0.1 * p.distance;
+          edge |= n.sky || n.instance != p.instance || n.visible != p.visible || glm::dot(n.normal, p.normal) < 0.9 ||
+                  std::fabs(n.distance - p.distance) > 0.1 * p.distance;
         }
       }
       if (edge) continue;
       ++compared;
       shadowed += p.visible == 0;
       shadowAgree += (shadow[i] > 0.5f) == (p.visible == 1);
-      depthAgree +=
-          glm::length(p.position - (eye + glm::normalize(unproject(x, y, 1.0) - eye) * p.distance)) <=
-          2e-3 * p.distance;
+      depthAgree += glm::length(p.position - (eye + glm::normalize(unproject(x, y, 1.0) - eye) * p.distance)) <=
+                    2e-3 * p.distance;
       // Motion: this pixel's centre minus where its surface point was in the previous frame, in pixels.
       const glm::dvec4 prev = previousViewProjection * glm::dvec4(p.position, 1.0);
-      const glm::dvec2 expected =
-          glm::dvec2(x + 0.5, y + 0.5) - (glm::dvec2(prev) / prev.w * 0.5 + 0.5) * glm::dvec2(W, H);
+      const glm::dvec2 expected = glm::dvec2(x + 0.5, y + 0.5) -
+                                  (glm::dvec2(prev) / prev.w * 0.5 + 0.5) * glm::dvec2(W, H);
       const glm::dvec2 got(motion[3 * i], motion[3 * i + 1]);
       motionAgree += glm::length(got - expected) <= 0.02 + 0.005 * glm::length(expected);
       moving += glm::length(got) > 0.25;
@@ -194,16 +188,14 @@ TEST_CASE("minimal integration: hard shadows match Embree, AO and motion vectors
       if (p.instance == 0) {
         const double nearBox = footprintDistance(scene[1], p.position);
         double nearest = 1e30;
-        for (size_t m = 1; m < scene.size(); ++m)
-          nearest = std::min(nearest, footprintDistance(scene[m], p.position));
+        for (size_t m = 1; m < scene.size(); ++m) nearest = std::min(nearest, footprintDistance(scene[m], p.position));
         if (nearBox > 0.0 && nearBox < 0.25) nearAo += ao[i], ++nearCount;
         if (nearest > 2.5) openAo += ao[i], ++openCount;
       }
     }
   }
   INFO("compared " << compared << " pixels (" << shadowed << " shadowed): shadow agrees on " << shadowAgree
-                   << ", depth on " << depthAgree << ", motion on " << motionAgree << " (" << moving
-                   << " moving)");
+                   << ", depth on " << depthAgree << ", motion on " << motionAgree << " (" << moving << " moving)");
   REQUIRE(compared > uint32_t(W * H / 3));
   REQUIRE(shadowed > 300);  // the boxes, the sphere and the floating slab really cast shadows in view
   CHECK(double(shadowAgree) / compared >= 0.99);

@@ -121,8 +121,8 @@ constexpr uint32_t kRefitClusterTriangles = 64;
 // A zero-initialised RefitPolicy is the documented default. Plain value; thread-safe to copy.
 struct RefitPolicy {
   RefitPolicyKind kind = RefitPolicyKind::Adaptive;
-  float maxAreaGrowth = 0;                // 0 = kDefaultMaxAreaGrowth; otherwise > 1 (Adaptive only)
-  uint32_t maxRefitsBeforeRebuild = 0;    // 0 = kDefaultMaxRefitsBeforeRebuild (Adaptive only)
+  float maxAreaGrowth = 0;              // 0 = kDefaultMaxAreaGrowth; otherwise > 1 (Adaptive only)
+  uint32_t maxRefitsBeforeRebuild = 0;  // 0 = kDefaultMaxRefitsBeforeRebuild (Adaptive only)
   // 0 = kDefaultRebuildTrianglesPerFrame (Adaptive only). Meshes over the measure wait, still refitting, until
   // their turn; a single mesh larger than the budget is rebuilt alone in a frame of its own.
   uint64_t rebuildTrianglesPerFrame = 0;
@@ -136,11 +136,11 @@ struct MeshDesc {
   VkFormat vertexFormat = VK_FORMAT_UNDEFINED;  // UNDEFINED = VK_FORMAT_R32G32B32_SFLOAT
   uint32_t vertexStride = 0;                    // 0 = the size of vertexFormat (tightly packed positions)
   IndexType indexType = IndexType::Uint32;      // default Uint32
-  VkDeviceAddress indexAddress = 0;   // required unless indexType is None
-  VkDeviceSize indexBufferBytes = 0;  // required unless indexType is None: bytes readable from indexAddress
-  uint32_t triangleCount = 0;         // required, > 0: triangles read (indexCount / 3, or vertexCount / 3)
-  MeshRole role = MeshRole::Static;   // default Static
-  bool nonOpaque = false;             // false = opaque: any-hit shaders are skipped for this geometry
+  VkDeviceAddress indexAddress = 0;             // required unless indexType is None
+  VkDeviceSize indexBufferBytes = 0;            // required unless indexType is None: bytes readable from indexAddress
+  uint32_t triangleCount = 0;                   // required, > 0: triangles read (indexCount / 3, or vertexCount / 3)
+  MeshRole role = MeshRole::Static;             // default Static
+  bool nonOpaque = false;                       // false = opaque: any-hit shaders are skipped for this geometry
   // Dedup: meshes with equal keys share one BLAS. Dynamic meshes deform independently, so they are deduplicated
   // only by an explicit contentKey. 0 = derive the key: a 64-bit hash of hostVertices and
   // hostIndices when both are given (or hostVertices for non-indexed meshes), else the buffer identity
@@ -196,9 +196,9 @@ struct TlasBuildOptions {
 struct TlasInfo {
   VkAccelerationStructureKHR tlas = VK_NULL_HANDLE;
   VkDeviceAddress address = 0;
-  uint32_t instanceCount = 0;    // instances written into the TLAS
-  uint32_t skippedInstances = 0; // instances whose mesh has no built BLAS yet (queued beyond the budget)
-  bool updated = false;          // true if refit rather than rebuilt
+  uint32_t instanceCount = 0;                // instances written into the TLAS
+  uint32_t skippedInstances = 0;             // instances whose mesh has no built BLAS yet (queued beyond the budget)
+  bool updated = false;                      // true if refit rather than rebuilt
   double originOffset[3] = {0.0, 0.0, 0.0};  // TlasBuildOptions::originOffset it was built with
   // With TlasBuildOptions::writeShadingRecords: a storage buffer of one record per TLAS instance (indexed by
   // gl_InstanceID), valid for this frame. VK_NULL_HANDLE otherwise.
@@ -259,19 +259,19 @@ struct BuildBatchTiming {
 };
 
 struct AsStats {
-  uint32_t meshHandles = 0;        // live handles (registered and not released)
-  uint32_t registrations = 0;      // registerMesh calls that succeeded
-  uint32_t dedupHits = 0;          // registrations that reused an existing BLAS
-  uint32_t blasCount = 0;          // BLASes that exist (built, building or queued)
-  uint32_t blasQueued = 0;         // waiting for a build
-  uint32_t blasCompacted = 0;      // BLASes whose storage was replaced by a compacted copy
-  uint32_t compactionsSkipped = 0; // compaction saved < 2% (lavapipe) so no copy was made
+  uint32_t meshHandles = 0;         // live handles (registered and not released)
+  uint32_t registrations = 0;       // registerMesh calls that succeeded
+  uint32_t dedupHits = 0;           // registrations that reused an existing BLAS
+  uint32_t blasCount = 0;           // BLASes that exist (built, building or queued)
+  uint32_t blasQueued = 0;          // waiting for a build
+  uint32_t blasCompacted = 0;       // BLASes whose storage was replaced by a compacted copy
+  uint32_t compactionsSkipped = 0;  // compaction saved < 2% (lavapipe) so no copy was made
   uint32_t evictions = 0;
-  uint64_t triangles = 0;          // triangles over all BLASes
+  uint64_t triangles = 0;                      // triangles over all BLASes
   VkDeviceSize blasBytesBeforeCompaction = 0;  // sum of built sizes of all BLASes
-  VkDeviceSize blasBytes = 0;                   // sum of current sizes (after compaction where it happened;
-                                                // every copy of a dynamic BLAS)
-  double bytesPerTriangle = 0.0;                // blasBytes / triangles
+  VkDeviceSize blasBytes = 0;                  // sum of current sizes (after compaction where it happened;
+                                               // every copy of a dynamic BLAS)
+  double bytesPerTriangle = 0.0;               // blasBytes / triangles
   uint32_t storageBlocks = 0;
   VkDeviceSize storageBlockBytes = 0;  // device memory held by the blocks
   VkDeviceSize storageUsedBytes = 0;   // bytes of the blocks in use (aligned BLAS sizes)
@@ -283,23 +283,22 @@ struct AsStats {
   uint64_t batchTimingsDropped = 0;       // older resolved timings no longer in `batches`
 
   // Dynamic meshes (cumulative unless said).
-  uint64_t refits = 0;                          // dynamic BLAS refits recorded
-  uint64_t rebuilds = 0;                        // full rebuilds of already built dynamic BLASes recorded
-  uint64_t lastFrameRefitTriangles = 0;         // of the latest frame's dynamic work
-  uint64_t lastFrameRebuildTriangles = 0;       // of the latest frame's dynamic work (rebuilds, not first builds)
-  bool async = false;                           // dynamic work runs on the async queue
-  uint32_t asyncQueueFamily = UINT32_MAX;       // its family, when async
-  std::string asyncFallbackReason;              // why not async, when an async mode was asked for; else empty
-  uint32_t staleBlas = 0;                       // instances of the last TLAS traced with a pose older than the
-                                                // mesh's newest update (one-frame-late mode)
-  double lastAsyncGpuMs = 0.0;                  // GPU time of the latest resolved async submission
-  VkDeviceSize dynamicBlasBytes = 0;            // storage of dynamic BLASes, all copies
+  uint64_t refits = 0;                     // dynamic BLAS refits recorded
+  uint64_t rebuilds = 0;                   // full rebuilds of already built dynamic BLASes recorded
+  uint64_t lastFrameRefitTriangles = 0;    // of the latest frame's dynamic work
+  uint64_t lastFrameRebuildTriangles = 0;  // of the latest frame's dynamic work (rebuilds, not first builds)
+  bool async = false;                      // dynamic work runs on the async queue
+  uint32_t asyncQueueFamily = UINT32_MAX;  // its family, when async
+  std::string asyncFallbackReason;         // why not async, when an async mode was asked for; else empty
+  uint32_t staleBlas = 0;                  // instances of the last TLAS traced with a pose older than the
+                                           // mesh's newest update (one-frame-late mode)
+  double lastAsyncGpuMs = 0.0;             // GPU time of the latest resolved async submission
+  VkDeviceSize dynamicBlasBytes = 0;       // storage of dynamic BLASes, all copies
 };
 
 class AccelerationStructureService {
  public:
-  static Result<std::unique_ptr<AccelerationStructureService>> create(Context& context,
-                                                                      const AsServiceDesc& desc = {});
+  static Result<std::unique_ptr<AccelerationStructureService>> create(Context& context, const AsServiceDesc& desc = {});
   // Never waits. Contract, as for the Context: the GPU is done with the engine's frames that used this service
   // and with the SDK's submissions on the async queue (the engine's vkDeviceWaitIdle, or a wait on that queue
   // or on the SDK's timeline), and the engine has submitted the signals of the `ready` values it passed.

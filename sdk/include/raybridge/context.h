@@ -30,11 +30,11 @@ struct ContextAccess;  // the SDK's own way in (sdk/src/context_access.h); not p
 // What the engine hands over. A zero-initialised ContextDesc is invalid only because the four handles below
 // are required; every other field's zero value is a documented default.
 struct ContextDesc {
-  VkInstance instance = VK_NULL_HANDLE;                     // required
-  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;          // required
-  VkDevice device = VK_NULL_HANDLE;                          // required; see requiredDeviceExtensions()
-  PFN_vkGetInstanceProcAddr getInstanceProcAddr = nullptr;   // required; every Vulkan function is loaded from it
-  uint32_t framesInFlight = 0;                               // 0 = 2; at most 8
+  VkInstance instance = VK_NULL_HANDLE;                        // required
+  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;            // required
+  VkDevice device = VK_NULL_HANDLE;                            // required; see requiredDeviceExtensions()
+  PFN_vkGetInstanceProcAddr getInstanceProcAddr = nullptr;     // required; every Vulkan function is loaded from it
+  uint32_t framesInFlight = 0;                                 // 0 = 2; at most 8
   const VkAllocationCallbacks* allocationCallbacks = nullptr;  // nullptr = the driver's allocator
   // Family of the engine's queue that executes Raybridge's recordings (for its timestamp bits). Refits of
   // deforming meshes are recorded into the same command buffers as everything else, unless the engine hands
@@ -81,8 +81,8 @@ struct DeviceInfo {
   uint32_t minAccelerationStructureScratchOffsetAlignment = 0;
   uint64_t maxPrimitiveCount = 0;
   uint64_t maxInstanceCount = 0;
-  float timestampPeriodNs = 0.0f;  // nanoseconds per timestamp tick
-  uint32_t timestampValidBits = 0; // of the queue family executing Raybridge's work
+  float timestampPeriodNs = 0.0f;   // nanoseconds per timestamp tick
+  uint32_t timestampValidBits = 0;  // of the queue family executing Raybridge's work
   bool timestampsSupported = false;
   // Ticks from `start` to `end`, modulo the counter's valid bits.
   uint64_t timestampTicks(uint64_t start, uint64_t end) const {
@@ -95,12 +95,12 @@ struct DeviceInfo {
 // disabled effect shows zero bytes in its category (once its destroyed pass's memory has been released).
 // Retired memory still counts until it is freed.
 enum class MemoryCategory : uint8_t {
-  BlasStorage = 0,   // suballocation blocks holding BLASes
-  Scratch,           // build scratch memory
-  Tlas,              // TLAS storage, scratch and instance buffers
-  ShaderTables,      // shader binding tables and pipeline constants
-  PassImages,        // images owned by the effect passes (history, intermediate results)
-  PassBuffers,       // other buffers owned by the effect passes
+  BlasStorage = 0,  // suballocation blocks holding BLASes
+  Scratch,          // build scratch memory
+  Tlas,             // TLAS storage, scratch and instance buffers
+  ShaderTables,     // shader binding tables and pipeline constants
+  PassImages,       // images owned by the effect passes (history, intermediate results)
+  PassBuffers,      // other buffers owned by the effect passes
   Count
 };
 const char* toString(MemoryCategory category);
@@ -136,7 +136,7 @@ class Context {
   // and every query (build timings, compacted sizes, pass statistics) recorded so far can be read.
   void releaseAfterIdle();
 
-  uint64_t frameIndex() const;        // number of beginFrame calls so far
+  uint64_t frameIndex() const;  // number of beginFrame calls so far
   uint32_t framesInFlight() const;
   const DeviceInfo& deviceInfo() const;
   VkDevice device() const;

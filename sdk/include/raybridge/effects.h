@@ -28,9 +28,9 @@ struct Light {
 
 // What one recorded pass did, resolved once its frame has finished on the GPU.
 struct PassStats {
-  uint64_t frame = 0;        // Context::frameIndex() when recorded; 0 = nothing resolved yet
-  double gpuMs = 0.0;        // GPU time between the pass's first and last command
-  uint64_t rays = 0;         // rays traced, counted by the shaders
+  uint64_t frame = 0;  // Context::frameIndex() when recorded; 0 = nothing resolved yet
+  double gpuMs = 0.0;  // GPU time between the pass's first and last command
+  uint64_t rays = 0;   // rays traced, counted by the shaders
   double raysPerSecond() const { return gpuMs > 0.0 ? double(rays) / (gpuMs * 1e-3) : 0.0; }
 };
 

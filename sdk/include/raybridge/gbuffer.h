@@ -50,8 +50,8 @@ struct GBufferDesc {
   // Optional: perceptual roughness in .x and metalness in .y (reflections; see also roughnessInNormalW).
   GBufferImage roughnessMetalness;
   bool roughnessInNormalW = false;  // true: roughness is in normal.w (WorldFloat encoding only)
-  GBufferImage albedo;        // optional: base colour in .rgb
-  GBufferImage motionVectors; // optional: screen-space motion in pixels (current - previous) in .xy
+  GBufferImage albedo;              // optional: base colour in .rgb
+  GBufferImage motionVectors;       // optional: screen-space motion in pixels (current - previous) in .xy
 
   // Camera, column-major 4x4 (GLM layout) as used to rasterize the G-buffer, Vulkan clip space (depth 0..1,
   // +Y down in NDC unless the projection flips it). Any projection works, including reversed-Z and infinite

@@ -132,7 +132,9 @@ struct HybridOutputs {
 // Per-pass measurements of the latest recordings whose frames have finished (zero for what does not exist).
 struct HybridStats {
   PassStats shadow, shadowDenoise, ao, aoDenoise, reflection;
-  double totalGpuMs() const { return shadow.gpuMs + shadowDenoise.gpuMs + ao.gpuMs + aoDenoise.gpuMs + reflection.gpuMs; }
+  double totalGpuMs() const {
+    return shadow.gpuMs + shadowDenoise.gpuMs + ao.gpuMs + aoDenoise.gpuMs + reflection.gpuMs;
+  }
   uint64_t totalRays() const { return shadow.rays + ao.rays + reflection.rays; }
 };
 

@@ -34,8 +34,8 @@ struct PrimaryRayTargets {
   // R32G32_UINT storage image in VK_IMAGE_LAYOUT_GENERAL: (primitive id, instance custom index), 0xFFFFFFFF
   // on a miss.
   VkImageView hitIds = VK_NULL_HANDLE;
-  uint32_t width = 0;  // required
-  uint32_t height = 0; // required
+  uint32_t width = 0;   // required
+  uint32_t height = 0;  // required
 };
 
 class PrimaryRayPass {

@@ -31,10 +31,11 @@ inline constexpr uint32_t kNoTexture = 0xFFFFFFFFu;
 struct Material {
   float baseColor[4] = {1.0f, 1.0f, 1.0f, 1.0f};  // linear RGBA factor
   float metallic = 0.0f;
-  float roughness = 1.0f;                  // perceptual
-  float emissive[3] = {0.0f, 0.0f, 0.0f};  // linear radiance
-  uint32_t baseColorTexture = kNoTexture;  // index into the textures of setMaterials (sRGB view: decoded)
+  float roughness = 1.0f;                          // perceptual
+  float emissive[3] = {0.0f, 0.0f, 0.0f};          // linear radiance
+  uint32_t baseColorTexture = kNoTexture;          // index into the textures of setMaterials (sRGB view: decoded)
   uint32_t metallicRoughnessTexture = kNoTexture;  // glTF layout: G = roughness, B = metallic
+  uint32_t emissiveTexture = kNoTexture;           // multiplies `emissive` (sRGB view: decoded)
 };
 
 // Defaults of ReflectionSettings (what a zero field means).

@@ -27,7 +27,7 @@ double animationLocalTime(double time, double duration);
 // Not thread-safe: one thread at a time per object; distinct objects are independent.
 class ScenePose {
  public:
-  struct KeyLocation {  // where a time falls among a sampler's keys
+  struct KeyLocation {        // where a time falls among a sampler's keys
     uint32_t k0 = 0, k1 = 0;  // surrounding keys (equal outside the key range)
     double s = 0.0;           // fraction from k0 to k1
   };
@@ -68,10 +68,10 @@ class ScenePose {
 
   std::vector<uint32_t> order_;  // node indices, parents before children
   // Samplers with equal key times form a group, located once per playback and frame (flat over animations).
-  std::vector<uint32_t> samplerBase_, groupBase_;  // per animation (+1): first sampler / group
-  std::vector<uint32_t> samplerGroup_;             // per sampler: its group
-  std::vector<uint32_t> groupSampler_;             // per group: its first sampler (flat index)
-  std::vector<KeyLocation> groupLocation_;         // per group: this frame's location (and next frame's hint)
+  std::vector<uint32_t> samplerBase_, groupBase_;   // per animation (+1): first sampler / group
+  std::vector<uint32_t> samplerGroup_;              // per sampler: its group
+  std::vector<uint32_t> groupSampler_;              // per group: its first sampler (flat index)
+  std::vector<KeyLocation> groupLocation_;          // per group: this frame's location (and next frame's hint)
   std::vector<const AnimationSampler*> canonical_;  // per sampler: the first equal one in the scene
   std::vector<double> durations_;
   std::vector<glm::dvec3> translation_, scale_;
@@ -82,7 +82,7 @@ class ScenePose {
   std::vector<glm::dmat4> nodeWorld_;
   std::vector<glm::mat4> nodeWorldF_, instanceWorldF_, joints_;
   std::vector<float> weights_;
-  struct JointGroup {  // skinned instances sharing a node and a skin share their matrices
+  struct JointGroup {       // skinned instances sharing a node and a skin share their matrices
     uint32_t instance = 0;  // the first of them
     uint32_t offset = 0;    // into joints_
   };

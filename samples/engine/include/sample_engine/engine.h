@@ -68,12 +68,12 @@ struct EngineConfig {
   // OR-ed into the engine's own. The chain must stay alive during Engine::create().
   const void* deviceFeaturesPNext = nullptr;
   VkPhysicalDeviceFeatures extraFeatures10{};
-  VkPhysicalDeviceVulkan11Features extraFeatures11 =
-      vkStruct<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
-  VkPhysicalDeviceVulkan12Features extraFeatures12 =
-      vkStruct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
-  VkPhysicalDeviceVulkan13Features extraFeatures13 =
-      vkStruct<VkPhysicalDeviceVulkan13Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
+  VkPhysicalDeviceVulkan11Features extraFeatures11 = vkStruct<VkPhysicalDeviceVulkan11Features>(
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
+  VkPhysicalDeviceVulkan12Features extraFeatures12 = vkStruct<VkPhysicalDeviceVulkan12Features>(
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
+  VkPhysicalDeviceVulkan13Features extraFeatures13 = vkStruct<VkPhysicalDeviceVulkan13Features>(
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
   // Also create one queue of a compute-capable family without graphics (when the device has one; lavapipe
   // does not) for add-ons, e.g. asynchronous BLAS builds: see Engine::asyncComputeQueue(). The engine never
   // submits to it; deformed vertex buffers and the index buffers of deforming meshes are then shared
@@ -299,15 +299,15 @@ struct PassTimings {
   double shadowMs = 0.0;
   double probeMs = 0.0;  // reflection-probe capture (0 on frames without a capture)
   double prepassMs = 0.0;
-  double ssaoMs = 0.0;   // SSAO + blur (0 when disabled)
+  double ssaoMs = 0.0;              // SSAO + blur (0 when disabled)
   double shadowVisibilityMs = 0.0;  // shadow-visibility output (0 unless requested)
-  double hookMs = 0.0;  // whatever the hook recorded
+  double hookMs = 0.0;              // whatever the hook recorded
   double lightingMs = 0.0;
   double tonemapMs = 0.0;
-  double deformMs = 0.0;  // the deformation submission (skinning / morphing); 0 when nothing deforms
+  double deformMs = 0.0;       // the deformation submission (skinning / morphing); 0 when nothing deforms
   bool probeCaptured = false;  // this frame captured the reflection probe
-  bool valid = false;   // false until a frame with timestamps has completed
-  uint64_t frameNumber = 0;  // Engine::frameNumber() of the frame these timings belong to
+  bool valid = false;          // false until a frame with timestamps has completed
+  uint64_t frameNumber = 0;    // Engine::frameNumber() of the frame these timings belong to
 };
 
 // A mesh as uploaded. Positions are R32G32B32_SFLOAT, tightly packed (stride 12) in their own buffer.
@@ -374,16 +374,16 @@ class Engine {
   uint32_t apiVersion() const;  // the instance/device API version the engine targets (1.3)
   const DeviceInfo& deviceInfo() const;
   const std::vector<std::string>& enabledDeviceExtensions() const;
-  uint32_t validationErrorCount() const;    // errors seen by the debug messenger (0 without validation)
+  uint32_t validationErrorCount() const;  // errors seen by the debug messenger (0 without validation)
   uint32_t validationWarningCount() const;
 
   // --- Scene ---
   // Copies, finalizes and uploads the scene, replacing the previous one (waits for the GPU first).
   Status loadScene(const Scene& scene);
-  const Scene& scene() const;              // finalized CPU copy
-  std::span<const GpuMesh> meshes() const;  // parallel to scene().meshes
+  const Scene& scene() const;                    // finalized CPU copy
+  std::span<const GpuMesh> meshes() const;       // parallel to scene().meshes
   std::span<const GpuTexture> textures() const;  // parallel to scene().textures, see GpuTexture
-  Bounds sceneBounds() const;  // rest pose
+  Bounds sceneBounds() const;                    // rest pose
   // The deforming (skinned and/or morphed) instances of the loaded scene, in instance order, fixed from
   // loadScene() on (empty for a static scene).
   std::span<const DeformedInstance> deformedInstances() const;

@@ -29,8 +29,7 @@ uint32_t cylinderTriangleCount(uint32_t slices, uint32_t heightSegments, bool ca
 // Torus segment (an arch) in the XY plane, centred at the origin, sweeping `arcRadians` from +X counter-
 // clockwise (pi gives a half ring standing on y = 0 from x = +majorRadius to x = -majorRadius). Tube ends
 // are open: 2 * arcSegments * tubeSegments triangles.
-MeshData makeArch(float majorRadius, float minorRadius, float arcRadians, uint32_t arcSegments,
-                  uint32_t tubeSegments);
+MeshData makeArch(float majorRadius, float minorRadius, float arcRadians, uint32_t arcSegments, uint32_t tubeSegments);
 uint32_t archTriangleCount(uint32_t arcSegments, uint32_t tubeSegments);
 
 // Ground plane with a checker texture, six columns, two arches, spheres and boxes with varied materials:

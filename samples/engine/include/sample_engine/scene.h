@@ -114,7 +114,7 @@ enum class AnimationInterpolation : uint8_t { Linear, Step, CubicSpline };
 // the last.
 struct AnimationSampler {
   AnimationInterpolation interpolation = AnimationInterpolation::Linear;
-  std::vector<float> times;   // seconds, non-decreasing
+  std::vector<float> times;  // seconds, non-decreasing
   // Per key `width` floats (3 for translation / scale, 4 for rotation as x, y, z, w, the morph target count
   // for weights); CUBICSPLINE keys hold in-tangent, value, out-tangent (3 * width floats).
   std::vector<float> values;
@@ -130,7 +130,7 @@ struct Animation {
   std::string name;  // may be empty
   std::vector<AnimationSampler> samplers;
   std::vector<AnimationChannel> channels;  // applied in order
-  float duration = 0.0f;  // seconds: the largest key time of its samplers; playback loops over it
+  float duration = 0.0f;                   // seconds: the largest key time of its samplers; playback loops over it
 };
 
 // Which animation plays, and where in it (FrameParams::animations).
@@ -173,9 +173,9 @@ struct Scene {
   std::vector<Material> materials;  // at least one is added by finalizeScene() if empty
   std::vector<TextureData> textures;
   std::vector<Instance> instances;
-  std::optional<Camera> camera;     // e.g. the first perspective camera of a glTF file
+  std::optional<Camera> camera;  // e.g. the first perspective camera of a glTF file
   std::optional<Sun> sun;
-  std::vector<Node> nodes;          // empty for a static scene
+  std::vector<Node> nodes;  // empty for a static scene
   std::vector<Skin> skins;
   std::vector<Animation> animations;
 

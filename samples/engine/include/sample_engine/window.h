@@ -33,7 +33,7 @@ class Window {
   bool keyDown(Key key) const;
   bool mouseButtonDown(int button) const;  // 0 = left, 1 = right, 2 = middle
   void cursorPosition(double& x, double& y) const;
-  double takeScrollDelta();                // vertical scroll accumulated since the last call
+  double takeScrollDelta();                     // vertical scroll accumulated since the last call
   void* glfwHandle() const { return window_; }  // GLFWwindow*, for input callbacks
 
  private:

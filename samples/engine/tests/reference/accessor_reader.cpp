@@ -12,45 +12,26 @@ namespace {
 int componentSize(int componentType) {
   switch (componentType) {
     case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return 1;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
     case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
-      return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT:
-      return 4;
-    default:
-      return 0;
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
   }
 }
 
 // Columns and rows of the accessor type (VECn is one column of n rows).
 bool typeShape(int type, int& columns, int& rows) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      columns = 1, rows = 1;
-      return true;
-    case TINYGLTF_TYPE_VEC2:
-      columns = 1, rows = 2;
-      return true;
-    case TINYGLTF_TYPE_VEC3:
-      columns = 1, rows = 3;
-      return true;
-    case TINYGLTF_TYPE_VEC4:
-      columns = 1, rows = 4;
-      return true;
-    case TINYGLTF_TYPE_MAT2:
-      columns = 2, rows = 2;
-      return true;
-    case TINYGLTF_TYPE_MAT3:
-      columns = 3, rows = 3;
-      return true;
-    case TINYGLTF_TYPE_MAT4:
-      columns = 4, rows = 4;
-      return true;
-    default:
-      return false;
+    case TINYGLTF_TYPE_SCALAR: columns = 1, rows = 1; return true;
+    case TINYGLTF_TYPE_VEC2: columns = 1, rows = 2; return true;
+    case TINYGLTF_TYPE_VEC3: columns = 1, rows = 3; return true;
+    case TINYGLTF_TYPE_VEC4: columns = 1, rows = 4; return true;
+    case TINYGLTF_TYPE_MAT2: columns = 2, rows = 2; return true;
+    case TINYGLTF_TYPE_MAT3: columns = 3, rows = 3; return true;
+    case TINYGLTF_TYPE_MAT4: columns = 4, rows = 4; return true;
+    default: return false;
   }
 }
 
@@ -84,8 +65,7 @@ double decode(const unsigned char* p, int componentType, bool normalized) {
       double c = load<uint32_t>(p);
       return normalized ? c / 4294967295.0 : c;
     }
-    default:
-      return double(load<float>(p));
+    default: return double(load<float>(p));
   }
 }
 
@@ -99,17 +79,15 @@ const unsigned char* viewBytes(const tinygltf::Model& model, int viewIndex, size
   }
   const tinygltf::BufferView& view = model.bufferViews[size_t(viewIndex)];
   if (view.buffer < 0 || size_t(view.buffer) >= model.buffers.size()) {
-    *error = what + ": bufferView " + std::to_string(viewIndex) + " names buffer " +
-             std::to_string(view.buffer) + ", out of range (the file has " +
-             std::to_string(model.buffers.size()) + ")";
+    *error = what + ": bufferView " + std::to_string(viewIndex) + " names buffer " + std::to_string(view.buffer) +
+             ", out of range (the file has " + std::to_string(model.buffers.size()) + ")";
     return nullptr;
   }
   const std::vector<unsigned char>& data = model.buffers[size_t(view.buffer)].data;
   if (view.byteOffset + view.byteLength > data.size() || offset + size > view.byteLength) {
     *error = what + ": needs bytes up to " + std::to_string(offset + size) + " of bufferView " +
-             std::to_string(viewIndex) + ", which has " + std::to_string(view.byteLength) +
-             " (buffer holds " + std::to_string(data.size()) + " bytes from offset " +
-             std::to_string(view.byteOffset) + ")";
+             std::to_string(viewIndex) + ", which has " + std::to_string(view.byteLength) + " (buffer holds " +
+             std::to_string(data.size()) + " bytes from offset " + std::to_string(view.byteOffset) + ")";
     return nullptr;
   }
   return data.data() + view.byteOffset + offset;
@@ -117,8 +95,7 @@ const unsigned char* viewBytes(const tinygltf::Model& model, int viewIndex, size
 
 }  // namespace
 
-std::optional<AccessorValues> readAccessor(const tinygltf::Model& model, int accessorIndex,
-                                           std::string* error) {
+std::optional<AccessorValues> readAccessor(const tinygltf::Model& model, int accessorIndex, std::string* error) {
   if (accessorIndex < 0 || size_t(accessorIndex) >= model.accessors.size()) {
     *error = "accessor " + std::to_string(accessorIndex) + " is out of range (the file has " +
              std::to_string(model.accessors.size()) + ")";
@@ -154,8 +131,8 @@ std::optional<AccessorValues> readAccessor(const tinygltf::Model& model, int acc
                                   ? model.bufferViews[size_t(acc.bufferView)].byteStride
                                   : 0;
     const size_t stride = viewStride ? viewStride : elementSize;
-    const unsigned char* base =
-        viewBytes(model, acc.bufferView, acc.byteOffset, stride * (acc.count - 1) + elementSize, what, error);
+    const unsigned char* base = viewBytes(model, acc.bufferView, acc.byteOffset, stride * (acc.count - 1) + elementSize,
+                                          what, error);
     if (!base) return std::nullopt;
     for (size_t i = 0; i < acc.count; ++i) decodeElement(base + i * stride, i);
   }
@@ -164,20 +141,18 @@ std::optional<AccessorValues> readAccessor(const tinygltf::Model& model, int acc
     const size_t n = size_t(acc.sparse.count);
     const int indexType = acc.sparse.indices.componentType;
     const int isize = componentSize(indexType);
-    if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-        indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+    if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
         indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
       *error = what + ": sparse indices have componentType " + std::to_string(indexType) +
                ", expected 5121, 5123 or 5125 (unsigned integers)";
       return std::nullopt;
     }
-    const unsigned char* indices =
-        viewBytes(model, acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset),
-                  n * size_t(isize), what + " (sparse indices)", error);
+    const unsigned char* indices = viewBytes(model, acc.sparse.indices.bufferView,
+                                             size_t(acc.sparse.indices.byteOffset), n * size_t(isize),
+                                             what + " (sparse indices)", error);
     if (!indices) return std::nullopt;
-    const unsigned char* values =
-        viewBytes(model, acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n * elementSize,
-                  what + " (sparse values)", error);
+    const unsigned char* values = viewBytes(model, acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset),
+                                            n * elementSize, what + " (sparse values)", error);
     if (!values) return std::nullopt;
     for (size_t i = 0; i < n; ++i) {
       const double index = decode(indices + i * size_t(isize), indexType, false);

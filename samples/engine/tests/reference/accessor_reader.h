@@ -20,15 +20,12 @@ struct AccessorValues {
   std::vector<double> values;
   size_t count = 0;
   int components = 0;  // 1 for SCALAR, 2..4 for VECn, 4/9/16 for MATn
-  double at(size_t element, int component) const {
-    return values[element * size_t(components) + size_t(component)];
-  }
+  double at(size_t element, int component) const { return values[element * size_t(components) + size_t(component)]; }
 };
 
 // Handles byteStride, a missing bufferView (all zeros, as sparse accessors allow) and sparse substitution.
 // Returns std::nullopt and sets *error (naming the accessor and the bad value) on out-of-range indices, reads
 // past a buffer view, or unknown component types / types.
-std::optional<AccessorValues> readAccessor(const tinygltf::Model& model, int accessorIndex,
-                                           std::string* error);
+std::optional<AccessorValues> readAccessor(const tinygltf::Model& model, int accessorIndex, std::string* error);
 
 }  // namespace pose_reference

@@ -14,8 +14,7 @@ std::string base64(const std::vector<uint8_t>& data) {
   std::string out;
   out.reserve((data.size() + 2) / 3 * 4);
   for (size_t i = 0; i < data.size(); i += 3) {
-    const uint32_t b0 = data[i], b1 = i + 1 < data.size() ? data[i + 1] : 0,
-                   b2 = i + 2 < data.size() ? data[i + 2] : 0;
+    const uint32_t b0 = data[i], b1 = i + 1 < data.size() ? data[i + 1] : 0, b2 = i + 2 < data.size() ? data[i + 2] : 0;
     const uint32_t triple = (b0 << 16) | (b1 << 8) | b2;
     out += alphabet[(triple >> 18) & 63];
     out += alphabet[(triple >> 12) & 63];
@@ -35,16 +34,11 @@ GltfDocumentBuilder::GltfDocumentBuilder() {
 
 const char* GltfDocumentBuilder::typeName(int components) {
   switch (components) {
-    case 1:
-      return "SCALAR";
-    case 2:
-      return "VEC2";
-    case 3:
-      return "VEC3";
-    case 4:
-      return "VEC4";
-    default:
-      return "MAT4";
+    case 1: return "SCALAR";
+    case 2: return "VEC2";
+    case 3: return "VEC3";
+    case 4: return "VEC4";
+    default: return "MAT4";
   }
 }
 
@@ -59,9 +53,8 @@ int GltfDocumentBuilder::addBufferView(const void* data, size_t bytes, int targe
   return int(doc_["bufferViews"].size()) - 1;
 }
 
-int GltfDocumentBuilder::addAccessor(int bufferView, int componentType, size_t count, const char* type,
-                                     bool normalized, const std::vector<double>& min,
-                                     const std::vector<double>& max) {
+int GltfDocumentBuilder::addAccessor(int bufferView, int componentType, size_t count, const char* type, bool normalized,
+                                     const std::vector<double>& min, const std::vector<double>& max) {
   nlohmann::json a = {{"componentType", componentType}, {"count", count}, {"type", type}};
   if (bufferView >= 0) a["bufferView"] = bufferView;
   if (normalized) a["normalized"] = true;
@@ -71,8 +64,7 @@ int GltfDocumentBuilder::addAccessor(int bufferView, int componentType, size_t c
   return int(doc_["accessors"].size()) - 1;
 }
 
-int GltfDocumentBuilder::addFloats(const std::vector<float>& values, int components, int target,
-                                   bool bounds) {
+int GltfDocumentBuilder::addFloats(const std::vector<float>& values, int components, int target, bool bounds) {
   const int view = addBufferView(values.data(), values.size() * sizeof(float), target);
   std::vector<double> lo, hi;
   if (bounds) {
@@ -83,8 +75,7 @@ int GltfDocumentBuilder::addFloats(const std::vector<float>& values, int compone
       hi[i % size_t(components)] = std::max(hi[i % size_t(components)], double(values[i]));
     }
   }
-  return addAccessor(view, 5126 /* FLOAT */, values.size() / size_t(components), typeName(components), false,
-                     lo, hi);
+  return addAccessor(view, 5126 /* FLOAT */, values.size() / size_t(components), typeName(components), false, lo, hi);
 }
 
 std::string GltfDocumentBuilder::write(const std::string& path) {

@@ -24,11 +24,9 @@ class GltfDocumentBuilder {
   // Float data in one call: `components` per element, min/max computed when `bounds`.
   int addFloats(const std::vector<float>& values, int components, int target, bool bounds = false);
   template <typename T>
-  int addIntegers(const std::vector<T>& values, int components, int componentType, int target,
-                  bool normalized) {
+  int addIntegers(const std::vector<T>& values, int components, int componentType, int target, bool normalized) {
     const int view = addBufferView(values.data(), values.size() * sizeof(T), target);
-    return addAccessor(view, componentType, values.size() / size_t(components), typeName(components),
-                       normalized);
+    return addAccessor(view, componentType, values.size() / size_t(components), typeName(components), normalized);
   }
 
   nlohmann::json& document() { return doc_; }   // the caller adds nodes, meshes, skins, animations

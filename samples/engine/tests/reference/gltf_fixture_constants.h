@@ -25,9 +25,7 @@ inline constexpr int kStripJointCount = 3;
 inline constexpr double kStripBoneLength = 1.0;  // joint1 and joint2 sit at (0, 1, 0) in their parent
 inline constexpr double kStripRootYawDegrees = 30.0;
 inline constexpr double kStripRootScale = 1.5;  // uniform, so joint rotations stay rotations in world space
-inline glm::dvec3 stripRootTranslation() {
-  return {1.0, 0.5, -2.0};
-}
+inline glm::dvec3 stripRootTranslation() { return {1.0, 0.5, -2.0}; }
 inline glm::dquat stripRootRotation() {
   return glm::angleAxis(glm::radians(kStripRootYawDegrees), glm::dvec3(0, 1, 0));
 }
@@ -37,16 +35,10 @@ inline glm::dmat4 stripRootMatrix() {
 }
 // The mesh node's own transform: ignored by skinning (glTF), but it defines the engine's local (deformed)
 // space.
-inline glm::dvec3 stripMeshNodeTranslation() {
-  return {0.5, 0.25, 0.0};
-}
-inline glm::dquat stripMeshNodeRotation() {
-  return glm::angleAxis(glm::radians(20.0), glm::dvec3(1, 0, 0));
-}
+inline glm::dvec3 stripMeshNodeTranslation() { return {0.5, 0.25, 0.0}; }
+inline glm::dquat stripMeshNodeRotation() { return glm::angleAxis(glm::radians(20.0), glm::dvec3(1, 0, 0)); }
 
-inline int stripVertexIndex(int row, int column) {
-  return row * 2 + column;
-}
+inline int stripVertexIndex(int row, int column) { return row * 2 + column; }
 // Vertex position in the strip's own frame (before the root transform): x = -/+ half width, y = row *
 // spacing.
 inline glm::dvec3 stripLocalVertex(int row, int column) {
@@ -65,13 +57,10 @@ inline glm::dvec3 stripBindPosition(int row, int column) {
 inline constexpr double kStripTentHalfWidth = 2.0;
 inline glm::dvec3 stripJointTotals(double y) {
   glm::dvec3 w;
-  for (int j = 0; j < 3; ++j)
-    w[j] = std::max(0.0, kStripTentHalfWidth - std::abs(y - (j + 0.5) * kStripBoneLength));
+  for (int j = 0; j < 3; ++j) w[j] = std::max(0.0, kStripTentHalfWidth - std::abs(y - (j + 0.5) * kStripBoneLength));
   return w / (w.x + w.y + w.z);
 }
-inline glm::dvec3 stripJointTotals(int row) {
-  return stripJointTotals(row * kStripRowSpacing);
-}
+inline glm::dvec3 stripJointTotals(int row) { return stripJointTotals(row * kStripRowSpacing); }
 // World position of joint j at the bind pose: the pivot of its rotation and scale.
 inline glm::dvec3 stripJointBindWorld(int joint) {
   return glm::dvec3(stripRootMatrix() * glm::dvec4(0.0, joint * kStripBoneLength, 0.0, 1.0));
@@ -103,12 +92,9 @@ inline constexpr int kStripZeroWeightVertex = 5;
 // node 1. One node per sampler because a glTF animation may target a node's weights only once.
 inline constexpr int kCubeVertexCount = 24;  // 6 faces x 4, faces in the order +X, -X, +Y, -Y, +Z, -Z
 inline constexpr int kCubeTargetCount = 2;
-inline constexpr std::array<double, 2> kCubeMeshWeights{0.25, 0.0};  // used by node 0 at rest
-inline constexpr std::array<double, 2> kCubeSplineNodeWeights{0.0,
-                                                              0.75};  // node 1's own weights, used at rest
-inline glm::dvec3 cubeNodeTranslation(int node) {
-  return node == 0 ? glm::dvec3(-1.5, 0, 0) : glm::dvec3(1.5, 0, 0);
-}
+inline constexpr std::array<double, 2> kCubeMeshWeights{0.25, 0.0};        // used by node 0 at rest
+inline constexpr std::array<double, 2> kCubeSplineNodeWeights{0.0, 0.75};  // node 1's own weights, used at rest
+inline glm::dvec3 cubeNodeTranslation(int node) { return node == 0 ? glm::dvec3(-1.5, 0, 0) : glm::dvec3(1.5, 0, 0); }
 inline glm::dquat cubeNodeRotation(int node) {
   return node == 0 ? glm::angleAxis(glm::radians(45.0), glm::dvec3(0, 1, 0)) : glm::dquat(1, 0, 0, 0);
 }

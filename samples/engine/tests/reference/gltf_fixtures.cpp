@@ -17,20 +17,14 @@ using nlohmann::json;
 constexpr int kFloat = 5126, kUnsignedByte = 5121, kUnsignedShort = 5123, kUnsignedInt = 5125;
 constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 
-json vec(const glm::dvec3& v) {
-  return json::array({v.x, v.y, v.z});
-}
-json quat(const glm::dquat& q) {
-  return json::array({q.x, q.y, q.z, q.w});
-}  // glTF order x, y, z, w
+json vec(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
+json quat(const glm::dquat& q) { return json::array({q.x, q.y, q.z, q.w}); }  // glTF order x, y, z, w
 // push_back per value: GCC 12 reports a false -Wstringop-overflow for vector::insert of initializer lists.
 template <typename T, typename... Values>
 void append(std::vector<T>& out, Values... values) {
   (out.push_back(T(values)), ...);
 }
-void push(std::vector<float>& out, const glm::dvec3& v) {
-  append(out, v.x, v.y, v.z);
-}
+void push(std::vector<float>& out, const glm::dvec3& v) { append(out, v.x, v.y, v.z); }
 
 enum class StripDefect { None, JointOutOfRange, ZeroWeights };
 
@@ -53,8 +47,8 @@ std::string writeStrip(const std::string& path, StripDefect defect, const char* 
       // the per-joint totals (what the tests derive positions from) stay exact to float precision.
       const glm::dvec3 total = stripJointTotals(row);
       auto quantize = [](double w) { return uint16_t(std::lround(w * 65535.0)); };
-      const uint16_t s4 = quantize(0.25 * total[1]), s5 = quantize(0.3 * total[2]),
-                     s6 = quantize(0.2 * total[0]), s7 = quantize(0.15 * total[1]);
+      const uint16_t s4 = quantize(0.25 * total[1]), s5 = quantize(0.3 * total[2]), s6 = quantize(0.2 * total[0]),
+                     s7 = quantize(0.15 * total[1]);
       const double rest0 = total[0] - s6 / 65535.0;
       float w[4] = {float(0.6 * rest0), float(total[1] - (s4 + s7) / 65535.0), float(total[2] - s5 / 65535.0),
                     float(0.4 * rest0)};
@@ -85,16 +79,15 @@ std::string writeStrip(const std::string& path, StripDefect defect, const char* 
                      {"JOINTS_1", b.addIntegers(joints1, 4, kUnsignedShort, kArrayBuffer, false)},
                      {"WEIGHTS_1", b.addIntegers(weights1, 4, kUnsignedShort, kArrayBuffer, true)}};
   const int indexAccessor = b.addIntegers(indices, 1, kUnsignedShort, kElementArrayBuffer, false);
-  doc["meshes"] =
-      json::array({{{"name", "strip"},
-                    {"primitives",
-                     json::array({{{"attributes", attributes}, {"indices", indexAccessor}, {"mode", 4}}})}}});
+  doc["meshes"] = json::array(
+      {{{"name", "strip"},
+        {"primitives", json::array({{{"attributes", attributes}, {"indices", indexAccessor}, {"mode", 4}}})}}});
 
   // Inverse bind matrices: inverses of the joints' bind world transforms, root included (not identity).
   std::vector<float> inverseBind;
   for (int j = 0; j < kStripJointCount; ++j) {
-    const glm::dmat4 bindWorld =
-        stripRootMatrix() * glm::translate(glm::dmat4(1.0), glm::dvec3(0, j * kStripBoneLength, 0));
+    const glm::dmat4 bindWorld = stripRootMatrix() *
+                                 glm::translate(glm::dmat4(1.0), glm::dvec3(0, j * kStripBoneLength, 0));
     const glm::dmat4 inv = glm::inverse(bindWorld);
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) inverseBind.push_back(float(inv[c][r]));
@@ -104,20 +97,19 @@ std::string writeStrip(const std::string& path, StripDefect defect, const char* 
                                {"inverseBindMatrices", b.addFloats(inverseBind, 16, 0)}}});
 
   const json boneOffset = vec({0, kStripBoneLength, 0});
-  doc["nodes"] =
-      json::array({{{"name", "root"},
-                    {"children", json::array({1, 2})},
-                    {"translation", vec(stripRootTranslation())},
-                    {"rotation", quat(stripRootRotation())},
-                    {"scale", vec(glm::dvec3(kStripRootScale))}},
-                   {{"name", "strip"},
-                    {"mesh", 0},
-                    {"skin", 0},
-                    {"translation", vec(stripMeshNodeTranslation())},
-                    {"rotation", quat(stripMeshNodeRotation())}},
-                   {{"name", "joint0"}, {"children", json::array({3})}},
-                   {{"name", "joint1"}, {"children", json::array({4})}, {"translation", boneOffset}},
-                   {{"name", "joint2"}, {"translation", boneOffset}}});
+  doc["nodes"] = json::array({{{"name", "root"},
+                               {"children", json::array({1, 2})},
+                               {"translation", vec(stripRootTranslation())},
+                               {"rotation", quat(stripRootRotation())},
+                               {"scale", vec(glm::dvec3(kStripRootScale))}},
+                              {{"name", "strip"},
+                               {"mesh", 0},
+                               {"skin", 0},
+                               {"translation", vec(stripMeshNodeTranslation())},
+                               {"rotation", quat(stripMeshNodeRotation())}},
+                              {{"name", "joint0"}, {"children", json::array({3})}},
+                              {{"name", "joint1"}, {"children", json::array({4})}, {"translation", boneOffset}},
+                              {{"name", "joint2"}, {"translation", boneOffset}}});
   doc["scenes"] = json::array({{{"nodes", json::array({kStripRootNode})}}});
   doc["scene"] = 0;
 
@@ -128,8 +120,7 @@ std::string writeStrip(const std::string& path, StripDefect defect, const char* 
   std::vector<float> rotations;
   for (size_t k = 0; k < kStripRotationTimes.size(); ++k) {
     const double half = glm::radians(kStripRotationDegrees[k]) / 2;
-    const bool last =
-        k + 1 == kStripRotationTimes.size();  // stored negated: same rotation, opposite hemisphere
+    const bool last = k + 1 == kStripRotationTimes.size();  // stored negated: same rotation, opposite hemisphere
     const double sign = last ? -1.0 : 1.0;
     append(rotations, 0.0, 0.0, sign * std::sin(half), sign * std::cos(half));
   }
@@ -201,15 +192,14 @@ std::string writeMorphCube(const std::string& path) {
       push(sparseValues, d);
       lo = glm::min(lo, d), hi = glm::max(hi, d);
     }
-  const int sparseAccessor =
-      b.addAccessor(-1, kFloat, kCubeVertexCount, "VEC3", false, {lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z});
+  const int sparseAccessor = b.addAccessor(-1, kFloat, kCubeVertexCount, "VEC3", false, {lo.x, lo.y, lo.z},
+                                           {hi.x, hi.y, hi.z});
   doc["accessors"][size_t(sparseAccessor)]["sparse"] = {
       {"count", sparseIndices.size()},
       {"indices",
        {{"bufferView", b.addBufferView(sparseIndices.data(), sparseIndices.size(), 0)},
         {"componentType", kUnsignedByte}}},
-      {"values",
-       {{"bufferView", b.addBufferView(sparseValues.data(), sparseValues.size() * sizeof(float), 0)}}}};
+      {"values", {{"bufferView", b.addBufferView(sparseValues.data(), sparseValues.size() * sizeof(float), 0)}}}};
 
   json primitive = {{"attributes",
                      {{"POSITION", b.addFloats(positions, 3, kArrayBuffer, true)},
@@ -236,8 +226,7 @@ std::string writeMorphCube(const std::string& path) {
 
   auto floats = [](const auto& values) { return std::vector<float>(values.begin(), values.end()); };
   std::vector<float> linearWeights, splineWeights;
-  for (const auto& key : kCubeLinearWeights)
-    linearWeights.insert(linearWeights.end(), key.begin(), key.end());
+  for (const auto& key : kCubeLinearWeights) linearWeights.insert(linearWeights.end(), key.begin(), key.end());
   for (const auto& key : kCubeSplineKeys)
     for (const auto& part : key) splineWeights.insert(splineWeights.end(), part.begin(), part.end());
   doc["animations"] = json::array(

@@ -17,8 +17,7 @@ namespace pose_reference {
 namespace {
 
 // The poser needs geometry only; decoding textures would cost time and fail on files without their images.
-bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-               void*) {
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
   return true;
 }
 
@@ -27,8 +26,7 @@ bool loadModel(const std::string& path, tinygltf::Model& model, std::string& err
   loader.SetImageLoader(skipImage, nullptr);
   std::string err, warn;
   std::string lower = path;
-  std::transform(lower.begin(), lower.end(), lower.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   const bool binary = lower.size() >= 4 && lower.compare(lower.size() - 4, 4, ".glb") == 0;
   const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
                          : loader.LoadASCIIFromFile(&model, &err, &warn, path);
@@ -49,8 +47,7 @@ struct LocalPose {
 
   glm::dmat4 local() const {
     if (hasMatrix) return matrix;
-    return glm::translate(glm::dmat4(1.0), translation) * glm::mat4_cast(rotation) *
-           glm::scale(glm::dmat4(1.0), scale);
+    return glm::translate(glm::dmat4(1.0), translation) * glm::mat4_cast(rotation) * glm::scale(glm::dmat4(1.0), scale);
   }
 };
 
@@ -63,8 +60,7 @@ class Poser {
     if (animation < -1 || animation >= animationCount)
       return fail("animation " + std::to_string(animation) + " is out of range: the file has " +
                   std::to_string(animationCount) + " (use -1 for the rest pose)");
-    if (!std::isfinite(time) || time < 0.0)
-      return fail("time " + std::to_string(time) + " must be finite and >= 0");
+    if (!std::isfinite(time) || time < 0.0) return fail("time " + std::to_string(time) + " must be finite and >= 0");
     if (!buildHierarchy() || !initLocalPoses()) return false;
     if (animation >= 0 && !applyAnimation(animation, time)) return false;
     if (!computeWorlds()) return false;
@@ -104,8 +100,8 @@ class Poser {
     for (size_t i = 0; i < n; ++i)
       for (int child : model_.nodes[i].children) {
         if (child < 0 || size_t(child) >= n)
-          return fail("node " + std::to_string(i) + " has child " + std::to_string(child) +
-                      ", out of range (" + std::to_string(n) + " nodes)");
+          return fail("node " + std::to_string(i) + " has child " + std::to_string(child) + ", out of range (" +
+                      std::to_string(n) + " nodes)");
         if (parent_[size_t(child)] != -1)
           return fail("node " + std::to_string(child) + " is a child of both node " +
                       std::to_string(parent_[size_t(child)]) + " and node " + std::to_string(i) +
@@ -128,8 +124,7 @@ class Poser {
         return fail("node " + std::to_string(i) + ": matrix has " + std::to_string(node.matrix.size()) +
                     " values, expected 16");
       }
-      if (node.translation.size() == 3)
-        p.translation = {node.translation[0], node.translation[1], node.translation[2]};
+      if (node.translation.size() == 3) p.translation = {node.translation[0], node.translation[1], node.translation[2]};
       if (node.scale.size() == 3) p.scale = {node.scale[0], node.scale[1], node.scale[2]};
       if (node.rotation.size() == 4)
         p.rotation = glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);
@@ -150,8 +145,8 @@ class Poser {
       if (input->count == 0) return fail(what + ": no keyframes");
       for (size_t k = 1; k < input->count; ++k)
         if (input->values[k] < input->values[k - 1])
-          return fail(what + ": keyframe time " + std::to_string(input->values[k]) + " (key " +
-                      std::to_string(k) + ") is before the previous one");
+          return fail(what + ": keyframe time " + std::to_string(input->values[k]) + " (key " + std::to_string(k) +
+                      ") is before the previous one");
       duration = std::max(duration, input->values.back());
       inputs[s] = std::move(input->values);
     }
@@ -167,8 +162,7 @@ class Poser {
         return fail(what + ": sampler " + std::to_string(channel.sampler) + " is out of range");
       const tinygltf::AnimationSampler& sampler = animation.samplers[size_t(channel.sampler)];
       Interpolation interpolation;
-      if (sampler.interpolation.empty() || sampler.interpolation == "LINEAR")
-        interpolation = Interpolation::Linear;
+      if (sampler.interpolation.empty() || sampler.interpolation == "LINEAR") interpolation = Interpolation::Linear;
       else if (sampler.interpolation == "STEP")
         interpolation = Interpolation::Step;
       else if (sampler.interpolation == "CUBICSPLINE")
@@ -179,8 +173,7 @@ class Poser {
       const std::string& path = channel.target_path;
       const size_t expectedWidth = path == "translation" || path == "scale" ? 3 : path == "rotation" ? 4 : 0;
       if (expectedWidth == 0 && path != "weights")
-        return fail(what + ": target path '" + path +
-                    "' is not supported (translation, rotation, scale, weights)");
+        return fail(what + ": target path '" + path + "' is not supported (translation, rotation, scale, weights)");
       std::optional<AccessorValues> output = read(sampler.output, what + " output", 0);
       if (!output) return false;
       const std::vector<double>& times = inputs[size_t(channel.sampler)];
@@ -194,10 +187,8 @@ class Poser {
       if (pose.hasMatrix && path != "weights")
         return fail(what + ": node " + std::to_string(channel.target_node) +
                     " has a matrix, which the spec forbids for animated nodes");
-      const std::vector<double> v =
-          sampleKeyframes(times, output->values, width, interpolation, path == "rotation", t);
-      if (path == "translation")
-        pose.translation = {v[0], v[1], v[2]};
+      const std::vector<double> v = sampleKeyframes(times, output->values, width, interpolation, path == "rotation", t);
+      if (path == "translation") pose.translation = {v[0], v[1], v[2]};
       else if (path == "scale")
         pose.scale = {v[0], v[1], v[2]};
       else if (path == "rotation")
@@ -222,8 +213,7 @@ class Poser {
       const int node = stack.back();
       stack.pop_back();
       const int parent = parent_[size_t(node)];
-      world_[size_t(node)] =
-          (parent >= 0 ? world_[size_t(parent)] : glm::dmat4(1.0)) * poses_[size_t(node)].local();
+      world_[size_t(node)] = (parent >= 0 ? world_[size_t(parent)] : glm::dmat4(1.0)) * poses_[size_t(node)].local();
       done[size_t(node)] = true;
       for (int child : model_.nodes[size_t(node)].children) stack.push_back(child);
     }
@@ -253,8 +243,7 @@ class Poser {
     const tinygltf::Node& node = model_.nodes[size_t(nodeIndex)];
     if (node.mesh >= 0) {
       if (size_t(node.mesh) >= model_.meshes.size())
-        return fail("node " + std::to_string(nodeIndex) + ": mesh " + std::to_string(node.mesh) +
-                    " is out of range");
+        return fail("node " + std::to_string(nodeIndex) + ": mesh " + std::to_string(node.mesh) + " is out of range");
       std::vector<glm::dmat4> joints;
       if (node.skin >= 0 && !jointMatrices(nodeIndex, joints)) return false;
       const tinygltf::Mesh& mesh = model_.meshes[size_t(node.mesh)];
@@ -306,13 +295,11 @@ class Poser {
   }
 
   // Morph weights in the spec's order of precedence: animated, node, mesh, zeros.
-  bool morphWeights(int nodeIndex, size_t targetCount, const std::string& what,
-                    std::vector<double>& weights) {
+  bool morphWeights(int nodeIndex, size_t targetCount, const std::string& what, std::vector<double>& weights) {
     const tinygltf::Node& node = model_.nodes[size_t(nodeIndex)];
     const LocalPose& pose = poses_[size_t(nodeIndex)];
     const tinygltf::Mesh& mesh = model_.meshes[size_t(node.mesh)];
-    if (pose.weightsAnimated)
-      weights = pose.weights;
+    if (pose.weightsAnimated) weights = pose.weights;
     else if (!node.weights.empty())
       weights = node.weights;
     else if (!mesh.weights.empty())
@@ -328,8 +315,7 @@ class Poser {
     return true;
   }
 
-  bool posePrimitive(const tinygltf::Primitive& prim, const std::vector<glm::dmat4>* joints,
-                     PosedPrimitive& posed) {
+  bool posePrimitive(const tinygltf::Primitive& prim, const std::vector<glm::dmat4>* joints, PosedPrimitive& posed) {
     const std::string what = "node " + std::to_string(posed.node) + " mesh " + std::to_string(posed.mesh) +
                              " primitive " + std::to_string(posed.primitive);
     auto attribute = [&](const std::map<std::string, int>& attrs, const char* name) {
@@ -344,8 +330,7 @@ class Poser {
       if (!v) return std::nullopt;
       if (name == "POSITION") n = v->count;
       if (v->count != n) {
-        fail(what + " " + name + ": " + std::to_string(v->count) + " elements for " + std::to_string(n) +
-             " vertices");
+        fail(what + " " + name + ": " + std::to_string(v->count) + " elements for " + std::to_string(n) + " vertices");
         return std::nullopt;
       }
       std::vector<glm::dvec3> r(n);
@@ -389,8 +374,8 @@ class Poser {
       posed.worldPositions[i] = glm::dvec3(vertexMatrix[i] * glm::dvec4((*pos)[i], 1.0));
       posed.localPositions[i] = glm::dvec3(toLocal * glm::dvec4(posed.worldPositions[i], 1.0));
       if (nrm)
-        posed.worldNormals[i] =
-            safeNormalize(glm::inverseTranspose(glm::dmat3(vertexMatrix[i])) * safeNormalize((*nrm)[i]));
+        posed.worldNormals[i] = safeNormalize(glm::inverseTranspose(glm::dmat3(vertexMatrix[i])) *
+                                              safeNormalize((*nrm)[i]));
     }
 
     if (prim.indices >= 0) {
@@ -399,8 +384,8 @@ class Poser {
       posed.indices.resize(idx->count);
       for (size_t i = 0; i < idx->count; ++i) {
         if (idx->values[i] >= double(n))
-          return fail(what + ": index " + std::to_string(uint64_t(idx->values[i])) + " (entry " +
-                      std::to_string(i) + ") is >= the vertex count " + std::to_string(n));
+          return fail(what + ": index " + std::to_string(uint64_t(idx->values[i])) + " (entry " + std::to_string(i) +
+                      ") is >= the vertex count " + std::to_string(n));
         posed.indices[i] = uint32_t(idx->values[i]);
       }
     } else {
@@ -412,8 +397,8 @@ class Poser {
 
   // Linear-blend skinning matrices: sum_i w_i * jointMatrix[j_i] over JOINTS_0/WEIGHTS_0 and
   // JOINTS_1/WEIGHTS_1.
-  bool blendJoints(const tinygltf::Primitive& prim, const std::vector<glm::dmat4>& joints,
-                   const std::string& what, size_t n, std::vector<glm::dmat4>& out) {
+  bool blendJoints(const tinygltf::Primitive& prim, const std::vector<glm::dmat4>& joints, const std::string& what,
+                   size_t n, std::vector<glm::dmat4>& out) {
     if (prim.attributes.count("JOINTS_2") || prim.attributes.count("WEIGHTS_2"))
       return fail(what + ": JOINTS_2/WEIGHTS_2 (more than 8 influences) are not supported");
     std::vector<AccessorValues> jointSets, weightSets;
@@ -430,8 +415,8 @@ class Poser {
       std::optional<AccessorValues> wv = jv ? read(wi->second, what + " " + w, 4) : std::nullopt;
       if (!wv) return false;
       if (jv->count != n || wv->count != n)
-        return fail(what + ": " + j + "/" + w + " have " + std::to_string(jv->count) + "/" +
-                    std::to_string(wv->count) + " elements for " + std::to_string(n) + " vertices");
+        return fail(what + ": " + j + "/" + w + " have " + std::to_string(jv->count) + "/" + std::to_string(wv->count) +
+                    " elements for " + std::to_string(n) + " vertices");
       jointSets.push_back(std::move(*jv));
       weightSets.push_back(std::move(*wv));
     }

@@ -35,10 +35,9 @@ struct PosedPrimitive {
   int primitive = -1;                      // primitive index within the mesh (TRIANGLES primitives only)
   glm::dmat4 nodeWorld{1.0};               // the node's world transform at that time
   std::vector<glm::dvec3> worldPositions;  // posed (morphed, then skinned), world space
-  std::vector<glm::dvec3>
-      localPositions;  // inverse(nodeWorld) * world position (the engine's deformed-buffer space)
-  std::vector<glm::dvec3> worldNormals;  // posed normals, normalized, world space; empty without NORMAL
-  std::vector<uint32_t> indices;         // triangle list (generated 0..n-1 when the primitive has none)
+  std::vector<glm::dvec3> localPositions;  // inverse(nodeWorld) * world position (the engine's deformed-buffer space)
+  std::vector<glm::dvec3> worldNormals;    // posed normals, normalized, world space; empty without NORMAL
+  std::vector<uint32_t> indices;           // triangle list (generated 0..n-1 when the primitive has none)
 };
 
 // Evaluates the default scene (else scene 0, else all root nodes) of a .gltf/.glb at `time` seconds (finite,

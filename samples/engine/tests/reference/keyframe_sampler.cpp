@@ -37,8 +37,8 @@ std::vector<double> slerp(const double* a, const double* bIn, double u) {
 
 }  // namespace
 
-std::vector<double> sampleKeyframes(const std::vector<double>& times, const std::vector<double>& values,
-                                    size_t width, Interpolation interpolation, bool rotation, double t) {
+std::vector<double> sampleKeyframes(const std::vector<double>& times, const std::vector<double>& values, size_t width,
+                                    Interpolation interpolation, bool rotation, double t) {
   const bool cubic = interpolation == Interpolation::CubicSpline;
   const size_t keyStride = cubic ? 3 * width : width;
   const size_t valueOffset = cubic ? width : 0;  // skip the in-tangent
@@ -58,8 +58,7 @@ std::vector<double> sampleKeyframes(const std::vector<double>& times, const std:
   const double delta = times[k + 1] - times[k];
   const double u = (t - times[k]) / delta;
   switch (interpolation) {
-    case Interpolation::Step:
-      return hold(k);
+    case Interpolation::Step: return hold(k);
     case Interpolation::Linear:
       if (rotation) {
         result = slerp(value(k), value(k + 1), u);

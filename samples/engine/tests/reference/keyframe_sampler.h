@@ -15,7 +15,7 @@ enum class Interpolation { Linear, Step, CubicSpline };
 // Before the first key / after the last key the first / last value holds (the spec's clamping).
 // `rotation` (width 4, quaternions x,y,z,w): LINEAR uses slerp along the shorter arc; the result of every
 // interpolation mode is normalized, as the spec asks of CUBICSPLINE rotations.
-std::vector<double> sampleKeyframes(const std::vector<double>& times, const std::vector<double>& values,
-                                    size_t width, Interpolation interpolation, bool rotation, double t);
+std::vector<double> sampleKeyframes(const std::vector<double>& times, const std::vector<double>& values, size_t width,
+                                    Interpolation interpolation, bool rotation, double t);
 
 }  // namespace pose_reference

@@ -49,12 +49,12 @@ std::string poseError(const std::string& path, int animation, double time) {
 bool near(const glm::dvec3& a, const glm::dvec3& b, double tolerance = kTolerance) {
   return glm::length(a - b) <= tolerance;
 }
-#define CHECK_NEAR(a, b)                                                                              \
-  do {                                                                                                \
-    const glm::dvec3 a_ = (a), b_ = (b);                                                              \
-    INFO(#a " = (" << a_.x << ", " << a_.y << ", " << a_.z << "), expected (" << b_.x << ", " << b_.y \
-                   << ", " << b_.z << ")");                                                           \
-    CHECK(near(a_, b_));                                                                              \
+#define CHECK_NEAR(a, b)                                                                                              \
+  do {                                                                                                                \
+    const glm::dvec3 a_ = (a), b_ = (b);                                                                              \
+    INFO(#a " = (" << a_.x << ", " << a_.y << ", " << a_.z << "), expected (" << b_.x << ", " << b_.y << ", " << b_.z \
+                   << ")");                                                                                           \
+    CHECK(near(a_, b_));                                                                                              \
   } while (0)
 
 // ---- Strip expectations, from rigid motions of the joints (no matrix chain of the poser is reused) ----
@@ -147,8 +147,7 @@ TEST_CASE("fixtures are valid glTF that tinygltf loads, with what they claim", "
 
 TEST_CASE("skinned strip: bind pose where every joint is at its bind transform", "[pose_reference]") {
   const std::string path = writeFixture("strip.gltf", writeSkinnedStrip);
-  const glm::dmat4 meshNodeWorld =
-      stripRootMatrix() * trs(stripMeshNodeTranslation(), stripMeshNodeRotation());
+  const glm::dmat4 meshNodeWorld = stripRootMatrix() * trs(stripMeshNodeTranslation(), stripMeshNodeRotation());
   // Rest pose, and the two animation times at which all three channels give the bind values.
   for (auto [animation, time] : {std::pair{-1, 0.0}, std::pair{0, 0.0}, std::pair{0, 1.5}}) {
     INFO("animation " << animation << " time " << time);
@@ -179,8 +178,7 @@ TEST_CASE("skinned strip: LINEAR rotation slerps along the shorter arc", "[pose_
   // Normals of vertices that joint0 does not influence turn with joint1 (rigidly).
   const PosedPrimitive p = pose(path, 0, 0.25)[0];
   const glm::dvec3 bindNormal = stripRootRotation() * glm::dvec3(0, 0, 1);
-  const glm::dvec3 turned =
-      glm::angleAxis(glm::radians(30.0), stripRootRotation() * glm::dvec3(0, 0, 1)) * bindNormal;
+  const glm::dvec3 turned = glm::angleAxis(glm::radians(30.0), stripRootRotation() * glm::dvec3(0, 0, 1)) * bindNormal;
   for (int row = 0; row < kStripRows; ++row)
     if (stripJointTotals(row)[0] == 0.0) CHECK_NEAR(p.worldNormals[size_t(stripVertexIndex(row, 0))], turned);
 }
@@ -193,13 +191,12 @@ TEST_CASE("skinned strip: STEP translation holds its value until the next key", 
   checkStrip(path, 1.5, 0.0, 0.0, 1.0);               // the third key restores the bind translation
 }
 
-TEST_CASE("skinned strip: CUBICSPLINE scale hits its keys and differs from linear between them",
-          "[pose_reference]") {
+TEST_CASE("skinned strip: CUBICSPLINE scale hits its keys and differs from linear between them", "[pose_reference]") {
   const std::string path = writeFixture("strip.gltf", writeSkinnedStrip);
   checkStrip(path, kStripScaleTimes[1], 0.0, 0.0, kStripScaleValues[1]);
   // Hermite at u = 0.5 of [1.5, 1.75] (delta 0.25): 0.5 * 1 + 0.125 * (0.25 * out0) + 0.5 * 1.5 - 0.125 * 0.
-  const double hermite =
-      0.5 * kStripScaleValues[0] + 0.125 * 0.25 * kStripScaleOutTangent0 + 0.5 * kStripScaleValues[1];
+  const double hermite = 0.5 * kStripScaleValues[0] + 0.125 * 0.25 * kStripScaleOutTangent0 +
+                         0.5 * kStripScaleValues[1];
   REQUIRE(hermite != 0.5 * (kStripScaleValues[0] + kStripScaleValues[1]));
   checkStrip(path, 1.625, 0.0, 0.0, hermite);
   // u = 0.6 of [1.75, 2], zero tangents: h00 = 2u^3 - 3u^2 + 1.
@@ -222,8 +219,7 @@ TEST_CASE("animation time loops over the duration", "[pose_reference]") {
   CHECK(pose(path, 0, kStripDuration)[0].worldPositions == pose(path, 0, 0.0)[0].worldPositions);
 }
 
-TEST_CASE("morph cube: base + sum of weights * deltas, with the spec's weight precedence",
-          "[pose_reference]") {
+TEST_CASE("morph cube: base + sum of weights * deltas, with the spec's weight precedence", "[pose_reference]") {
   const std::string path = writeFixture("cube.gltf", writeMorphCube);
   struct Case {
     int animation;
@@ -232,9 +228,7 @@ TEST_CASE("morph cube: base + sum of weights * deltas, with the spec's weight pr
   };
   const double l0 = kCubeLinearWeights[1][0], l1 = kCubeLinearWeights[1][1];
   const Case cases[] = {
-      {-1,
-       0.0,
-       {{kCubeMeshWeights[0], kCubeMeshWeights[1]}, {kCubeSplineNodeWeights[0], kCubeSplineNodeWeights[1]}}},
+      {-1, 0.0, {{kCubeMeshWeights[0], kCubeMeshWeights[1]}, {kCubeSplineNodeWeights[0], kCubeSplineNodeWeights[1]}}},
       {0, 0.0, {{0, 0}, {0, 0}}},
       {0, 0.5, {{0.5 * l0, 0.5 * l1}, {0, 0}}},  // LINEAR halfway; the spline's first key holds
       {0, 1.0, {{l0, l1}, {0, 0}}},              // keys of both samplers
@@ -255,12 +249,10 @@ TEST_CASE("morph cube: base + sum of weights * deltas, with the spec's weight pr
       for (int v = 0; v < kCubeVertexCount; ++v) {
         INFO("vertex " << v);
         const glm::dvec2 w = c.weights[node];
-        const glm::dvec3 local =
-            cubePosition(v) + w[0] * cubePositionDelta(0, v) + w[1] * cubePositionDelta(1, v);
+        const glm::dvec3 local = cubePosition(v) + w[0] * cubePositionDelta(0, v) + w[1] * cubePositionDelta(1, v);
         CHECK_NEAR(p.localPositions[size_t(v)], local);
         CHECK_NEAR(p.worldPositions[size_t(v)], glm::dvec3(world * glm::dvec4(local, 1.0)));
-        const glm::dvec3 normal =
-            cubeFaceNormal(v / 4) + w[0] * cubeNormalDelta(0, v) + w[1] * cubeNormalDelta(1, v);
+        const glm::dvec3 normal = cubeFaceNormal(v / 4) + w[0] * cubeNormalDelta(0, v) + w[1] * cubeNormalDelta(1, v);
         CHECK_NEAR(p.worldNormals[size_t(v)], glm::normalize(glm::dmat3(world) * normal));
       }
     }
@@ -281,8 +273,7 @@ TEST_CASE("bad input is reported, naming the value", "[pose_reference]") {
   CHECK(badJoint.find("vertex " + std::to_string(kStripBadJointVertex) + " JOINTS_0[0] = joint index " +
                       std::to_string(kStripJointCount) + ", which is >= the skin's joint count " +
                       std::to_string(kStripJointCount)) != std::string::npos);
-  const std::string zero =
-      poseError(writeFixture("zero_weights.gltf", writeSkinnedStripZeroWeights), -1, 0.0);
+  const std::string zero = poseError(writeFixture("zero_weights.gltf", writeSkinnedStripZeroWeights), -1, 0.0);
   INFO(zero);
   CHECK(zero.find("vertex " + std::to_string(kStripZeroWeightVertex) + " has all skinning weights zero") !=
         std::string::npos);
@@ -295,8 +286,7 @@ namespace {
 void checkSampleModel(const char* name) {
   const std::string path = std::string(POSE_REFERENCE_SCENES_DIR) + "/" + name + "/" + name + ".gltf";
   if (!fs::exists(path)) SKIP(path << " is absent");
-  const std::vector<PosedPrimitive> rest = pose(path, -1, 0.0), a = pose(path, 0, 0.0),
-                                    b = pose(path, 0, 1.0);
+  const std::vector<PosedPrimitive> rest = pose(path, -1, 0.0), a = pose(path, 0, 0.0), b = pose(path, 0, 1.0);
   REQUIRE(!rest.empty());
   REQUIRE((a.size() == rest.size() && b.size() == rest.size()));
   // Bounds: the rest pose's extent, grown generously: a posed character stays near its bind pose.
@@ -341,15 +331,7 @@ void checkSampleModel(const char* name) {
 
 }  // namespace
 
-TEST_CASE("sample model CesiumMan poses sanely", "[pose_reference][samples]") {
-  checkSampleModel("CesiumMan");
-}
-TEST_CASE("sample model Fox poses sanely", "[pose_reference][samples]") {
-  checkSampleModel("Fox");
-}
-TEST_CASE("sample model BrainStem poses sanely", "[pose_reference][samples]") {
-  checkSampleModel("BrainStem");
-}
-TEST_CASE("sample model RiggedFigure poses sanely", "[pose_reference][samples]") {
-  checkSampleModel("RiggedFigure");
-}
+TEST_CASE("sample model CesiumMan poses sanely", "[pose_reference][samples]") { checkSampleModel("CesiumMan"); }
+TEST_CASE("sample model Fox poses sanely", "[pose_reference][samples]") { checkSampleModel("Fox"); }
+TEST_CASE("sample model BrainStem poses sanely", "[pose_reference][samples]") { checkSampleModel("BrainStem"); }
+TEST_CASE("sample model RiggedFigure poses sanely", "[pose_reference][samples]") { checkSampleModel("RiggedFigure"); }
