@@ -295,3 +295,36 @@ TEST_CASE("soft shadow penumbra matches the analytic visible fraction of a disk 
   CHECK(double(within) / penumbra >= 0.99);
   CHECK(std::fabs(sumError / penumbra) < 0.01);  // unbiased on average
 }
+
+TEST_CASE("single-sided geometry seen from behind still casts shadows (rays hit both sides)",
+          "[shadow][double-sided]") {
+  GpuFixture fx;
+  TestScene scene;
+  scene.meshes.push_back(rbsamples::makeGrid(20.0f, 4));
+  // A 3 m single-sided roof 1 m above the ground, its only side facing up to the sun: the shadow rays from the
+  // ground reach its back face, which a renderer culling back faces would let the light through.
+  scene.meshes.push_back(rbsamples::makeGrid(3.0f, 2));
+  scene.instances.push_back({0, translation(0, 0, 0)});
+  scene.instances.push_back({1, translation(0, 1, 0)});
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  SyntheticView view;
+  view.eye = {0.0, 6.0, 6.0};
+  view.target = {0.0, 0.0, 0.0};
+  view.width = 128;
+  view.height = 96;
+  CpuGBuffer cpu = traceGBuffer(embree, view);
+  const glm::dvec3 toSun(0.2, 1.0, 0.1);
+  ShadowRun run = runShadowPass(fx, scene, cpu, sun(toSun));
+  std::vector<int> ref = referenceHardShadow(embree, cpu, toSun);
+  uint32_t groundShadowed = 0, agree = 0, compared = 0;
+  for (size_t i = 0; i < ref.size(); ++i) {
+    if (!cpu.hit[i] || cpu.instance[i] != 0) continue;  // ground pixels
+    ++compared;
+    groundShadowed += ref[i] == 0;
+    agree += (run.visibility[i] >= 0.5f) == (ref[i] == 1);
+  }
+  INFO("ground pixels " << compared << ", shadowed by the roof " << groundShadowed << ", agree " << agree);
+  REQUIRE(groundShadowed > 200);
+  CHECK(double(agree) / compared >= 0.995);
+}
