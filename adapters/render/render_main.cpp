@@ -377,7 +377,8 @@ int main(int argc, char** argv) {
       se::Status s = se::writeExr((out / name).string(), img, /*halfFloat=*/false);
       return s ? std::string() : s.error;
     };
-    std::string e = write("depth.exr", toExr(f, distances(f, capturedViewProj, params.camera.eye), 1));
+    // The hook's viewProj is camera-relative: the eye is at the origin of the positions it reconstructs.
+    std::string e = write("depth.exr", toExr(f, distances(f, capturedViewProj, glm::vec3(0.0f)), 1));
     if (e.empty()) e = write("normal.exr", toExr(f, f.normal, 4));
     std::vector<std::string> written = {"depth.exr", "normal.exr"};
     // Hybrid: Raybridge's images as captured in the hook (raw only where a denoiser ran).

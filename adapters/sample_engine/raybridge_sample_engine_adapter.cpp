@@ -182,7 +182,7 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   g.geometricNormal = {info.geometricNormal.view, info.geometricNormal.layout};  // w = metallic, unused
   std::memcpy(g.view, &info.view[0][0], sizeof(g.view));
   std::memcpy(g.projection, &info.proj[0][0], sizeof(g.projection));
-  for (int i = 0; i < 3; ++i) g.cameraPosition[i] = info.cameraPosition[i];  // camera-relative TLAS and rays
+  for (int i = 0; i < 3; ++i) g.cameraPosition[i] = info.cameraPositionD[i];  // camera-relative TLAS and rays
   rb::GBufferDesc shading = g;  // roughness lives in normalRoughness.w: reflections read the shading normals
   shading.normal = {info.normalRoughness.view, info.normalRoughness.layout};
   shading.roughnessInNormalW = true;

@@ -50,8 +50,9 @@ void main() {
   vec3 diffuse = (1.0 - f) * (1.0 - s.metallic) * s.baseColor / PI;
 
   float visibility = frame.inputs.x != 0u ? clamp(texture(externalVisibility, screenUv).r, 0.0, 1.0)
-                                          : sunVisibility(shadowMap, inWorldPos, s.n, s.ng);
+                                          : sunVisibility(shadowMap, inEyeRelativePos, s.n, s.ng);
   float ao = frame.inputs.y != 0u ? clamp(texture(externalAo, screenUv).r, 0.0, 1.0) : 1.0;
+  ao *= s.occlusion;  // glTF material occlusion (gltf loader work): ambient and environment terms only
 
   vec3 color = (diffuse + specular) * frame.sunRadiance.rgb * nDotL * visibility;
   vec3 ambient = frame.sky.rgb * frame.sky.w;

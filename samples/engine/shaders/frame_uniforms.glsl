@@ -1,12 +1,13 @@
 // Per-frame uniforms, set 0 of every pass (scene passes and fullscreen passes). Keep in sync with
 // FrameUniforms in src/pipelines.h.
+// Positions are camera-relative (world position - eye, world axes; the probe capture: - probe position).
 layout(set = 0, binding = 0) uniform FrameUniforms {
-  mat4 view;
+  mat4 view;           // rotation only
   mat4 proj;
-  mat4 viewProj;
-  mat4 invViewProj;
-  mat4 lightViewProj;
-  vec4 cameraPos;     // xyz
+  mat4 viewProj;       // camera-relative position -> clip
+  mat4 invViewProj;    // clip -> camera-relative position
+  mat4 lightViewProj;  // camera-relative position -> the shadow map's clip space
+  vec4 cameraPos;     // xyz: the world-space eye (float); no pass needs it
   vec4 sunDirection;  // xyz: towards the sun, normalized
   vec4 sunRadiance;   // rgb: color * intensity
   vec4 sky;           // rgb: sky radiance (background), w: ambient intensity

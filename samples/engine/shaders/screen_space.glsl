@@ -3,7 +3,8 @@
 // Pixel centre -> UV in [0,1]; pixel (0,0) is the top-left, matching NDC y = -1 (the projection flips Y).
 vec2 pixelUv(ivec2 pixel) { return (vec2(pixel) + 0.5) * frame.viewport.zw; }
 
-vec3 worldFromDepth(vec2 uv, float depth) {
+// Camera-relative position (world position - eye, world axes): invViewProj has a rotation-only view.
+vec3 eyeRelativeFromDepth(vec2 uv, float depth) {
   vec4 p = frame.invViewProj * vec4(uv * 2.0 - 1.0, depth, 1.0);
   return p.xyz / p.w;
 }

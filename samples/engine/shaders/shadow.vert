@@ -1,6 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Depth-only shadow-map pass (no fragment shader), positions only.
+// Depth-only shadow-map pass (no fragment shader), positions only; draw.model and frame.lightViewProj are
+// both camera-relative.
 #include "common.glsl"
 
 layout(location = 0) in vec3 inPosition;

@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Writes the lighting pass's shadow-map sun visibility per pixel (1 = lit, background = 1) so applications
 // can read the engine's own shadows back, e.g. to compare them with a ray-traced reference. The position is
-// reconstructed from the pre-pass depth; normals come from the pre-pass.
+// reconstructed (camera-relative) from the pre-pass depth; normals come from the pre-pass.
 #include "frame_uniforms.glsl"
 #include "screen_space.glsl"
 #include "shadow_sampling.glsl"
@@ -21,8 +21,8 @@ void main() {
     outVisibility = 1.0;
     return;
   }
-  vec3 world = worldFromDepth(pixelUv(pixel), depth);
+  vec3 position = eyeRelativeFromDepth(pixelUv(pixel), depth);
   vec3 n = normalize(texelFetch(normalTex, pixel, 0).xyz);
   vec3 ng = normalize(texelFetch(geometricNormalTex, pixel, 0).xyz);
-  outVisibility = sunVisibility(shadowMap, world, n, ng);
+  outVisibility = sunVisibility(shadowMap, position, n, ng);
 }

@@ -18,9 +18,12 @@ namespace {
 constexpr VkImageLayout kDepthReadLayout = VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL;
 constexpr VkImageLayout kReadLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
 
-// Orthographic sun camera enclosing the scene's bounding sphere, looking along -direction.
-glm::mat4 lightViewProjection(const Bounds& bounds, const glm::vec3& towardsSun, float& radius) {
-  glm::vec3 center = bounds.valid() ? bounds.center() : glm::vec3(0.0f);
+// Orthographic sun camera enclosing the scene's bounding sphere, looking along -direction, for positions
+// relative to `origin` (the camera, or the reflection probe): the sphere's centre is rebased in double, so
+// the matrix carries only a small translation wherever the scene is.
+glm::mat4 lightViewProjection(const Bounds& bounds, const glm::vec3& towardsSun, const glm::dvec3& origin,
+                              float& radius) {
+  const glm::vec3 center(bounds.valid() ? glm::dvec3(bounds.center()) - origin : -origin);
   radius = bounds.valid() ? std::max(bounds.radius(), 1e-3f) : 1.0f;
   glm::vec3 l = glm::normalize(towardsSun);
   glm::vec3 up = std::abs(l.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
@@ -78,13 +81,18 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   // --- Uniforms ---
   const VkExtent2D extent = targets.extent;
   const Bounds bounds = sceneLoaded ? scene.bounds : Bounds{};
+  // Camera-relative raster: draws rebase their model matrices to the eye in double (drawScene), the view is
+  // rotation only, and every position the shaders see is relative to the eye. A world-space viewProj in float
+  // would lose about |eye| * 2^-24 per operation (1 mm at 20 km), amplified by the perspective divide.
+  const glm::dvec3 eye(params.camera.eye);
   FrameUniforms u{};
   u.view = viewMatrix(params.camera);
+  u.view[3] = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
   u.proj = projectionMatrix(params.camera, float(extent.width) / float(extent.height));
   u.viewProj = u.proj * u.view;
   u.invViewProj = glm::inverse(u.viewProj);
   float lightRadius = 1.0f;
-  u.lightViewProj = lightViewProjection(bounds, params.sun.direction, lightRadius);
+  u.lightViewProj = lightViewProjection(bounds, params.sun.direction, eye, lightRadius);
   u.cameraPos = glm::vec4(params.camera.eye, 1.0f);
   u.sunDirection = glm::vec4(glm::normalize(params.sun.direction), 0.0f);
   u.sunRadiance = glm::vec4(params.sun.color * params.sun.intensity, 0.0f);
@@ -102,14 +110,17 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   ProbeKey probeKey;
   bool captureProbe = false;
   if (params.reflectionProbe.enabled) {
+    // Its light matrix is relative to the probe, not the camera: moving the camera does not recapture.
+    const glm::vec3 probePosition = ReflectionProbe::positionFor(params.reflectionProbe, bounds);
+    float probeLightRadius = 1.0f;
     probeKey = ProbeKey{sceneVersion,
                         probeResolution,
-                        ReflectionProbe::positionFor(params.reflectionProbe, bounds),
+                        probePosition,
                         u.sunDirection,
                         u.sunRadiance,
                         u.sky,
                         u.shadow,
-                        u.lightViewProj,
+                        lightViewProjection(bounds, params.sun.direction, glm::dvec3(probePosition), probeLightRadius),
                         params.shadow.depthBiasConstant,
                         params.shadow.depthBiasSlope};
     captureProbe = probe.needsCapture(probeKey);
@@ -185,6 +196,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
   VkCommandBuffer cmd = frame.cmd;
   const VkExtent2D extent = targets.extent;
   const bool haveScene = sceneLoaded;
+  const glm::dvec3 eye(params.camera.eye);  // drawScene rebases every model matrix to it
   auto timestamp = [&](TimestampSlot s) {
     if (frame.timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, frame.timestamps, s);
   };
@@ -213,7 +225,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     beginRendering(cmd, {targets.shadowMapSize, targets.shadowMapSize}, {}, &depth);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.shadow);
     vkCmdSetDepthBias(cmd, params.shadow.depthBiasConstant, 0.0f, params.shadow.depthBiasSlope);
-    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Shadow);
+    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Shadow, eye);
     vkCmdEndRendering(cmd);
     imageBarrier(cmd, targets.shadowMap.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                  kReadLayout, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
@@ -254,7 +266,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
         cmd, extent,
         {colorAttachment(targets.normalRoughness.view, {}), colorAttachment(targets.geometricNormal.view, {})}, &depth);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.prepass);
-    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Prepass);
+    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Prepass, eye);
     vkCmdEndRendering(cmd);
   }
   // Readable by anything the hook records; depth stays usable as the lighting pass's read-only attachment.
@@ -295,6 +307,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     info.invProj = glm::inverse(uniformsIn.proj);
     info.invViewProj = uniformsIn.invViewProj;
     info.cameraPosition = params.camera.eye;
+    info.cameraPositionD = eye;
     info.sunDirection = glm::vec3(uniformsIn.sunDirection);
     info.sunRadiance = glm::vec3(uniformsIn.sunRadiance);
     info.skyColor = glm::vec3(uniformsIn.sky);
@@ -351,7 +364,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
                             nullptr);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 2, 1, &frame.lightingSet, 0,
                             nullptr);
-    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Lighting);
+    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Lighting, eye);
     vkCmdEndRendering(cmd);
   }
   timestamp(kTsLightingEnd);

@@ -1,6 +1,8 @@
 // glTF 2.0 loader on top of tinygltf: flattens the node hierarchy into Scene instances (keeping the nodes,
-// skins and animations for animation), converts each triangle primitive into a MeshData and each image into
-// an RGBA8 TextureData.
+// skins and animations for animation), converts each triangle primitive (lists, strips and fans) into a
+// MeshData and each image into an RGBA8 TextureData.
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <map>
@@ -18,6 +20,47 @@ namespace {
 
 using detail::readFloats;
 using detail::readIndices;
+
+// The extensions a file may list in extensionsRequired. KHR_mesh_quantization needs nothing beyond the
+// accessor reader's integer and normalized formats.
+const char* const kSupportedExtensions[] = {"KHR_mesh_quantization", "KHR_texture_transform",
+                                            "KHR_materials_emissive_strength"};
+
+const char* modeName(int mode) {
+  switch (mode) {
+    case TINYGLTF_MODE_POINTS: return "POINTS";
+    case TINYGLTF_MODE_LINE: return "LINES";
+    case TINYGLTF_MODE_LINE_LOOP: return "LINE_LOOP";
+    case TINYGLTF_MODE_LINE_STRIP: return "LINE_STRIP";
+    default: return "unknown";
+  }
+}
+
+double number(const tinygltf::Value& v, double fallback) { return v.IsNumber() ? v.GetNumberAsDouble() : fallback; }
+
+glm::vec2 vec2Of(const tinygltf::Value& object, const char* key, glm::vec2 fallback) {
+  if (!object.Has(key)) return fallback;
+  const tinygltf::Value& a = object.Get(key);
+  if (!a.IsArray() || a.ArrayLen() != 2) return fallback;
+  return glm::vec2(float(number(a.Get(0), fallback.x)), float(number(a.Get(1), fallback.y)));
+}
+
+// textureInfo.texCoord and its KHR_texture_transform (whose texCoord, when present, overrides).
+UvMapping uvMapping(int texCoord, const tinygltf::ExtensionMap& extensions) {
+  UvMapping u;
+  u.texCoord = uint32_t(std::max(texCoord, 0));
+  auto it = extensions.find("KHR_texture_transform");
+  if (it == extensions.end() || !it->second.IsObject()) return u;
+  const tinygltf::Value& t = it->second;
+  u.offset = vec2Of(t, "offset", u.offset);
+  u.scale = vec2Of(t, "scale", u.scale);
+  if (t.Has("rotation")) u.rotation = float(number(t.Get("rotation"), 0.0));
+  if (t.Has("texCoord") && t.Get("texCoord").IsNumber())
+    u.texCoord = uint32_t(std::max(t.Get("texCoord").GetNumberAsInt(), 0));
+  return u;
+}
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 TextureData convertImage(const tinygltf::Image& img) {
   TextureData t;
@@ -50,6 +93,7 @@ struct Loader {
   std::map<int, std::vector<uint32_t>> meshPrimitives;  // glTF mesh -> Scene mesh indices
   std::vector<std::pair<int, int>> meshOrigin;          // Scene mesh -> glTF (mesh, primitive)
   std::set<std::pair<int, uint32_t>> checkedSkins;      // (skin, Scene mesh) pairs already validated
+  std::vector<UvMapping> bakedUv;                       // per glTF material: the mapping baked into its UVs
   std::string error;                                    // the first fatal problem
 
   void fail(std::string message) {
@@ -78,7 +122,48 @@ struct Loader {
       out.metallicRoughnessTexture = textureImage(pbr.metallicRoughnessTexture.index);
       out.normalTexture = textureImage(m.normalTexture.index);
       out.emissiveTexture = textureImage(m.emissiveTexture.index);
+      out.occlusionTexture = textureImage(m.occlusionTexture.index);
+      out.occlusionStrength = float(m.occlusionTexture.strength);
       out.normalScale = float(m.normalTexture.scale);
+      if (auto it = m.extensions.find("KHR_materials_emissive_strength");
+          it != m.extensions.end() && it->second.IsObject() && it->second.Has("emissiveStrength"))
+        out.emissiveFactor *= float(number(it->second.Get("emissiveStrength"), 1.0));
+      out.baseColorUv = uvMapping(pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions);
+      out.metallicRoughnessUv = uvMapping(pbr.metallicRoughnessTexture.texCoord,
+                                          pbr.metallicRoughnessTexture.extensions);
+      out.normalUv = uvMapping(m.normalTexture.texCoord, m.normalTexture.extensions);
+      out.emissiveUv = uvMapping(m.emissiveTexture.texCoord, m.emissiveTexture.extensions);
+      out.occlusionUv = uvMapping(m.occlusionTexture.texCoord, m.occlusionTexture.extensions);
+      // The engine samples every texture with one UV set: bake the textures' shared mapping into it; when
+      // they differ, the base colour texture's (else the first present) wins.
+      const std::pair<const char*, std::pair<int, const UvMapping*>> slots[] = {
+          {"baseColorTexture", {pbr.baseColorTexture.index, &out.baseColorUv}},
+          {"metallicRoughnessTexture", {pbr.metallicRoughnessTexture.index, &out.metallicRoughnessUv}},
+          {"normalTexture", {m.normalTexture.index, &out.normalUv}},
+          {"emissiveTexture", {m.emissiveTexture.index, &out.emissiveUv}},
+          {"occlusionTexture", {m.occlusionTexture.index, &out.occlusionUv}}};
+      const char* chosenSlot = nullptr;
+      UvMapping chosen;
+      bool differ = false;
+      for (const auto& [slot, texture] : slots) {
+        if (texture.first < 0) continue;
+        if (!chosenSlot) {
+          chosenSlot = slot;
+          chosen = *texture.second;
+        } else
+          differ |= !(*texture.second == chosen);
+      }
+      if (differ)
+        result.warnings.push_back("material '" + m.name +
+                                  "': its textures use different UV mappings (texCoord / KHR_texture_transform); "
+                                  "all are sampled with the " +
+                                  chosenSlot + "'s");
+      if (chosen.texCoord > 1) {
+        result.warnings.push_back("material '" + m.name + "': TEXCOORD_" + std::to_string(chosen.texCoord) +
+                                  " is unsupported; TEXCOORD_0 used");
+        chosen.texCoord = 0;
+      }
+      bakedUv.push_back(chosen);
       if (m.alphaMode == "BLEND" || m.alphaMode == "MASK")
         result.warnings.push_back("material '" + m.name + "': alphaMode " + m.alphaMode + " rendered as opaque");
       result.scene.materials.push_back(out);
@@ -89,9 +174,10 @@ struct Loader {
   bool convertPrimitive(const tinygltf::Mesh& mesh, size_t index, MeshData& out) {
     const tinygltf::Primitive& prim = mesh.primitives[index];
     const std::string where = "mesh '" + mesh.name + "' primitive " + std::to_string(index);
-    if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) {
-      result.warnings.push_back(where + ": skipped, mode " + std::to_string(prim.mode) +
-                                " is not TRIANGLES (points/lines/strips/fans are unsupported)");
+    const bool strip = prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP, fan = prim.mode == TINYGLTF_MODE_TRIANGLE_FAN;
+    if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1 && !strip && !fan) {
+      result.warnings.push_back(where + ": skipped, mode " + std::to_string(prim.mode) + " (" + modeName(prim.mode) +
+                                ") is not a triangle mode (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN)");
       return false;
     }
     auto pos = prim.attributes.find("POSITION");
@@ -123,6 +209,7 @@ struct Loader {
     };
     optional("NORMAL", 3, out.normals);
     optional("TEXCOORD_0", 2, out.uvs);
+    optional("TEXCOORD_1", 2, out.uvs1);
     optional("TANGENT", 4, out.tangents);
     if (!readDeformation(prim, where, out)) return false;
     for (double w : mesh.weights) out.morphWeights.push_back(float(w));
@@ -137,12 +224,92 @@ struct Loader {
           return false;
         }
     }
+    if (strip || fan) toTriangleList(strip, out);
+    skipNonFinite(prim, where, out);
     out.material = prim.material >= 0 ? uint32_t(prim.material) : uint32_t(result.scene.materials.size());
+    if (prim.material >= 0 && size_t(prim.material) < bakedUv.size())
+      bakeUvs(bakedUv[size_t(prim.material)], where, out);
     if (out.triangleCount() == 0) {
       result.warnings.push_back(where + ": skipped, no triangles");
       return false;
     }
     return true;
+  }
+
+  // Strip / fan corners (indexed or not) into an indexed triangle list with the glTF 2.0 winding (3.7.2.1):
+  // strip triangle i = (v[i], v[i + 1 + i % 2], v[i + 2 - i % 2]), fan triangle i = (v[i + 1], v[i + 2], v[0]).
+  // Strip triangles that repeat an index (degenerate, used to join strips) are dropped.
+  static void toTriangleList(bool strip, MeshData& out) {
+    std::vector<uint32_t> corners = std::move(out.indices);
+    if (corners.empty()) {
+      corners.resize(out.positions.size());
+      for (size_t i = 0; i < corners.size(); ++i) corners[i] = uint32_t(i);
+    }
+    out.indices.clear();
+    for (size_t i = 0; i + 2 < corners.size(); ++i) {
+      const size_t odd = i % 2;
+      const uint32_t a = strip ? corners[i] : corners[i + 1], b = strip ? corners[i + 1 + odd] : corners[i + 2],
+                     c = strip ? corners[i + 2 - odd] : corners[0];
+      if (strip && (a == b || b == c || a == c)) continue;
+      out.indices.insert(out.indices.end(), {a, b, c});
+    }
+  }
+
+  // Drops the triangles that use a non-finite position or normal (one warning naming the accessors) and
+  // replaces those values with finite ones, so that bounds, camera framing and BLAS builds see finite data.
+  void skipNonFinite(const tinygltf::Primitive& prim, const std::string& where, MeshData& out) {
+    const size_t n = out.positions.size();
+    std::vector<bool> bad(n, false);
+    bool badPosition = false, badNormal = false;
+    size_t firstBad = n;
+    for (size_t v = 0; v < n; ++v) {
+      const bool p = !finite(out.positions[v]), q = v < out.normals.size() && !finite(out.normals[v]);
+      badPosition |= p;
+      badNormal |= q;
+      bad[v] = p || q;
+      if (bad[v] && firstBad == n) firstBad = v;
+    }
+    if (firstBad == n) return;
+    const size_t corners = out.indices.empty() ? n / 3 * 3 : out.indices.size() / 3 * 3;
+    std::vector<uint32_t> kept;
+    size_t skipped = 0;
+    for (size_t t = 0; t < corners; t += 3) {
+      uint32_t tri[3];
+      for (size_t k = 0; k < 3; ++k) tri[k] = out.indices.empty() ? uint32_t(t + k) : out.indices[t + k];
+      if (bad[tri[0]] || bad[tri[1]] || bad[tri[2]]) {
+        ++skipped;
+        continue;
+      }
+      kept.insert(kept.end(), tri, tri + 3);
+    }
+    const glm::vec3 stand = kept.empty() ? glm::vec3(0.0f) : out.positions[kept[0]];
+    for (size_t v = 0; v < n; ++v) {
+      if (!finite(out.positions[v])) out.positions[v] = stand;
+      if (v < out.normals.size() && !finite(out.normals[v])) out.normals[v] = glm::vec3(0.0f, 1.0f, 0.0f);
+    }
+    out.indices = std::move(kept);
+    std::string accessors;
+    if (badPosition) accessors = "POSITION accessor " + std::to_string(prim.attributes.at("POSITION"));
+    if (badNormal)
+      accessors += std::string(badPosition ? " and " : "") + "NORMAL accessor " +
+                   std::to_string(prim.attributes.at("NORMAL"));
+    result.warnings.push_back(where + ": " + accessors + " has non-finite values (first at vertex " +
+                              std::to_string(firstBad) + "); skipped the " + std::to_string(skipped) + " of " +
+                              std::to_string(corners / 3) + " triangles that use them");
+  }
+
+  // Replaces the mesh's UVs by `mapping` applied to its UV set (see Material).
+  void bakeUvs(const UvMapping& mapping, const std::string& where, MeshData& out) {
+    const std::vector<glm::vec2>& source = mapping.texCoord == 1 ? out.uvs1 : out.uvs;
+    if (mapping.texCoord == 1 && source.empty()) {
+      result.warnings.push_back(where + ": its material's textures use TEXCOORD_1, which it lacks; TEXCOORD_0 used");
+      if (mapping.identity()) return;
+    }
+    if (mapping.texCoord == 0 && mapping.identity()) return;
+    const std::vector<glm::vec2>& from = source.empty() ? out.uvs : source;
+    std::vector<glm::vec2> mapped(from.size());
+    for (size_t v = 0; v < from.size(); ++v) mapped[v] = mapping.apply(from[v]);
+    out.uvs = std::move(mapped);
   }
 
   // Reads a required per-vertex attribute of `comps` floats; a problem is fatal (the mesh could not animate).
@@ -312,7 +479,15 @@ SceneLoadResult loadGltf(const std::string& path) {
       result.error = "failed to parse glTF '" + path + "': " + (err.empty() ? "unknown error" : err);
       return result;
     }
-    Loader loader{model, result, {}, {}, {}, {}};
+    for (const std::string& required : model.extensionsRequired)
+      if (std::find(std::begin(kSupportedExtensions), std::end(kSupportedExtensions), required) ==
+          std::end(kSupportedExtensions)) {
+        result.error = "glTF '" + path + "' requires extension " + required +
+                       ", which the sample engine does not support (it supports KHR_mesh_quantization, "
+                       "KHR_texture_transform and KHR_materials_emissive_strength)";
+        return result;
+      }
+    Loader loader{model, result, {}, {}, {}, {}, {}};
     if (std::string e = detail::convertNodes(model, result.scene); !e.empty()) loader.fail(e);
     if (std::string e = detail::convertSkins(model, result.scene); !e.empty()) loader.fail(e);
     if (std::string e = detail::convertAnimations(model, result.scene, result.warnings); !e.empty()) loader.fail(e);
@@ -328,12 +503,19 @@ SceneLoadResult loadGltf(const std::string& path) {
     loader.convertMaterials();
     // Textures that failed to decode must not be referenced.
     for (Material& m : result.scene.materials)
-      for (int* t : {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture, &m.emissiveTexture})
+      for (int* t : {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture, &m.emissiveTexture,
+                     &m.occlusionTexture})
         if (*t >= 0 && result.scene.textures[*t].rgba8.empty()) *t = -1;
 
+    // glTF: the file's "scene", else scene 0 (an application choice the spec allows), else every root node.
     std::vector<int> roots;
-    int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : (model.scenes.empty() ? -1 : 0);
-    if (sceneIndex >= 0 && sceneIndex < int(model.scenes.size())) {
+    if (model.defaultScene >= int(model.scenes.size())) {
+      result.error = "glTF '" + path + "': the default scene " + std::to_string(model.defaultScene) +
+                     " is out of range (the file has " + std::to_string(model.scenes.size()) + " scenes)";
+      return result;
+    }
+    const int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : (model.scenes.empty() ? -1 : 0);
+    if (sceneIndex >= 0) {
       roots = model.scenes[sceneIndex].nodes;
     } else {  // no scene declared: every node that is nobody's child is a root
       std::vector<bool> isChild(model.nodes.size(), false);
@@ -357,7 +539,12 @@ SceneLoadResult loadGltf(const std::string& path) {
       for (MeshData& m : result.scene.meshes)
         if (m.material > index) m.material = index;
     }
-    if (result.scene.instances.empty()) result.error = "glTF '" + path + "' contains no renderable triangles";
+    if (result.scene.instances.empty()) {
+      result.error = "glTF '" + path + "' contains no renderable triangles";
+      for (size_t w = 0; w < result.warnings.size() && w < 3; ++w)
+        result.error += (w ? "; " : " (") + result.warnings[w];
+      if (!result.warnings.empty()) result.error += result.warnings.size() > 3 ? "; ...)" : ")";
+    }
     // Whatever the checks above did not name in glTF terms (e.g. a cycle among unvisited nodes).
     else if (Status s = ScenePose().reset(result.scene); !s)
       result.error = "glTF '" + path + "': " + s.error;

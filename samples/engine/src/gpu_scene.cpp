@@ -1,6 +1,7 @@
 // Scene upload: everything goes through one staging buffer and one command buffer.
 #include "gpu_scene.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "vk_check.h"
@@ -312,7 +313,12 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     DrawConstants& c = out.materialConstants[m];
     c.model = glm::mat4(1.0f);
     c.baseColorFactor = mat.baseColorFactor;
-    c.material = glm::vec4(mat.metallicFactor, mat.roughnessFactor, mat.normalScale, 0.0f);
+    // w: occlusion strength, sampled from the metallic-roughness texture's R channel (packed ORM); 0 when the
+    // occlusion texture is another image, which has no descriptor slot (see Material::occlusionTexture).
+    const bool packedOcclusion = mat.occlusionTexture >= 0 && mat.occlusionTexture == mat.metallicRoughnessTexture &&
+                                 mat.occlusionUv == mat.metallicRoughnessUv && out.textures[mat.occlusionTexture].image;
+    c.material = glm::vec4(mat.metallicFactor, mat.roughnessFactor, mat.normalScale,
+                           packedOcclusion ? std::clamp(mat.occlusionStrength, 0.0f, 1.0f) : 0.0f);
     c.emissive = glm::vec4(mat.emissiveFactor, 0.0f);
   }
   return {};

@@ -23,13 +23,11 @@ constexpr float kFaceAxes[6][3][3] = {
     {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}},  // -Z
 };
 
-glm::mat4 faceView(uint32_t face, const glm::vec3& eye) {
+// Rotation only: the capture's positions are relative to the probe (drawScene rebases to it).
+glm::mat4 faceView(uint32_t face) {
   glm::mat4 v(1.0f);
-  for (int row = 0; row < 3; ++row) {
-    glm::vec3 axis(kFaceAxes[face][row][0], kFaceAxes[face][row][1], kFaceAxes[face][row][2]);
-    for (int col = 0; col < 3; ++col) v[col][row] = axis[col];
-    v[3][row] = -glm::dot(axis, eye);
-  }
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) v[col][row] = kFaceAxes[face][row][col];
   return v;
 }
 
@@ -190,11 +188,12 @@ void ReflectionProbe::recordCapture(VkCommandBuffer cmd, uint32_t slot, const Fr
   const glm::mat4 proj = faceProjection(zNear, zFar);
   for (uint32_t f = 0; f < 6; ++f) {
     FrameUniforms u = base;
-    u.view = faceView(f, key.position);
+    u.view = faceView(f);
     u.proj = proj;
     u.viewProj = proj * u.view;
     u.invViewProj = glm::inverse(u.viewProj);
     u.invProj = glm::inverse(proj);
+    u.lightViewProj = key.lightViewProj;  // the same shadow-map texels as the camera's, probe-relative
     u.cameraPos = glm::vec4(key.position, 1.0f);
     u.viewport = glm::vec4(float(size), float(size), 1.0f / float(size), 1.0f / float(size));
     u.inputs = glm::uvec4(0u);  // own shadow map, no AO, constant-sky reflections
@@ -238,7 +237,7 @@ void ReflectionProbe::recordCapture(VkCommandBuffer cmd, uint32_t slot, const Fr
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.probeCapture);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.sceneLayout, 0, 1, &res.faceSets[f], 0, nullptr);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.sceneLayout, 2, 1, &res.lightingSet, 0, nullptr);
-    if (scene) drawScene(cmd, *scene, p, DrawPass::Lighting);
+    if (scene) drawScene(cmd, *scene, p, DrawPass::Lighting, glm::dvec3(key.position));
     vkCmdEndRendering(cmd);
   }
 

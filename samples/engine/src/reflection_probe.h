@@ -17,9 +17,9 @@ namespace sample_engine::detail {
 struct ProbeKey {
   uint64_t sceneVersion = 0;
   uint32_t resolution = 0;
-  glm::vec3 position{0.0f};
+  glm::vec3 position{0.0f};  // world space; the capture rebases the scene to it
   glm::vec4 sunDirection{0.0f}, sunRadiance{0.0f}, sky{0.0f}, shadow{0.0f};
-  glm::mat4 lightViewProj{0.0f};
+  glm::mat4 lightViewProj{0.0f};  // the shadow map's light view-projection for positions relative to `position`
   float depthBiasConstant = 0.0f, depthBiasSlope = 0.0f;
   bool operator==(const ProbeKey&) const = default;
 };
@@ -41,7 +41,8 @@ class ReflectionProbe {
 
   // Records the capture of the six faces and the mip chain into `cmd`, using frame slot `slot`'s uniform
   // buffer and descriptor sets (free once that slot's previous frame completed). `base` supplies the sun,
-  // sky, shadow-map and light matrices of the frame; `shadowMap` must be in SHADER_READ_ONLY_OPTIMAL.
+  // sky and shadow-map settings of the frame, `key` the position and the probe-relative light matrix (the
+  // faces are rendered relative to the probe position); `shadowMap` must be in SHADER_READ_ONLY_OPTIMAL.
   // Binds set 0 and set 2 of Pipelines::sceneLayout: the caller rebinds its own afterwards.
   void recordCapture(VkCommandBuffer cmd, uint32_t slot, const FrameUniforms& base, const ProbeKey& key,
                      const GpuScene* scene, VkImageView shadowMap, const DefaultImages& defaults);

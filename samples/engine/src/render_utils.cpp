@@ -27,7 +27,16 @@ void beginRendering(VkCommandBuffer cmd, VkExtent2D extent, const std::vector<Vk
   vkCmdSetScissor(cmd, 0, 1, &scissor);
 }
 
-void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass) {
+glm::mat4 rebasedTransform(const glm::mat4& world, const glm::dvec3& origin) {
+  // translate(-origin) * world: every column loses origin times its w (1 for the translation, 0 otherwise).
+  glm::mat4 out = world;
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 3; ++r) out[c][r] = float(double(world[c][r]) - origin[r] * double(world[c][3]));
+  return out;
+}
+
+void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass,
+               const glm::dvec3& origin) {
   uint32_t boundMaterial = UINT32_MAX;
   for (size_t i = 0; i < scene.cpu.instances.size(); ++i) {
     const Instance& inst = scene.cpu.instances[i];
@@ -43,7 +52,7 @@ void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, D
       boundMaterial = mesh.material;
     }
     DrawConstants c = scene.materialConstants[mesh.material];
-    c.model = scene.instanceTransforms[i];
+    c.model = rebasedTransform(scene.instanceTransforms[i], origin);
     vkCmdPushConstants(cmd, p.sceneLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(c), &c);
     if (mesh.indexCount > 0) {
       vkCmdBindIndexBuffer(cmd, mesh.indexBuffer, 0, VK_INDEX_TYPE_UINT32);

@@ -19,11 +19,16 @@ void beginRendering(VkCommandBuffer cmd, VkExtent2D extent, const std::vector<Vk
 
 enum class DrawPass { Shadow, Prepass, Lighting };
 
+// `world` with `origin` subtracted from its translation, in double precision, then rounded to float: the
+// model matrix of a pass whose positions are relative to `origin` (the camera or the probe), so a vertex far
+// from the world origin keeps float precision near the eye.
+glm::mat4 rebasedTransform(const glm::mat4& world, const glm::dvec3& origin);
+
 // One draw per instance with its GpuScene::instanceTransforms / instanceVertices entry (this frame's world
-// transform, deformed buffers); binds vertex buffers, material sets (set 1, except for Shadow) and push
-// constants.
+// transform rebased to `origin`, deformed buffers); binds vertex buffers, material sets (set 1, except for
+// Shadow) and push constants.
 // Set 0 (and set 2 for Lighting) must already be bound.
-void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass);
+void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass, const glm::dvec3& origin);
 
 // Writes infos[i] to binding i of `set` (combined image samplers).
 void writeImageDescriptors(VkDevice device, VkDescriptorSet set, const std::vector<VkDescriptorImageInfo>& infos);

@@ -6,6 +6,12 @@
 
 namespace sample_engine {
 
+glm::vec2 UvMapping::apply(const glm::vec2& uv) const {
+  const glm::vec2 s = scale * uv;
+  const float c = std::cos(rotation), n = std::sin(rotation);
+  return offset + glm::vec2(c * s.x + n * s.y, -n * s.x + c * s.y);
+}
+
 Bounds Scene::bounds() const {
   Bounds b;
   for (const Instance& inst : instances) {
@@ -94,6 +100,7 @@ void finalizeMesh(MeshData& m) {
       m.normals.resize(n);
       m.uvs.resize(n);
       m.tangents.resize(n);
+      if (!m.uvs1.empty()) m.uvs1.resize(n);
       // Per-vertex skin and morph arrays follow (empty ones stay empty).
       for (auto* j : {&m.joints0, &m.joints1})
         if (!j->empty()) j->resize(n);
@@ -112,7 +119,8 @@ void finalizeScene(Scene& scene) {
   if (scene.materials.empty()) scene.materials.push_back(Material{.name = "default"});
   const int textureCount = static_cast<int>(scene.textures.size());
   for (Material& mat : scene.materials) {
-    for (int* t : {&mat.baseColorTexture, &mat.metallicRoughnessTexture, &mat.normalTexture, &mat.emissiveTexture})
+    for (int* t : {&mat.baseColorTexture, &mat.metallicRoughnessTexture, &mat.normalTexture, &mat.emissiveTexture,
+                   &mat.occlusionTexture})
       if (*t >= textureCount) *t = -1;
   }
   for (MeshData& m : scene.meshes) {

@@ -223,9 +223,12 @@ struct PrepassHookInfo {
   // (0,0,0,0) for background. SHADER_READ_ONLY_OPTIMAL.
   PassImage geometricNormal;
   bool reversedZ = false;
-  glm::mat4 view{1.0f}, proj{1.0f}, viewProj{1.0f};  // proj: Vulkan clip space, Y flipped, depth [0,1]
+  // Camera-relative, as the engine rasterizes (precision far from the origin): `view` is rotation only, so
+  // viewProj maps world position - cameraPosition to clip space. proj: Vulkan clip space, Y flipped, depth [0,1].
+  glm::mat4 view{1.0f}, proj{1.0f}, viewProj{1.0f};
   glm::mat4 invView{1.0f}, invProj{1.0f}, invViewProj{1.0f};
-  glm::vec3 cameraPosition{0.0f};
+  glm::vec3 cameraPosition{0.0f};            // world-space eye (FrameParams::camera.eye)
+  glm::dvec3 cameraPositionD{0.0};           // the same in double: the origin of the camera-relative raster
   glm::vec3 sunDirection{0.0f, 1.0f, 0.0f};  // towards the sun, normalized
   // The frame's lighting (FrameParams): sun colour * intensity, sky colour and ambient intensity.
   glm::vec3 sunRadiance{0.0f};

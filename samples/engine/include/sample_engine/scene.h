@@ -4,6 +4,7 @@
 // Plain data: not thread-safe; distinct Scene objects are independent.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -27,7 +28,10 @@ struct MeshData {
   std::string name;
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
-  std::vector<glm::vec2> uvs;
+  std::vector<glm::vec2> uvs;  // what every texture of the material is sampled with (glTF loader: see Material)
+  // A second UV set (glTF TEXCOORD_1), untransformed; CPU only: the GPU vertex layout carries `uvs` alone.
+  // Empty or one per vertex.
+  std::vector<glm::vec2> uvs1;
   std::vector<glm::vec4> tangents;  // xyz tangent, w = bitangent sign (glTF convention)
   std::vector<uint32_t> indices;    // empty: non-indexed, every 3 consecutive vertices form a triangle
   uint32_t material = 0;            // index into Scene::materials
@@ -59,18 +63,41 @@ struct TextureData {
   std::vector<uint8_t> rgba8;
 };
 
+// How a texture of a glTF material maps its UV set (textureInfo.texCoord and KHR_texture_transform):
+// uv' = offset + R(rotation) * (scale * TEXCOORD_<texCoord>), R = [cos sin; -sin cos] (glTF's clockwise
+// rotation in UV space).
+struct UvMapping {
+  uint32_t texCoord = 0;  // 0 = TEXCOORD_0, 1 = TEXCOORD_1
+  glm::vec2 offset{0.0f};
+  float rotation = 0.0f;  // radians
+  glm::vec2 scale{1.0f};
+
+  glm::vec2 apply(const glm::vec2& uv) const;
+  bool identity() const { return offset == glm::vec2(0.0f) && rotation == 0.0f && scale == glm::vec2(1.0f); }
+  bool operator==(const UvMapping&) const = default;
+};
+
 // glTF 2.0 metallic-roughness material (opaque only). Texture indices are into Scene::textures, -1 = none.
+// The engine samples every texture with MeshData::uvs; the glTF loader bakes the material's UvMapping into
+// them (the base colour texture's when the textures disagree, with a warning). The *Uv fields keep the
+// file's mappings for reference; the engine does not apply them again.
 struct Material {
   std::string name;
   glm::vec4 baseColorFactor{1.0f};
   float metallicFactor = 0.0f;
-  float roughnessFactor = 0.5f;  // perceptual roughness
-  glm::vec3 emissiveFactor{0.0f};
+  float roughnessFactor = 0.5f;    // perceptual roughness
+  glm::vec3 emissiveFactor{0.0f};  // glTF emissiveFactor times KHR_materials_emissive_strength
   float normalScale = 1.0f;
   int baseColorTexture = -1;
   int metallicRoughnessTexture = -1;  // glTF layout: G = roughness, B = metallic
   int normalTexture = -1;
   int emissiveTexture = -1;  // sRGB, multiplied by emissiveFactor
+  // Ambient occlusion (glTF occlusionTexture, R channel): ambient *= mix(1, R, occlusionStrength). The
+  // engine applies it when it is the metallic-roughness texture with the same mapping (packed ORM, the usual
+  // case); a separate occlusion image is kept here but not sampled (the material descriptor set has no slot).
+  int occlusionTexture = -1;
+  float occlusionStrength = 1.0f;
+  UvMapping baseColorUv, metallicRoughnessUv, normalUv, emissiveUv, occlusionUv;
 };
 
 // A placement of a mesh in the world.
@@ -162,7 +189,8 @@ struct Bounds {
   bool valid() const { return min.x <= max.x; }
   glm::vec3 center() const { return (min + max) * 0.5f; }
   float radius() const { return glm::length(max - min) * 0.5f; }
-  void extend(const glm::vec3& p) {
+  void extend(const glm::vec3& p) {  // non-finite points are ignored
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return;
     min = glm::min(min, p);
     max = glm::max(max, p);
   }
