@@ -65,8 +65,8 @@ void PassCore::writeCommon(Context& ctx, DescriptorWrites& w, const GBufferDesc&
   w.storageBuffer(RB_BINDING_RAY_COUNTERS, metrics.counterBuffer(), metrics.counterOffset(ctx), metrics.counterBytes());
 }
 
-Status PassCore::writeMaterials(DescriptorWrites& w, const TlasInfo& tlas,
-                                const MaterialTable* materials, const char* passName, uint32_t& gbufferFlags) {
+Status PassCore::writeMaterials(DescriptorWrites& w, const TlasInfo& tlas, const MaterialTable* materials,
+                                const char* passName, uint32_t& gbufferFlags) {
   const MaterialTable::Impl& table = internal::materialTableImpl(materials ? *materials : *fallbackMaterials);
   const bool alphaTest = materials && tlas.nonOpaqueInstances > 0;
   if (alphaTest && !tlas.shadingRecords) {
@@ -91,9 +91,8 @@ void PassCore::bind(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w
                     uint32_t constantBytes) const {
   pipeline.bind(ctx, cmd, w.writes, constants, constantBytes);
   if (textureLayout) {
-    internal::deviceFunctions(ctx).vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR,
-                                                           pipeline.layout, RB_SET_TEXTURES, 1, &boundTextures, 0,
-                                                           nullptr);
+    internal::deviceFunctions(ctx).vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipeline.layout,
+                                                           RB_SET_TEXTURES, 1, &boundTextures, 0, nullptr);
   }
 }
 

@@ -41,8 +41,8 @@ struct PassCore {
   // Writes the material bindings and picks the texture set: `materials` (null = the fallback, and the TLAS is
   // traced as opaque) and the TLAS's shading records. Sets RB_GB_ALPHA_TEST in `gbufferFlags` when the TLAS
   // holds non-opaque instances and a table is given; those need shading records (an error names `passName`).
-  Status writeMaterials(DescriptorWrites& w, const TlasInfo& tlas, const MaterialTable* materials,
-                        const char* passName, uint32_t& gbufferFlags);
+  Status writeMaterials(DescriptorWrites& w, const TlasInfo& tlas, const MaterialTable* materials, const char* passName,
+                        uint32_t& gbufferFlags);
 
   // Ensures the outputs, starts the measurements and makes the outputs writable.
   Status begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const std::vector<PassImages::Spec>& outputs);

@@ -199,8 +199,8 @@ struct TlasBuildOptions {
 struct TlasInfo {
   VkAccelerationStructureKHR tlas = VK_NULL_HANDLE;
   VkDeviceAddress address = 0;
-  uint32_t instanceCount = 0;                // instances written into the TLAS
-  uint32_t skippedInstances = 0;             // instances whose mesh has no built BLAS yet (queued beyond the budget)
+  uint32_t instanceCount = 0;     // instances written into the TLAS
+  uint32_t skippedInstances = 0;  // instances whose mesh has no built BLAS yet (queued beyond the budget)
   // Instances written whose geometry runs any-hit shaders (MeshDesc::nonOpaque, or forced by
   // VK_GEOMETRY_INSTANCE_FORCE_NO_OPAQUE_BIT_KHR). 0 = the passes keep the opaque fast path.
   uint32_t nonOpaqueInstances = 0;
