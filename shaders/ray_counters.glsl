@@ -1,11 +1,17 @@
-// The ray counters every G-buffer pass adds the rays it traced to (read back by PassMetrics).
+// The ray counters every G-buffer pass adds the rays it traced to, and the any-hit invocations its rays ran
+// (read back by PassMetrics).
 #ifndef RAYBRIDGE_RAY_COUNTERS_GLSL
 #define RAYBRIDGE_RAY_COUNTERS_GLSL
 
 #include "raybridge_shader_interface.glsl"
 
-layout(set = 0, binding = RB_BINDING_RAY_COUNTERS) buffer RayCounters { uint rayCount[RB_RAY_COUNTER_SLOTS]; };
+layout(set = 0, binding = RB_BINDING_RAY_COUNTERS) buffer RayCounters {
+  uint rayCount[RB_RAY_COUNTER_SLOTS];
+  uint anyHitCount[RB_RAY_COUNTER_SLOTS];
+};
 
 void rbCountRays(uvec2 pixel, uint rays) { atomicAdd(rayCount[RB_RAY_COUNTER_SLOT(pixel.x, pixel.y)], rays); }
+
+void rbCountAnyHit(uvec2 pixel) { atomicAdd(anyHitCount[RB_RAY_COUNTER_SLOT(pixel.x, pixel.y)], 1u); }
 
 #endif

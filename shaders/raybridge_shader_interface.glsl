@@ -16,9 +16,11 @@
 #define RB_AO_BINDING_OUTPUT 5
 #define RB_REFLECTION_BINDING_ROUGHNESS_METALNESS 5  // the normal image again when roughness is in normal.w
 #define RB_REFLECTION_BINDING_RADIANCE 6
-#define RB_REFLECTION_BINDING_SHADING_RECORDS 7
-#define RB_REFLECTION_BINDING_MATERIALS 8
-#define RB_REFLECTION_SET_TEXTURES 1  // binding 0: the engine's textures, bindless
+// Every pass whose rays can hit non-opaque geometry (shadow, AO, reflection) also has the TLAS's shading
+// records, the material table and the texture set (alpha testing in the any-hit shaders, shading in reflections).
+#define RB_BINDING_SHADING_RECORDS 7
+#define RB_BINDING_MATERIALS 8
+#define RB_SET_TEXTURES 1  // binding 0: the engine's textures, bindless (MaterialTable)
 // The primary-ray (first trace) pass.
 #define RB_PRIMARY_BINDING_TLAS 0
 #define RB_PRIMARY_BINDING_HIT_DISTANCE 1
@@ -45,6 +47,12 @@
 #define RB_GB_ROUGHNESS_IN_NORMAL_W 8u
 #define RB_GB_ROUGHNESS_IMAGE 16u
 #define RB_GB_ALBEDO_IMAGE 32u
+#define RB_GB_ALPHA_TEST 64u  // the TLAS holds non-opaque geometry and a material table is bound: rays run any-hits
+
+// GpuMaterial::alphaMode: the values of rb::AlphaMode.
+#define RB_ALPHA_OPAQUE 0u
+#define RB_ALPHA_MASK 1u
+#define RB_ALPHA_BLEND 2u
 
 // ShadowConstants::lightType: the values of rb::LightType.
 #define RB_LIGHT_DIRECTIONAL 0u
@@ -81,5 +89,6 @@
 // (one warp or subgroup) never add to the same address, so the atomics do not serialise (PassMetrics).
 #define RB_RAY_COUNTER_SLOTS 4096
 #define RB_RAY_COUNTER_SLOT(x, y) (((x) & 63u) | (((y) & 63u) << 6))
+// Any-hit invocations are counted the same way, in the RB_RAY_COUNTER_SLOTS counters after the ray counters.
 
 #endif

@@ -15,8 +15,6 @@ layout(location = 0) rayPayloadInEXT ReflectionPayload payload;
 layout(location = 1) rayPayloadEXT float shadowHit;
 hitAttributeEXT vec2 barycentrics;
 
-
-
 void main() {
   ShadingRecord r = records[gl_InstanceID];
   vec3 bary = vec3(1.0 - barycentrics.x - barycentrics.y, barycentrics.x, barycentrics.y);
@@ -43,16 +41,12 @@ void main() {
     sn = normalize(normalToWorld * sn);
     n = dot(sn, ng) < 0.0 ? -sn : sn;
   }
-  vec2 uv = vec2(0.0);
-  if (!rbIsNull(r.texcoords)) {
-    uint s = r.texcoordStride;
-    uv = bary.x * vec2(rbLoadFloat(r.texcoords, i0 * s), rbLoadFloat(r.texcoords, i0 * s + 4u)) +
-         bary.y * vec2(rbLoadFloat(r.texcoords, i1 * s), rbLoadFloat(r.texcoords, i1 * s + 4u)) +
-         bary.z * vec2(rbLoadFloat(r.texcoords, i2 * s), rbLoadFloat(r.texcoords, i2 * s + 4u));
-  }
+  vec2 uv = rbHitTexcoord(r, uint(gl_PrimitiveID), barycentrics);
   GpuMaterial m = materials[r.material];
   vec4 base = m.baseColor;
-  if (m.baseColorTexture != 0xFFFFFFFFu) base *= textureLod(textures[nonuniformEXT(m.baseColorTexture)], uv, 0.0);
+  if (m.baseColorTexture != 0xFFFFFFFFu) {
+    base *= textureLod(textures[nonuniformEXT(m.baseColorTexture)], rbMaterialUv(m, uv), 0.0);
+  }
   float metallic = m.metallic;
   if (m.metallicRoughnessTexture != 0xFFFFFFFFu) {
     metallic *= textureLod(textures[nonuniformEXT(m.metallicRoughnessTexture)], uv, 0.0).b;
@@ -64,8 +58,9 @@ void main() {
   if (nDotL > 0.0 && dot(ng, toSun) > 0.0) {
     vec3 origin = rbOffsetRayOrigin(hit + ng * 1e-4 * max(1.0, gl_HitTEXT), ng);
     shadowHit = -1.0;
-    traceRayEXT(tlas, gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT,
-                0xFF, 0, 0, 1, origin, 0.0, toSun, 1e30, 1);
+    uint flags = gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT;
+    if ((pc.gbuffer.flags & RB_GB_ALPHA_TEST) == 0u) flags |= gl_RayFlagsOpaqueEXT;
+    traceRayEXT(tlas, flags, 0xFF, 0, 0, 1, origin, 0.0, toSun, 1e30, 1);
     sunVisible = shadowHit == 0.0 ? 1.0 : 0.0;
     // Shadow rays from hits are the pass's rays too.
     rbCountRays(gl_LaunchIDEXT.xy, 1u);

@@ -1,75 +1,12 @@
-// Shared by the reflection shaders: payloads, the per-instance shading records and the material table.
+// Shared by the reflection shaders: the payload, and (shading_records.glsl) the per-instance shading records
+// and the material table.
 #ifndef RAYBRIDGE_REFLECTION_COMMON_GLSL
 #define RAYBRIDGE_REFLECTION_COMMON_GLSL
 
-#extension GL_EXT_buffer_reference : require
-#extension GL_EXT_buffer_reference_uvec2 : require
-#extension GL_EXT_nonuniform_qualifier : require
-
-#include "raybridge_shader_interface.glsl"
+#include "shading_records.glsl"
 
 struct ReflectionPayload {
   vec3 radiance;
 };
-
-// Mirrors rb::ShadingRecord (sdk/src/as_service_impl.h): where an instance's vertex data is.
-struct ShadingRecord {
-  uvec2 positions;
-  uvec2 indices;
-  uvec2 normals;    // 0 = none
-  uvec2 texcoords;  // 0 = none
-  uint positionStride;
-  uint normalStride;
-  uint texcoordStride;
-  uint indexType;  // 0 u32, 1 u16, 2 none
-  uint material;
-  uint positionFormat;  // VkFormat; 106 = R32G32B32_SFLOAT
-  uint pad0;
-  uint pad1;
-};
-
-// Mirrors rb::GpuMaterial (sdk/src/reflection_pass.cpp).
-struct GpuMaterial {
-  vec4 baseColor;
-  float metallic;
-  float roughness;
-  uint baseColorTexture;  // 0xFFFFFFFF = none
-  uint metallicRoughnessTexture;
-  vec3 emissive;
-  uint emissiveTexture;  // 0xFFFFFFFF = none
-};
-
-layout(set = 0, binding = RB_REFLECTION_BINDING_SHADING_RECORDS, std430) readonly buffer ShadingRecords {
-  ShadingRecord records[];
-};
-layout(set = 0, binding = RB_REFLECTION_BINDING_MATERIALS, std430) readonly buffer Materials {
-  GpuMaterial materials[];
-};
-layout(set = RB_REFLECTION_SET_TEXTURES, binding = 0) uniform sampler2D textures[];
-
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer FloatRef { float v; };
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer UintRef { uint v; };
-
-uvec2 rbAddressOffset(uvec2 a, uint offset) {
-  uint lo = a.x + offset;
-  return uvec2(lo, a.y + (lo < a.x ? 1u : 0u));
-}
-bool rbIsNull(uvec2 a) { return a.x == 0u && a.y == 0u; }
-
-float rbLoadFloat(uvec2 base, uint offset) { return FloatRef(rbAddressOffset(base, offset)).v; }
-
-vec3 rbLoadVec3(uvec2 base, uint offset) {
-  return vec3(rbLoadFloat(base, offset), rbLoadFloat(base, offset + 4u), rbLoadFloat(base, offset + 8u));
-}
-
-uint rbLoadIndex(ShadingRecord r, uint i) {
-  if (r.indexType == 2u) return i;
-  if (r.indexType == 0u) return UintRef(rbAddressOffset(r.indices, 4u * i)).v;
-  // 16-bit: read the aligned word that holds it.
-  uint byteOffset = 2u * i + (r.indices.x & 3u);
-  uvec2 aligned = uvec2(r.indices.x & ~3u, r.indices.y);
-  uint word = UintRef(rbAddressOffset(aligned, byteOffset & ~3u)).v;
-  return (byteOffset & 2u) != 0u ? word >> 16 : word & 0xFFFFu;
-}
 
 #endif

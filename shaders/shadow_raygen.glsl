@@ -70,7 +70,8 @@ void main() {
       rbBasis(toLight, t, b);
       uint visible = 0u;
       // Without the distance output any occluder will do: stop at the first and skip the hit shader.
-      uint flags = gl_RayFlagsOpaqueEXT;
+      // Opaque fast path unless the TLAS has non-opaque geometry (alpha-tested by the any-hit shader).
+      uint flags = (pc.gbuffer.flags & RB_GB_ALPHA_TEST) != 0u ? gl_RayFlagsNoneEXT : gl_RayFlagsOpaqueEXT;
       if (!kWriteHitDistance) flags |= gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT;
       nearest = 1e30;
       for (uint i = 0u; i < count; ++i) {

@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -77,7 +78,20 @@ ReferenceHit EmbreeScene::intersect(const float o[3], const float d[3], float tM
   out.geometricNormal[0] = rh.hit.Ng_x;
   out.geometricNormal[1] = rh.hit.Ng_y;
   out.geometricNormal[2] = rh.hit.Ng_z;
+  out.barycentrics[0] = rh.hit.u;
+  out.barycentrics[1] = rh.hit.v;
   return out;
+}
+
+ReferenceHit EmbreeScene::intersect(const float o[3], const float d[3], float tMin, float tMax,
+                                    const HitFilter& stops) const {
+  for (int passes = 0; passes < 1000; ++passes) {
+    ReferenceHit h = intersect(o, d, tMin, tMax);
+    if (!h.hit || stops(h)) return h;
+    // Past the rejected hit: a few ulps on, so the same triangle is not found again.
+    tMin = h.t + std::max(1e-6f * h.t, 1e-7f);
+  }
+  return {};
 }
 
 }  // namespace rbtest

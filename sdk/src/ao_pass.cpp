@@ -31,7 +31,7 @@ Result<std::unique_ptr<AoPass>> AoPass::create(Context& context) {
   p.bindings.push_back(
       {RB_AO_BINDING_OUTPUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr});
   p.pushConstantBytes = sizeof(AoConstants);
-  if (Status s = impl->core.init(context, p); !s) return s.error();
+  if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::ao_rahit)); !s) return s.error();
   return std::unique_ptr<AoPass>(new AoPass(std::move(impl)));
 }
 
@@ -55,8 +55,9 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultAoRays;
   pc.estimator = static_cast<uint32_t>(settings.estimator);  // RB_AO_*
 
-  if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}}); !st) return st;
   DescriptorWrites w;
+  if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "AoPass", pc.gbuffer.flags); !st) return st;
+  if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}}); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
   w.storageImage(RB_AO_BINDING_OUTPUT, s.core.images[0].view);
   s.core.traceAndEnd(s.ctx, cmd, w, pc, g);

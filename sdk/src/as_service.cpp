@@ -655,6 +655,10 @@ AsStats AccelerationStructureService::stats() const {
   s.resolveDynamicSubmissions();
   AsStats out = s.counters;
   out.meshHandles = s.liveRegistrations();
+  out.nonOpaqueMeshes = 0;
+  for (const Registration& r : s.registrations) {
+    if (r.live && r.mesh.desc.nonOpaque) ++out.nonOpaqueMeshes;
+  }
   out.blasCount = out.blasQueued = 0;
   out.triangles = out.blasBytes = out.blasBytesBeforeCompaction = out.dynamicBlasBytes = 0;
   for (uint32_t i = 1; i < s.entries.size(); ++i) {

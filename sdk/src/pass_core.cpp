@@ -1,11 +1,32 @@
 #include "pass_core.h"
 
+#include <string>
+
 #include "context_impl.h"
 #include "gbuffer_sampler.h"
+#include "material_table_impl.h"
 
 namespace rb {
 
-Status PassCore::init(Context& ctx, const RayTracingPipelineDesc& desc) {
+Status PassCore::init(Context& ctx, RayTracingPipelineDesc desc, SpirvModule alphaAnyHit,
+                      VkShaderStageFlags recordStages) {
+  if (alphaAnyHit.code) {
+    for (HitGroupDesc& g : desc.hitGroups) g.anyHit = alphaAnyHit;
+    const VkShaderStageFlags stages = recordStages | VK_SHADER_STAGE_ANY_HIT_BIT_KHR;
+    for (VkDescriptorSetLayoutBinding& b : desc.bindings) {
+      if (b.binding == RB_BINDING_RAY_COUNTERS) b.stageFlags |= VK_SHADER_STAGE_ANY_HIT_BIT_KHR;
+    }
+    desc.bindings.push_back({RB_BINDING_SHADING_RECORDS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr});
+    desc.bindings.push_back({RB_BINDING_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr});
+    Result<VkDescriptorSetLayout> layout = createTextureSetLayout(ctx);
+    if (!layout) return layout.error();
+    textureLayout = layout.value();
+    static_assert(RB_SET_TEXTURES == 1, "the texture set is the first extra set");
+    desc.extraSetLayouts = {textureLayout};
+    Result<std::unique_ptr<MaterialTable>> fallback = MaterialTable::create(ctx);
+    if (!fallback) return fallback.error();
+    fallbackMaterials = std::move(fallback.value());
+  }
   Result<RayTracingPipeline> p = RayTracingPipeline::create(ctx, desc);
   if (!p) return p.error();
   pipeline = p.value();
@@ -20,6 +41,8 @@ void PassCore::retire(Context& ctx) {
   internal::contextImpl(ctx).retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
   images.retire(ctx);
   metrics.retire(ctx);
+  internal::contextImpl(ctx).retireHandle(textureLayout, &DeviceFunctions::vkDestroyDescriptorSetLayout);
+  fallbackMaterials.reset();  // retires its own buffer and set
 }
 
 std::vector<VkDescriptorSetLayoutBinding> PassCore::commonBindings() {
@@ -42,6 +65,37 @@ void PassCore::writeCommon(Context& ctx, DescriptorWrites& w, const GBufferDesc&
   w.storageBuffer(RB_BINDING_RAY_COUNTERS, metrics.counterBuffer(), metrics.counterOffset(ctx), metrics.counterBytes());
 }
 
+Status PassCore::writeMaterials(DescriptorWrites& w, const TlasInfo& tlas, const MaterialTable* materials,
+                                const char* passName, uint32_t& gbufferFlags) {
+  const MaterialTable::Impl& table = internal::materialTableImpl(materials ? *materials : *fallbackMaterials);
+  const bool alphaTest = materials && tlas.nonOpaqueInstances > 0;
+  if (alphaTest && !tlas.shadingRecords) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 std::string(passName) + ": the TLAS has " + std::to_string(tlas.nonOpaqueInstances) +
+                     " non-opaque instances but no shading records; build it with "
+                     "TlasBuildOptions::writeShadingRecords = true to alpha-test them"};
+  }
+  if (alphaTest) gbufferFlags |= RB_GB_ALPHA_TEST;
+  if (tlas.shadingRecords) {
+    w.storageBuffer(RB_BINDING_SHADING_RECORDS, tlas.shadingRecords, 0, tlas.shadingRecordsBytes);
+  } else {
+    // Never read (no RB_GB_ALPHA_TEST, so rays are opaque), but the binding must be valid.
+    w.storageBuffer(RB_BINDING_SHADING_RECORDS, table.materials.buffer, 0, table.materials.size);
+  }
+  w.storageBuffer(RB_BINDING_MATERIALS, table.materials.buffer, 0, table.materials.size);
+  boundTextures = table.textureSet;
+  return {};
+}
+
+void PassCore::bind(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
+                    uint32_t constantBytes) const {
+  pipeline.bind(ctx, cmd, w.writes, constants, constantBytes);
+  if (textureLayout) {
+    internal::deviceFunctions(ctx).vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipeline.layout,
+                                                           RB_SET_TEXTURES, 1, &boundTextures, 0, nullptr);
+  }
+}
+
 Status PassCore::begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
                        const std::vector<PassImages::Spec>& outputs) {
   if (Status s = images.ensure(ctx, g.width, g.height, outputs); !s) return s;
@@ -53,7 +107,7 @@ Status PassCore::begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
 
 void PassCore::traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
                            uint32_t constantBytes, const GBufferDesc& g) {
-  pipeline.bind(ctx, cmd, w.writes, constants, constantBytes);
+  bind(ctx, cmd, w, constants, constantBytes);
   pipeline.trace(ctx, cmd, g.width, g.height);
   images.endWrite(ctx, cmd);
   metrics.writeEnd(ctx, cmd);

@@ -4,6 +4,9 @@
 
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/gbuffer.h>
+#include <raybridge/material_table.h>
+
+#include <memory>
 
 #include "pass_constants.h"
 #include "pass_images.h"
@@ -17,8 +20,16 @@ struct PassCore {
   VkSampler sampler = VK_NULL_HANDLE;
   PassImages images;
   PassMetrics metrics;
+  // Alpha testing (addMaterialBindings): the texture set's layout, and the table bound when the caller gives
+  // none (the bindings are statically used by the any-hit shader, so they must be valid even unread).
+  VkDescriptorSetLayout textureLayout = VK_NULL_HANDLE;
+  std::unique_ptr<MaterialTable> fallbackMaterials;
+  VkDescriptorSet boundTextures = VK_NULL_HANDLE;  // set RB_SET_TEXTURES of this recording
 
-  Status init(Context& ctx, const RayTracingPipelineDesc& desc);
+  // With `alphaAnyHit`, `desc`'s hit groups get that any-hit shader and the material bindings are added
+  // (shading records, materials, texture set); `recordStages` are the stages besides any-hit that read them.
+  Status init(Context& ctx, RayTracingPipelineDesc desc, SpirvModule alphaAnyHit = {},
+              VkShaderStageFlags recordStages = 0);
   // Hands the pipeline, sampler, images and measurement objects to the context's deferred release: the pass
   // may be destroyed while frames that recorded it are still in flight.
   void retire(Context& ctx);
@@ -27,9 +38,17 @@ struct PassCore {
   // normal, geometric normal (or the normal), ray counters. Pass-specific bindings follow.
   static std::vector<VkDescriptorSetLayoutBinding> commonBindings();
   void writeCommon(Context& ctx, DescriptorWrites& w, const GBufferDesc& g, const TlasInfo& tlas) const;
+  // Writes the material bindings and picks the texture set: `materials` (null = the fallback, and the TLAS is
+  // traced as opaque) and the TLAS's shading records. Sets RB_GB_ALPHA_TEST in `gbufferFlags` when the TLAS
+  // holds non-opaque instances and a table is given; those need shading records (an error names `passName`).
+  Status writeMaterials(DescriptorWrites& w, const TlasInfo& tlas, const MaterialTable* materials, const char* passName,
+                        uint32_t& gbufferFlags);
 
   // Ensures the outputs, starts the measurements and makes the outputs writable.
   Status begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const std::vector<PassImages::Spec>& outputs);
+  // Binds the pipeline, set 0 (`w`), the texture set (when the pass has one) and the push constants.
+  void bind(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
+            uint32_t constantBytes) const;
   // Traces one ray generation invocation per G-buffer pixel with the pass's push constants (ShadowConstants,
   // AoConstants, ...), then makes the outputs readable.
   template <typename Constants>

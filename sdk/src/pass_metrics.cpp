@@ -10,7 +10,7 @@ namespace rb {
 Status PassMetrics::init(Context& ctx, const char* passName) {
   Context::Impl& c = internal::contextImpl(ctx);
   const uint32_t slots = c.desc.framesInFlight;
-  Result<GpuBuffer> b = createBuffer(ctx, VkDeviceSize(slots) * kCounterSlots * sizeof(uint32_t),
+  Result<GpuBuffer> b = createBuffer(ctx, VkDeviceSize(slots) * kCountersPerFrame * sizeof(uint32_t),
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                      MemoryLocation::HostVisible, MemoryCategory::PassBuffers, passName);
   if (!b) return b.error();
@@ -48,6 +48,7 @@ void PassMetrics::collect(Context& ctx) {
     const uint32_t* counts = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(counters_.mapped) +
                                                                slot * counterBytes());
     for (uint32_t i = 0; i < kCounterSlots; ++i) s.rays += counts[i];
+    for (uint32_t i = 0; i < kCounterSlots; ++i) s.anyHitInvocations += counts[kCounterSlots + i];
     if (timing_) {
       uint64_t ticks[2] = {0, 0};
       if (c.vk.vkGetQueryPoolResults(c.desc.device, timestamps_, 2 * slot, 2, sizeof ticks, ticks, sizeof(uint64_t),

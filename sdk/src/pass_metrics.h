@@ -15,7 +15,9 @@ class PassMetrics {
  public:
   // Rays are summed into 4096 counters, one per pixel of a 64x64 tile: neighbouring invocations (one warp or
   // subgroup) never add to the same address, so the atomics do not serialise (shaders/ray_counters.glsl).
+  // Any-hit invocations follow in as many counters.
   static constexpr uint32_t kCounterSlots = RB_RAY_COUNTER_SLOTS;
+  static constexpr uint32_t kCountersPerFrame = 2 * kCounterSlots;
 
   Status init(Context& ctx, const char* passName);
   // Hands the counter buffer and the query pool to the context's deferred release (frames in flight may still
@@ -29,7 +31,7 @@ class PassMetrics {
   // The counter buffer of this frame's slot, for the shader's ray counters.
   VkBuffer counterBuffer() const { return counters_.buffer; }
   VkDeviceSize counterOffset(Context& ctx) const;
-  VkDeviceSize counterBytes() const { return kCounterSlots * sizeof(uint32_t); }
+  VkDeviceSize counterBytes() const { return kCountersPerFrame * sizeof(uint32_t); }
   // Collects finished frames first.
   const PassStats& latest(Context& ctx) {
     collect(ctx);
@@ -38,7 +40,7 @@ class PassMetrics {
 
  private:
   void collect(Context& ctx);
-  GpuBuffer counters_;  // host-visible, framesInFlight * kCounterSlots uints
+  GpuBuffer counters_;  // host-visible, framesInFlight * kCountersPerFrame uints
   VkQueryPool timestamps_ = VK_NULL_HANDLE;
   std::vector<uint64_t> recordedFrame_;  // per slot; UINT64_MAX = nothing pending
   PassStats latest_;

@@ -43,7 +43,7 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
     p.bindings.push_back({RB_SHADOW_BINDING_HIT_DISTANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
   }
   p.pushConstantBytes = sizeof(ShadowConstants);
-  if (Status s = impl->core.init(context, p); !s) return s.error();
+  if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::shadow_rahit)); !s) return s.error();
   return std::unique_ptr<ShadowPass>(new ShadowPass(std::move(impl)));
 }
 
@@ -101,9 +101,10 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
 
   std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16_SFLOAT, "shadow visibility"}};
   if (s.desc.outputHitDistance) specs.push_back({VK_FORMAT_R32_SFLOAT, "shadow hit distance"});
+  DescriptorWrites w;
+  if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ShadowPass", pc.gbuffer.flags); !st) return st;
   if (Status st = s.core.begin(s.ctx, cmd, g, specs); !st) return st;
   const PassImages& images = s.core.images;
-  DescriptorWrites w;
   s.core.writeCommon(s.ctx, w, g, tlas);
   w.storageImage(RB_SHADOW_BINDING_VISIBILITY, images[0].view);
   if (s.desc.outputHitDistance) w.storageImage(RB_SHADOW_BINDING_HIT_DISTANCE, images[1].view);

@@ -101,7 +101,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   const uint64_t serial = s.tlasSerial + 1;
   auto* out = static_cast<VkAccelerationStructureInstanceKHR*>(slot.instances.mapped);
   auto* records = options.writeShadingRecords ? static_cast<ShadingRecord*>(slot.shading.mapped) : nullptr;
-  uint32_t written = 0, skipped = 0, stale = 0;
+  uint32_t written = 0, skipped = 0, stale = 0, nonOpaque = 0;
   uint64_t signature = 0;
   const bool rebase = options.originOffset[0] != 0.0 || options.originOffset[1] != 0.0 ||
                       options.originOffset[2] != 0.0;
@@ -155,6 +155,9 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
       r.positionFormat = static_cast<uint32_t>(m.vertexFormat);
       records[written] = r;
     }
+    const bool forcedOpaque = (in.flags & VK_GEOMETRY_INSTANCE_FORCE_OPAQUE_BIT_KHR) != 0;
+    const bool forcedNonOpaque = (in.flags & VK_GEOMETRY_INSTANCE_FORCE_NO_OPAQUE_BIT_KHR) != 0;
+    if (forcedNonOpaque || (reg.mesh.desc.nonOpaque && !forcedOpaque)) ++nonOpaque;
     out[written++] = inst;
     e.lastUsedFrame = c.frame;
     e.lastTlasSerial = serial;
@@ -257,6 +260,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   result.address = c.vk.vkGetAccelerationStructureDeviceAddressKHR(c.desc.device, &ai);
   result.instanceCount = written;
   result.skippedInstances = skipped;
+  result.nonOpaqueInstances = nonOpaque;
   result.updated = source != nullptr;
   for (int i = 0; i < 3; ++i) result.originOffset[i] = options.originOffset[i];
   if (records) {

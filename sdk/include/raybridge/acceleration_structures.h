@@ -168,7 +168,9 @@ struct Instance {
   uint8_t mask = 0xFF;       // default: visible to all rays
   uint32_t sbtRecordOffset = 0;
   VkGeometryInstanceFlagsKHR flags = 0;
-  uint32_t material = 0;  // index into ReflectionPass::setMaterials(); read only by passes that shade hits
+  // Index into the MaterialTable (MaterialTable::setMaterials); read by passes that shade hits and by the
+  // alpha test of non-opaque meshes.
+  uint32_t material = 0;
 
   // Sets `transform` from a column-major 4x4 matrix (GLM's and most engines' layout); the last row is ignored.
   void setTransformColumnMajor(const float m[16]) {
@@ -189,15 +191,19 @@ struct TlasBuildOptions {
   // float precision far from the world origin. Default 0: world space.
   double originOffset[3] = {0.0, 0.0, 0.0};
   // Also write, per TLAS instance, where its vertex data and material are (TlasInfo::shadingRecords), for
-  // passes that shade the surfaces rays hit (reflections). false = no such buffer is allocated.
+  // passes that shade the surfaces rays hit (reflections) or alpha-test them (any pass, when a mesh is
+  // non-opaque). false = no such buffer is allocated.
   bool writeShadingRecords = false;
 };
 
 struct TlasInfo {
   VkAccelerationStructureKHR tlas = VK_NULL_HANDLE;
   VkDeviceAddress address = 0;
-  uint32_t instanceCount = 0;                // instances written into the TLAS
-  uint32_t skippedInstances = 0;             // instances whose mesh has no built BLAS yet (queued beyond the budget)
+  uint32_t instanceCount = 0;     // instances written into the TLAS
+  uint32_t skippedInstances = 0;  // instances whose mesh has no built BLAS yet (queued beyond the budget)
+  // Instances written whose geometry runs any-hit shaders (MeshDesc::nonOpaque, or forced by
+  // VK_GEOMETRY_INSTANCE_FORCE_NO_OPAQUE_BIT_KHR). 0 = the passes keep the opaque fast path.
+  uint32_t nonOpaqueInstances = 0;
   bool updated = false;                      // true if refit rather than rebuilt
   double originOffset[3] = {0.0, 0.0, 0.0};  // TlasBuildOptions::originOffset it was built with
   // With TlasBuildOptions::writeShadingRecords: a storage buffer of one record per TLAS instance (indexed by
@@ -260,6 +266,7 @@ struct BuildBatchTiming {
 
 struct AsStats {
   uint32_t meshHandles = 0;         // live handles (registered and not released)
+  uint32_t nonOpaqueMeshes = 0;     // live handles registered with MeshDesc::nonOpaque
   uint32_t registrations = 0;       // registerMesh calls that succeeded
   uint32_t dedupHits = 0;           // registrations that reused an existing BLAS
   uint32_t blasCount = 0;           // BLASes that exist (built, building or queued)

@@ -14,6 +14,7 @@
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
+#include <raybridge/material_table.h>
 
 #include <memory>
 
@@ -31,6 +32,9 @@ struct AoSettings {
   uint32_t raysPerPixel = 0;  // 0 = kDefaultAoRays
   float range = 0.0f;         // world units; 0 = kDefaultAoRange. Use a large value (e.g. 1e6) for unlimited range.
   AoEstimator estimator = AoEstimator::Binary;
+  // The materials that alpha-test non-opaque geometry (MaterialTable: Mask cut-outs, stochastic Blend), read
+  // through the TLAS's shading records (needed then). nullptr = none: every surface occludes.
+  const MaterialTable* materials = nullptr;
 };
 
 // Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record().

@@ -31,6 +31,9 @@ struct PassStats {
   uint64_t frame = 0;  // Context::frameIndex() when recorded; 0 = nothing resolved yet
   double gpuMs = 0.0;  // GPU time between the pass's first and last command
   uint64_t rays = 0;   // rays traced, counted by the shaders
+  // Any-hit shader invocations (alpha tests on non-opaque geometry, MeshDesc::nonOpaque); 0 when every mesh the
+  // rays reached is opaque.
+  uint64_t anyHitInvocations = 0;
   double raysPerSecond() const { return gpuMs > 0.0 ? double(rays) / (gpuMs * 1e-3) : 0.0; }
 };
 

@@ -7,7 +7,9 @@
 //
 // Needs: roughness in the G-buffer (GBufferDesc::roughnessInNormalW or roughnessMetalness), a TLAS built
 // with TlasBuildOptions::writeShadingRecords, Instance::material set, and the engine's materials and
-// textures given to setMaterials().
+// textures: a MaterialTable shared with the other passes (ReflectionSettings::materials), or the pass's own
+// table given to setMaterials(). Reflection rays and the shadow rays from their hits alpha-test non-opaque
+// geometry with the same table (material_table.h).
 //
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output image,
 // material table, texture set and measurement objects are handed to the Context's deferred release (see
@@ -19,24 +21,12 @@
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
+#include <raybridge/material_table.h>
 
 #include <memory>
 #include <span>
 
 namespace rb {
-
-inline constexpr uint32_t kNoTexture = 0xFFFFFFFFu;
-
-// A surface material as the reflection hits shade it (glTF metallic-roughness).
-struct Material {
-  float baseColor[4] = {1.0f, 1.0f, 1.0f, 1.0f};  // linear RGBA factor
-  float metallic = 0.0f;
-  float roughness = 1.0f;                          // perceptual
-  float emissive[3] = {0.0f, 0.0f, 0.0f};          // linear radiance
-  uint32_t baseColorTexture = kNoTexture;          // index into the textures of setMaterials (sRGB view: decoded)
-  uint32_t metallicRoughnessTexture = kNoTexture;  // glTF layout: G = roughness, B = metallic
-  uint32_t emissiveTexture = kNoTexture;           // multiplies `emissive` (sRGB view: decoded)
-};
 
 // Defaults of ReflectionSettings (what a zero field means).
 inline constexpr float kDefaultReflectionRoughnessThreshold = 0.3f;
@@ -60,6 +50,8 @@ struct ReflectionSettings {
   float skyRadiance[3] = {0.0f, 0.0f, 0.0f};   // linear, returned by rays that escape; 0 = kDefaultSkyRadiance
   float ambientIntensity = 0.0f;  // sky light on hit surfaces, times skyRadiance; 0 = kDefaultAmbientIntensity
   uint32_t flags = 0;             // ReflectionFlags
+  // The table hits shade with and alpha-test with; nullptr = the pass's own table (setMaterials()).
+  const MaterialTable* materials = nullptr;
 };
 
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
@@ -77,8 +69,8 @@ class ReflectionPass {
   // the frames already recorded.
   ~ReflectionPass();
 
-  // The engine's materials and texture views (2D, sampled, in SHADER_READ_ONLY_OPTIMAL while used). Call
-  // when they change; the previous table is released once frames in flight are done with it.
+  // Fills the pass's own MaterialTable (MaterialTable::setMaterials), used where ReflectionSettings::materials
+  // is nullptr. Call when they change; the previous table is released once frames in flight are done with it.
   Status setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures);
   Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas,
                 const ReflectionSettings& settings = {});

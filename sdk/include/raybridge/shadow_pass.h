@@ -16,6 +16,7 @@
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
+#include <raybridge/material_table.h>
 
 #include <memory>
 
@@ -33,6 +34,9 @@ struct ShadowSettings {
   // Rays per pixel for a soft light (angular radius or radius > 0); 0 = kDefaultSoftShadowRays. A hard light
   // always uses one.
   uint32_t raysPerPixel = 0;
+  // The materials that alpha-test non-opaque geometry (MaterialTable: Mask cut-outs, stochastic Blend), read
+  // through the TLAS's shading records (needed then). nullptr = none: every surface casts a solid shadow.
+  const MaterialTable* materials = nullptr;
 };
 
 // Images owned by the pass, sized to the G-buffer, left in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL after
