@@ -224,9 +224,16 @@ struct UploadedTextures {
 // runs inside each frame, `readback` after it.
 using FrameRecorder =
     std::function<void(VkCommandBuffer, const rb::GBufferDesc&, const rb::TlasInfo&, const rb::MaterialTable&)>;
+// With `frontEnd`, each frame records an rb::HybridEffects given the service, the instances and the scene's
+// materials instead (it builds the TLAS itself); `record` is not called then.
+struct FrontEndRun {
+  rb::HybridEffects* effects = nullptr;  // created by runAlphaFrames on the scene's service
+  rb::HybridEffectsDesc desc;
+  rb::Light light;
+};
 void runAlphaFrames(GpuFixture& fx, const AlphaScene& s, const CpuGBuffer& cpu, uint32_t frames,
                     const FrameRecorder& record, const PassReadback& readback, uint32_t* nonOpaqueInstances = nullptr,
-                    uint32_t* nonOpaqueMeshes = nullptr) {
+                    uint32_t* nonOpaqueMeshes = nullptr, FrontEndRun* frontEnd = nullptr) {
   auto service = rb::AccelerationStructureService::create(fx.ctx());
   RB_REQUIRE_OK(service);
   std::vector<UploadedMesh> uploads;
@@ -265,7 +272,27 @@ void runAlphaFrames(GpuFixture& fx, const AlphaScene& s, const CpuGBuffer& cpu, 
     RB_REQUIRE_OK(table.value()->setMaterials(s.materials, textures.views));
     GpuGBuffer gbuffer(fx, cpu);
     rb::GBufferDesc desc = gbuffer.desc();
+    std::unique_ptr<rb::HybridEffects> effects;
+    if (frontEnd) {
+      auto created = rb::HybridEffects::create(fx.ctx(), service.value().get(), frontEnd->desc);
+      RB_REQUIRE_OK(created);
+      effects = std::move(created.value());
+      RB_REQUIRE_OK(effects->setMaterials(s.materials, textures.views));
+      frontEnd->effects = effects.get();
+    }
     for (uint32_t f = 0; f < frames; ++f) {
+      if (effects) {
+        fx.runFrame([&](VkCommandBuffer cmd) {
+          rb::HybridFrame frame;
+          frame.gbuffer = desc;
+          frame.instances = instances;
+          frame.light = frontEnd->light;
+          RB_REQUIRE_OK(effects->record(cmd, frame));
+          if (nonOpaqueInstances) *nonOpaqueInstances = effects->lastTlas().nonOpaqueInstances;
+        });
+        readback(desc);
+        continue;
+      }
       fx.runFrame([&](VkCommandBuffer cmd) {
         RB_REQUIRE_OK(service.value()->recordPendingWork(cmd));
         auto tlas = service.value()->recordTlasBuild(cmd, instances, gbuffer.cameraRelativeTlas(true));
@@ -278,6 +305,7 @@ void runAlphaFrames(GpuFixture& fx, const AlphaScene& s, const CpuGBuffer& cpu, 
     }
     for (uint32_t i = 0; i < fx.ctx().framesInFlight(); ++i) fx.ctx().beginFrame();
     (void)fx.device().waitIdle();
+    if (frontEnd) frontEnd->effects = nullptr;
   }
   for (UploadedMesh& m : uploads) fx.destroy(m);
   for (rb::HeadlessBuffer& b : texcoords) fx.device().destroyBuffer(b);
@@ -522,4 +550,38 @@ TEST_CASE("stochastic shadows through two BLEND layers converge to the product o
   within(sumAB / nAB, nAB, 0.7 * 0.5);
   within(sumB / nB, nB, 0.5);
   CHECK(run.stats.anyHitInvocations > 0);
+}
+
+TEST_CASE("the effects front end alpha-tests its shadows exactly like the shadow pass given the table",
+          "[alpha][hybrid_effects]") {
+  GpuFixture fx;
+  AlphaScene s = fenceAndCanopy(false);
+  const SyntheticView view = alphaView();
+  CpuGBuffer cpu = groundGBuffer(view);
+  ShadowResult direct = runShadows(fx, s, cpu, kToSun);
+  FrontEndRun frontEnd;
+  frontEnd.desc = rb::withPreset({}, rb::Preset::HardShadows);
+  frontEnd.light.direction[0] = float(kToSun.x);
+  frontEnd.light.direction[1] = float(kToSun.y);
+  frontEnd.light.direction[2] = float(kToSun.z);
+  std::vector<float> visibility;
+  uint32_t nonOpaqueInstances = 0;
+  rb::PassStats stats;
+  runAlphaFrames(
+      fx, s, cpu, 1, {},
+      [&](const rb::GBufferDesc& desc) {
+        const rb::HybridOutputs& out = frontEnd.effects->outputs();
+        visibility = readR16f(fx, out.shadow.image, desc.width, desc.height);
+        CHECK(out.shadow.image == out.shadowRaw.image);  // hard shadows: no denoiser
+      },
+      &nonOpaqueInstances, nullptr, &frontEnd);
+  // The front end wrote shading records on its own (no reflections: only because meshes are non-opaque) and
+  // handed its material table to the shadow pass: the same rays, the same cut-outs.
+  CHECK(nonOpaqueInstances == 2);
+  REQUIRE(visibility.size() == direct.visibility.size());
+  CHECK(visibility == direct.visibility);
+  uint32_t lit = 0;
+  for (float v : visibility) lit += v > 0.5f;
+  CHECK(lit > 0);
+  CHECK(lit < visibility.size());
 }

@@ -647,6 +647,14 @@ Result<VkDeviceAddress> AccelerationStructureService::blasAddress(MeshHandle mes
   return e.address;
 }
 
+uint32_t AccelerationStructureService::nonOpaqueMeshCount() const {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  uint32_t count = 0;
+  for (const Registration& r : s.registrations) count += r.live && r.mesh.desc.nonOpaque;
+  return count;
+}
+
 AsStats AccelerationStructureService::stats() const {
   Impl& s = *impl_;
   std::lock_guard<std::mutex> lock(s.mutex);
@@ -656,9 +664,7 @@ AsStats AccelerationStructureService::stats() const {
   AsStats out = s.counters;
   out.meshHandles = s.liveRegistrations();
   out.nonOpaqueMeshes = 0;
-  for (const Registration& r : s.registrations) {
-    if (r.live && r.mesh.desc.nonOpaque) ++out.nonOpaqueMeshes;
-  }
+  for (const Registration& r : s.registrations) out.nonOpaqueMeshes += r.live && r.mesh.desc.nonOpaque;
   out.blasCount = out.blasQueued = 0;
   out.triangles = out.blasBytes = out.blasBytesBeforeCompaction = out.dynamicBlasBytes = 0;
   for (uint32_t i = 1; i < s.entries.size(); ++i) {

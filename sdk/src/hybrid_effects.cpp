@@ -108,9 +108,29 @@ struct HybridEffects::Impl {
   std::unique_ptr<AoPass> ao;
   std::unique_ptr<Denoiser> aoDenoiser;
   std::unique_ptr<ReflectionPass> reflection;
-  std::vector<Material> materials;
-  std::vector<VkImageView> textures;
-  bool materialsDirty = false;  // the reflection pass has not seen the latest setMaterials
+  // The engine's materials, shared by every pass: reflection hits shade with them, and shadow, AO and
+  // reflection rays alpha-test non-opaque geometry with them. The table (GPU memory) exists only while a pass
+  // does; the engine's last setMaterials is kept here to fill it when one is created.
+  std::unique_ptr<MaterialTable> materials;
+  std::vector<Material> materialData;
+  std::vector<VkImageView> textureData;
+  bool haveMaterialData = false;
+
+  Status syncMaterialTable() {
+    if (!shadow && !ao && !reflection) {
+      materials.reset();  // retired to the Context like the passes
+      return {};
+    }
+    if (materials) return {};
+    auto table = MaterialTable::create(ctx);
+    if (!table) return wrap("MaterialTable::create", table.error());
+    if (haveMaterialData) {
+      if (Status st = table.value()->setMaterials(materialData, textureData); !st)
+        return wrap("MaterialTable::setMaterials", st.error());
+    }
+    materials = std::move(table.value());
+    return {};
+  }
   HybridOutputs outputs;
   TlasInfo tlas;
 
@@ -123,15 +143,13 @@ struct HybridEffects::Impl {
         !s)
       return s;
     if (Status s = ensure(ao, e & kEffectAo, "AoPass::create", [&] { return AoPass::create(ctx); }); !s) return s;
-    const bool hadReflection = reflection != nullptr;
     if (Status s = ensure(reflection, e & kEffectReflections, "ReflectionPass::create",
                           [&] { return ReflectionPass::create(ctx); });
         !s)
       return s;
-    if (reflection && !hadReflection) materialsDirty = true;
     if (!shadow || desc.shadows.disableDenoiser) shadowDenoiser.reset();
     if (!ao || desc.ao.disableDenoiser) aoDenoiser.reset();
-    return {};
+    return syncMaterialTable();
   }
 
   Status recordShadows(VkCommandBuffer cmd, const HybridFrame& f);
@@ -143,6 +161,7 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   const ShadowPlan plan = planShadows(desc.shadows, f.light);
   ShadowSettings s;
   s.raysPerPixel = plan.rays;
+  s.materials = materials.get();  // alpha tests non-opaque geometry
   if (Status st = shadow->record(cmd, f.gbuffer, tlas, plan.light, s); !st)
     return wrap("ShadowPass::record", st.error());
   const ShadowOutputs& o = shadow->outputs();
@@ -164,6 +183,7 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
 
 Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) {
   AoSettings s;
+  s.materials = materials.get();
   s.raysPerPixel = desc.ao.raysPerPixel;
   s.range = desc.ao.range;
   s.estimator = desc.ao.estimator;
@@ -186,12 +206,8 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
 }
 
 Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
-  if (materialsDirty) {
-    if (Status st = reflection->setMaterials(materials, textures); !st)
-      return wrap("ReflectionPass::setMaterials", st.error());
-    materialsDirty = false;
-  }
   ReflectionSettings s;
+  s.materials = materials.get();
   s.roughnessThreshold = desc.reflections.roughnessThreshold;
   s.raysPerPixel = desc.reflections.raysPerPixel;
   s.flags = (f.flags & kFrameExplicitLighting) ? kReflectionExplicitLighting : 0u;
@@ -241,14 +257,13 @@ const HybridEffectsDesc& HybridEffects::desc() const { return impl_->desc; }
 
 Status HybridEffects::setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures) {
   Impl& a = *impl_;
-  a.materials.assign(materials.begin(), materials.end());
-  a.textures.assign(textures.begin(), textures.end());
-  a.materialsDirty = true;
-  if (!a.reflection) return {};
-  // Validate now, so a bad table is reported by the call that brought it.
-  if (Status st = a.reflection->setMaterials(a.materials, a.textures); !st)
-    return wrap("ReflectionPass::setMaterials", st.error());
-  a.materialsDirty = false;
+  if (a.materials) {
+    if (Status st = a.materials->setMaterials(materials, textures); !st)
+      return wrap("MaterialTable::setMaterials", st.error());
+  }
+  a.materialData.assign(materials.begin(), materials.end());
+  a.textureData.assign(textures.begin(), textures.end());
+  a.haveMaterialData = true;
   return {};
 }
 
@@ -271,7 +286,9 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
       // TlasInfo, so a G-buffer without cameraPosition (all zero) simply gets a world-space TLAS.
       for (int i = 0; i < 3; ++i) options.originOffset[i] = frame.gbuffer.cameraPosition[i];
     }
-    options.writeShadingRecords = a.reflection != nullptr;  // vertex data + material per instance, for hits
+    // Vertex data + material per instance: for reflection hits, and for the any-hit alpha tests of non-opaque
+    // geometry in every ray; an all-opaque scene without reflections allocates none.
+    options.writeShadingRecords = a.reflection != nullptr || a.service->nonOpaqueMeshCount() > 0;
     auto tlas = a.service->recordTlasBuild(cmd, frame.instances, options);
     if (!tlas) return wrap("recordTlasBuild", tlas.error());
     a.tlas = tlas.value();

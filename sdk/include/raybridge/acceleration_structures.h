@@ -367,6 +367,9 @@ class AccelerationStructureService {
   // For a dynamic mesh: the newest copy (see DynamicBuildMode), which changes with every update.
   Result<VkDeviceAddress> blasAddress(MeshHandle mesh) const;
   AsStats stats() const;
+  // Live registrations with MeshDesc::nonOpaque (what AsStats::nonOpaqueMeshes reports), without resolving the
+  // rest of the statistics: a TLAS needs shading records for alpha testing when it is non-zero.
+  uint32_t nonOpaqueMeshCount() const;
 
   struct Impl;
 

@@ -4,7 +4,7 @@
 // directly; this object only composes them.
 //
 //   auto fx = rb::HybridEffects::create(context, &service, rb::withPreset({}, rb::Preset::High)).value();
-//   fx->setMaterials(materials, textureViews);          // once per scene, for reflection hits
+//   fx->setMaterials(materials, textureViews);          // once per scene: reflection hits and alpha tests
 //   // each frame, after ctx.beginFrame() and the G-buffer pass:
 //   rb::HybridFrame frame;
 //   frame.gbuffer = gbuffer;                            // the engine's pre-pass (gbuffer.h)
@@ -154,8 +154,11 @@ class HybridEffects {
   Status applyPreset(Preset preset) { return setDesc(withPreset(desc(), preset)); }
   const HybridEffectsDesc& desc() const;
 
-  // The engine's materials and texture views for reflection hits (see ReflectionPass::setMaterials). Kept
-  // and handed to the reflection pass whenever it exists; the views must stay valid until the next call.
+  // The engine's materials and texture views (material_table.h): reflection hits shade with them, and shadow,
+  // AO and reflection rays alpha-test the meshes registered with MeshDesc::nonOpaque through them (Mask
+  // cut-outs, stochastic Blend). One table shared by every pass, in GPU memory only while an effect is enabled
+  // (validated now when one is, else when one is enabled); the views must stay valid until the next call.
+  // Without a call every instance is white and opaque.
   Status setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures);
 
   // Records the enabled effects (see Order above). On an error, outputs() names no image of this frame and
