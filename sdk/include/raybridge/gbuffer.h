@@ -12,6 +12,12 @@
 // shadows differing on 30% of the pixels at 20 km before it did this (adapters/tests/far_origin_test.cpp).
 // Instance transforms given to the TLAS stay world-space: TlasBuildOptions::originOffset is subtracted in double.
 //
+// Sides: the normals (shading and geometric) must face the viewer, as rasterised: for a double-sided surface
+// seen from behind, write the flipped normal (gl_FrontFacing). The passes offset ray origins and orient their
+// hemispheres by them. Rays themselves hit both sides of every triangle (no face culling), so a closed or
+// single-sided mesh still occludes from behind; the engine's raster culling of single-sided surfaces does not
+// change what the rays see.
+//
 // Thread safety: plain data.
 #pragma once
 
