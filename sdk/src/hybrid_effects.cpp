@@ -152,6 +152,20 @@ struct HybridEffects::Impl {
     return syncMaterialTable();
   }
 
+  // The denoiser of one signal: created when wanted, retired when not; `out` becomes its output when it runs.
+  // `rays`: binary rays behind the signal (DenoiseSettings::raysPerPixel; 0 = estimate the noise).
+  Status denoise(std::unique_ptr<Denoiser>& slot, bool wanted, const char* what, VkCommandBuffer cmd,
+                 const GBufferDesc& gbuffer, VkImageView signal, uint32_t rays, EffectImage& out) {
+    if (Status st = ensure(slot, wanted, what, [&] { return Denoiser::create(ctx); }); !st) return st;
+    if (!slot) return {};
+    DenoiseSettings d = desc.denoiser;
+    d.raysPerPixel = rays;
+    if (Status st = slot->record(cmd, gbuffer, signal, d); !st) return wrap(what, st.error());
+    const DenoiseOutputs& dn = slot->outputs();
+    out = image(dn.denoised, dn.denoisedView, VK_FORMAT_R16_SFLOAT, dn.layout, dn.width, dn.height);
+    return {};
+  }
+
   Status recordShadows(VkCommandBuffer cmd, const HybridFrame& f);
   Status recordAo(VkCommandBuffer cmd, const HybridFrame& f);
   Status recordReflections(VkCommandBuffer cmd, const HybridFrame& f);
@@ -167,18 +181,9 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   const ShadowOutputs& o = shadow->outputs();
   outputs.shadowRaw = outputs.shadow = image(o.visibility, o.visibilityView, VK_FORMAT_R16_SFLOAT, o.layout, o.width,
                                              o.height);
-  const bool denoise = plan.soft && !desc.shadows.disableDenoiser;
-  if (Status st = ensure(shadowDenoiser, denoise, "Denoiser::create (shadows)", [&] { return Denoiser::create(ctx); });
-      !st)
-    return st;
-  if (!shadowDenoiser) return {};
-  DenoiseSettings d = desc.denoiser;
-  d.raysPerPixel = plan.rays;  // the visibility is a fraction of this many binary rays
-  if (Status st = shadowDenoiser->record(cmd, f.gbuffer, o.visibilityView, d); !st)
-    return wrap("Denoiser::record (shadows)", st.error());
-  const DenoiseOutputs& dn = shadowDenoiser->outputs();
-  outputs.shadow = image(dn.denoised, dn.denoisedView, VK_FORMAT_R16_SFLOAT, dn.layout, dn.width, dn.height);
-  return {};
+  // The visibility is a fraction of plan.rays binary rays.
+  return denoise(shadowDenoiser, plan.soft && !desc.shadows.disableDenoiser, "Denoiser (shadows)", cmd, f.gbuffer,
+                 o.visibilityView, plan.rays, outputs.shadow);
 }
 
 Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -190,19 +195,9 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   if (Status st = ao->record(cmd, f.gbuffer, tlas, s); !st) return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
   outputs.aoRaw = outputs.ao = image(o.ao, o.aoView, VK_FORMAT_R16_SFLOAT, o.layout, o.width, o.height);
-  if (Status st = ensure(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser::create (AO)",
-                         [&] { return Denoiser::create(ctx); });
-      !st)
-    return st;
-  if (!aoDenoiser) return {};
-  DenoiseSettings d = desc.denoiser;
   // Binary AO is a fraction of binary rays; distance-weighted AO is not, so its noise is estimated.
-  d.raysPerPixel = s.estimator == AoEstimator::Binary ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays) : 0u;
-  if (Status st = aoDenoiser->record(cmd, f.gbuffer, o.aoView, d); !st)
-    return wrap("Denoiser::record (AO)", st.error());
-  const DenoiseOutputs& dn = aoDenoiser->outputs();
-  outputs.ao = image(dn.denoised, dn.denoisedView, VK_FORMAT_R16_SFLOAT, dn.layout, dn.width, dn.height);
-  return {};
+  const uint32_t rays = s.estimator == AoEstimator::Binary ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays) : 0u;
+  return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, f.gbuffer, o.aoView, rays, outputs.ao);
 }
 
 Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -219,14 +214,7 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   if (f.light.type == LightType::Directional) {
     for (int i = 0; i < 3; ++i) s.sunDirection[i] = f.light.direction[i];
   } else {
-    // The reflection pass lights hits by one directional light: a local light leaves them to the sky alone.
-    if (!(s.flags & kReflectionExplicitLighting)) {
-      const bool skyUnset = s.skyRadiance[0] == 0.0f && s.skyRadiance[1] == 0.0f && s.skyRadiance[2] == 0.0f;
-      for (int i = 0; i < 3; ++i) s.skyRadiance[i] = skyUnset ? kDefaultSkyRadiance[i] : s.skyRadiance[i];
-      if (s.ambientIntensity == 0.0f) s.ambientIntensity = kDefaultAmbientIntensity;
-      s.flags |= kReflectionExplicitLighting;
-    }
-    for (float& c : s.sunRadiance) c = 0.0f;
+    s.flags |= kReflectionNoSun;  // the pass lights hits by one directional light: a local one leaves the sky
   }
   const GBufferDesc& g = f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer;
   if (Status st = reflection->record(cmd, g, tlas, s); !st) return wrap("ReflectionPass::record", st.error());

@@ -96,7 +96,9 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ReflectionPass", pc.gbuffer); !st) return st;
   for (int i = 0; i < 3; ++i) {
     pc.sunDirection[i] = sunDirection[i] / sunLen;
-    pc.sunRadiance[i] = defaultSun ? kDefaultSunRadiance : settings.sunRadiance[i];
+    pc.sunRadiance[i] = (settings.flags & kReflectionNoSun) ? 0.0f
+                        : defaultSun                        ? kDefaultSunRadiance
+                                                            : settings.sunRadiance[i];
     pc.skyRadiance[i] = defaultSky ? kDefaultSkyRadiance[i] : settings.skyRadiance[i];
   }
   pc.roughnessThreshold = threshold;

@@ -39,6 +39,9 @@ enum ReflectionFlags : uint32_t {
   // Take sunRadiance, skyRadiance and ambientIntensity as given, zeros included (a black sky, no sky light).
   // Without it an all-zero colour or a zero intensity means its default constant.
   kReflectionExplicitLighting = 1u << 0,
+  // No directional light: hits are lit by the sky alone (sunRadiance is taken as zero), while sky and ambient
+  // keep their zero-means-default rule.
+  kReflectionNoSun = 1u << 1,
 };
 
 // A zero-initialised ReflectionSettings is valid: every zero field means the default constant above.
