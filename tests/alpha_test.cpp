@@ -145,77 +145,17 @@ SyntheticView alphaView() {
 // One GPU image for each texture: RGBA8 UNORM, sampled, in SHADER_READ_ONLY_OPTIMAL.
 struct UploadedTextures {
   GpuFixture& fx;
-  std::vector<VkImage> images;
+  std::vector<SampledImage> images;
   std::vector<VkImageView> views;
-  std::vector<VkDeviceMemory> memory;
   UploadedTextures(GpuFixture& f, const std::vector<AlphaTexture>& textures) : fx(f) {
-    const rb::DeviceFunctions& vk = fx.vk();
-    VkDevice device = fx.ctx().device();
     for (const AlphaTexture& t : textures) {
-      VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-      ici.imageType = VK_IMAGE_TYPE_2D;
-      ici.format = VK_FORMAT_R8G8B8A8_UNORM;
-      ici.extent = {t.width, t.height, 1};
-      ici.mipLevels = ici.arrayLayers = 1;
-      ici.samples = VK_SAMPLE_COUNT_1_BIT;
-      ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-      ici.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-      VkImage image = VK_NULL_HANDLE;
-      REQUIRE(vk.vkCreateImage(device, &ici, nullptr, &image) == VK_SUCCESS);
-      VkMemoryRequirements req;
-      vk.vkGetImageMemoryRequirements(device, image, &req);
-      VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-      mai.allocationSize = req.size;
-      mai.memoryTypeIndex = uint32_t(rb::internal::contextImpl(fx.ctx()).findMemoryType(
-          req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0));
-      VkDeviceMemory mem = VK_NULL_HANDLE;
-      REQUIRE(vk.vkAllocateMemory(device, &mai, nullptr, &mem) == VK_SUCCESS);
-      vk.vkBindImageMemory(device, image, mem, 0);
-      VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-      vci.image = image;
-      vci.viewType = VK_IMAGE_VIEW_TYPE_2D;
-      vci.format = ici.format;
-      vci.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-      VkImageView view = VK_NULL_HANDLE;
-      REQUIRE(vk.vkCreateImageView(device, &vci, nullptr, &view) == VK_SUCCESS);
-      auto staging = fx.device().createBuffer(t.rgba.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, t.rgba.data());
-      RB_REQUIRE_OK(staging);
-      auto cmd = fx.device().beginCommands();
-      RB_REQUIRE_OK(cmd);
-      VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-      b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-      b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-      b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-      b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-      b.image = image;
-      b.subresourceRange = vci.subresourceRange;
-      vk.vkCmdPipelineBarrier(cmd.value(), VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
-                              nullptr, 0, nullptr, 1, &b);
-      VkBufferImageCopy region{};
-      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-      region.imageExtent = ici.extent;
-      vk.vkCmdCopyBufferToImage(cmd.value(), staging->buffer, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-      b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-      b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-      b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-      b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-      vk.vkCmdPipelineBarrier(cmd.value(), VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR,
-                              0, 0, nullptr, 0, nullptr, 1, &b);
-      RB_REQUIRE_OK(fx.device().submitAndWait(cmd.value()));
-      fx.device().destroyBuffer(staging.value());
-      images.push_back(image);
-      views.push_back(view);
-      memory.push_back(mem);
+      images.push_back(uploadSampledImage(fx, VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_ASPECT_COLOR_BIT, t.width, t.height,
+                                          t.rgba.data(), t.rgba.size()));
+      views.push_back(images.back().view);
     }
   }
   ~UploadedTextures() {
-    const rb::DeviceFunctions& vk = fx.vk();
-    VkDevice device = fx.ctx().device();
-    for (size_t i = 0; i < images.size(); ++i) {
-      vk.vkDestroyImageView(device, views[i], nullptr);
-      vk.vkDestroyImage(device, images[i], nullptr);
-      vk.vkFreeMemory(device, memory[i], nullptr);
-    }
+    for (SampledImage& image : images) destroySampledImage(fx, image);
   }
 };
 

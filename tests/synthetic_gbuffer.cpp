@@ -65,14 +65,15 @@ CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& v, const
   return g;
 }
 
-GpuGBuffer::Image GpuGBuffer::upload(VkFormat format, VkImageAspectFlags aspect, const void* data, size_t bytes) {
-  const rb::DeviceFunctions& vk = fx_.vk();
-  VkDevice device = fx_.ctx().device();
-  Image img;
+SampledImage uploadSampledImage(GpuFixture& fx, VkFormat format, VkImageAspectFlags aspect, uint32_t width,
+                                uint32_t height, const void* data, size_t bytes) {
+  const rb::DeviceFunctions& vk = fx.vk();
+  VkDevice device = fx.ctx().device();
+  SampledImage img;
   VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   ici.imageType = VK_IMAGE_TYPE_2D;
   ici.format = format;
-  ici.extent = {desc_.width, desc_.height, 1};
+  ici.extent = {width, height, 1};
   ici.mipLevels = ici.arrayLayers = 1;
   ici.samples = VK_SAMPLE_COUNT_1_BIT;
   ici.tiling = VK_IMAGE_TILING_OPTIMAL;
@@ -83,7 +84,7 @@ GpuGBuffer::Image GpuGBuffer::upload(VkFormat format, VkImageAspectFlags aspect,
   VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mai.allocationSize = req.size;
   mai.memoryTypeIndex = uint32_t(
-      rb::internal::contextImpl(fx_.ctx()).findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0));
+      rb::internal::contextImpl(fx.ctx()).findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0));
   REQUIRE(vk.vkAllocateMemory(device, &mai, nullptr, &img.memory) == VK_SUCCESS);
   vk.vkBindImageMemory(device, img.image, img.memory, 0);
   VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
@@ -93,9 +94,9 @@ GpuGBuffer::Image GpuGBuffer::upload(VkFormat format, VkImageAspectFlags aspect,
   vci.subresourceRange = {aspect, 0, 1, 0, 1};
   REQUIRE(vk.vkCreateImageView(device, &vci, nullptr, &img.view) == VK_SUCCESS);
 
-  auto staging = fx_.device().createBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, data);
+  auto staging = fx.device().createBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, data);
   RB_REQUIRE_OK(staging);
-  auto cmd = fx_.device().beginCommands();
+  auto cmd = fx.device().beginCommands();
   RB_REQUIRE_OK(cmd);
   VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
   b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
@@ -108,7 +109,7 @@ GpuGBuffer::Image GpuGBuffer::upload(VkFormat format, VkImageAspectFlags aspect,
                           0, nullptr, 1, &b);
   VkBufferImageCopy region{};
   region.imageSubresource = {aspect, 0, 0, 1};
-  region.imageExtent = {desc_.width, desc_.height, 1};
+  region.imageExtent = {width, height, 1};
   vk.vkCmdCopyBufferToImage(cmd.value(), staging->buffer, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
   b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
   b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
@@ -116,16 +117,27 @@ GpuGBuffer::Image GpuGBuffer::upload(VkFormat format, VkImageAspectFlags aspect,
   b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   vk.vkCmdPipelineBarrier(cmd.value(), VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, 0,
                           0, nullptr, 0, nullptr, 1, &b);
-  RB_REQUIRE_OK(fx_.device().submitAndWait(cmd.value()));
-  fx_.device().destroyBuffer(staging.value());
+  RB_REQUIRE_OK(fx.device().submitAndWait(cmd.value()));
+  fx.device().destroyBuffer(staging.value());
   return img;
+}
+
+void destroySampledImage(GpuFixture& fx, SampledImage& image) {
+  const rb::DeviceFunctions& vk = fx.vk();
+  VkDevice device = fx.ctx().device();
+  vk.vkDestroyImageView(device, image.view, nullptr);
+  vk.vkDestroyImage(device, image.image, nullptr);
+  vk.vkFreeMemory(device, image.memory, nullptr);
+  image = {};
 }
 
 GpuGBuffer::GpuGBuffer(GpuFixture& fx, const CpuGBuffer& cpu) : fx_(fx) {
   desc_.width = cpu.view.width;
   desc_.height = cpu.view.height;
-  depth_ = upload(VK_FORMAT_D32_SFLOAT, VK_IMAGE_ASPECT_DEPTH_BIT, cpu.depth.data(), cpu.depth.size() * 4);
-  normal_ = upload(VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_ASPECT_COLOR_BIT, cpu.normal.data(), cpu.normal.size() * 16);
+  depth_ = uploadSampledImage(fx, VK_FORMAT_D32_SFLOAT, VK_IMAGE_ASPECT_DEPTH_BIT, desc_.width, desc_.height,
+                              cpu.depth.data(), cpu.depth.size() * 4);
+  normal_ = uploadSampledImage(fx, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_ASPECT_COLOR_BIT, desc_.width, desc_.height,
+                               cpu.normal.data(), cpu.normal.size() * 16);
   desc_.depth = {depth_.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   desc_.depthConvention = cpu.view.reversedZ ? rb::DepthConvention::ReversedZ : rb::DepthConvention::Standard;
   desc_.normal = {normal_.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
@@ -138,14 +150,9 @@ GpuGBuffer::GpuGBuffer(GpuFixture& fx, const CpuGBuffer& cpu) : fx_(fx) {
 }
 
 GpuGBuffer::~GpuGBuffer() {
-  const rb::DeviceFunctions& vk = fx_.vk();
-  VkDevice device = fx_.ctx().device();
   (void)fx_.device().waitIdle();
-  for (Image* img : {&depth_, &normal_}) {
-    vk.vkDestroyImageView(device, img->view, nullptr);
-    vk.vkDestroyImage(device, img->image, nullptr);
-    vk.vkFreeMemory(device, img->memory, nullptr);
-  }
+  destroySampledImage(fx_, depth_);
+  destroySampledImage(fx_, normal_);
 }
 
 void runPassFrame(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu, bool shadingRecords,

@@ -45,6 +45,17 @@ struct CpuGBuffer {
 // instance, goes to the normal image's w (GBufferDesc::roughnessInNormalW); empty = 0 everywhere.
 CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& view, const std::vector<float>& roughness = {});
 
+// A device-local 2D image with one mip and layer, sampled, uploaded from `data` (`bytes` bytes, tightly packed)
+// and left in SHADER_READ_ONLY_OPTIMAL for ray tracing shaders: G-buffer images, material textures.
+struct SampledImage {
+  VkImage image = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+};
+SampledImage uploadSampledImage(GpuFixture& fx, VkFormat format, VkImageAspectFlags aspect, uint32_t width,
+                                uint32_t height, const void* data, size_t bytes);
+void destroySampledImage(GpuFixture& fx, SampledImage& image);
+
 // The G-buffer uploaded: D32 depth and RGBA32F normal images in SHADER_READ_ONLY_OPTIMAL.
 class GpuGBuffer {
  public:
@@ -60,14 +71,8 @@ class GpuGBuffer {
   }
 
  private:
-  struct Image {
-    VkImage image = VK_NULL_HANDLE;
-    VkImageView view = VK_NULL_HANDLE;
-    VkDeviceMemory memory = VK_NULL_HANDLE;
-  };
-  Image upload(VkFormat format, VkImageAspectFlags aspect, const void* data, size_t bytes);
   GpuFixture& fx_;
-  Image depth_, normal_;
+  SampledImage depth_, normal_;
   rb::GBufferDesc desc_;
 };
 
