@@ -79,8 +79,9 @@ se::ImageRGBA32F toExr(const CapturedFrame& f, const std::vector<float>& values,
   return img;
 }
 
-// Distance along each pixel-centre primary ray from the eye to the surface, from the depth buffer.
-std::vector<float> distances(const CapturedFrame& f, const glm::mat4& viewProj, const glm::vec3& eye) {
+// Distance along each pixel-centre primary ray from the eye to the surface, from the depth buffer and the
+// hook's camera-relative viewProj (the eye is at the origin of its space).
+std::vector<float> distances(const CapturedFrame& f, const glm::mat4& viewProj) {
   const glm::dmat4 inv = glm::inverse(glm::dmat4(viewProj));
   std::vector<float> out(size_t(f.width) * f.height, 0.0f);
   for (uint32_t y = 0; y < f.height; ++y) {
@@ -89,7 +90,7 @@ std::vector<float> distances(const CapturedFrame& f, const glm::mat4& viewProj, 
       const double d = f.depth[i];
       if (d >= 1.0) continue;  // sky: cleared to the far plane
       glm::dvec4 p = inv * glm::dvec4((x + 0.5) / f.width * 2.0 - 1.0, (y + 0.5) / f.height * 2.0 - 1.0, d, 1.0);
-      out[i] = float(glm::length(glm::dvec3(p) / p.w - glm::dvec3(eye)));
+      out[i] = float(glm::length(glm::dvec3(p) / p.w));
     }
   }
   return out;
@@ -378,7 +379,7 @@ int main(int argc, char** argv) {
       return s ? std::string() : s.error;
     };
     // The hook's viewProj is camera-relative: the eye is at the origin of the positions it reconstructs.
-    std::string e = write("depth.exr", toExr(f, distances(f, capturedViewProj, glm::vec3(0.0f)), 1));
+    std::string e = write("depth.exr", toExr(f, distances(f, capturedViewProj), 1));
     if (e.empty()) e = write("normal.exr", toExr(f, f.normal, 4));
     std::vector<std::string> written = {"depth.exr", "normal.exr"};
     // Hybrid: Raybridge's images as captured in the hook (raw only where a denoiser ran).

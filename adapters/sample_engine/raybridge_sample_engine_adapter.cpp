@@ -12,7 +12,9 @@ std::string message(const char* what, const rb::Error& e) {
   return std::string(what) + ": " + rb::toString(e.code) + ": " + e.message;
 }
 se::Status failure(const char* what, const rb::Error& e) { return se::Status::failure(message(what, e)); }
-void keepFirst(std::string& error, std::string message) { error = error.empty() ? std::move(message) : error; }
+void keepFirst(std::string& error, std::string message) {
+  if (error.empty()) error = std::move(message);
+}
 
 // The engine's materials as reflection hits shade them, and the texture table they index: base colour and
 // emissive as the engine's sRGB views, metallic-roughness as its UNORM views (G = roughness, B = metallic).
