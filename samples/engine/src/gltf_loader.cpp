@@ -164,8 +164,13 @@ struct Loader {
         chosen.texCoord = 0;
       }
       bakedUv.push_back(chosen);
-      if (m.alphaMode == "BLEND" || m.alphaMode == "MASK")
-        result.warnings.push_back("material '" + m.name + "': alphaMode " + m.alphaMode + " rendered as opaque");
+      out.alphaMode = m.alphaMode == "MASK"    ? AlphaMode::Mask
+                      : m.alphaMode == "BLEND" ? AlphaMode::Blend
+                                               : AlphaMode::Opaque;
+      if (m.alphaMode != "OPAQUE" && m.alphaMode != "MASK" && m.alphaMode != "BLEND")
+        result.warnings.push_back("material '" + m.name + "': unknown alphaMode '" + m.alphaMode + "', drawn opaque");
+      out.alphaCutoff = std::isfinite(m.alphaCutoff) && m.alphaCutoff >= 0.0 ? float(m.alphaCutoff) : 0.5f;
+      out.doubleSided = m.doubleSided;
       result.scene.materials.push_back(out);
     }
   }

@@ -77,7 +77,16 @@ struct UvMapping {
   bool operator==(const UvMapping&) const = default;
 };
 
-// glTF 2.0 metallic-roughness material (opaque only). Texture indices are into Scene::textures, -1 = none.
+// How a material's coverage is decided (glTF alphaMode). alpha = baseColorFactor.a * the base colour
+// texture's alpha.
+enum class AlphaMode : uint8_t {
+  Opaque,  // covers everything (glTF OPAQUE)
+  Mask,    // cut out where alpha < Material::alphaCutoff (glTF MASK): discarded in every raster pass
+  Blend,   // blended over what is behind with opacity alpha (glTF BLEND): a forward pass after lighting,
+           // never in the pre-pass / G-buffer
+};
+
+// glTF 2.0 metallic-roughness material. Texture indices are into Scene::textures, -1 = none.
 // The engine samples every texture with MeshData::uvs; the glTF loader bakes the material's UvMapping into
 // them (the base colour texture's when the textures disagree, with a warning). The *Uv fields keep the
 // file's mappings for reference; the engine does not apply them again.
@@ -98,6 +107,12 @@ struct Material {
   int occlusionTexture = -1;
   float occlusionStrength = 1.0f;
   UvMapping baseColorUv, metallicRoughnessUv, normalUv, emissiveUv, occlusionUv;
+  AlphaMode alphaMode = AlphaMode::Opaque;
+  float alphaCutoff = 0.5f;  // Mask only (glTF's default 0.5)
+  // false: back faces (clockwise in the image, after the model matrix's handedness) are culled in raster.
+  // true: both sides are drawn and the shading normal faces the viewer. Default true, so procedural meshes
+  // need not be closed or consistently wound; the glTF loader sets the file's value (glTF's default false).
+  bool doubleSided = true;
 };
 
 // A placement of a mesh in the world.
