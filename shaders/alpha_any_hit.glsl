@@ -6,8 +6,9 @@
 //   Blend:  the hit counts with probability alpha (a per-pixel, per-frame, per-surface random number), so
 //           visibility through a layer is 1 - alpha in the mean
 //   Opaque: the hit counts (a non-opaque mesh with an opaque material)
-// Included by one module per pass (shadow.rahit, ao.rahit, reflect.rahit) after the pass's push constant block;
-// RB_FRAME_INDEX names the frame's noise seed there.
+// Included by one module per pass (shadow.rahit, ao.rahit, reflect.rahit, primary.rahit) after the pass's push
+// constant block; RB_FRAME_INDEX names the frame's noise seed there. With RB_BLEND_INVISIBLE (primary rays),
+// Blend surfaces never count: primary rays stand for the G-buffer, which holds no blended surface.
 #include "ray_counters.glsl"
 #include "raybridge_sampling.glsl"
 #include "shading_records.glsl"
@@ -19,6 +20,9 @@ void main() {
   ShadingRecord r = records[gl_InstanceID];
   GpuMaterial m = materials[min(r.material, uint(materials.length()) - 1u)];
   if (m.alphaMode == RB_ALPHA_OPAQUE) return;
+#ifdef RB_BLEND_INVISIBLE
+  if (m.alphaMode == RB_ALPHA_BLEND) ignoreIntersectionEXT;
+#endif
   float alpha = m.baseColor.a;
   if (m.baseColorTexture != 0xFFFFFFFFu) {
     vec2 uv = rbMaterialUv(m, rbHitTexcoord(r, uint(gl_PrimitiveID), barycentrics));

@@ -58,7 +58,7 @@ struct ReflectionConstants {
   uint raysPerPixel;         // 204
 };
 
-// PrimaryRayPass. 64 bytes. The ray through pixel (x, y) counted from the top-left, through the pixel centre:
+// PrimaryRayPass. 80 bytes. The ray through pixel (x, y) counted from the top-left, through the pixel centre:
 //   dir = normalize(forward + ndcX * right - ndcY * up), ndc in [-1, 1].
 struct PrimaryConstants {
   vec3 eye;      //   0
@@ -69,6 +69,10 @@ struct PrimaryConstants {
   uint width;    //  44
   vec3 forward;  //  48: unit length
   uint height;   //  60
+  uint flags;       //  64: RB_GB_ALPHA_TEST or 0
+  uint frameIndex;  //  68: Context::frameIndex(), the BLEND noise seed
+  uint pad0;        //  72
+  uint pad1;        //  76
 };
 
 // The denoiser's temporal and a-trous passes. 224 bytes.

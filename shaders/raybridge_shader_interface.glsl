@@ -21,7 +21,8 @@
 #define RB_BINDING_SHADING_RECORDS 7
 #define RB_BINDING_MATERIALS 8
 #define RB_SET_TEXTURES 1  // binding 0: the engine's textures, bindless (MaterialTable)
-// The primary-ray (first trace) pass.
+// The primary-ray (first trace) pass; it also has RB_BINDING_RAY_COUNTERS, RB_BINDING_SHADING_RECORDS,
+// RB_BINDING_MATERIALS and the texture set.
 #define RB_PRIMARY_BINDING_TLAS 0
 #define RB_PRIMARY_BINDING_HIT_DISTANCE 1
 #define RB_PRIMARY_BINDING_HIT_IDS 2

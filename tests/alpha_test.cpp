@@ -7,6 +7,7 @@
 #include <glm/glm.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "synthetic_gbuffer.h"
@@ -439,6 +440,129 @@ TEST_CASE("AO through MASK cut-outs matches Embree's filtered AO", "[alpha][ao][
   CHECK(refDifference / n > 0.01);  // the cut-outs change AO visibly
   CHECK(rmse < rmseSolid);
   CHECK(pass.value()->stats().anyHitInvocations > 0);
+}
+
+namespace {
+
+// The primary ray through each pixel of `view`, as PrimaryRayPass traces it.
+rb::PrimaryRayCamera primaryCamera(const SyntheticView& view) {
+  rb::PrimaryRayCamera c;
+  for (int i = 0; i < 3; ++i) {
+    c.eye[i] = float(view.eye[i]);
+    c.target[i] = float(view.target[i]);
+    c.upHint[i] = float(view.up[i]);
+  }
+  c.verticalFovDegrees = float(view.fovYDegrees);
+  return c;
+}
+
+struct PrimaryResult {
+  std::vector<float> t;            // hit distance, 0 = miss
+  std::vector<uint32_t> instance;  // instance custom index (= scene instance), 0xFFFFFFFF = miss
+  rb::PassStats stats;
+};
+
+// PrimaryRayPass over the scene's camera-relative TLAS, given the scene's material table.
+PrimaryResult runPrimary(GpuFixture& fx, const AlphaScene& s, const SyntheticView& view) {
+  auto pass = rb::PrimaryRayPass::create(fx.ctx());
+  RB_REQUIRE_OK(pass);
+  const uint32_t w = view.width, h = view.height;
+  rb::GpuImage dist = fx.makeImage(w, h, VK_FORMAT_R32_SFLOAT);
+  rb::GpuImage ids = fx.makeImage(w, h, VK_FORMAT_R32G32_UINT);
+  PrimaryResult out;
+  runAlphaFrames(
+      fx, s, groundGBuffer(view), 1,  // the pass reads no G-buffer; runAlphaFrames wants one
+      [&](VkCommandBuffer cmd, const rb::GBufferDesc&, const rb::TlasInfo& tlas, const rb::MaterialTable& m) {
+        fx.toGeneral(cmd, dist);
+        fx.toGeneral(cmd, ids);
+        rb::PrimaryRaySettings settings;
+        settings.materials = &m;
+        RB_REQUIRE_OK(pass.value()->record(cmd, tlas, primaryCamera(view), {dist.view, ids.view, w, h}, settings));
+      },
+      [&](const rb::GBufferDesc&) {
+        std::vector<uint8_t> d = fx.readImage(dist, 4), i = fx.readImage(ids, 8);
+        out.t.resize(size_t(w) * h);
+        std::memcpy(out.t.data(), d.data(), out.t.size() * sizeof(float));
+        out.instance.resize(out.t.size());
+        for (size_t k = 0; k < out.t.size(); ++k) std::memcpy(&out.instance[k], &i[8 * k + 4], sizeof(uint32_t));
+      });
+  out.stats = pass.value()->stats();
+  fx.destroyImage(dist);
+  fx.destroyImage(ids);
+  return out;
+}
+
+// Embree's nearest hit per pixel that `stops` accepts: the instance (-1 = miss) and distance.
+void referencePrimary(const EmbreeScene& embree, const SyntheticView& view, const HitFilter& stops,
+                      std::vector<int>& instance, std::vector<float>& t) {
+  auto basis = rb::computeCameraBasis(primaryCamera(view), view.width, view.height);
+  RB_REQUIRE_OK(basis);
+  instance.assign(size_t(view.width) * view.height, -1);
+  t.assign(instance.size(), 0.0f);
+  for (uint32_t y = 0; y < view.height; ++y) {
+    for (uint32_t x = 0; x < view.width; ++x) {
+      PixelRay r = rayThrough(basis.value(), float(x) + 0.5f, float(y) + 0.5f, view.width, view.height);
+      ReferenceHit hit = embree.intersect(r.origin, r.dir, 0.0f, 1e30f, stops);
+      size_t i = size_t(y) * view.width + x;
+      if (hit.hit) instance[i] = int(hit.instanceId), t[i] = hit.t;
+    }
+  }
+}
+
+}  // namespace
+
+TEST_CASE("primary rays through MASK cut-outs match Embree's depth; BLEND surfaces are invisible to them",
+          "[alpha][primary][embree]") {
+  GpuFixture fx;
+  const SyntheticView view = alphaView();
+  AlphaScene s = fenceAndCanopy(false);
+  EmbreeScene embree;
+  addToEmbree(embree, s.scene);
+  std::vector<int> refInstance, solidInstance;
+  std::vector<float> refT, solidT;
+  referencePrimary(embree, view, alphaFilter(s), refInstance, refT);
+  referencePrimary(
+      embree, view, [](const ReferenceHit&) { return true; }, solidInstance, solidT);
+  PrimaryResult gpu = runPrimary(fx, s, view);
+  const int w = int(view.width), h = int(view.height);
+  uint32_t compared = 0, agree = 0, cutOut = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (!awayFromEdges(refInstance, x, y, w, h)) continue;
+      size_t i = size_t(y) * w + x;
+      ++compared;
+      cutOut += refInstance[i] != solidInstance[i];
+      bool gpuHit = gpu.instance[i] != 0xFFFFFFFFu, refHit = refInstance[i] >= 0;
+      if (gpuHit != refHit) continue;
+      if (!refHit || (int(gpu.instance[i]) == refInstance[i] && std::fabs(gpu.t[i] - refT[i]) <= 1e-4f * refT[i]))
+        ++agree;
+    }
+  }
+  INFO("compared " << compared << " pixels, agree " << agree << ", seen through cut-outs " << cutOut);
+  REQUIRE(compared > uint32_t(w * h / 2));
+  CHECK(double(agree) >= 0.995 * compared);
+  CHECK(double(cutOut) > 0.02 * compared);  // the cut-outs change what primary rays see
+  CHECK(gpu.stats.rays == uint64_t(w) * h);
+  CHECK(gpu.stats.anyHitInvocations > 0);
+
+  SECTION("the all-opaque scene takes the opaque fast path") {
+    PrimaryResult opaque = runPrimary(fx, fenceAndCanopy(true), view);
+    CHECK(opaque.stats.anyHitInvocations == 0);
+    uint32_t same = 0;
+    for (size_t i = 0; i < opaque.instance.size(); ++i)
+      same += int(opaque.instance[i] == 0xFFFFFFFFu ? -1 : int(opaque.instance[i])) == solidInstance[i];
+    CHECK(double(same) >= 0.995 * opaque.instance.size());
+  }
+  SECTION("a BLEND canopy is invisible to primary rays, as to the G-buffer") {
+    AlphaScene blend = fenceAndCanopy(false);
+    blend.materials[2].alphaMode = rb::AlphaMode::Blend;
+    blend.materials[2].baseColor[3] = 0.9f;
+    uint32_t canopyBefore = 0, canopyAfter = 0;
+    for (uint32_t id : gpu.instance) canopyBefore += id == 2;
+    for (uint32_t id : runPrimary(fx, blend, view).instance) canopyAfter += id == 2;
+    CHECK(canopyBefore > 100);
+    CHECK(canopyAfter == 0);
+  }
 }
 
 TEST_CASE("stochastic shadows through two BLEND layers converge to the product of their transmittances",

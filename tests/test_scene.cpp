@@ -72,14 +72,6 @@ void addToEmbree(EmbreeScene& embree, const TestScene& scene) {
   embree.commit();
 }
 
-namespace {
-
-struct PixelRay {
-  float origin[3];
-  float dir[3];
-};
-
-// The same ray the raygen shader builds (see PrimaryRayCamera), for pixel coordinates that may be fractional.
 PixelRay rayThrough(const rb::CameraBasis& b, float px, float py, uint32_t w, uint32_t h) {
   float nx = px / float(w) * 2.0f - 1.0f, ny = py / float(h) * 2.0f - 1.0f;
   PixelRay r;
@@ -92,8 +84,6 @@ PixelRay rayThrough(const rb::CameraBasis& b, float px, float py, uint32_t w, ui
   for (float& d : r.dir) d /= std::sqrt(len2);
   return r;
 }
-
-}  // namespace
 
 TraceComparison compareFirstTrace(GpuFixture& fx, const TestScene& scene, VkAccelerationStructureKHR tlas,
                                   const rb::PrimaryRayCamera& cam, uint32_t W, uint32_t H) {

@@ -41,6 +41,14 @@ BuiltScene buildScene(GpuFixture& fx, rb::AccelerationStructureService& service,
 void destroyScene(GpuFixture& fx, BuiltScene& built);
 void addToEmbree(EmbreeScene& embree, const TestScene& scene);
 
+struct PixelRay {
+  float origin[3];
+  float dir[3];
+};
+// The same ray the primary raygen shader builds (see PrimaryRayCamera), for pixel coordinates that may be
+// fractional (the pixel centre is x + 0.5).
+PixelRay rayThrough(const rb::CameraBasis& b, float px, float py, uint32_t w, uint32_t h);
+
 // Traces the scene's TLAS with the first-trace pass and compares every pixel away from silhouettes with
 // Embree tracing the same rays.
 struct TraceComparison {

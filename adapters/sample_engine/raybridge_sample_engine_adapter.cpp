@@ -37,6 +37,11 @@ void convertMaterials(const se::Scene& scene, std::span<const se::GpuTexture> gp
     r.metallicRoughnessTexture = slot(m.metallicRoughnessTexture, false);
     r.emissiveTexture = slot(m.emissiveTexture, true);
     std::memcpy(r.emissive, &m.emissiveFactor[0], sizeof(r.emissive));
+    // Cut-outs and blending, with the UVs the engine samples (its loader bakes texture transforms into them).
+    r.alphaMode = m.alphaMode == se::AlphaMode::Mask    ? rb::AlphaMode::Mask
+                  : m.alphaMode == se::AlphaMode::Blend ? rb::AlphaMode::Blend
+                                                        : rb::AlphaMode::Opaque;
+    r.alphaCutoff = m.alphaMode == se::AlphaMode::Mask ? std::max(m.alphaCutoff, 1e-6f) : 0.0f;  // 0 = default
     out.push_back(r);
   }
   if (out.empty()) out.emplace_back();
@@ -56,6 +61,11 @@ rb::MeshDesc describeMesh(VkDeviceAddress positions, uint32_t positionStride, ui
   d.normalStride = d.texcoordStride = attributeStride;
   if (topology.cpu) d.debugName = topology.cpu->name.c_str();
   return d;
+}
+
+// Meshes whose material cuts out or blends run the SDK's any-hit shaders; the others keep the opaque fast path.
+bool nonOpaque(const se::Scene& scene, const se::GpuMesh& mesh) {
+  return mesh.material < scene.materials.size() && scene.materials[mesh.material].alphaMode != se::AlphaMode::Opaque;
 }
 
 }  // namespace
@@ -131,6 +141,7 @@ se::Status Adapter::syncScene() {
                                  "EngineConfig::enableRayTracingInputs and rbAdapter::configureEngine()");
     rb::MeshDesc d = describeMesh(m.positionAddress, m.positionStride, m.vertexCount, m, m.attributeAddress,
                                   m.attributeStride);
+    d.nonOpaque = nonOpaque(scene, m);
     if (m.cpu) d.hostVertices = m.cpu->positions.data();  // content-hash dedup of identical static meshes
     if (m.cpu && !m.cpu->indices.empty()) d.hostIndices = m.cpu->indices.data();
     auto handle = a.as->registerMesh(d);
@@ -142,6 +153,7 @@ se::Status Adapter::syncScene() {
   for (const se::DeformedInstance& di : a.engine.deformedInstances()) {
     rb::MeshDesc d = describeMesh(di.positionAddress, 12, di.vertexCount, meshes[di.mesh], di.attributeAddress, 36);
     d.role = rb::MeshRole::Dynamic;
+    d.nonOpaque = nonOpaque(scene, meshes[di.mesh]);
     auto handle = a.as->registerMesh(d);
     if (!handle) return failure("registerMesh (deforming instance)", handle.error());
     a.deformed.push_back(byInstance[di.instance] = handle.value());

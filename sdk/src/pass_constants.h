@@ -108,8 +108,11 @@ struct PrimaryConstants {
   uint32_t width;
   float forward[3];
   uint32_t height;
+  uint32_t flags;  // RB_GB_ALPHA_TEST or 0
+  uint32_t frameIndex;
+  uint32_t pad0, pad1;
 };
-static_assert(sizeof(PrimaryConstants) == 64);
+static_assert(sizeof(PrimaryConstants) == 80);
 RB_ASSERT_OFFSET(PrimaryConstants, eye, 0);
 RB_ASSERT_OFFSET(PrimaryConstants, tMin, 12);
 RB_ASSERT_OFFSET(PrimaryConstants, right, 16);
@@ -118,6 +121,8 @@ RB_ASSERT_OFFSET(PrimaryConstants, up, 32);
 RB_ASSERT_OFFSET(PrimaryConstants, width, 44);
 RB_ASSERT_OFFSET(PrimaryConstants, forward, 48);
 RB_ASSERT_OFFSET(PrimaryConstants, height, 60);
+RB_ASSERT_OFFSET(PrimaryConstants, flags, 64);
+RB_ASSERT_OFFSET(PrimaryConstants, frameIndex, 68);
 
 struct DenoiseConstants {
   float inverseProjection[16];

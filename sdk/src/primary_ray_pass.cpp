@@ -5,7 +5,7 @@
 
 #include "context_impl.h"
 #include "pass_constants.h"
-#include "ray_tracing_pipeline.h"
+#include "pass_core.h"
 #include "raybridge_shaders.h"
 
 namespace rb {
@@ -68,9 +68,9 @@ Result<CameraBasis> computeCameraBasis(const PrimaryRayCamera& camera, uint32_t 
 
 struct PrimaryRayPass::Impl {
   Context& ctx;
-  RayTracingPipeline pipeline;
+  PassCore core;  // pipeline, metrics and material bindings; no G-buffer, no output images of its own
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() { pipeline.retire(ctx); }  // frames in flight may still trace with it
+  ~Impl() { core.retire(ctx); }  // frames in flight may still trace with it
 };
 
 PrimaryRayPass::PrimaryRayPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -87,20 +87,31 @@ Result<std::unique_ptr<PrimaryRayPass>> PrimaryRayPass::create(Context& context)
       {RB_PRIMARY_BINDING_TLAS, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, rg, nullptr},
       {RB_PRIMARY_BINDING_HIT_DISTANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr},
       {RB_PRIMARY_BINDING_HIT_IDS, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr},
+      {RB_BINDING_RAY_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr},
   };
   desc.pushConstantBytes = sizeof(PrimaryConstants);
   auto impl = std::make_unique<Impl>(context);
-  Result<RayTracingPipeline> p = RayTracingPipeline::create(context, desc);
-  if (!p) return p.error();
-  impl->pipeline = p.value();
+  if (Status s = impl->core.init(context, desc, SpirvModule::of(spirv::primary_rahit)); !s) return s.error();
   return std::unique_ptr<PrimaryRayPass>(new PrimaryRayPass(std::move(impl)));
 }
 
 Status PrimaryRayPass::record(VkCommandBuffer cmd, VkAccelerationStructureKHR tlas, const PrimaryRayCamera& camera,
                               const PrimaryRayTargets& targets) {
+  TlasInfo info;
+  info.tlas = tlas;
+  return record(cmd, info, camera, targets, {});
+}
+
+Status PrimaryRayPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, const PrimaryRayCamera& worldCamera,
+                              const PrimaryRayTargets& targets, const PrimaryRaySettings& settings) {
   auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, m}; };
   if (!cmd) return invalid("PrimaryRayPass::record: cmd is VK_NULL_HANDLE");
-  if (!tlas) return invalid("PrimaryRayPass::record: tlas is VK_NULL_HANDLE; build one with recordTlasBuild()");
+  if (!tlas.tlas) return invalid("PrimaryRayPass::record: tlas is VK_NULL_HANDLE; build one with recordTlasBuild()");
+  PrimaryRayCamera camera = worldCamera;  // in the TLAS's space
+  for (int i = 0; i < 3; ++i) {
+    camera.eye[i] = float(double(worldCamera.eye[i]) - tlas.originOffset[i]);
+    camera.target[i] = float(double(worldCamera.target[i]) - tlas.originOffset[i]);
+  }
   if (!targets.hitDistance || !targets.hitIds) {
     return invalid("PrimaryRayPass::record: targets.hitDistance and targets.hitIds are required");
   }
@@ -117,13 +128,23 @@ Status PrimaryRayPass::record(VkCommandBuffer cmd, VkAccelerationStructureKHR tl
   pc.height = targets.height;
   pc.tMin = camera.tMin;
   pc.tMax = camera.tMax > 0.0f ? camera.tMax : 1e30f;
+  pc.frameIndex = uint32_t(impl_->ctx.frameIndex());
+  Impl& s = *impl_;
   DescriptorWrites w;
-  w.accelerationStructure(RB_PRIMARY_BINDING_TLAS, tlas);
+  if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "PrimaryRayPass", pc.flags); !st) return st;
+  w.accelerationStructure(RB_PRIMARY_BINDING_TLAS, tlas.tlas);
   w.storageImage(RB_PRIMARY_BINDING_HIT_DISTANCE, targets.hitDistance);
   w.storageImage(RB_PRIMARY_BINDING_HIT_IDS, targets.hitIds);
-  impl_->pipeline.bind(impl_->ctx, cmd, w.writes, &pc, sizeof(pc));
-  impl_->pipeline.trace(impl_->ctx, cmd, targets.width, targets.height);
+  w.storageBuffer(RB_BINDING_RAY_COUNTERS, s.core.metrics.counterBuffer(), s.core.metrics.counterOffset(s.ctx),
+                  s.core.metrics.counterBytes());
+  s.core.metrics.beginRecording(s.ctx, cmd);
+  s.core.metrics.writeStart(s.ctx, cmd);
+  s.core.bind(s.ctx, cmd, w, &pc, sizeof(pc));
+  s.core.pipeline.trace(s.ctx, cmd, targets.width, targets.height);
+  s.core.metrics.writeEnd(s.ctx, cmd);
   return {};
 }
+
+PassStats PrimaryRayPass::stats() const { return impl_->core.metrics.latest(impl_->ctx); }
 
 }  // namespace rb

@@ -1,6 +1,6 @@
 // The engine's materials and textures as the SDK's rays see them: one table, shared by every pass. Reflection
-// hits shade with it; shadow, AO and reflection rays alpha-test non-opaque geometry (MeshDesc::nonOpaque) with
-// it in their any-hit shaders. Instances pick their entry with Instance::material, through the TLAS's shading
+// hits shade with it; primary, shadow, AO and reflection rays alpha-test non-opaque geometry (MeshDesc::nonOpaque)
+// with it in their any-hit shaders. Instances pick their entry with Instance::material, through the TLAS's shading
 // records (TlasBuildOptions::writeShadingRecords).
 //
 // Alpha testing, per ray type (the base colour factor's alpha times the base colour texture's alpha; the
@@ -8,7 +8,8 @@
 //   AlphaMode::Mask   every ray passes through where alpha < alphaCutoff.
 //   AlphaMode::Blend  shadow, AO and reflection rays pass through with probability 1 - alpha (a per-pixel,
 //                     per-frame random number): unbiased in the mean, noisy per frame (denoise or accumulate).
-//                     The engine draws blended surfaces in a forward pass, so the G-buffer never holds them.
+//                     The engine draws blended surfaces in a forward pass, so the G-buffer never holds them,
+//                     and primary rays (PrimaryRayPass), which stand for the G-buffer, pass through them.
 //   AlphaMode::Opaque every hit counts.
 // Only meshes registered with MeshDesc::nonOpaque = true run the any-hit shader; opaque meshes keep the opaque
 // fast path, whatever their material says. Register the meshes of Mask and Blend materials as non-opaque.

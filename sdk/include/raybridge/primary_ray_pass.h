@@ -1,6 +1,9 @@
 // The first trace: one primary ray per pixel through the TLAS, writing hit distance and ids. It proves the
 // acceleration-structure service end to end and is the reference for conformance tests; the effect passes
-// start from the engine's G-buffer instead of primary rays.
+// start from the engine's G-buffer instead of primary rays. Given a MaterialTable and a TLAS with non-opaque
+// instances, primary rays alpha-test like every other ray (material_table.h): they pass through Mask cut-outs,
+// and Blend surfaces are invisible to them, as they are to an engine's G-buffer (blended surfaces are drawn in a
+// forward pass after lighting). Otherwise they take the opaque fast path.
 //
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline and shader
 // binding table are handed to the Context's deferred release (see context.h) and freed once those frames are
@@ -9,7 +12,10 @@
 // Thread safety: externally synchronised, like the Context it was created from.
 #pragma once
 
+#include <raybridge/acceleration_structures.h>
 #include <raybridge/context.h>
+#include <raybridge/effects.h>
+#include <raybridge/material_table.h>
 
 #include <memory>
 
@@ -38,6 +44,12 @@ struct PrimaryRayTargets {
   uint32_t height = 0;  // required
 };
 
+struct PrimaryRaySettings {
+  // The engine's materials, for alpha-tested geometry (MeshDesc::nonOpaque); null = every hit counts. The TLAS
+  // then needs shading records (TlasBuildOptions::writeShadingRecords) when it has non-opaque instances.
+  const MaterialTable* materials = nullptr;
+};
+
 class PrimaryRayPass {
  public:
   static Result<std::unique_ptr<PrimaryRayPass>> create(Context& context);
@@ -49,6 +61,12 @@ class PrimaryRayPass {
   // VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR / VK_ACCESS_SHADER_WRITE_BIT.
   Status record(VkCommandBuffer cmd, VkAccelerationStructureKHR tlas, const PrimaryRayCamera& camera,
                 const PrimaryRayTargets& targets);
+  // The same through a TlasInfo, with alpha testing. The camera is in world space; the pass subtracts
+  // TlasInfo::originOffset from eye and target (in double) to trace a camera-relative TLAS.
+  Status record(VkCommandBuffer cmd, const TlasInfo& tlas, const PrimaryRayCamera& camera,
+                const PrimaryRayTargets& targets, const PrimaryRaySettings& settings = {});
+  // The latest measurement whose frame has finished (rays, any-hit invocations, GPU time).
+  PassStats stats() const;
 
   struct Impl;
 
