@@ -58,6 +58,18 @@ struct ReflectionConstants {
   uint raysPerPixel;         // 204
 };
 
+// ManyLightPass (its tile culling and its rays). 192 bytes.
+struct ManyLightConstants {
+  GBufferConstants gbuffer;  //   0
+  uint lightCount;           // 160
+  uint mode;                 // 164: RB_ML_*
+  uint raysPerPixel;         // 168: Stochastic
+  uint candidates;           // 172: Stochastic, per ray
+  uvec2 tiles;               // 176: tile grid size
+  uint pad0;                 // 184
+  uint pad1;                 // 188
+};
+
 // PrimaryRayPass. 80 bytes. The ray through pixel (x, y) counted from the top-left, through the pixel centre:
 //   dir = normalize(forward + ndcX * right - ndcY * up), ndc in [-1, 1].
 struct PrimaryConstants {

@@ -21,6 +21,18 @@
 #define RB_BINDING_SHADING_RECORDS 7
 #define RB_BINDING_MATERIALS 8
 #define RB_SET_TEXTURES 1  // binding 0: the engine's textures, bindless (MaterialTable)
+// ManyLightPass: its ray tracing pass (set 0 also has the common bindings, shading records and materials) and its
+// tile-culling compute pass.
+#define RB_ML_BINDING_LIGHTS 5      // GpuLight[], TLAS space
+#define RB_ML_BINDING_TILES 6       // per tile: count (RB_ML_TILE_OVERFLOW = all lights), packed 16-bit indices
+#define RB_ML_BINDING_IRRADIANCE 9  // rgba16f output
+#define RB_ML_CULL_BINDING_DEPTH 0
+#define RB_ML_CULL_BINDING_LIGHTS 1
+#define RB_ML_CULL_BINDING_TILES 2
+#define RB_ML_TILE_SIZE 16
+#define RB_ML_MAX_TILE_LIGHTS 256
+#define RB_ML_TILE_UINTS (1 + RB_ML_MAX_TILE_LIGHTS / 2)
+#define RB_ML_TILE_OVERFLOW 0xFFFFFFFFu
 // The primary-ray (first trace) pass; it also has RB_BINDING_RAY_COUNTERS, RB_BINDING_SHADING_RECORDS,
 // RB_BINDING_MATERIALS and the texture set.
 #define RB_PRIMARY_BINDING_TLAS 0
@@ -59,6 +71,10 @@
 #define RB_LIGHT_DIRECTIONAL 0u
 #define RB_LIGHT_POINT 1u
 #define RB_LIGHT_SPOT 2u
+
+// ManyLightConstants::mode: the values of rb::ManyLightMode.
+#define RB_ML_STOCHASTIC 0u
+#define RB_ML_EXACT 1u
 
 // AoConstants::estimator: the values of rb::AoEstimator.
 #define RB_AO_BINARY 0u

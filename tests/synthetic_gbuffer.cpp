@@ -233,6 +233,17 @@ std::vector<float> readR16f(GpuFixture& fx, VkImage image, uint32_t width, uint3
   return out;
 }
 
+std::vector<float> readRgba16f(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height) {
+  std::vector<uint8_t> raw = readPassImage(fx, image, width, height, 8);
+  std::vector<float> out(size_t(width) * height * 4);
+  for (size_t i = 0; i < out.size(); ++i) {
+    uint16_t h;
+    std::memcpy(&h, raw.data() + 2 * i, 2);
+    out[i] = halfToFloat(h);
+  }
+  return out;
+}
+
 std::vector<float> readR32f(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height) {
   std::vector<uint8_t> raw = readPassImage(fx, image, width, height, 4);
   std::vector<float> out(size_t(width) * height);

@@ -88,6 +88,8 @@ void runPassFrame(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu,
 std::vector<uint8_t> readPassImage(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height,
                                    uint32_t bytesPerPixel);
 std::vector<float> readR16f(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height);
+// RGBA16F: 4 floats per pixel.
+std::vector<float> readRgba16f(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height);
 std::vector<float> readR32f(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height);
 
 }  // namespace rbtest

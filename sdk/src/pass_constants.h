@@ -124,6 +124,22 @@ RB_ASSERT_OFFSET(PrimaryConstants, height, 60);
 RB_ASSERT_OFFSET(PrimaryConstants, flags, 64);
 RB_ASSERT_OFFSET(PrimaryConstants, frameIndex, 68);
 
+struct ManyLightConstants {
+  GBufferConstants gbuffer;
+  uint32_t lightCount;
+  uint32_t mode;  // RB_ML_*
+  uint32_t raysPerPixel;
+  uint32_t candidates;
+  uint32_t tiles[2];
+  uint32_t pad0, pad1;
+};
+static_assert(sizeof(ManyLightConstants) == 192);
+RB_ASSERT_OFFSET(ManyLightConstants, lightCount, 160);
+RB_ASSERT_OFFSET(ManyLightConstants, mode, 164);
+RB_ASSERT_OFFSET(ManyLightConstants, raysPerPixel, 168);
+RB_ASSERT_OFFSET(ManyLightConstants, candidates, 172);
+RB_ASSERT_OFFSET(ManyLightConstants, tiles, 176);
+
 struct DenoiseConstants {
   float inverseProjection[16];
   float viewToWorld[3][4];  // as GBufferConstants::viewToWorld

@@ -10,6 +10,7 @@
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/hybrid_effects.h>
+#include <raybridge/many_light_pass.h>
 #include <raybridge/material_table.h>
 #include <raybridge/presets.h>
 #include <raybridge/primary_ray_pass.h>

@@ -1,0 +1,107 @@
+// Shadowed lighting from many lights at a fixed ray budget: the engine hands over its whole light list each
+// frame (up to kMaxLights point, spot and directional lights), and the pass writes the shadowed diffuse
+// irradiance at every G-buffer surface point, RGB, HDR:
+//
+//   E = sum over lights of  colour * intensity * max(dot(n, l), 0) * falloff * visibility
+//   falloff: directional 1 (intensity in lux); point and spot 1 / d^2 (intensity in candela), times glTF's
+//            range window clamp(1 - (d / range)^4, 0, 1) when range > 0, times for spots glTF's cone falloff
+//            clamp((cos(angle) - cos(outer)) / (cos(inner) - cos(outer)), 0, 1)^2.
+//
+// No BRDF and no albedo: the engine multiplies by its diffuse colour (Lambert: albedo / pi * E).
+//
+// How (ManyLightSettings::mode):
+//   Stochastic  a fixed number of shadow rays per pixel whatever the light count. Per ray, the pixel draws
+//               candidates from the lights that can reach its screen tile and keeps one in proportion to its
+//               unshadowed contribution there (resampled importance sampling), then traces one shadow ray to it.
+//               Unbiased in the mean; noisy per frame (give the output to a Denoiser made with
+//               DenoiserDesc::signal = DenoiseSignal::Rgb). Where the tile holds no more lights than rays,
+//               every light gets its own ray instead (exact, no noise).
+//   Exact       one shadow ray per light that reaches the pixel: the reference, for few lights and tests.
+// A culling pass first lists, per 16x16-pixel tile, the lights whose range and cone can reach the tile's surface
+// points: lights that cannot reach a pixel cost nothing there (no candidate, no ray), sky pixels trace nothing.
+// A tile reached by more than kMaxTileLights lights draws its candidates from the whole list instead (still
+// unbiased, noisier).
+//
+// The lights are copied into a per-frame ring (one slot per frame in flight) and from there into a device
+// buffer by commands record() adds, so the caller's array may change right after the call.
+//
+// Lifetime: destroying it is safe while frames that recorded it are in flight: its pipelines, buffers, output
+// image and measurement objects are handed to the Context's deferred release (see context.h). Destroy it
+// before its Context.
+//
+// Thread safety: externally synchronised, like the Context it was created from.
+#pragma once
+
+#include <raybridge/acceleration_structures.h>
+#include <raybridge/effects.h>
+#include <raybridge/gbuffer.h>
+#include <raybridge/material_table.h>
+
+#include <memory>
+#include <span>
+
+namespace rb {
+
+inline constexpr uint32_t kMaxLights = 65536;
+inline constexpr uint32_t kMaxTileLights = 256;     // lights one tile lists; more = candidates from all
+inline constexpr uint32_t kManyLightTileSize = 16;  // pixels per tile side
+inline constexpr uint32_t kDefaultLightRays = 1;    // shadow rays per pixel in Stochastic mode
+inline constexpr uint32_t kDefaultLightCandidates = 8;
+
+// One light of the engine's list: the geometry and softness of rb::Light, with colour and intensity in
+// KHR_lights_punctual's units. Defaults are glTF's (colour white, intensity 1, inner cone angle 0).
+struct LightSource {
+  // type, direction (directional: towards the light; spot: the direction it shines), position, range (0 =
+  // unlimited: no range window), spotOuterAngleDegrees (0 = 45), and the softness: radius (point, spot) or
+  // angularRadiusDegrees (directional), 0 = hard shadows.
+  Light light;
+  float color[3] = {1.0f, 1.0f, 1.0f};  // linear RGB, >= 0
+  float intensity = 1.0f;               // candela (point, spot) or lux (directional), finite and >= 0
+  float spotInnerAngleDegrees = 0.0f;   // spot: full intensity inside it; in [0, outer]
+};
+
+enum class ManyLightMode : uint32_t {
+  Stochastic = 0,  // default: ManyLightSettings::raysPerPixel rays whatever the light count
+  Exact,           // one ray per light that reaches the pixel
+};
+
+struct ManyLightSettings {
+  ManyLightMode mode = ManyLightMode::Stochastic;
+  uint32_t raysPerPixel = 0;  // Stochastic: 0 = kDefaultLightRays; at most 64
+  uint32_t candidates = 0;    // Stochastic: lights weighed per ray; 0 = kDefaultLightCandidates; at most 64
+  // Alpha-tested geometry (see ShadowSettings::materials); nullptr = every surface casts a solid shadow.
+  const MaterialTable* materials = nullptr;
+};
+
+// Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record(), readable by
+// fragment, compute and ray tracing shaders.
+struct ManyLightOutputs {
+  VkImage irradiance = VK_NULL_HANDLE;  // R16G16B16A16_SFLOAT: rgb = E, a = 1; sky pixels 0
+  VkImageView irradianceView = VK_NULL_HANDLE;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  uint32_t width = 0, height = 0;
+};
+
+class ManyLightPass {
+ public:
+  static Result<std::unique_ptr<ManyLightPass>> create(Context& context);
+  // Retires its Vulkan objects to the context, without waiting.
+  ~ManyLightPass();
+
+  // Records the light upload, the tile culling and the shadow rays. `lights` may be empty (the output is then
+  // black and no ray is traced). Every light is checked first; on error nothing is recorded and the message
+  // names the light's index and field.
+  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas,
+                std::span<const LightSource> lights, const ManyLightSettings& settings = {});
+  const ManyLightOutputs& outputs() const;
+  // GPU time (upload, culling and tracing) and rays of the latest recording whose frame has finished.
+  PassStats stats() const;
+
+  struct Impl;
+
+ private:
+  explicit ManyLightPass(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rb

@@ -1,0 +1,268 @@
+#include <raybridge/many_light_pass.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "compute_pipeline.h"
+#include "context_impl.h"
+#include "pass_core.h"
+#include "raybridge_shaders.h"
+
+namespace rb {
+
+namespace {
+
+constexpr float kDegrees = 3.14159265358979f / 180.0f;
+static_assert(RB_ML_STOCHASTIC == uint32_t(ManyLightMode::Stochastic));
+static_assert(RB_ML_EXACT == uint32_t(ManyLightMode::Exact));
+static_assert(RB_ML_MAX_TILE_LIGHTS == kMaxTileLights && RB_ML_TILE_SIZE == kManyLightTileSize);
+static_assert(kMaxLights <= 65536, "tile lists hold 16-bit light indices");
+constexpr uint32_t kMaxRaysOrCandidates = 64;
+
+// Mirrors GpuLight in shaders/many_lights_common.glsl (std430).
+struct GpuLight {
+  float position[3];
+  float range;
+  float direction[3];
+  uint32_t type;
+  float intensity[3];
+  float softness;
+  float cosOuter;
+  float coneScale;
+  float coneOffset;
+  float pad0;
+};
+static_assert(sizeof(GpuLight) == 64);
+
+bool finite3(const float v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+
+// Checks one light and converts it to the GPU's form in the TLAS's space; the error names the light and field.
+Status convertLight(const LightSource& s, uint32_t index, const double originOffset[3], GpuLight& out) {
+  auto invalid = [&](const std::string& m) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: lights[" + std::to_string(index) + "]: " + m};
+  };
+  const Light& l = s.light;
+  if (!(std::isfinite(s.intensity) && s.intensity >= 0.0f))
+    return invalid("intensity " + std::to_string(s.intensity) + " must be finite and >= 0");
+  if (!finite3(s.color) || s.color[0] < 0.0f || s.color[1] < 0.0f || s.color[2] < 0.0f)
+    return invalid("color must be finite and >= 0");
+  out = {};
+  for (int i = 0; i < 3; ++i) out.intensity[i] = s.color[i] * s.intensity;
+  float dir[3] = {l.direction[0], l.direction[1], l.direction[2]};
+  if (!finite3(dir)) return invalid("direction must be finite");
+  if (dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) dir[1] = l.type == LightType::Spot ? -1.0f : 1.0f;
+  const float len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+  for (int i = 0; i < 3; ++i) out.direction[i] = dir[i] / len;
+  out.type = uint32_t(l.type);
+  switch (l.type) {
+    case LightType::Directional:
+      if (!(l.angularRadiusDegrees >= 0.0f && l.angularRadiusDegrees < 45.0f))
+        return invalid("angularRadiusDegrees " + std::to_string(l.angularRadiusDegrees) + " is outside [0, 45)");
+      out.softness = std::tan(l.angularRadiusDegrees * kDegrees);
+      return {};
+    case LightType::Point:
+    case LightType::Spot: {
+      for (int i = 0; i < 3; ++i) {
+        if (!std::isfinite(l.position[i])) return invalid("position must be finite");
+        out.position[i] = float(l.position[i] - originOffset[i]);
+      }
+      if (!(l.radius >= 0.0f && std::isfinite(l.radius))) return invalid("radius must be finite and >= 0");
+      if (!(l.range >= 0.0f && std::isfinite(l.range))) return invalid("range must be finite and >= 0 (0 = unlimited)");
+      out.range = l.range;
+      out.softness = l.radius;
+      if (l.type == LightType::Point) return {};
+      const float outer = l.spotOuterAngleDegrees == 0.0f ? 45.0f : l.spotOuterAngleDegrees;
+      if (!(outer > 0.0f && outer <= 90.0f))
+        return invalid("spotOuterAngleDegrees " + std::to_string(outer) + " is outside (0, 90]");
+      if (!(s.spotInnerAngleDegrees >= 0.0f && s.spotInnerAngleDegrees <= outer))
+        return invalid("spotInnerAngleDegrees " + std::to_string(s.spotInnerAngleDegrees) +
+                       " must be in [0, the outer angle " + std::to_string(outer) + "]");
+      const float cosOuter = std::cos(outer * kDegrees), cosInner = std::cos(s.spotInnerAngleDegrees * kDegrees);
+      out.cosOuter = cosOuter;
+      out.coneScale = 1.0f / std::max(1e-3f, cosInner - cosOuter);  // KHR_lights_punctual's formula
+      out.coneOffset = -cosOuter * out.coneScale;
+      return {};
+    }
+  }
+  return invalid("light.type has an unknown value");
+}
+
+VkBufferMemoryBarrier bufferBarrier(VkBuffer buffer, VkAccessFlags src, VkAccessFlags dst) {
+  VkBufferMemoryBarrier b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+  b.srcAccessMask = src;
+  b.dstAccessMask = dst;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.buffer = buffer;
+  b.size = VK_WHOLE_SIZE;
+  return b;
+}
+
+}  // namespace
+
+struct ManyLightPass::Impl {
+  Context& ctx;
+  PassCore core;
+  ComputePipeline cull;
+  // The light ring (host-visible, one slot of `capacity` lights per frame in flight), its device copy and the
+  // tile lists; grown on demand, retired when replaced.
+  GpuBuffer ring, lights, tiles;
+  uint32_t capacity = 0;
+  std::vector<GpuLight> staging;
+  ManyLightOutputs outputs;
+  explicit Impl(Context& c) : ctx(c) {}
+  ~Impl() {  // frames in flight may still use them
+    core.retire(ctx);
+    cull.retire(ctx);
+    retireBuffer(ctx, ring);
+    retireBuffer(ctx, lights);
+    retireBuffer(ctx, tiles);
+  }
+  Status ensureBuffers(uint32_t lightCount, VkDeviceSize tileBytes);
+};
+
+Status ManyLightPass::Impl::ensureBuffers(uint32_t lightCount, VkDeviceSize tileBytes) {
+  if (lightCount > capacity) {
+    uint32_t grown = std::max(64u, capacity);
+    while (grown < lightCount) grown *= 2;
+    grown = std::min(grown, kMaxLights);
+    retireBuffer(ctx, ring);
+    retireBuffer(ctx, lights);
+    capacity = 0;
+    const VkDeviceSize slot = VkDeviceSize(grown) * sizeof(GpuLight);
+    Result<GpuBuffer> r = createBuffer(ctx, slot * ctx.framesInFlight(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                       MemoryLocation::HostVisible, MemoryCategory::PassBuffers, "many-light ring");
+    if (!r) return r.error();
+    ring = r.value();
+    Result<GpuBuffer> d = createBuffer(ctx, slot, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                       MemoryLocation::DeviceLocal, MemoryCategory::PassBuffers, "many-light list");
+    if (!d) return d.error();
+    lights = d.value();
+    capacity = grown;
+  }
+  if (tiles.size != tileBytes) {
+    retireBuffer(ctx, tiles);
+    Result<GpuBuffer> t = createBuffer(ctx, tileBytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryLocation::DeviceLocal,
+                                       MemoryCategory::PassBuffers, "many-light tiles");
+    if (!t) return t.error();
+    tiles = t.value();
+  }
+  return {};
+}
+
+ManyLightPass::ManyLightPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ManyLightPass::~ManyLightPass() = default;
+
+Result<std::unique_ptr<ManyLightPass>> ManyLightPass::create(Context& context) {
+  auto impl = std::make_unique<Impl>(context);
+  RayTracingPipelineDesc p;
+  p.name = "many-light pass";
+  p.raygen = SpirvModule::of(spirv::many_lights_rgen);
+  p.misses = {SpirvModule::of(spirv::occlusion_rmiss)};
+  // Rays skip the closest-hit shader by flag; a hit group without shaders crashes validation layer 1.3.239.
+  p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::occlusion_rchit), {}}};
+  const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
+  p.bindings = PassCore::commonBindings();
+  p.bindings.push_back({RB_ML_BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr});
+  p.bindings.push_back({RB_ML_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr});
+  p.bindings.push_back({RB_ML_BINDING_IRRADIANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
+  p.pushConstantBytes = sizeof(ManyLightConstants);
+  if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::many_lights_rahit)); !s) return s.error();
+  const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+  Result<ComputePipeline> cull =
+      ComputePipeline::create(context, SpirvModule::of(spirv::many_lights_cull_comp),
+                              {{RB_ML_CULL_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs, nullptr},
+                               {RB_ML_CULL_BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, cs, nullptr},
+                               {RB_ML_CULL_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, cs, nullptr}},
+                              sizeof(ManyLightConstants), "many-light tile culling");
+  if (!cull) return cull.error();
+  impl->cull = cull.value();
+  return std::unique_ptr<ManyLightPass>(new ManyLightPass(std::move(impl)));
+}
+
+Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,
+                             std::span<const LightSource> lightList, const ManyLightSettings& settings) {
+  Impl& s = *impl_;
+  auto invalid = [](const std::string& m) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: " + m};
+  };
+  if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
+  if (lightList.size() > kMaxLights)
+    return invalid(std::to_string(lightList.size()) + " lights exceed kMaxLights (" + std::to_string(kMaxLights) +
+                   "); pass the strongest or nearest ones");
+  if (settings.mode != ManyLightMode::Stochastic && settings.mode != ManyLightMode::Exact)
+    return invalid("ManyLightSettings::mode has an unknown value");
+  if (settings.raysPerPixel > kMaxRaysOrCandidates || settings.candidates > kMaxRaysOrCandidates)
+    return invalid("ManyLightSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " and candidates " +
+                   std::to_string(settings.candidates) + " must be at most 64");
+  ManyLightConstants pc{};
+  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ManyLightPass", pc.gbuffer); !st) return st;
+  const uint32_t count = uint32_t(lightList.size());
+  s.staging.resize(count);
+  for (uint32_t i = 0; i < count; ++i)
+    if (Status st = convertLight(lightList[i], i, tlas.originOffset, s.staging[i]); !st) return st;
+  pc.lightCount = count;
+  pc.mode = uint32_t(settings.mode);
+  pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultLightRays;
+  pc.candidates = settings.candidates ? settings.candidates : kDefaultLightCandidates;
+  pc.tiles[0] = (g.width + kManyLightTileSize - 1) / kManyLightTileSize;
+  pc.tiles[1] = (g.height + kManyLightTileSize - 1) / kManyLightTileSize;
+  const VkDeviceSize tileBytes = VkDeviceSize(pc.tiles[0]) * pc.tiles[1] * RB_ML_TILE_UINTS * sizeof(uint32_t);
+  if (Status st = s.ensureBuffers(std::max(count, 1u), tileBytes); !st) return st;
+
+  DescriptorWrites w;
+  if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ManyLightPass", pc.gbuffer.flags); !st) return st;
+  if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16G16B16A16_SFLOAT, "many-light irradiance"}}); !st)
+    return st;
+  const DeviceFunctions& vk = internal::deviceFunctions(s.ctx);
+  // Upload: this frame's ring slot, copied to the device list once last frame's readers are done with it.
+  const uint32_t slot = uint32_t(s.ctx.frameIndex() % s.ctx.framesInFlight());
+  const VkDeviceSize slotBytes = VkDeviceSize(s.capacity) * sizeof(GpuLight);
+  const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
+                                       VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
+  if (count > 0) {
+    std::memcpy(static_cast<uint8_t*>(s.ring.mapped) + slot * slotBytes, s.staging.data(), count * sizeof(GpuLight));
+    VkBufferMemoryBarrier before = bufferBarrier(s.lights.buffer, VK_ACCESS_SHADER_READ_BIT,
+                                                 VK_ACCESS_TRANSFER_WRITE_BIT);
+    vk.vkCmdPipelineBarrier(cmd, readers, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 1, &before, 0, nullptr);
+    VkBufferCopy region{slot * slotBytes, 0, count * sizeof(GpuLight)};
+    vk.vkCmdCopyBuffer(cmd, s.ring.buffer, s.lights.buffer, 1, &region);
+    VkBufferMemoryBarrier after = bufferBarrier(s.lights.buffer, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                                VK_ACCESS_SHADER_READ_BIT);
+    vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, readers, 0, 0, nullptr, 1, &after, 0, nullptr);
+  }
+  // Tile culling: last frame's rays read the lists this overwrites.
+  VkBufferMemoryBarrier tilesFree = bufferBarrier(s.tiles.buffer, VK_ACCESS_SHADER_READ_BIT,
+                                                  VK_ACCESS_SHADER_WRITE_BIT);
+  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
+                          nullptr, 1, &tilesFree, 0, nullptr);
+  DescriptorWrites cw;
+  cw.sampledImage(RB_ML_CULL_BINDING_DEPTH, g.depth.view, s.core.sampler, readLayout(g.depth));
+  cw.storageBuffer(RB_ML_CULL_BINDING_LIGHTS, s.lights.buffer);
+  cw.storageBuffer(RB_ML_CULL_BINDING_TILES, s.tiles.buffer);
+  s.cull.dispatch(s.ctx, cmd, cw.writes, &pc, sizeof(pc), pc.tiles[0] * 8, pc.tiles[1] * 8);  // a group per tile
+  VkBufferMemoryBarrier tilesReady = bufferBarrier(s.tiles.buffer, VK_ACCESS_SHADER_WRITE_BIT,
+                                                   VK_ACCESS_SHADER_READ_BIT);
+  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, 0, 0,
+                          nullptr, 1, &tilesReady, 0, nullptr);
+
+  const PassImages& images = s.core.images;
+  s.core.writeCommon(s.ctx, w, g, tlas);
+  w.storageBuffer(RB_ML_BINDING_LIGHTS, s.lights.buffer);
+  w.storageBuffer(RB_ML_BINDING_TILES, s.tiles.buffer);
+  w.storageImage(RB_ML_BINDING_IRRADIANCE, images[0].view);
+  s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+
+  ManyLightOutputs& o = s.outputs;
+  o.irradiance = images[0].image;
+  o.irradianceView = images[0].view;
+  o.width = g.width;
+  o.height = g.height;
+  return {};
+}
+
+const ManyLightOutputs& ManyLightPass::outputs() const { return impl_->outputs; }
+PassStats ManyLightPass::stats() const { return impl_->core.metrics.latest(impl_->ctx); }
+
+}  // namespace rb

@@ -1,0 +1,98 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// ManyLightPass, step 1: per 16x16-pixel tile (one workgroup), the bounding box of the tile's surface points and
+// the lights whose range and cone can reach it, in light order (a prefix sum per chunk of 64 lights, so the list
+// is the same on every run). More than RB_ML_MAX_TILE_LIGHTS: the tile is marked to sample all lights. Sky-only
+// tiles list none.
+#include "many_lights_common.glsl"
+#include "pass_inputs.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = RB_ML_CULL_BINDING_DEPTH) uniform sampler2D gDepth;
+layout(set = 0, binding = RB_ML_CULL_BINDING_LIGHTS, std430) readonly buffer Lights { GpuLight lights[]; };
+layout(set = 0, binding = RB_ML_CULL_BINDING_TILES, std430) writeonly buffer Tiles { uint tiles[]; };
+
+shared vec3 boxMin[64];
+shared vec3 boxMax[64];
+shared uint scan[64];
+shared uint packedList[RB_ML_MAX_TILE_LIGHTS / 2];
+
+// Whether a light can reach some point of the box [lo, hi].
+bool reaches(GpuLight light, vec3 lo, vec3 hi) {
+  if (light.type == RB_LIGHT_DIRECTIONAL) return true;
+  vec3 nearest = clamp(light.position, lo, hi);
+  vec3 d = nearest - light.position;
+  if (light.range > 0.0 && dot(d, d) > light.range * light.range) return false;
+  if (light.type == RB_LIGHT_SPOT) {
+    // The cone against the box's bounding sphere: outside when the angle to its centre exceeds the cone's
+    // half-angle by more than the sphere's angular radius.
+    vec3 c = 0.5 * (lo + hi) - light.position;
+    float r = 0.5 * length(hi - lo), dist = length(c);
+    if (dist > r) {
+      float angle = acos(clamp(dot(c / dist, light.direction), -1.0, 1.0));
+      if (angle - asin(min(r / dist, 1.0)) > acos(clamp(light.cosOuter, -1.0, 1.0))) return false;
+    }
+  }
+  return true;
+}
+
+void main() {
+  uint tid = gl_LocalInvocationIndex;
+  uvec2 tile = gl_WorkGroupID.xy;
+  if (any(greaterThanEqual(tile, pc.tiles))) return;  // whole workgroups only: barriers stay uniform
+  vec3 lo = vec3(1e30), hi = vec3(-1e30);
+  uvec2 base = tile * RB_ML_TILE_SIZE + gl_LocalInvocationID.xy * 2u;
+  for (uint k = 0u; k < 4u; ++k) {
+    uvec2 pixel = base + uvec2(k & 1u, k >> 1);
+    if (any(greaterThanEqual(pixel, pc.gbuffer.size))) continue;
+    float depth = texelFetch(gDepth, ivec2(pixel), 0).r;
+    if (rbIsSky(depth)) continue;
+    vec3 p = rbSurfacePoint(pixel, depth);
+    lo = min(lo, p);
+    hi = max(hi, p);
+  }
+  boxMin[tid] = lo;
+  boxMax[tid] = hi;
+  for (uint i = tid; i < RB_ML_MAX_TILE_LIGHTS / 2; i += 64u) packedList[i] = 0u;
+  barrier();
+  for (uint s = 32u; s > 0u; s >>= 1) {
+    if (tid < s) {
+      boxMin[tid] = min(boxMin[tid], boxMin[tid + s]);
+      boxMax[tid] = max(boxMax[tid], boxMax[tid + s]);
+    }
+    barrier();
+  }
+  lo = boxMin[0];
+  hi = boxMax[0];
+  // A margin for the reconstruction error of the points (they are offset before tracing).
+  vec3 margin = vec3(1e-3) * max(1.0, max(length(lo), length(hi)) * 1e-3);
+  lo -= margin;
+  hi += margin;
+  bool empty = lo.x > hi.x;
+  uint total = 0u;
+  bool overflow = false;
+  for (uint chunk = 0u; chunk < pc.lightCount && !empty; chunk += 64u) {
+    uint index = chunk + tid;
+    uint flag = index < pc.lightCount && reaches(lights[index], lo, hi) ? 1u : 0u;
+    scan[tid] = flag;
+    barrier();
+    for (uint s = 1u; s < 64u; s <<= 1) {  // inclusive Hillis-Steele prefix sum
+      uint add = tid >= s ? scan[tid - s] : 0u;
+      barrier();
+      scan[tid] += add;
+      barrier();
+    }
+    uint slot = total + scan[tid] - flag;
+    if (flag != 0u && slot < RB_ML_MAX_TILE_LIGHTS)
+      atomicOr(packedList[slot >> 1], (index & 0xFFFFu) << ((slot & 1u) * 16u));
+    total += scan[63];
+    barrier();
+    if (total > RB_ML_MAX_TILE_LIGHTS) {
+      overflow = true;
+      break;
+    }
+  }
+  uint tileBase = (tile.y * pc.tiles.x + tile.x) * RB_ML_TILE_UINTS;
+  if (tid == 0u) tiles[tileBase] = overflow ? RB_ML_TILE_OVERFLOW : (empty ? 0u : total);
+  for (uint i = tid; i < RB_ML_MAX_TILE_LIGHTS / 2; i += 64u) tiles[tileBase + 1u + i] = packedList[i];
+}
