@@ -25,7 +25,7 @@ TEST_CASE("preset names round-trip and the table matches the thesis", "[presets]
   CHECK_FALSE(rb::parsePreset("High").has_value());
   CHECK_FALSE(rb::parsePreset("").has_value());
   const rb::PresetDesc ultra = rb::presetDesc(rb::Preset::Ultra);
-  CHECK(ultra.effects == rb::kAllEffects);
+  CHECK(ultra.effects == rb::kThesisEffects);
   CHECK((ultra.shadowRaysPerPixel == 8 && ultra.aoRaysPerPixel == 16));
   CHECK((ultra.raster.mapSize == 8192 && ultra.raster.pcfKernel == 8));
   const rb::PresetDesc medium = rb::presetDesc(rb::Preset::Medium);

@@ -347,3 +347,49 @@ TEST_CASE("many-light bad lights fail naming the light and field; nothing is rec
   CHECK(wrong == 0);
   CHECK(none.stats.rays == 0);
 }
+
+TEST_CASE("the effects front end's local lights are the many-light pass's, and cost nothing when disabled",
+          "[many_lights][hybrid_effects]") {
+  GpuFixture fx;
+  TestScene scene = makeRoom();
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  CpuGBuffer cpu = traceGBuffer(embree, roomView(64, 48));
+  std::vector<rb::LightSource> lights = roomLights();
+  rb::ManyLightSettings exact;
+  exact.mode = rb::ManyLightMode::Exact;
+  ManyLightRun direct = runManyLights(fx, scene, cpu, lights, exact);
+
+  rb::HybridEffectsDesc desc;
+  desc.effects = rb::kEffectLocalLights;
+  desc.localLights.mode = rb::ManyLightMode::Exact;
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  BuiltScene built = buildScene(fx, *service.value(), scene);
+  {
+    auto fxDisabled = rb::HybridEffects::create(fx.ctx(), service.value().get(), {});
+    RB_REQUIRE_OK(fxDisabled);
+    CHECK(fxDisabled.value()->localLightPass() == nullptr);
+    auto effects = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
+    RB_REQUIRE_OK(effects);
+    REQUIRE(effects.value()->localLightPass() != nullptr);
+    GpuGBuffer gbuffer(fx, cpu);
+    fx.runFrame([&](VkCommandBuffer cmd) {
+      rb::HybridFrame frame;
+      frame.gbuffer = gbuffer.desc();
+      frame.instances = built.instances;
+      frame.localLights = lights;
+      RB_REQUIRE_OK(effects.value()->record(cmd, frame));
+    });
+    const rb::HybridOutputs& out = effects.value()->outputs();
+    REQUIRE(out.localLights.image != VK_NULL_HANDLE);
+    CHECK(out.localLights.format == VK_FORMAT_R16G16B16A16_SFLOAT);
+    CHECK(out.shadow.image == VK_NULL_HANDLE);  // only what is enabled
+    std::vector<float> viaFrontEnd = readRgba16f(fx, out.localLights.image, cpu.view.width, cpu.view.height);
+    CHECK(viaFrontEnd == direct.rgba);
+    for (uint32_t i = 0; i < fx.ctx().framesInFlight(); ++i) fx.ctx().beginFrame();
+    (void)fx.device().waitIdle();
+    CHECK(effects.value()->stats().localLights.rays == direct.stats.rays);
+  }
+  destroyScene(fx, built);
+}

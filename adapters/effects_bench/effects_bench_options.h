@@ -11,7 +11,7 @@ namespace rbEffects {
 
 struct Options {
   std::string scenario = "speed-vs-error";
-  rb::EffectSet effects = rb::kAllEffects;
+  rb::EffectSet effects = rb::kThesisEffects;
   // Empty: 1920x1080 on a GPU, 320x180 on a CPU device (lavapipe); --quick: 160x90.
   std::optional<uint32_t> width, height;
   std::string out;     // JSON file; empty = none

@@ -33,6 +33,11 @@ Status validate(const HybridEffectsDesc& d) {
   if (!(d.reflections.roughnessThreshold >= 0.0f && d.reflections.roughnessThreshold <= 1.0f))
     return invalid("reflections.roughnessThreshold " + std::to_string(d.reflections.roughnessThreshold) +
                    " is outside [0, 1]");
+  if (d.localLights.mode != ManyLightMode::Stochastic && d.localLights.mode != ManyLightMode::Exact)
+    return invalid("localLights.mode has an unknown value");
+  if (d.localLights.raysPerPixel > 64 || d.localLights.candidates > 64)
+    return invalid("localLights.raysPerPixel " + std::to_string(d.localLights.raysPerPixel) + " and candidates " +
+                   std::to_string(d.localLights.candidates) + " must be at most 64");
   if (d.reflections.raysPerPixel > 64)
     return invalid("reflections.raysPerPixel " + std::to_string(d.reflections.raysPerPixel) + " exceeds 64");
   return {};
@@ -108,6 +113,7 @@ struct HybridEffects::Impl {
   std::unique_ptr<AoPass> ao;
   std::unique_ptr<Denoiser> aoDenoiser;
   std::unique_ptr<ReflectionPass> reflection;
+  std::unique_ptr<ManyLightPass> localLights;
   // The engine's materials, shared by every pass: reflection hits shade with them, and shadow, AO and
   // reflection rays alpha-test non-opaque geometry with them. The table (GPU memory) exists only while a pass
   // does; the engine's last setMaterials is kept here to fill it when one is created.
@@ -117,7 +123,7 @@ struct HybridEffects::Impl {
   bool haveMaterialData = false;
 
   Status syncMaterialTable() {
-    if (!shadow && !ao && !reflection) {
+    if (!shadow && !ao && !reflection && !localLights) {
       materials.reset();  // retired to the Context like the passes
       return {};
     }
@@ -147,6 +153,10 @@ struct HybridEffects::Impl {
                           [&] { return ReflectionPass::create(ctx); });
         !s)
       return s;
+    if (Status s = ensure(localLights, e & kEffectLocalLights, "ManyLightPass::create",
+                          [&] { return ManyLightPass::create(ctx); });
+        !s)
+      return s;
     if (!shadow || desc.shadows.disableDenoiser) shadowDenoiser.reset();
     if (!ao || desc.ao.disableDenoiser) aoDenoiser.reset();
     return syncMaterialTable();
@@ -169,7 +179,22 @@ struct HybridEffects::Impl {
   Status recordShadows(VkCommandBuffer cmd, const HybridFrame& f);
   Status recordAo(VkCommandBuffer cmd, const HybridFrame& f);
   Status recordReflections(VkCommandBuffer cmd, const HybridFrame& f);
+  Status recordLocalLights(VkCommandBuffer cmd, const HybridFrame& f);
 };
+
+Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridFrame& f) {
+  ManyLightSettings s;
+  s.mode = desc.localLights.mode;
+  s.raysPerPixel = desc.localLights.raysPerPixel;
+  s.candidates = desc.localLights.candidates;
+  s.materials = materials.get();
+  if (Status st = localLights->record(cmd, f.gbuffer, tlas, f.localLights, s); !st)
+    return wrap("ManyLightPass::record", st.error());
+  const ManyLightOutputs& o = localLights->outputs();
+  outputs.localLights = outputs.localLightsRaw = image(o.irradiance, o.irradianceView, VK_FORMAT_R16G16B16A16_SFLOAT,
+                                                       o.layout, o.width, o.height);
+  return {};
+}
 
 Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame& f) {
   const ShadowPlan plan = planShadows(desc.shadows, f.light);
@@ -284,6 +309,7 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
   Status st;
   if (a.shadow) st = a.recordShadows(cmd, frame);
   if (st && a.ao) st = a.recordAo(cmd, frame);
+  if (st && a.localLights) st = a.recordLocalLights(cmd, frame);
   if (st && a.reflection) st = a.recordReflections(cmd, frame);
   if (!st) a.outputs = {};
   return st;
@@ -299,7 +325,8 @@ void HybridEffects::resetHistory() {
 
 HybridStats HybridEffects::stats() const {
   const Impl& a = *impl_;
-  return {statsOf(a.shadow), statsOf(a.shadowDenoiser), statsOf(a.ao), statsOf(a.aoDenoiser), statsOf(a.reflection)};
+  return {statsOf(a.shadow),     statsOf(a.shadowDenoiser), statsOf(a.ao),
+          statsOf(a.aoDenoiser), statsOf(a.reflection),     statsOf(a.localLights)};
 }
 
 MemoryStats HybridEffects::memoryStats() const {
@@ -314,6 +341,7 @@ MemoryStats HybridEffects::memoryStats() const {
 const ShadowPass* HybridEffects::shadowPass() const { return impl_->shadow.get(); }
 const AoPass* HybridEffects::aoPass() const { return impl_->ao.get(); }
 const ReflectionPass* HybridEffects::reflectionPass() const { return impl_->reflection.get(); }
+const ManyLightPass* HybridEffects::localLightPass() const { return impl_->localLights.get(); }
 const Denoiser* HybridEffects::shadowDenoiser() const { return impl_->shadowDenoiser.get(); }
 const Denoiser* HybridEffects::aoDenoiser() const { return impl_->aoDenoiser.get(); }
 

@@ -24,8 +24,8 @@ constexpr std::array<PresetRow, kPresetCount> kPresetTable = {{
     {Preset::SoftShadows8, "soft-shadows8", {kEffectShadows, 8, 0, {8192, 8}}},
     {Preset::Low, "low", {kEffectShadows | kEffectAo, 1, 4, {2048, 0}}},
     {Preset::Medium, "medium", {kEffectShadows | kEffectAo, 4, 4, {4096, 4}}},
-    {Preset::High, "high", {kAllEffects, 4, 4, {4096, 4}}},
-    {Preset::Ultra, "ultra", {kAllEffects, 8, 16, {8192, 8}}},
+    {Preset::High, "high", {kThesisEffects, 4, 4, {4096, 4}}},
+    {Preset::Ultra, "ultra", {kThesisEffects, 8, 16, {8192, 8}}},
 }};
 
 constexpr bool tableInEnumOrder() {

@@ -10,13 +10,14 @@
 //   frame.gbuffer = gbuffer;                            // the engine's pre-pass (gbuffer.h)
 //   frame.instances = instances;                        // or frame.tlas = the engine's own TLAS
 //   frame.light = sun;                                  // the light the shadow effect shadows
+//   frame.localLights = lights;                         // the engine's light list (local lights effect)
 //   fx->record(cmd, frame);                             // BLAS work, TLAS, shadows, AO, reflections, denoising
 //   fx->outputs().shadow.view ...                       // SHADER_READ_ONLY_OPTIMAL, readable by fragment and
 //                                                       // compute shaders
 //
 // Order inside record(): pending BLAS work and the TLAS (when it builds one) -> shadows [-> denoiser] -> AO
-// [-> denoiser] -> reflections. Only what the description enables exists: a disabled effect has no pass,
-// no denoiser, no image and traces no ray; hard shadows (one ray) are never denoised.
+// [-> denoiser] -> local lights -> reflections. Only what the description enables exists: a disabled effect has no
+// pass, no denoiser, no image and traces no ray; hard shadows (one ray) are never denoised.
 //
 // Lifetime: setDesc()/applyPreset() and the destructor retire passes to the Context's deferred release (see
 // context.h), so switching effects mid-run needs no wait-idle. Destroy it before its Context and before the
@@ -30,6 +31,7 @@
 #include <raybridge/denoiser.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
+#include <raybridge/many_light_pass.h>
 #include <raybridge/presets.h>
 #include <raybridge/reflection_pass.h>
 #include <raybridge/shadow_pass.h>
@@ -70,12 +72,19 @@ struct ReflectionEffectSettings {
   uint32_t raysPerPixel = 0;        // glossy pixels; 0 = kDefaultReflectionRays (mirrors trace one)
 };
 
+struct LocalLightEffectSettings {
+  ManyLightMode mode = ManyLightMode::Stochastic;  // Exact = one ray per light per pixel (few lights, references)
+  uint32_t raysPerPixel = 0;                       // Stochastic: 0 = kDefaultLightRays
+  uint32_t candidates = 0;                         // Stochastic: 0 = kDefaultLightCandidates
+};
+
 // What runs. A zero-initialised description is valid: no effect, nothing allocated, nothing traced.
 struct HybridEffectsDesc {
   EffectSet effects = 0;
   ShadowEffectSettings shadows;
   AoEffectSettings ao;
   ReflectionEffectSettings reflections;
+  LocalLightEffectSettings localLights;
   DenoiseSettings denoiser;  // shared by the shadow and AO denoisers (raysPerPixel is filled in per signal)
   // Build the TLAS with camera-relative origin (TlasBuildOptions::originOffset = the G-buffer's camera
   // position), so precision holds far from the world origin. Only used when record() builds the TLAS.
@@ -103,6 +112,9 @@ struct HybridFrame {
   const TlasInfo* tlas = nullptr;
   std::span<const Instance> instances;
   Light light;  // the light the shadow effect shadows and reflection hits are lit by (default: the sun, up)
+  // The engine's light list for the local lights effect (many_light_pass.h; at most kMaxLights), this frame's
+  // positions. Copied during record(). Empty = black, no rays.
+  std::span<const LightSource> localLights;
   // Lighting of reflection hits: the light's radiance (colour * intensity), the sky's radiance returned by
   // escaping rays, and the sky light on hit surfaces (ambientIntensity * skyRadiance). Zero = the default
   // constants above unless kFrameExplicitLighting.
@@ -127,15 +139,18 @@ struct HybridOutputs {
   EffectImage shadow, shadowRaw;  // R16_SFLOAT visibility, 1 = lit
   EffectImage ao, aoRaw;          // R16_SFLOAT open fraction, 1 = open
   EffectImage reflection;         // R16G16B16A16_SFLOAT radiance, a = 1 where rays were traced
+  // R16G16B16A16_SFLOAT shadowed diffuse irradiance of the local lights (ManyLightOutputs). Not denoised yet:
+  // localLights = localLightsRaw.
+  EffectImage localLights, localLightsRaw;
 };
 
 // Per-pass measurements of the latest recordings whose frames have finished (zero for what does not exist).
 struct HybridStats {
-  PassStats shadow, shadowDenoise, ao, aoDenoise, reflection;
+  PassStats shadow, shadowDenoise, ao, aoDenoise, reflection, localLights;
   double totalGpuMs() const {
-    return shadow.gpuMs + shadowDenoise.gpuMs + ao.gpuMs + aoDenoise.gpuMs + reflection.gpuMs;
+    return shadow.gpuMs + shadowDenoise.gpuMs + ao.gpuMs + aoDenoise.gpuMs + reflection.gpuMs + localLights.gpuMs;
   }
-  uint64_t totalRays() const { return shadow.rays + ao.rays + reflection.rays; }
+  uint64_t totalRays() const { return shadow.rays + ao.rays + reflection.rays + localLights.rays; }
 };
 
 class HybridEffects {
@@ -179,6 +194,7 @@ class HybridEffects {
   const ShadowPass* shadowPass() const;
   const AoPass* aoPass() const;
   const ReflectionPass* reflectionPass() const;
+  const ManyLightPass* localLightPass() const;
   const Denoiser* shadowDenoiser() const;
   const Denoiser* aoDenoiser() const;
 

@@ -32,9 +32,12 @@ enum EffectBits : uint32_t {
   kEffectShadows = 1u << 0,      // ShadowPass: visibility of the frame's light
   kEffectAo = 1u << 1,           // AoPass: ambient occlusion
   kEffectReflections = 1u << 2,  // ReflectionPass: mirror and glossy reflections
+  kEffectLocalLights = 1u << 3,  // ManyLightPass: shadowed irradiance from the frame's light list
 };
 using EffectSet = uint32_t;
-inline constexpr EffectSet kAllEffects = kEffectShadows | kEffectAo | kEffectReflections;
+inline constexpr EffectSet kAllEffects = kEffectShadows | kEffectAo | kEffectReflections | kEffectLocalLights;
+// The thesis's three effects: what the High and Ultra presets run (local lights are enabled on top of a preset).
+inline constexpr EffectSet kThesisEffects = kEffectShadows | kEffectAo | kEffectReflections;
 
 enum class Preset : uint8_t {
   None = 0,  // default: no effect
