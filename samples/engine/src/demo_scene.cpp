@@ -1,5 +1,6 @@
 // The default demo scene: a small colonnade on a checkered ground with a few test objects chosen to show
-// what a ray-tracing add-on changes (sharp metal, mirrors, contact shadows under arches).
+// what a ray-tracing add-on changes (sharp metal, mirrors, contact shadows under arches, a leaf canopy's
+// alpha-tested dappled shadow).
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "sample_engine/procedural.h"
@@ -39,6 +40,58 @@ void place(Scene& s, uint32_t mesh, glm::vec3 position, float yawDegrees = 0.0f)
   glm::mat4 m = glm::translate(glm::mat4(1.0f), position);
   m = glm::rotate(m, glm::radians(yawDegrees), glm::vec3(0, 1, 0));
   s.instances.push_back(Instance{mesh, m});
+}
+
+// A plane card whose texture repeats every `tile` metres.
+MeshData makeCard(float sizeX, float sizeZ, float tile) {
+  MeshData card = makePlane(sizeX, sizeZ, 1, 1);
+  for (glm::vec2& uv : card.uvs) uv *= glm::vec2(sizeX, sizeZ) / tile;
+  return card;
+}
+
+// A wooden pergola under a leaf canopy, centred at (centre.x, 0, centre.y): four posts, two beams along X,
+// rafters along Z, a horizontal leaf card on the rafters and leaf curtains hanging from its +Z and +X edges
+// (the sides the camera sees). The leaves are alpha-tested (Mask, cutoff 0.5) and double-sided.
+void addPergola(Scene& s, glm::vec2 centre) {
+  const float postHeight = 2.5f, span = 3.2f, overhang = 0.25f;  // span: between post centres
+  const float beamHeight = 0.2f, rafterHeight = 0.14f;
+  const int rafters = 6;
+  // The leaves reach 0.1 m past the rafter ends; leafTile: metres per texture repeat.
+  const float canopySize = span + 2.0f * overhang + 0.2f, curtainDrop = 0.45f, leafTile = 2.0f;
+  const float canopyY = postHeight + rafterHeight + 0.02f;
+
+  const int leafTexture = int(s.textures.size());
+  s.textures.push_back(makeLeafTexture(512, 7));
+  const uint32_t wood = addMaterial(s, "weathered wood", {0.46f, 0.33f, 0.21f}, 0.0f, 0.8f);
+  const uint32_t leaves = addMaterial(s, "leaf canopy", {1.0f, 1.0f, 1.0f}, 0.0f, 0.6f, leafTexture);
+  s.materials[leaves].alphaMode = AlphaMode::Mask;
+  s.materials[leaves].alphaCutoff = 0.5f;
+  s.materials[leaves].doubleSided = true;
+
+  const glm::vec3 c(centre.x, 0.0f, centre.y);
+  const float h = span * 0.5f;
+  const uint32_t post = addMesh(s, makeBox({0.14f, postHeight, 0.14f}), wood);
+  for (float dx : {-h, h})
+    for (float dz : {-h, h}) place(s, post, c + glm::vec3(dx, postHeight * 0.5f, dz));
+  const uint32_t beam = addMesh(s, makeBox({span + 2.0f * overhang, beamHeight, 0.12f}), wood);
+  for (float dz : {-h, h}) place(s, beam, c + glm::vec3(0.0f, postHeight - beamHeight * 0.5f, dz));
+  const uint32_t rafter = addMesh(s, makeBox({0.07f, rafterHeight, span + 2.0f * overhang}), wood);
+  for (int i = 0; i < rafters; ++i) {
+    const float dx = -h + span * float(i) / float(rafters - 1);
+    place(s, rafter, c + glm::vec3(dx, postHeight + rafterHeight * 0.5f, 0.0f));
+  }
+
+  place(s, addMesh(s, makeCard(canopySize, canopySize, leafTile), leaves), c + glm::vec3(0.0f, canopyY, 0.0f));
+  // The curtain card stands in the XY plane facing +Z (the plane's +Y turned by 90 degrees about X).
+  const uint32_t curtain = addMesh(s, makeCard(canopySize, curtainDrop, leafTile), leaves);
+  const glm::vec3 curtainCentreY(0.0f, canopyY - curtainDrop * 0.5f, 0.0f);
+  for (float yaw : {0.0f, 90.0f}) {
+    const glm::vec3 edge = yaw == 0.0f ? glm::vec3(0.0f, 0.0f, canopySize * 0.5f) : glm::vec3(canopySize * 0.5f, 0, 0);
+    glm::mat4 m = glm::translate(glm::mat4(1.0f), c + curtainCentreY + edge);
+    m = glm::rotate(m, glm::radians(yaw), glm::vec3(0, 1, 0));
+    m = glm::rotate(m, glm::radians(90.0f), glm::vec3(1, 0, 0));
+    s.instances.push_back(Instance{curtain, m});
+  }
 }
 
 }  // namespace
@@ -86,6 +139,11 @@ Scene makeDefaultDemoScene() {
   place(s, addMesh(s, makeCylinder(0.5f, 1.4f, 64, 2, true), copper), {4.6f, 0.0f, 2.4f});
   // Mirror patch lying on the ground in front of the objects (a thin box so it has real thickness).
   place(s, addMesh(s, makeBox({3.0f, 0.02f, 1.8f}, 1), mirror), {0.0f, 0.01f, 4.2f});
+
+  // A pergola at the frame's left edge, in front of the colonnade's left end: the sun (from the left, behind
+  // the camera) throws the canopy's dappled shadow to the right, onto open ground in front of the mirror box,
+  // in the camera's view. Sight lines to the columns and test objects pass right of it or behind its rear edge.
+  addPergola(s, {-7.8f, 5.4f});
 
   s.camera = Camera{
       .eye = {0.0f, 4.2f, 12.5f}, .target = {0.0f, 1.2f, 0.0f}, .fovYDegrees = 50.0f, .zNear = 0.1f, .zFar = 200.0f};
