@@ -4,7 +4,9 @@
 // the lights whose range and cone can reach it, in light order (a prefix sum per chunk of 64 lights, so the list
 // is the same on every run). More than RB_ML_MAX_TILE_LIGHTS: the tile is marked to sample all lights. Sky-only
 // tiles list none.
-#include "many_lights_common.glsl"
+#include "raybridge_pass_constants.glsl"
+layout(push_constant) uniform ManyLightPushConstants { ManyLightConstants pc; };
+#include "light_list.glsl"
 #include "pass_inputs.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

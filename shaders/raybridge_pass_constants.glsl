@@ -47,7 +47,7 @@ struct AoConstants {
   uint pad0;                 // 172
 };
 
-// ReflectionPass. 208 bytes.
+// ReflectionPass. 224 bytes.
 struct ReflectionConstants {
   GBufferConstants gbuffer;  //   0
   vec3 sunDirection;         // 160: towards the sun, unit length
@@ -56,6 +56,10 @@ struct ReflectionConstants {
   float ambientIntensity;    // 188: scales skyRadiance as the ambient light of hit points
   vec3 skyRadiance;          // 192: what rays that escape see
   uint raysPerPixel;         // 204
+  uint lightCount;           // 208: local lights lighting hits (RB_REFLECTION_BINDING_LIGHTS); 0 = none
+  uint lightCandidates;      // 212: lights weighed per hit to pick the one it traces a shadow ray to
+  uint pad0;                 // 216
+  uint pad1;                 // 220
 };
 
 // ManyLightPass (its tile culling and its rays). 192 bytes.

@@ -16,6 +16,7 @@
 #define RB_AO_BINDING_OUTPUT 5
 #define RB_REFLECTION_BINDING_ROUGHNESS_METALNESS 5  // the normal image again when roughness is in normal.w
 #define RB_REFLECTION_BINDING_RADIANCE 6
+#define RB_REFLECTION_BINDING_LIGHTS 10  // the ManyLightPass's light list (GpuLight[]), read by the hits
 // Every pass whose rays can hit non-opaque geometry (shadow, AO, reflection) also has the TLAS's shading
 // records, the material table and the texture set (alpha testing in the any-hit shaders, shading in reflections).
 #define RB_BINDING_SHADING_RECORDS 7

@@ -3,14 +3,19 @@
 #extension GL_GOOGLE_include_directive : require
 // Shades the surface a reflection ray hits: its material (factors and textures), the sun with a shadow ray
 // (Lambert diffuse for dielectrics, the base colour as specular colour for metals), the sky's ambient light,
-// and emission. Attributes come from the instance's shading record, fetched by device address.
+// and emission, and the local lights of a ManyLightPass when given: one light per hit, chosen among
+// pc.lightCandidates drawn uniformly from the list in proportion to its unshadowed luminance there (resampled
+// importance sampling, unbiased), with its shadow ray. Attributes come from the instance's shading record,
+// fetched by device address.
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ReflectionPushConstants { ReflectionConstants pc; };
 #include "pass_inputs.glsl"
 #include "ray_counters.glsl"
 #include "reflection_common.glsl"
+#include "light_list.glsl"
 
 layout(set = 0, binding = RB_BINDING_TLAS) uniform accelerationStructureEXT tlas;
+layout(set = 0, binding = RB_REFLECTION_BINDING_LIGHTS, std430) readonly buffer Lights { GpuLight lights[]; };
 layout(location = 0) rayPayloadInEXT ReflectionPayload payload;
 layout(location = 1) rayPayloadEXT float shadowHit;
 hitAttributeEXT vec2 barycentrics;
@@ -55,20 +60,50 @@ void main() {
   vec3 toSun = normalize(pc.sunDirection);
   float nDotL = dot(n, toSun);
   float sunVisible = 0.0;
-  if (nDotL > 0.0 && dot(ng, toSun) > 0.0) {
-    vec3 origin = rbOffsetRayOrigin(hit + ng * 1e-4 * max(1.0, gl_HitTEXT), ng);
+  vec3 origin = rbOffsetRayOrigin(hit + ng * 1e-4 * max(1.0, gl_HitTEXT), ng);
+  uint flags = gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT;
+  if ((pc.gbuffer.flags & RB_GB_ALPHA_TEST) == 0u) flags |= gl_RayFlagsOpaqueEXT;
+  if (nDotL > 0.0 && dot(ng, toSun) > 0.0 && any(greaterThan(pc.sunRadiance, vec3(0.0)))) {
     shadowHit = -1.0;
-    uint flags = gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT;
-    if ((pc.gbuffer.flags & RB_GB_ALPHA_TEST) == 0u) flags |= gl_RayFlagsOpaqueEXT;
     traceRayEXT(tlas, flags, 0xFF, 0, 0, 1, origin, 0.0, toSun, 1e30, 1);
     sunVisible = shadowHit == 0.0 ? 1.0 : 0.0;
     // Shadow rays from hits are the pass's rays too.
     rbCountRays(gl_LaunchIDEXT.xy, 1u);
   }
+  // Local lights: irradiance E from one resampled light (see the top), shadowed.
+  vec3 localIrradiance = vec3(0.0);
+  uint count = pc.lightCount;
+  if (count > 0u) {
+    uvec3 bits = floatBitsToUint(dir);
+    uint seed = rbPcg(gl_LaunchIDEXT.x + 65521u * gl_LaunchIDEXT.y + rbPcg(pc.gbuffer.frameIndex ^ 0x2545f491u));
+    seed = rbPcg(seed ^ rbPcg(bits.x ^ rbPcg(bits.y ^ bits.z)));
+    uint m = max(pc.lightCandidates, 1u);
+    float weightSum = 0.0, keptWeight = 0.0, keptDistance = 0.0;
+    vec3 keptE = vec3(0.0), keptDir = vec3(0.0);
+    for (uint c = 0u; c < m; ++c) {
+      seed = rbPcg(seed);
+      uint index = min(uint(rbToUnit(seed) * float(count)), count - 1u);
+      vec3 toLight;
+      float distance;
+      vec3 e = rbLightIrradiance(lights[index], hit, n, ng, toLight, distance);
+      float w = rbLuminance(e);
+      if (w <= 0.0) continue;
+      weightSum += w;
+      seed = rbPcg(seed);
+      if (rbToUnit(seed) * weightSum < w) keptWeight = w, keptE = e, keptDir = toLight, keptDistance = distance;
+    }
+    if (weightSum > 0.0) {
+      shadowHit = -1.0;
+      float tMax = keptDistance >= 1e29 ? 1e30 : 0.999 * keptDistance;
+      traceRayEXT(tlas, flags, 0xFF, 0, 0, 1, origin, 0.0, keptDir, tMax, 1);
+      rbCountRays(gl_LaunchIDEXT.xy, 1u);
+      if (shadowHit == 0.0) localIrradiance = keptE * (weightSum * float(count) / (float(m) * keptWeight));
+    }
+  }
   vec3 diffuse = base.rgb * (1.0 - metallic) / RB_PI;
   vec3 specularColour = mix(vec3(0.04), base.rgb, metallic);
-  // Direct sun: diffuse, plus a broad specular approximation so metals are not black under the sun.
-  vec3 direct = (diffuse + specularColour / RB_PI) * pc.sunRadiance * max(nDotL, 0.0) * sunVisible;
+  // Direct light: diffuse, plus a broad specular approximation so metals are not black under the sun.
+  vec3 direct = (diffuse + specularColour / RB_PI) * (pc.sunRadiance * max(nDotL, 0.0) * sunVisible + localIrradiance);
   vec3 ambient = (base.rgb * (1.0 - metallic) + specularColour * metallic) * pc.skyRadiance * pc.ambientIntensity;
   vec3 emissive = m.emissive;
   if (m.emissiveTexture != 0xFFFFFFFFu) emissive *= textureLod(textures[nonuniformEXT(m.emissiveTexture)], uv, 0.0).rgb;

@@ -177,3 +177,107 @@ TEST_CASE("reflection input errors name the problem", "[reflection][bad-input]")
   CHECK(s.error().message.find("texture 3") != std::string::npos);
   CHECK(!pass.value()->setMaterials({}, {}).ok());
 }
+
+TEST_CASE("reflection hits are lit by the many-light pass's light list", "[reflection][many_lights]") {
+  GpuFixture fx;
+  TestScene scene;
+  scene.meshes.push_back(rbsamples::makeGrid(12.0f, 12));
+  const float mn[3] = {-0.6f, 0.0f, -0.6f}, mx[3] = {0.6f, 1.5f, 0.6f};
+  scene.meshes.push_back(rbsamples::makeBox(mn, mx, 2));
+  scene.instances.push_back({0, translation(0, 0, 0), 0});
+  scene.instances.push_back({1, translation(0, 0, -1.5f), 1});
+  std::vector<rb::Material> materials(2);
+  materials[1].baseColor[0] = 0.8f, materials[1].baseColor[1] = 0.3f, materials[1].baseColor[2] = 0.1f;
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  SyntheticView view;
+  view.eye = {0.3, 1.2, 4.0};
+  view.target = {0.0, 0.2, -1.0};
+  view.width = 96;
+  view.height = 72;
+  CpuGBuffer cpu = traceGBuffer(embree, view, {0.0f, 1.0f});  // floor a mirror
+  // No sun, a black sky, no ambient: the point light in front of the box is the only light.
+  rb::ReflectionSettings settings;
+  settings.flags = rb::kReflectionExplicitLighting | rb::kReflectionNoSun;
+  rb::LightSource light;
+  light.light.type = rb::LightType::Point;
+  light.light.position[0] = 0.4, light.light.position[1] = 1.0, light.light.position[2] = 0.2;
+  light.intensity = 5.0f;
+  light.color[1] = 0.8f;
+  auto lights = rb::ManyLightPass::create(fx.ctx());
+  RB_REQUIRE_OK(lights);
+  auto pass = rb::ReflectionPass::create(fx.ctx());
+  RB_REQUIRE_OK(pass);
+  RB_REQUIRE_OK(pass.value()->setMaterials(materials, {}));
+  std::vector<glm::vec4> lit, unlit;
+  auto read = [&](const rb::GBufferDesc& desc, std::vector<glm::vec4>& out) {
+    std::vector<float> rgba = readRgba16f(fx, pass.value()->outputs().radiance, desc.width, desc.height);
+    out.resize(size_t(desc.width) * desc.height);
+    std::memcpy(out.data(), rgba.data(), rgba.size() * sizeof(float));
+  };
+  for (bool withLights : {true, false}) {
+    runPassFrame(
+        fx, scene, cpu, true,
+        [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
+          rb::ReflectionSettings s = settings;
+          if (withLights) {
+            RB_REQUIRE_OK(lights.value()->record(cmd, desc, tlas, std::span(&light, 1)));
+            s.lights = lights.value().get();
+          }
+          RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, s));
+        },
+        [&](const rb::GBufferDesc& desc) { read(desc, withLights ? lit : unlit); });
+  }
+  // The reference: the box point the mirror ray hits, lit by the light: (albedo / pi + 0.04 / pi) * E.
+  uint32_t compared = 0, agree = 0, dark = 0;
+  const glm::dvec3 lp(light.light.position[0], light.light.position[1], light.light.position[2]);
+  for (uint32_t y = 0; y < view.height; ++y) {
+    for (uint32_t x = 0; x < view.width; ++x) {
+      size_t i = size_t(y) * view.width + x;
+      if (!cpu.hit[i] || cpu.instance[i] != 0) continue;
+      glm::dvec3 v = glm::normalize(cpu.position[i] - view.eye);
+      glm::dvec3 r = glm::reflect(v, glm::dvec3(0, 1, 0));
+      glm::dvec3 o = cpu.position[i] + glm::dvec3(0, 1e-4, 0);
+      float of[3] = {float(o.x), float(o.y), float(o.z)}, d[3] = {float(r.x), float(r.y), float(r.z)};
+      ReferenceHit h = embree.intersect(of, d, 0.0f, 1e30f);
+      if (!h.hit || h.instanceId != 1) continue;
+      glm::dvec3 p = o + r * double(h.t);
+      glm::dvec3 n = glm::normalize(glm::dvec3(h.geometricNormal[0], h.geometricNormal[1], h.geometricNormal[2]));
+      if (glm::dot(n, r) > 0) n = -n;
+      glm::dvec3 toLight = lp - p;
+      double dist = glm::length(toLight);
+      toLight /= dist;
+      double cosine = glm::dot(n, toLight);
+      // Skip box edges (a neighbour's mirror ray may hit another face) and faces turned from the light.
+      if (cosine < 0.05 || std::fabs(std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z) - 1.0) > 1e-3) continue;
+      glm::dvec3 e = glm::dvec3(light.color[0], light.color[1], light.color[2]) * double(light.intensity) * cosine /
+                     (dist * dist);
+      glm::dvec3 expected =
+          (glm::dvec3(materials[1].baseColor[0], materials[1].baseColor[1], materials[1].baseColor[2]) + 0.04) / M_PI *
+          e;
+      ++compared;
+      bool ok = true;
+      for (int c = 0; c < 3; ++c) ok &= std::fabs(lit[i][c] - expected[c]) <= 0.03 * expected[c] + 1e-3;
+      agree += ok;
+      dark += unlit[i].r == 0.0f && unlit[i].g == 0.0f && unlit[i].b == 0.0f;
+    }
+  }
+  INFO("box pixels seen in the mirror and lit: " << compared << ", agree " << agree << ", black without lights "
+                                                 << dark);
+  REQUIRE(compared > 100);
+  CHECK(double(agree) >= 0.97 * compared);  // a few pixels on a face's border hit the neighbouring face
+  CHECK(dark == compared);
+
+  SECTION("a light list not recorded this frame is an error") {
+    runPassFrame(
+        fx, scene, cpu, true,
+        [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
+          rb::ReflectionSettings s = settings;
+          s.lights = lights.value().get();
+          rb::Status st = pass.value()->record(cmd, desc, tlas, s);
+          REQUIRE_FALSE(st);
+          CHECK(st.error().message.find("not recorded this frame") != std::string::npos);
+        },
+        [](const rb::GBufferDesc&) {});
+  }
+}

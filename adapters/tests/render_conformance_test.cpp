@@ -1,6 +1,8 @@
 // raybridge-render end to end against an independent tracer: the demo scene rendered headless, its dumped
 // depth (distance along the primary ray through the pixel centre) and hard-shadow visibility compared with
-// Embree tracing the same camera rays and sun over the same geometry, with --gbuffer-normals geometric.
+// Embree tracing the same camera rays and sun over the same geometry, with --gbuffer-normals geometric. Rays
+// pass through the cut-outs of MASK materials (the pergola's leaf canopy) by the SDK's rule: base colour alpha
+// times the texture's alpha at the nearest texel of mip 0, against the cutoff.
 #include <catch2/catch_test_macros.hpp>
 
 
@@ -18,6 +20,34 @@
 
 namespace fs = std::filesystem;
 using rbRenderTest::readExrRed;
+
+namespace {
+
+// Whether an Embree hit on the demo scene stops a ray: MASK materials cut out where alpha < cutoff.
+rbtest::HitFilter alphaCutouts(const sample_engine::Scene& scene) {
+  return [&scene](const rbtest::ReferenceHit& h) {
+    const sample_engine::MeshData& m = scene.meshes[scene.instances[h.instanceId].mesh];
+    const sample_engine::Material& mat = scene.materials[std::min<size_t>(m.material, scene.materials.size() - 1)];
+    if (mat.alphaMode != sample_engine::AlphaMode::Mask) return true;
+    float alpha = mat.baseColorFactor.a;
+    if (mat.baseColorTexture >= 0 && !m.uvs.empty()) {
+      const sample_engine::TextureData& t = scene.textures[size_t(mat.baseColorTexture)];
+      const float w[3] = {1.0f - h.barycentrics[0] - h.barycentrics[1], h.barycentrics[0], h.barycentrics[1]};
+      glm::vec2 uv(0.0f);
+      for (int k = 0; k < 3; ++k) {
+        uint32_t v = m.indices.empty() ? 3 * h.primitiveId + k : m.indices[3 * h.primitiveId + k];
+        uv += w[k] * m.uvs[v];
+      }
+      uv -= glm::floor(uv);
+      int x = std::clamp(int(std::floor(uv.x * float(t.width))), 0, int(t.width) - 1);
+      int y = std::clamp(int(std::floor(uv.y * float(t.height))), 0, int(t.height) - 1);
+      alpha *= float(t.rgba8[(size_t(y) * t.width + x) * 4 + 3]) / 255.0f;
+    }
+    return alpha >= mat.alphaCutoff;
+  };
+}
+
+}  // namespace
 
 
 TEST_CASE("raybridge-render's depth and hard shadows match Embree on the demo scene", "[render][embree]") {
@@ -58,6 +88,8 @@ TEST_CASE("raybridge-render's depth and hard shadows match Embree on the demo sc
     embree.addInstance(cpu, rowMajor, i);
   }
   embree.commit();
+  const rbtest::HitFilter stops = alphaCutouts(scene);
+  bool cutOutInView = false;  // the canopy is seen: the filter matters
 
   // The documented camera convention: up = +Y, right-handed, pixel (x, y) from the top-left, through its centre.
   const glm::vec3 forward = glm::normalize(target - eye);
@@ -77,7 +109,7 @@ TEST_CASE("raybridge-render's depth and hard shadows match Embree on the demo sc
     for (uint32_t x = 0; x < W; ++x) {
       glm::vec3 d = rayDir(x + 0.5f, y + 0.5f);
       Ref& r = ref[size_t(y) * W + x];
-      r.hit = embree.intersect(&eye.x, &d.x, 0.0f, 1e30f);
+      r.hit = embree.intersect(&eye.x, &d.x, 0.0f, 1e30f, stops);
       if (!r.hit.hit) continue;
       glm::vec3 n = glm::normalize(
           glm::vec3(r.hit.geometricNormal[0], r.hit.geometricNormal[1], r.hit.geometricNormal[2]));
@@ -87,7 +119,8 @@ TEST_CASE("raybridge-render's depth and hard shadows match Embree on the demo sc
         continue;
       }
       glm::vec3 o = eye + d * r.hit.t + n * 1e-4f * std::max(1.0f, r.hit.t);
-      r.visible = embree.intersect(&o.x, &toSun.x, 0.0f, 1e30f).hit ? 0 : 1;
+      r.visible = embree.intersect(&o.x, &toSun.x, 0.0f, 1e30f, stops).hit ? 0 : 1;
+      cutOutInView |= r.visible == 1 && embree.intersect(&o.x, &toSun.x, 0.0f, 1e30f).hit;
     }
   }
   uint32_t compared = 0, depthAgree = 0, shadowAgree = 0, shadowed = 0, skyPixels = 0, skyZero = 0;
@@ -118,6 +151,7 @@ TEST_CASE("raybridge-render's depth and hard shadows match Embree on the demo sc
                    << ", shadow on " << shadowAgree);
   REQUIRE(compared > W * H / 3);  // the rest is sky, silhouettes and shadow edges
   REQUIRE(shadowed > 200);
+  CHECK(cutOutInView);          // some sun rays pass through the leaf canopy's holes
   CHECK(skyZero == skyPixels);  // depth.exr is 0 where nothing is hit
   CHECK(double(depthAgree) / compared >= 0.999);
   CHECK(double(shadowAgree) / compared >= 0.999);

@@ -236,6 +236,7 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
     s.skyRadiance[i] = f.skyRadiance[i];
   }
   s.ambientIntensity = f.ambientIntensity;
+  if (localLights && !f.localLights.empty()) s.lights = localLights.get();  // recorded earlier this frame
   if (f.light.type == LightType::Directional) {
     for (int i = 0; i < 3; ++i) s.sunDirection[i] = f.light.direction[i];
   } else {

@@ -7,6 +7,7 @@
 
 #include "compute_pipeline.h"
 #include "context_impl.h"
+#include "many_light_pass_impl.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
 
@@ -21,20 +22,6 @@ static_assert(RB_ML_MAX_TILE_LIGHTS == kMaxTileLights && RB_ML_TILE_SIZE == kMan
 static_assert(kMaxLights <= 65536, "tile lists hold 16-bit light indices");
 constexpr uint32_t kMaxRaysOrCandidates = 64;
 
-// Mirrors GpuLight in shaders/many_lights_common.glsl (std430).
-struct GpuLight {
-  float position[3];
-  float range;
-  float direction[3];
-  uint32_t type;
-  float intensity[3];
-  float softness;
-  float cosOuter;
-  float coneScale;
-  float coneOffset;
-  float pad0;
-};
-static_assert(sizeof(GpuLight) == 64);
 
 bool finite3(const float v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 
@@ -111,6 +98,7 @@ struct ManyLightPass::Impl {
   uint32_t capacity = 0;
   std::vector<GpuLight> staging;
   ManyLightOutputs outputs;
+  internal::LightListView recorded;  // what the latest record() uploaded, for reflection hits
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still use them
     core.retire(ctx);
@@ -254,12 +242,20 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   w.storageImage(RB_ML_BINDING_IRRADIANCE, images[0].view);
   s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
 
+  s.recorded.buffer = s.lights.buffer;
+  s.recorded.count = count;
+  s.recorded.frame = s.ctx.frameIndex();
+  for (int i = 0; i < 3; ++i) s.recorded.originOffset[i] = tlas.originOffset[i];
   ManyLightOutputs& o = s.outputs;
   o.irradiance = images[0].image;
   o.irradianceView = images[0].view;
   o.width = g.width;
   o.height = g.height;
   return {};
+}
+
+internal::LightListView internal::ManyLightPassAccess::lightList(const ManyLightPass& pass) {
+  return pass.impl_->recorded;
 }
 
 const ManyLightOutputs& ManyLightPass::outputs() const { return impl_->outputs; }

@@ -89,8 +89,11 @@ struct ReflectionConstants {
   float ambientIntensity;
   float skyRadiance[3];
   uint32_t raysPerPixel;
+  uint32_t lightCount;
+  uint32_t lightCandidates;
+  uint32_t pad0, pad1;
 };
-static_assert(sizeof(ReflectionConstants) == 208);
+static_assert(sizeof(ReflectionConstants) == 224);
 RB_ASSERT_OFFSET(ReflectionConstants, gbuffer, 0);
 RB_ASSERT_OFFSET(ReflectionConstants, sunDirection, 160);
 RB_ASSERT_OFFSET(ReflectionConstants, roughnessThreshold, 172);
@@ -98,6 +101,8 @@ RB_ASSERT_OFFSET(ReflectionConstants, sunRadiance, 176);
 RB_ASSERT_OFFSET(ReflectionConstants, ambientIntensity, 188);
 RB_ASSERT_OFFSET(ReflectionConstants, skyRadiance, 192);
 RB_ASSERT_OFFSET(ReflectionConstants, raysPerPixel, 204);
+RB_ASSERT_OFFSET(ReflectionConstants, lightCount, 208);
+RB_ASSERT_OFFSET(ReflectionConstants, lightCandidates, 212);
 
 struct PrimaryConstants {
   float eye[3];

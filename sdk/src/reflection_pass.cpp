@@ -5,6 +5,8 @@
 #include <string>
 
 #include "context_impl.h"
+#include "many_light_pass_impl.h"
+#include "material_table_impl.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
 
@@ -47,6 +49,7 @@ Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context)
   p.bindings.push_back(
       {RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
   p.bindings.push_back({RB_REFLECTION_BINDING_RADIANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
+  p.bindings.push_back({RB_REFLECTION_BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit, nullptr});
   p.pushConstantBytes = sizeof(ReflectionConstants);
   // Shading records and materials: read by the hits (shading) and the any-hits (alpha).
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::reflect_rahit), hit); !s) return s.error();
@@ -106,6 +109,20 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
                                                                                : settings.ambientIntensity;
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultReflectionRays;
 
+  internal::LightListView lights;
+  if (settings.lights) {
+    lights = internal::lightList(*settings.lights);
+    if (lights.frame != s.ctx.frameIndex())
+      return invalid("ReflectionSettings::lights: that ManyLightPass was not recorded this frame; record it before "
+                     "the reflection pass");
+    for (int i = 0; i < 3; ++i)
+      if (lights.originOffset[i] != tlas.originOffset[i])
+        return invalid("ReflectionSettings::lights: that ManyLightPass traced another TLAS space (originOffset)");
+    if (settings.lightCandidates > 64)
+      return invalid("ReflectionSettings::lightCandidates " + std::to_string(settings.lightCandidates) + " exceeds 64");
+    pc.lightCount = lights.count;
+    pc.lightCandidates = settings.lightCandidates ? settings.lightCandidates : kDefaultReflectionLightCandidates;
+  }
   DescriptorWrites w;
   const MaterialTable* table = settings.materials ? settings.materials : s.ownMaterials.get();
   if (Status st = s.core.writeMaterials(w, tlas, table, "ReflectionPass", pc.gbuffer.flags); !st) return st;
@@ -114,6 +131,9 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   const GBufferImage& rm = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
   w.sampledImage(RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, rm.view, s.core.sampler, readLayout(rm));
   w.storageImage(RB_REFLECTION_BINDING_RADIANCE, s.core.images[0].view);
+  // The local lights' list when given, else any valid buffer (never read: lightCount is 0).
+  w.storageBuffer(RB_REFLECTION_BINDING_LIGHTS,
+                  pc.lightCount ? lights.buffer : internal::materialTableImpl(*table).materials.buffer);
   s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
   s.outputs.radiance = s.core.images[0].image;
   s.outputs.radianceView = s.core.images[0].view;

@@ -42,6 +42,10 @@
 
 namespace rb {
 
+namespace internal {
+struct ManyLightPassAccess;
+}
+
 inline constexpr uint32_t kMaxLights = 65536;
 inline constexpr uint32_t kMaxTileLights = 256;     // lights one tile lists; more = candidates from all
 inline constexpr uint32_t kManyLightTileSize = 16;  // pixels per tile side
@@ -100,6 +104,7 @@ class ManyLightPass {
   struct Impl;
 
  private:
+  friend struct internal::ManyLightPassAccess;
   explicit ManyLightPass(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

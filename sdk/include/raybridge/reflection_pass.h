@@ -21,6 +21,7 @@
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
+#include <raybridge/many_light_pass.h>
 #include <raybridge/material_table.h>
 
 #include <memory>
@@ -34,6 +35,7 @@ inline constexpr uint32_t kDefaultReflectionRays = 1;
 inline constexpr float kDefaultSunRadiance = 3.0f;  // per channel
 inline constexpr float kDefaultSkyRadiance[3] = {0.45f, 0.62f, 0.9f};
 inline constexpr float kDefaultAmbientIntensity = 0.4f;
+inline constexpr uint32_t kDefaultReflectionLightCandidates = 4;  // local lights weighed per hit
 
 enum ReflectionFlags : uint32_t {
   // Take sunRadiance, skyRadiance and ambientIntensity as given, zeros included (a black sky, no sky light).
@@ -55,6 +57,11 @@ struct ReflectionSettings {
   uint32_t flags = 0;             // ReflectionFlags
   // The table hits shade with and alpha-test with; nullptr = the pass's own table (setMaterials()).
   const MaterialTable* materials = nullptr;
+  // Local lights: hits are also lit by the light list this ManyLightPass uploaded in its record() earlier this
+  // frame (same TLAS), one light per hit chosen among lightCandidates in proportion to its unshadowed
+  // contribution there, with a shadow ray (unbiased, noisy like glossy rays). nullptr = sun and sky only.
+  const ManyLightPass* lights = nullptr;
+  uint32_t lightCandidates = 0;  // 0 = kDefaultReflectionLightCandidates; at most 64
 };
 
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().

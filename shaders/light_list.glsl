@@ -1,12 +1,12 @@
-// ManyLightPass: the light list as the GPU reads it, its push constants, and each light's unshadowed
-// irradiance at a surface point (the formula of many_light_pass.h). Shared by the culling and the ray pass.
-#ifndef RAYBRIDGE_MANY_LIGHTS_COMMON_GLSL
-#define RAYBRIDGE_MANY_LIGHTS_COMMON_GLSL
+// The light list as the GPU reads it (ManyLightPass uploads it) and each light's unshadowed irradiance at a
+// surface point (the formula of many_light_pass.h). Shared by the many-light culling and rays, and the
+// reflection hits lit by the same list.
+#ifndef RAYBRIDGE_LIGHT_LIST_GLSL
+#define RAYBRIDGE_LIGHT_LIST_GLSL
 
-#include "raybridge_pass_constants.glsl"
-layout(push_constant) uniform ManyLightPushConstants { ManyLightConstants pc; };
+#include "raybridge_shader_interface.glsl"
 
-// Mirrors GpuLight in sdk/src/many_light_pass.cpp (std430, 64 bytes). Filled on the host.
+// Mirrors GpuLight in sdk/src/many_light_pass_impl.h (std430, 64 bytes). Filled on the host.
 struct GpuLight {
   vec3 position;   // point, spot: TLAS space
   float range;     // point, spot: 0 = unlimited
