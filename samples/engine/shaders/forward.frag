@@ -2,8 +2,11 @@
 #extension GL_GOOGLE_include_directive : require
 // Forward PBR lighting: GGX specular + Lambert diffuse for the sun, constant-sky ambient, with optional
 // external sun visibility / AO / reflection images replacing the engine's own terms (the reflection only
-// where its alpha says it covers the pixel). Also used (depth LESS)
-// to capture the reflection probe, with frame.probe.x = 0 and no screen-space inputs.
+// where its alpha says it covers the pixel). Also used (depth LESS) to capture the reflection probe, with
+// frame.probe.x = 0 and no screen-space inputs, and for BLEND draws after the opaque lighting: output alpha =
+// the surface's, blended over the target (src alpha, one minus src alpha). The screen-space inputs describe
+// the opaque surface behind a blended one, so BLEND draws ignore them: shadow map (or unshadowed), no AO
+// image, the engine's own environment term.
 #include "common.glsl"
 #include "surface.glsl"
 #include "shadow_sampling.glsl"
@@ -31,6 +34,9 @@ vec3 environmentBrdf(vec3 f0, float roughness, float nDotV) {
 
 void main() {
   Surface s = evaluateSurface();
+  alphaTest(s);
+  const bool blended = draw.alphaMode == SE_ALPHA_BLEND;
+  const bool screenInputs = !blended;
   vec2 screenUv = gl_FragCoord.xy * frame.viewport.zw;
   vec3 l = frame.sunDirection.xyz;
   vec3 h = normalize(l + s.v);
@@ -49,9 +55,9 @@ void main() {
   vec3 specular = d * vis * f;
   vec3 diffuse = (1.0 - f) * (1.0 - s.metallic) * s.baseColor / PI;
 
-  float visibility = frame.inputs.x != 0u ? clamp(texture(externalVisibility, screenUv).r, 0.0, 1.0)
-                                          : sunVisibility(shadowMap, inEyeRelativePos, s.n, s.ng);
-  float ao = frame.inputs.y != 0u ? clamp(texture(externalAo, screenUv).r, 0.0, 1.0) : 1.0;
+  float visibility = screenInputs && frame.inputs.x != 0u ? clamp(texture(externalVisibility, screenUv).r, 0.0, 1.0)
+                                                          : sunVisibility(shadowMap, inEyeRelativePos, s.n, s.ng);
+  float ao = screenInputs && frame.inputs.y != 0u ? clamp(texture(externalAo, screenUv).r, 0.0, 1.0) : 1.0;
   ao *= s.occlusion;  // glTF material occlusion (gltf loader work): ambient and environment terms only
 
   vec3 color = (diffuse + specular) * frame.sunRadiance.rgb * nDotL * visibility;
@@ -68,11 +74,11 @@ void main() {
   }
   // An external reflection replaces it where it covers the pixel: alpha = coverage (1 = its radiance,
   // 0 = keep the engine's term, e.g. pixels a ray-traced pass did not trace).
-  if (frame.inputs.z != 0u) {
+  if (screenInputs && frame.inputs.z != 0u) {
     vec4 ext = texture(externalReflection, screenUv);
     reflected = mix(reflected, ext.rgb, clamp(ext.a, 0.0, 1.0));
   }
   color += reflected * specularWeight;
   color += s.emissive;
-  outColor = vec4(color, 1.0);
+  outColor = vec4(color, blended ? clamp(s.alpha, 0.0, 1.0) : 1.0);
 }

@@ -1,7 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Depth-only shadow-map pass (no fragment shader), positions only; draw.model and frame.lightViewProj are
-// both camera-relative.
+// Depth-only shadow-map pass of OPAQUE draws (no fragment shader), positions only; MASK and BLEND draws take
+// shadow_alpha.vert/.frag. draw.model and frame.lightViewProj are both camera-relative.
 #include "common.glsl"
 
 layout(location = 0) in vec3 inPosition;

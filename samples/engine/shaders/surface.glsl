@@ -1,8 +1,13 @@
-// Material evaluation shared by the pre-pass and the lighting pass.
-layout(set = 1, binding = 0) uniform sampler2D baseColorTex;          // sRGB view
+// Material evaluation shared by the pre-pass and the lighting pass (and the blend pass and probe capture).
+layout(set = 1, binding = 0) uniform sampler2D baseColorTex;          // sRGB view; A = alpha (coverage)
 layout(set = 1, binding = 1) uniform sampler2D metallicRoughnessTex;  // G roughness, B metallic
 layout(set = 1, binding = 2) uniform sampler2D normalTex;
-layout(set = 1, binding = 3) uniform sampler2D emissiveTex;          // sRGB view
+layout(set = 1, binding = 3) uniform sampler2D emissiveTex;   // sRGB view
+layout(set = 1, binding = 4) uniform sampler2D occlusionTex;  // R = ambient occlusion; white when none
+
+// True in the pipelines that draw MASK materials (Pipelines::*Masked). The others carry no discard at all, so
+// the depth-writing passes keep their early depth test for opaque draws.
+layout(constant_id = 0) const bool kAlphaTested = false;
 
 layout(location = 0) in vec3 inEyeRelativePos;  // world position - eye (world axes)
 layout(location = 1) in vec3 inNormal;
@@ -18,6 +23,7 @@ struct Surface {
   float roughness;  // perceptual
   vec3 emissive;
   float occlusion;  // material ambient occlusion (1 = none)
+  float alpha;      // baseColorFactor.a * base colour texture alpha: MASK coverage, BLEND opacity
 };
 
 Surface evaluateSurface() {
@@ -41,10 +47,17 @@ Surface evaluateSurface() {
   vec4 base = texture(baseColorTex, inUv) * draw.baseColorFactor;
   vec4 mr = texture(metallicRoughnessTex, inUv);
   s.baseColor = base.rgb;
+  s.alpha = base.a;
   s.metallic = clamp(draw.material.x * mr.b, 0.0, 1.0);
   s.roughness = clamp(draw.material.y * mr.g, 0.02, 1.0);
   s.emissive = draw.emissive.rgb * texture(emissiveTex, inUv).rgb;
-  // glTF occlusion packed in the metallic-roughness texture's R channel; draw.material.w = strength (0 = none).
-  s.occlusion = mix(1.0, mr.r, draw.material.w);
+  // glTF occlusionTexture (R channel), whichever image it is (a packed ORM binds the metallic-roughness one).
+  s.occlusion = mix(1.0, texture(occlusionTex, inUv).r, draw.material.w);
   return s;
+}
+
+// MASK: drops the fragment where alpha < alphaCutoff (glTF), in the pipelines built with kAlphaTested. Call it
+// after evaluateSurface(): derivatives and implicit-LOD lookups are undefined after a quad neighbour's discard.
+void alphaTest(Surface s) {
+  if (kAlphaTested && s.alpha < draw.alphaCutoff) discard;
 }

@@ -1,5 +1,5 @@
 // One frame: shadow map -> [probe capture] -> pre-pass -> [SSAO] -> [shadow visibility] -> hook -> lighting
-// -> tonemap (-> blit to the swapchain).
+// (opaque, then blended) -> tonemap (-> blit to the swapchain).
 #include <algorithm>
 #include <cstring>
 
@@ -225,7 +225,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     beginRendering(cmd, {targets.shadowMapSize, targets.shadowMapSize}, {}, &depth);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.shadow);
     vkCmdSetDepthBias(cmd, params.shadow.depthBiasConstant, 0.0f, params.shadow.depthBiasSlope);
-    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Shadow, eye);
+    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Shadow, {}, eye);
     vkCmdEndRendering(cmd);
     imageBarrier(cmd, targets.shadowMap.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                  kReadLayout, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
@@ -265,8 +265,9 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     beginRendering(
         cmd, extent,
         {colorAttachment(targets.normalRoughness.view, {}), colorAttachment(targets.geometricNormal.view, {})}, &depth);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.prepass);
-    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Prepass, eye);
+    // BLEND surfaces stay out: depth and normals (and what the hook computes from them) are the opaque scene's.
+    if (haveScene)
+      drawScene(cmd, scene, pipelines, DrawPass::Prepass, {pipelines.prepass, pipelines.prepassMasked}, eye);
     vkCmdEndRendering(cmd);
   }
   // Readable by anything the hook records; depth stays usable as the lighting pass's read-only attachment.
@@ -346,7 +347,8 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
        {pipelines.cubeSampler, useProbe ? probe.view() : probe.fallbackView(), kReadLayout}});
   writeImageDescriptors(ctx.device, frame.tonemapSet, {{pipelines.nearestSampler, targets.hdr.view, kReadLayout}});
 
-  // (4) Forward lighting: EQUAL test against the pre-pass depth, background keeps the sky clear color.
+  // (4) Forward lighting: EQUAL test against the pre-pass depth, background keeps the sky clear color; then the
+  // blended surfaces in the same rendering scope.
   imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
                VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
@@ -358,13 +360,16 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     depth.storeOp = VK_ATTACHMENT_STORE_OP_NONE;  // read-only: no write access at the end of the pass
     VkClearColorValue sky{{params.skyColor.r, params.skyColor.g, params.skyColor.b, 1.0f}};
     beginRendering(cmd, extent, {colorAttachment(targets.hdr.view, sky)}, &depth);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.forward);
     // Set 0 again: the effect passes' pipeline layout (other push constants) disturbed the binding.
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 0, 1, &frame.frameSet, 0,
                             nullptr);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 2, 1, &frame.lightingSet, 0,
                             nullptr);
-    if (haveScene) drawScene(cmd, scene, pipelines, DrawPass::Lighting, eye);
+    if (haveScene) {
+      drawScene(cmd, scene, pipelines, DrawPass::Lighting, {pipelines.forward, pipelines.forwardMasked}, eye);
+      // (4b) BLEND surfaces over the lit opaque scene, back to front, tested against the pre-pass depth.
+      drawBlended(cmd, scene, pipelines, eye);
+    }
     vkCmdEndRendering(cmd);
   }
   timestamp(kTsLightingEnd);

@@ -257,6 +257,14 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     out.instanceTransforms[i] = s.instances[i].transform;
     const MeshBuffers& b = out.buffers[s.instances[i].mesh];
     out.instanceVertices[i] = {b.positions.buffer, b.attributes.buffer};
+    const AlphaMode mode = s.materials[s.meshes[s.instances[i].mesh].material].alphaMode;
+    out.instancesByAlpha[size_t(mode)].push_back(uint32_t(i));  // finalizeScene: Opaque, Mask or Blend
+  }
+  out.meshCenters.resize(s.meshes.size());
+  for (size_t m = 0; m < s.meshes.size(); ++m) {
+    Bounds local;
+    for (const glm::vec3& p : s.meshes[m].positions) local.extend(p);
+    out.meshCenters[m] = local.valid() ? local.center() : glm::vec3(0.0f);
   }
 
   // --- Textures ---
@@ -275,7 +283,7 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
 
   // --- Materials ---
   const uint32_t materialCount = uint32_t(s.materials.size());
-  VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4 * materialCount};
+  VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kMaterialSetBindings * materialCount};
   VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pci.maxSets = materialCount;
   pci.poolSizeCount = 1;
@@ -295,31 +303,32 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
       if (texture < 0 || !out.textures[texture].image) return fallback.view;
       return srgb ? out.textures[texture].altView : out.textures[texture].view;
     };
-    VkDescriptorImageInfo infos[4] = {{pipelines.materialSampler, view(mat.baseColorTexture, defaults.white, true),
-                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                      {pipelines.materialSampler,
-                                       view(mat.metallicRoughnessTexture, defaults.white, false),
-                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                      {pipelines.materialSampler, view(mat.normalTexture, defaults.flatNormal, false),
-                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                      {pipelines.materialSampler, view(mat.emissiveTexture, defaults.white, true),
-                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
+    // Bindings of surface.glsl. A packed ORM texture is bound twice (metallic-roughness and occlusion).
+    const VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    const VkSampler sampler = pipelines.materialSampler;
+    VkDescriptorImageInfo infos[kMaterialSetBindings] = {
+        {sampler, view(mat.baseColorTexture, defaults.white, true), layout},
+        {sampler, view(mat.metallicRoughnessTexture, defaults.white, false), layout},
+        {sampler, view(mat.normalTexture, defaults.flatNormal, false), layout},
+        {sampler, view(mat.emissiveTexture, defaults.white, true), layout},
+        {sampler, view(mat.occlusionTexture, defaults.white, false), layout}};
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     w.dstSet = out.materialSets[m];
-    w.descriptorCount = 4;
+    w.descriptorCount = kMaterialSetBindings;
     w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     w.pImageInfo = infos;
     vkUpdateDescriptorSets(gpu.device(), 1, &w, 0, nullptr);
     DrawConstants& c = out.materialConstants[m];
     c.model = glm::mat4(1.0f);
     c.baseColorFactor = mat.baseColorFactor;
-    // w: occlusion strength, sampled from the metallic-roughness texture's R channel (packed ORM); 0 when the
-    // occlusion texture is another image, which has no descriptor slot (see Material::occlusionTexture).
-    const bool packedOcclusion = mat.occlusionTexture >= 0 && mat.occlusionTexture == mat.metallicRoughnessTexture &&
-                                 mat.occlusionUv == mat.metallicRoughnessUv && out.textures[mat.occlusionTexture].image;
+    // w: occlusion strength (the occlusion binding's R channel); 0 without an occlusion image (white is bound).
+    const bool occlusion = mat.occlusionTexture >= 0 && out.textures[mat.occlusionTexture].image;
     c.material = glm::vec4(mat.metallicFactor, mat.roughnessFactor, mat.normalScale,
-                           packedOcclusion ? std::clamp(mat.occlusionStrength, 0.0f, 1.0f) : 0.0f);
-    c.emissive = glm::vec4(mat.emissiveFactor, 0.0f);
+                           occlusion ? std::clamp(mat.occlusionStrength, 0.0f, 1.0f) : 0.0f);
+    c.emissive = mat.emissiveFactor;
+    c.alphaMode = uint32_t(mat.alphaMode);
+    c.alphaCutoff = mat.alphaCutoff;
+    c.instance = 0;
   }
   return {};
 }

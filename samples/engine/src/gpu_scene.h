@@ -35,8 +35,12 @@ struct GpuScene {
   std::vector<GpuTexture> textureViews;  // public view of `textures`
   VkDescriptorPool materialPool = VK_NULL_HANDLE;
   std::vector<VkDescriptorSet> materialSets;
-  std::vector<DrawConstants> materialConstants;  // model matrix filled per draw
+  std::vector<DrawConstants> materialConstants;  // model matrix and instance filled per draw
   Bounds bounds;
+  // Scene::instances indices by their material's AlphaMode (index = the enum's value), in scene order: what
+  // each pass draws and with which pipeline.
+  std::array<std::vector<uint32_t>, 3> instancesByAlpha;
+  std::vector<glm::vec3> meshCenters;  // per mesh: its bounding-box centre (local), for sorting BLEND draws
   // Per Scene instance, what the raster passes draw: this frame's world transform, and the position /
   // attribute buffers (the mesh's, or the instance's deformed buffers).
   std::vector<glm::mat4> instanceTransforms;

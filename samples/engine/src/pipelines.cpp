@@ -30,38 +30,50 @@ VkDescriptorSetLayoutBinding samplerBinding(uint32_t binding) {
   return {binding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
 }
 
+enum class VertexInput {
+  None,          // fullscreen passes
+  Positions,     // binding 0 only
+  PositionsUvs,  // binding 0 + the UV of binding 1 (location 2)
+  Full,          // positions (binding 0) + attributes (binding 1)
+};
+
 struct PipelineDesc {
   VkShaderModule vert = VK_NULL_HANDLE;
   VkShaderModule frag = VK_NULL_HANDLE;
-  bool sceneVertices = true;   // positions (binding 0) + attributes (binding 1)
-  bool positionsOnly = false;  // binding 0 only
+  VertexInput vertices = VertexInput::Full;
   std::vector<VkFormat> colorFormats;
   VkFormat depthFormat = VK_FORMAT_UNDEFINED;
   bool depthTest = false, depthWrite = false;
   VkCompareOp depthCompare = VK_COMPARE_OP_LESS;
   bool depthBias = false;
+  bool dynamicCulling = false;  // cull mode and front face set per draw (else: no culling)
+  bool alphaTested = false;     // fragment specialization constant 0 (kAlphaTested in surface.glsl)
+  bool blend = false;           // colour = src * src alpha + dst * (1 - src alpha)
   VkPipelineLayout layout = VK_NULL_HANDLE;
 };
 
 std::string makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out) {
+  const VkBool32 alphaTested = d.alphaTested;
+  const VkSpecializationMapEntry alphaTestedEntry{0, 0, sizeof(VkBool32)};
+  const VkSpecializationInfo specialization{1, &alphaTestedEntry, sizeof(alphaTested), &alphaTested};
   std::vector<VkPipelineShaderStageCreateInfo> stages;
   stages.push_back({VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT, d.vert,
                     "main", nullptr});
   if (d.frag)
     stages.push_back({VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT,
-                      d.frag, "main", nullptr});
+                      d.frag, "main", d.alphaTested ? &specialization : nullptr});
   std::vector<VkVertexInputBindingDescription> bindings;
   std::vector<VkVertexInputAttributeDescription> attributes;
-  if (d.sceneVertices || d.positionsOnly) {
+  if (d.vertices != VertexInput::None) {
     bindings.push_back({0, 12, VK_VERTEX_INPUT_RATE_VERTEX});
     attributes.push_back({0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0});
   }
-  if (d.sceneVertices && !d.positionsOnly) {
+  if (d.vertices == VertexInput::PositionsUvs || d.vertices == VertexInput::Full)
     bindings.push_back({1, 36, VK_VERTEX_INPUT_RATE_VERTEX});
-    attributes.push_back({1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0});
+  if (d.vertices == VertexInput::Full) attributes.push_back({1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0});
+  if (d.vertices == VertexInput::PositionsUvs || d.vertices == VertexInput::Full)
     attributes.push_back({2, 1, VK_FORMAT_R32G32_SFLOAT, 12});
-    attributes.push_back({3, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 20});
-  }
+  if (d.vertices == VertexInput::Full) attributes.push_back({3, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 20});
   VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
   vi.vertexBindingDescriptionCount = uint32_t(bindings.size());
   vi.pVertexBindingDescriptions = bindings.data();
@@ -74,7 +86,8 @@ std::string makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out
   vp.scissorCount = 1;
   VkPipelineRasterizationStateCreateInfo rs{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
   rs.polygonMode = VK_POLYGON_MODE_FILL;
-  rs.cullMode = VK_CULL_MODE_NONE;  // glTF double-sided materials and open meshes; shaders face normals
+  // Static: no culling (the shadow passes, fullscreen triangles). Dynamic: per draw (drawScene).
+  rs.cullMode = VK_CULL_MODE_NONE;
   rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
   rs.depthBiasEnable = d.depthBias;
   rs.lineWidth = 1.0f;
@@ -85,14 +98,24 @@ std::string makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out
   ds.depthWriteEnable = d.depthWrite;
   ds.depthCompareOp = d.depthCompare;
   std::vector<VkPipelineColorBlendAttachmentState> blends(d.colorFormats.size());
-  for (auto& b : blends)
+  for (auto& b : blends) {
     b.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
                        VK_COLOR_COMPONENT_A_BIT;
+    if (!d.blend) continue;
+    b.blendEnable = VK_TRUE;  // glTF BLEND: the Porter-Duff "over" of the shaded colour with opacity alpha
+    b.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+    b.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    b.colorBlendOp = VK_BLEND_OP_ADD;
+    b.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    b.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    b.alphaBlendOp = VK_BLEND_OP_ADD;
+  }
   VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
   cb.attachmentCount = uint32_t(blends.size());
   cb.pAttachments = blends.data();
   std::vector<VkDynamicState> dyn = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
   if (d.depthBias) dyn.push_back(VK_DYNAMIC_STATE_DEPTH_BIAS);
+  if (d.dynamicCulling) dyn.insert(dyn.end(), {VK_DYNAMIC_STATE_CULL_MODE, VK_DYNAMIC_STATE_FRONT_FACE});  // core 1.3
   VkPipelineDynamicStateCreateInfo dy{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
   dy.dynamicStateCount = uint32_t(dyn.size());
   dy.pDynamicStates = dyn.data();
@@ -143,7 +166,8 @@ std::string Pipelines::create(VkDevice device) {
                       {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1,
                         VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, nullptr}},
                       frameSetLayout));
-  check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3)},
+  check(makeSetLayout(device,
+                      {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3), samplerBinding(4)},
                       materialSetLayout));
   check(makeSetLayout(device,
                       {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3), samplerBinding(4)},
@@ -173,11 +197,14 @@ std::string Pipelines::create(VkDevice device) {
   lci.pPushConstantRanges = &screenRange;
   SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &screenLayout));
 
-  VkShaderModule meshVert = VK_NULL_HANDLE, shadowVert = VK_NULL_HANDLE, prepassFrag = VK_NULL_HANDLE,
-                 forwardFrag = VK_NULL_HANDLE, fullscreenVert = VK_NULL_HANDLE, tonemapFrag = VK_NULL_HANDLE,
-                 ssaoFrag = VK_NULL_HANDLE, ssaoBlurFrag = VK_NULL_HANDLE, shadowVisibilityFrag = VK_NULL_HANDLE;
+  VkShaderModule meshVert = VK_NULL_HANDLE, shadowVert = VK_NULL_HANDLE, shadowAlphaVert = VK_NULL_HANDLE,
+                 shadowAlphaFrag = VK_NULL_HANDLE, prepassFrag = VK_NULL_HANDLE, forwardFrag = VK_NULL_HANDLE,
+                 fullscreenVert = VK_NULL_HANDLE, tonemapFrag = VK_NULL_HANDLE, ssaoFrag = VK_NULL_HANDLE,
+                 ssaoBlurFrag = VK_NULL_HANDLE, shadowVisibilityFrag = VK_NULL_HANDLE;
   check(makeModule(device, spirv::mesh_vert, meshVert));
   check(makeModule(device, spirv::shadow_vert, shadowVert));
+  check(makeModule(device, spirv::shadow_alpha_vert, shadowAlphaVert));
+  check(makeModule(device, spirv::shadow_alpha_frag, shadowAlphaFrag));
   check(makeModule(device, spirv::prepass_frag, prepassFrag));
   check(makeModule(device, spirv::forward_frag, forwardFrag));
   check(makeModule(device, spirv::fullscreen_vert, fullscreenVert));
@@ -186,15 +213,24 @@ std::string Pipelines::create(VkDevice device) {
   check(makeModule(device, spirv::ssao_blur_frag, ssaoBlurFrag));
   check(makeModule(device, spirv::shadow_visibility_frag, shadowVisibilityFrag));
   if (e.empty()) {
+    // The shadow map keeps culling off whatever Material::doubleSided says: doubleSided is about which side
+    // the camera may see, not about what blocks light. A single-sided wall, roof or leaf whose back faces the
+    // sun must still shadow what is behind it (as the SDK's two-sided shadow rays see it), and a closed mesh
+    // casts the same shadow with either side culled.
     PipelineDesc d;
     d.vert = shadowVert;
-    d.positionsOnly = true;
+    d.vertices = VertexInput::Positions;
     d.depthFormat = kDepthFormat;
     d.depthTest = d.depthWrite = true;
     d.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
     d.depthBias = true;
     d.layout = sceneLayout;
     check(makePipeline(device, d, shadow));
+
+    d.vert = shadowAlphaVert;
+    d.frag = shadowAlphaFrag;
+    d.vertices = VertexInput::PositionsUvs;
+    check(makePipeline(device, d, shadowAlpha));
 
     d = {};
     d.vert = meshVert;
@@ -203,24 +239,39 @@ std::string Pipelines::create(VkDevice device) {
     d.depthFormat = kDepthFormat;
     d.depthTest = d.depthWrite = true;
     d.depthCompare = VK_COMPARE_OP_LESS;
+    d.dynamicCulling = true;
     d.layout = sceneLayout;
     check(makePipeline(device, d, prepass));
+    d.alphaTested = true;
+    check(makePipeline(device, d, prepassMasked));
 
     d.frag = forwardFrag;
     d.colorFormats = {kHdrFormat};
     d.depthWrite = false;
     d.depthCompare = VK_COMPARE_OP_EQUAL;  // only the surface the pre-pass kept gets shaded
+    d.alphaTested = false;
     check(makePipeline(device, d, forward));
+    d.alphaTested = true;
+    check(makePipeline(device, d, forwardMasked));
+
+    // In front of what the pre-pass (or the probe's opaque draws) left, never hiding what follows.
+    d.depthCompare = VK_COMPARE_OP_LESS;
+    d.alphaTested = false;
+    d.blend = true;
+    check(makePipeline(device, d, blend));
+    d.blend = false;
 
     // Probe faces have no pre-pass: the capture does its own depth test.
     d.depthWrite = true;
     d.depthCompare = VK_COMPARE_OP_LESS;
     check(makePipeline(device, d, probeCapture));
+    d.alphaTested = true;
+    check(makePipeline(device, d, probeCaptureMasked));
 
     d = {};
     d.vert = fullscreenVert;
     d.frag = tonemapFrag;
-    d.sceneVertices = false;
+    d.vertices = VertexInput::None;
     d.colorFormats = {kLdrFormat};
     d.layout = tonemapLayout;
     check(makePipeline(device, d, tonemap));
@@ -234,8 +285,8 @@ std::string Pipelines::create(VkDevice device) {
     d.frag = shadowVisibilityFrag;
     check(makePipeline(device, d, shadowVisibility));
   }
-  for (VkShaderModule m : {meshVert, shadowVert, prepassFrag, forwardFrag, fullscreenVert, tonemapFrag, ssaoFrag,
-                           ssaoBlurFrag, shadowVisibilityFrag})
+  for (VkShaderModule m : {meshVert, shadowVert, shadowAlphaVert, shadowAlphaFrag, prepassFrag, forwardFrag,
+                           fullscreenVert, tonemapFrag, ssaoFrag, ssaoBlurFrag, shadowVisibilityFrag})
     if (m) vkDestroyShaderModule(device, m, nullptr);
   if (!e.empty()) return e;
 
@@ -250,7 +301,8 @@ std::string Pipelines::create(VkDevice device) {
 }
 
 void Pipelines::destroy(VkDevice device) {
-  for (VkPipeline p : {shadow, prepass, forward, tonemap, probeCapture, ssao, ssaoBlur, shadowVisibility})
+  for (VkPipeline p : {shadow, shadowAlpha, prepass, prepassMasked, forward, forwardMasked, blend, tonemap,
+                       probeCapture, probeCaptureMasked, ssao, ssaoBlur, shadowVisibility})
     if (p) vkDestroyPipeline(device, p, nullptr);
   for (VkPipelineLayout l : {sceneLayout, tonemapLayout, screenLayout})
     if (l) vkDestroyPipelineLayout(device, l, nullptr);

@@ -1,10 +1,14 @@
 // Descriptor-set layouts, pipeline layouts, samplers and the graphics pipelines of every pass.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 
 #include <vulkan/vulkan.h>
 #include <glm/glm.hpp>
+
+#include "sample_engine/scene.h"
 
 namespace sample_engine::detail {
 
@@ -17,13 +21,26 @@ struct FrameUniforms {
   glm::vec4 probe;  // x: 1 = sample the reflection probe, y: its last mip level
 };
 
-// Mirror of DrawConstants in shaders/common.glsl (push constants, vertex + fragment).
+// Mirror of DrawConstants in shaders/common.glsl (push constants, vertex + fragment; std430 layout).
 struct DrawConstants {
-  glm::mat4 model;
+  glm::mat4 model;  // instance-local -> camera-relative, per draw
   glm::vec4 baseColorFactor;
-  glm::vec4 material;
-  glm::vec4 emissive;
+  glm::vec4 material;  // x: metallic, y: perceptual roughness, z: normal scale, w: occlusion strength (0 = none)
+  glm::vec3 emissive;
+  uint32_t alphaMode;  // Material::alphaMode (SE_ALPHA_* in common.glsl)
+  float alphaCutoff;   // Material::alphaCutoff
+  uint32_t instance;   // Scene::instances index, per draw (seeds the hashed shadow test of BLEND draws)
 };
+static_assert(offsetof(DrawConstants, baseColorFactor) == 64);
+static_assert(offsetof(DrawConstants, material) == 80);
+static_assert(offsetof(DrawConstants, emissive) == 96);
+static_assert(offsetof(DrawConstants, alphaMode) == 108);
+static_assert(offsetof(DrawConstants, alphaCutoff) == 112);
+static_assert(offsetof(DrawConstants, instance) == 116);
+static_assert(sizeof(DrawConstants) == 120);
+static_assert(sizeof(DrawConstants) <= 128, "Vulkan guarantees 128 bytes of push constants");
+// SE_ALPHA_OPAQUE / MASK / BLEND in shaders/common.glsl.
+static_assert(uint32_t(AlphaMode::Opaque) == 0 && uint32_t(AlphaMode::Mask) == 1 && uint32_t(AlphaMode::Blend) == 2);
 
 inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 inline constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
@@ -31,7 +48,8 @@ inline constexpr VkFormat kHdrFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kLdrFormat = VK_FORMAT_R8G8B8A8_SRGB;
 // Single-channel effect images (SSAO, shadow visibility): 16-bit float keeps smooth gradients for readback.
 inline constexpr VkFormat kEffectFormat = VK_FORMAT_R16_SFLOAT;
-inline constexpr uint32_t kScreenSetBindings = 4;  // combined image samplers of a fullscreen pass (set 1)
+inline constexpr uint32_t kScreenSetBindings = 4;    // combined image samplers of a fullscreen pass (set 1)
+inline constexpr uint32_t kMaterialSetBindings = 5;  // base colour, metallic-roughness, normal, emissive, occlusion
 inline constexpr uint32_t kLightingSetBindings = 5;
 
 // Mirror of SsaoConstants in shaders/ssao.frag and ssao_blur.frag (push constants of the fullscreen passes).
@@ -55,11 +73,22 @@ struct Pipelines {
   VkPipelineLayout sceneLayout = VK_NULL_HANDLE;
   VkPipelineLayout tonemapLayout = VK_NULL_HANDLE;
   VkPipelineLayout screenLayout = VK_NULL_HANDLE;
-  VkPipeline shadow = VK_NULL_HANDLE;
+  // Scene pipelines come in pairs: OPAQUE draws, and MASK draws (*Masked: the alpha test's discard, which the
+  // opaque ones lack so that their depth writes keep early depth tests). BLEND draws use `blend` (and the
+  // shadow map's alpha-tested variant). Camera passes take cull mode and front face per draw (dynamic state,
+  // Material::doubleSided and the model matrix's handedness); the shadow passes never cull.
+  VkPipeline shadow = VK_NULL_HANDLE;       // positions only, no fragment shader: OPAQUE draws
+  VkPipeline shadowAlpha = VK_NULL_HANDLE;  // positions + UVs, alpha test (MASK: cutoff, BLEND: hashed)
   VkPipeline prepass = VK_NULL_HANDLE;
-  VkPipeline forward = VK_NULL_HANDLE;
+  VkPipeline prepassMasked = VK_NULL_HANDLE;
+  VkPipeline forward = VK_NULL_HANDLE;  // depth EQUAL against the pre-pass
+  VkPipeline forwardMasked = VK_NULL_HANDLE;
+  // BLEND draws, after the opaque lighting, in the main view and the probe capture: forward shading blended
+  // (src alpha, one minus src alpha) into the HDR target, depth LESS without writes.
+  VkPipeline blend = VK_NULL_HANDLE;
   VkPipeline tonemap = VK_NULL_HANDLE;
   VkPipeline probeCapture = VK_NULL_HANDLE;  // forward shading with its own depth test (LESS, writes)
+  VkPipeline probeCaptureMasked = VK_NULL_HANDLE;
   VkPipeline ssao = VK_NULL_HANDLE;
   VkPipeline ssaoBlur = VK_NULL_HANDLE;
   VkPipeline shadowVisibility = VK_NULL_HANDLE;

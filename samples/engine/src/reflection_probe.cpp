@@ -234,10 +234,15 @@ void ReflectionProbe::recordCapture(VkCommandBuffer cmd, uint32_t slot, const Fr
     depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
     depth.clearValue.depthStencil = {1.0f, 0};
     beginRendering(cmd, extent, {colorAttachment(faceViews_[f], clear)}, &depth);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.probeCapture);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.sceneLayout, 0, 1, &res.faceSets[f], 0, nullptr);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.sceneLayout, 2, 1, &res.lightingSet, 0, nullptr);
-    if (scene) drawScene(cmd, *scene, p, DrawPass::Lighting, glm::dvec3(key.position));
+    if (scene) {
+      // The faces are mirror images (see kFaceAxes): front faces wind the other way.
+      const glm::dvec3 origin(key.position);
+      drawScene(cmd, *scene, p, DrawPass::Lighting, {p.probeCapture, p.probeCaptureMasked}, origin,
+                ViewHandedness::MirroredCubeFace);
+      drawBlended(cmd, *scene, p, origin, ViewHandedness::MirroredCubeFace);
+    }
     vkCmdEndRendering(cmd);
   }
 

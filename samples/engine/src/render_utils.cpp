@@ -1,5 +1,8 @@
 #include "render_utils.h"
 
+#include <algorithm>
+#include <utility>
+
 namespace sample_engine::detail {
 
 VkRenderingAttachmentInfo colorAttachment(VkImageView view, VkClearColorValue clear) {
@@ -35,31 +38,113 @@ glm::mat4 rebasedTransform(const glm::mat4& world, const glm::dvec3& origin) {
   return out;
 }
 
+namespace {
+
+// Front faces wind counter-clockwise in a camera's image (glTF, the procedural meshes); a model matrix with a
+// negative determinant (a mirrored instance) and a mirrored view each reverse that.
+VkFrontFace frontFaceOf(const glm::mat4& model, ViewHandedness view) {
+  const bool mirrored = (glm::determinant(glm::mat3(model)) < 0.0f) != (view == ViewHandedness::MirroredCubeFace);
+  return mirrored ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
+}
+
+// Binds what instance `i` needs (vertex buffers, its material set unless `positionsOnly`), pushes its
+// constants and draws it.
+void drawInstance(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, uint32_t i, const glm::mat4& model,
+                  bool positionsOnly, uint32_t& boundMaterial) {
+  const GpuMesh& mesh = scene.meshes[scene.cpu.instances[i].mesh];
+  // The instance's own deformed buffers when it deforms, else the mesh's.
+  const VkBuffer* buffers = scene.instanceVertices[i].data();
+  VkDeviceSize offsets[2] = {0, 0};
+  vkCmdBindVertexBuffers(cmd, 0, positionsOnly ? 1 : 2, buffers, offsets);
+  if (!positionsOnly && boundMaterial != mesh.material) {
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.sceneLayout, 1, 1,
+                            &scene.materialSets[mesh.material], 0, nullptr);
+    boundMaterial = mesh.material;
+  }
+  DrawConstants c = scene.materialConstants[mesh.material];
+  c.model = model;
+  c.instance = i;
+  vkCmdPushConstants(cmd, p.sceneLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(c), &c);
+  if (mesh.indexCount > 0) {
+    vkCmdBindIndexBuffer(cmd, mesh.indexBuffer, 0, VK_INDEX_TYPE_UINT32);
+    vkCmdDrawIndexed(cmd, mesh.indexCount, 1, 0, 0, 0);
+  } else {
+    vkCmdDraw(cmd, mesh.vertexCount, 1, 0, 0);
+  }
+}
+
+bool drawable(const GpuScene& scene, uint32_t i) { return scene.meshes[scene.cpu.instances[i].mesh].vertexCount > 0; }
+
+const Material& materialOf(const GpuScene& scene, uint32_t i) {
+  return scene.cpu.materials[scene.meshes[scene.cpu.instances[i].mesh].material];
+}
+
+}  // namespace
+
 void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass,
-               const glm::dvec3& origin) {
+               const PassPipelines& pipelines, const glm::dvec3& origin, ViewHandedness view) {
+  const auto& opaque = scene.instancesByAlpha[size_t(AlphaMode::Opaque)];
+  const auto& masked = scene.instancesByAlpha[size_t(AlphaMode::Mask)];
+  const auto& blended = scene.instancesByAlpha[size_t(AlphaMode::Blend)];
   uint32_t boundMaterial = UINT32_MAX;
-  for (size_t i = 0; i < scene.cpu.instances.size(); ++i) {
-    const Instance& inst = scene.cpu.instances[i];
-    const GpuMesh& mesh = scene.meshes[inst.mesh];
-    if (mesh.vertexCount == 0) continue;
-    // The instance's own deformed buffers when it deforms, else the mesh's.
-    const VkBuffer* buffers = scene.instanceVertices[i].data();
-    VkDeviceSize offsets[2] = {0, 0};
-    vkCmdBindVertexBuffers(cmd, 0, pass == DrawPass::Shadow ? 1 : 2, buffers, offsets);
-    if (pass != DrawPass::Shadow && boundMaterial != mesh.material) {
-      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.sceneLayout, 1, 1,
-                              &scene.materialSets[mesh.material], 0, nullptr);
-      boundMaterial = mesh.material;
+  if (pass == DrawPass::Shadow) {
+    // No culling (see Pipelines::create). Opaque casters need positions only; the others their alpha test.
+    auto draw = [&](const std::vector<uint32_t>& list, VkPipeline pipeline, bool positionsOnly) {
+      bool bound = false;
+      for (uint32_t i : list) {
+        if (!drawable(scene, i)) continue;
+        if (!bound) vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+        bound = true;
+        drawInstance(cmd, scene, p, i, rebasedTransform(scene.instanceTransforms[i], origin), positionsOnly,
+                     boundMaterial);
+      }
+    };
+    draw(opaque, p.shadow, true);
+    draw(masked, p.shadowAlpha, false);
+    draw(blended, p.shadowAlpha, false);
+    return;
+  }
+  for (const auto& [list, pipeline] : {std::pair{&opaque, pipelines.opaque}, std::pair{&masked, pipelines.masked}}) {
+    bool bound = false;
+    for (uint32_t i : *list) {
+      if (!drawable(scene, i)) continue;
+      if (!bound) vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+      bound = true;
+      const glm::mat4 model = rebasedTransform(scene.instanceTransforms[i], origin);
+      // Single-sided (glTF doubleSided false): back faces are culled. Double-sided: both sides are drawn and
+      // surface.glsl turns the shading normal towards the viewer.
+      vkCmdSetCullMode(cmd, materialOf(scene, i).doubleSided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT);
+      vkCmdSetFrontFace(cmd, frontFaceOf(model, view));
+      drawInstance(cmd, scene, p, i, model, false, boundMaterial);
     }
-    DrawConstants c = scene.materialConstants[mesh.material];
-    c.model = rebasedTransform(scene.instanceTransforms[i], origin);
-    vkCmdPushConstants(cmd, p.sceneLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(c), &c);
-    if (mesh.indexCount > 0) {
-      vkCmdBindIndexBuffer(cmd, mesh.indexBuffer, 0, VK_INDEX_TYPE_UINT32);
-      vkCmdDrawIndexed(cmd, mesh.indexCount, 1, 0, 0, 0);
-    } else {
-      vkCmdDraw(cmd, mesh.vertexCount, 1, 0, 0);
+  }
+}
+
+void drawBlended(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, const glm::dvec3& origin,
+                 ViewHandedness view) {
+  const auto& blended = scene.instancesByAlpha[size_t(AlphaMode::Blend)];
+  if (blended.empty()) return;
+  std::vector<std::pair<double, uint32_t>> order;  // squared distance, instance
+  order.reserve(blended.size());
+  for (uint32_t i : blended) {
+    if (!drawable(scene, i)) continue;
+    const glm::dvec4 center = glm::dmat4(scene.instanceTransforms[i]) *
+                              glm::dvec4(scene.meshCenters[scene.cpu.instances[i].mesh], 1.0);
+    const glm::dvec3 d = glm::dvec3(center) - origin;
+    order.push_back({glm::dot(d, d), i});
+  }
+  std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.blend);
+  uint32_t boundMaterial = UINT32_MAX;
+  for (const auto& [distance, i] : order) {
+    const glm::mat4 model = rebasedTransform(scene.instanceTransforms[i], origin);
+    vkCmdSetFrontFace(cmd, frontFaceOf(model, view));
+    if (materialOf(scene, i).doubleSided) {
+      vkCmdSetCullMode(cmd, VK_CULL_MODE_FRONT_BIT);
+      drawInstance(cmd, scene, p, i, model, false, boundMaterial);
     }
+    vkCmdSetCullMode(cmd, VK_CULL_MODE_BACK_BIT);
+    drawInstance(cmd, scene, p, i, model, false, boundMaterial);
   }
 }
 

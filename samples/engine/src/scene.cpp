@@ -122,6 +122,9 @@ void finalizeScene(Scene& scene) {
     for (int* t : {&mat.baseColorTexture, &mat.metallicRoughnessTexture, &mat.normalTexture, &mat.emissiveTexture,
                    &mat.occlusionTexture})
       if (*t >= textureCount) *t = -1;
+    // As the glTF loader reads an unknown alphaMode and a bad cutoff (glTF's default 0.5).
+    if (mat.alphaMode != AlphaMode::Mask && mat.alphaMode != AlphaMode::Blend) mat.alphaMode = AlphaMode::Opaque;
+    if (!std::isfinite(mat.alphaCutoff)) mat.alphaCutoff = 0.5f;
   }
   for (MeshData& m : scene.meshes) {
     if (m.material >= scene.materials.size()) m.material = 0;

@@ -1,7 +1,27 @@
 // The sample forward engine: owns a Vulkan 1.3 instance/device/queue, renders a Scene with
 //   shadow map -> [probe capture] -> depth+normal pre-pass -> [SSAO] -> [shadow visibility] -> [pre-pass hook]
-//   -> forward PBR lighting -> tonemap
+//   -> forward PBR lighting -> blended surfaces -> tonemap
 // into an offscreen image (read back to the CPU) and optionally presents it to a swapchain.
+//
+// Materials (scene.h): glTF metallic-roughness with base colour, metallic-roughness, normal, emissive and
+// occlusion textures, and the glTF alpha modes and sidedness in every raster pass:
+//   * OPAQUE: pre-pass, lighting (depth EQUAL), shadow map (positions only).
+//   * MASK: as OPAQUE, with fragments where alpha < alphaCutoff discarded in every pass (the shadow map takes
+//     an alpha-tested pipeline for them; opaque draws keep the positions-only one).
+//   * BLEND: not in the pre-pass, so the depth and normals the hook and the SSAO see are the opaque scene's.
+//     After the opaque lighting they are shaded like it and blended into the HDR target (src alpha, one minus
+//     src alpha), depth test LESS against the pre-pass depth without writes, sorted back to front by the
+//     distance from the eye to each instance's bounding-box centre (a double-sided one draws its back faces
+//     first). Lighting: sun with the shadow map when one is drawn (else unshadowed), the sky ambient and the
+//     engine's own environment term (probe or constant sky). The LightingInputs describe the opaque surface
+//     behind, so blended surfaces ignore all three of them (and the SSAO). In the shadow map a BLEND surface
+//     casts with a hashed alpha test: each shadow-map texel is covered with probability alpha (a hash of the
+//     texel and the instance, stable from frame to frame), so after PCF it blocks alpha of the light in the
+//     mean, like the SDK's stochastic BLEND shadows.
+//   * Material::doubleSided false culls back faces in the camera passes (cull mode and front face per draw,
+//     the winding flipped for model matrices with a negative determinant); the shadow map never culls.
+// Mip-mapped MASK textures are not coverage-corrected (thin cut-outs thin out at a distance), and blended
+// surfaces are sorted per instance, not per triangle.
 //
 // Animated scenes (glTF node animation, skins, morph targets): each frame first evaluates the animation on
 // the CPU (FrameParams::time / animations / restPose), then, when the scene has deforming (skinned and/or
@@ -147,6 +167,9 @@ struct ReflectionProbeSettings {
 // External images the lighting pass samples instead of its own terms. Each must be a 2D view that stays
 // valid until the frame completes, in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL when the lighting pass
 // runs, and covering the whole viewport (any resolution: sampled bilinearly at the pixel's UV).
+// They describe the opaque surface of the pre-pass at each pixel, so they light OPAQUE and MASK surfaces only:
+// a BLEND surface in front of it takes the shadow map (unshadowed without one), no AO image and the engine's
+// own environment term instead.
 struct LightingInputs {
   // R channel, 1 = lit, 0 = shadowed (R8_UNORM / R16_SFLOAT / R32_SFLOAT...). Replaces the shadow map.
   VkImageView sunVisibility = VK_NULL_HANDLE;
@@ -214,6 +237,8 @@ struct PrepassHookInfo {
   uint32_t frameIndex = 0;                         // frame in flight, 0..kFramesInFlight-1
   uint64_t frameNumber = 0;                        // increments every rendered frame
   VkExtent2D extent{};                             // viewport = size of every pre-pass image
+  // The pre-pass images hold OPAQUE and MASK surfaces only (MASK cut-outs show what is behind); BLEND ones
+  // are drawn after the lighting pass and never appear here.
   // D32_SFLOAT, standard depth (1.0 = far plane / background), DEPTH_READ_ONLY_OPTIMAL.
   PassImage depth;
   // RGBA16F: xyz = shading normal (world space, normal-mapped, facing the camera), w = perceptual
@@ -305,7 +330,7 @@ struct PassTimings {
   double ssaoMs = 0.0;              // SSAO + blur (0 when disabled)
   double shadowVisibilityMs = 0.0;  // shadow-visibility output (0 unless requested)
   double hookMs = 0.0;              // whatever the hook recorded
-  double lightingMs = 0.0;
+  double lightingMs = 0.0;          // opaque lighting and the blended surfaces after it
   double tonemapMs = 0.0;
   double deformMs = 0.0;       // the deformation submission (skinning / morphing); 0 when nothing deforms
   bool probeCaptured = false;  // this frame captured the reflection probe

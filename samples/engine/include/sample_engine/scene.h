@@ -78,12 +78,13 @@ struct UvMapping {
 };
 
 // How a material's coverage is decided (glTF alphaMode). alpha = baseColorFactor.a * the base colour
-// texture's alpha.
+// texture's alpha, sampled with MeshData::uvs like every other texture.
 enum class AlphaMode : uint8_t {
-  Opaque,  // covers everything (glTF OPAQUE)
-  Mask,    // cut out where alpha < Material::alphaCutoff (glTF MASK): discarded in every raster pass
-  Blend,   // blended over what is behind with opacity alpha (glTF BLEND): a forward pass after lighting,
-           // never in the pre-pass / G-buffer
+  Opaque,  // covers everything, alpha ignored (glTF OPAQUE)
+  Mask,    // cut out where alpha < Material::alphaCutoff (glTF MASK): discarded in every raster pass (pre-pass,
+           // lighting, shadow map, reflection-probe capture)
+  Blend,   // blended over what is behind with opacity alpha (glTF BLEND): drawn after the opaque lighting,
+           // back to front, never into the pre-pass / G-buffer; casts a hashed shadow (see engine.h)
 };
 
 // glTF 2.0 metallic-roughness material. Texture indices are into Scene::textures, -1 = none.
@@ -101,17 +102,20 @@ struct Material {
   int metallicRoughnessTexture = -1;  // glTF layout: G = roughness, B = metallic
   int normalTexture = -1;
   int emissiveTexture = -1;  // sRGB, multiplied by emissiveFactor
-  // Ambient occlusion (glTF occlusionTexture, R channel): ambient *= mix(1, R, occlusionStrength). The
-  // engine applies it when it is the metallic-roughness texture with the same mapping (packed ORM, the usual
-  // case); a separate occlusion image is kept here but not sampled (the material descriptor set has no slot).
+  // Ambient occlusion (glTF occlusionTexture, R channel, linear): the ambient (sky) and environment terms are
+  // multiplied by mix(1, R, occlusionStrength), whichever image it is (a packed ORM's metallic-roughness
+  // texture or a separate one). Strength is clamped to [0, 1].
   int occlusionTexture = -1;
   float occlusionStrength = 1.0f;
   UvMapping baseColorUv, metallicRoughnessUv, normalUv, emissiveUv, occlusionUv;
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alphaCutoff = 0.5f;  // Mask only (glTF's default 0.5)
-  // false: back faces (clockwise in the image, after the model matrix's handedness) are culled in raster.
-  // true: both sides are drawn and the shading normal faces the viewer. Default true, so procedural meshes
-  // need not be closed or consistently wound; the glTF loader sets the file's value (glTF's default false).
+  // false: back faces (clockwise in the image; a model matrix with a negative determinant flips the winding)
+  // are culled in the camera passes: pre-pass, lighting, blend pass, reflection-probe capture. The shadow map
+  // draws both sides (a surface seen from behind still blocks the sun). true: both sides are drawn and the
+  // shading normal faces the viewer. Default true, so hand-built meshes need not be closed or consistently
+  // wound (the procedural ones are counter-clockwise outward); the glTF loader sets the file's value (glTF's
+  // default false).
   bool doubleSided = true;
 };
 
@@ -238,7 +242,8 @@ struct Scene {
 // own camera and sun. Returns the index in dst.animations of src's first animation.
 uint32_t appendScene(Scene& dst, const Scene& src, const glm::mat4& placement);
 
-// Fills missing normals/UVs/tangents, clamps material indices and adds a default material if needed.
+// Fills missing normals/UVs/tangents, clamps material and texture indices, adds a default material if needed,
+// and reads an AlphaMode beyond Blend as Opaque and a non-finite alphaCutoff as 0.5.
 // The engine calls this on its own copy during upload; call it yourself to inspect the final arrays.
 void finalizeMesh(MeshData& mesh);
 void finalizeScene(Scene& scene);
