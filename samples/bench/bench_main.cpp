@@ -98,6 +98,7 @@ int run(const BenchOptions& options) {
       {"tlas", [&] { return runTlasScenario(env); }},
       {"trace", [&] { return runTraceScenario(env); }},
       {"gigarays", [&] { return runGigaRaysScenario(env); }},
+      {"alpha", [&] { return runAlphaScenario(env); }},
   };
   // A failing scenario is reported and the others still run (a GPU session is too costly to lose whole).
   std::vector<std::string> failures;

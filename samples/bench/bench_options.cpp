@@ -6,8 +6,9 @@
 namespace rbbench {
 
 const std::vector<std::string>& scenarioNames() {
-  static const std::vector<std::string> names = {"build", "duplication", "fastbuild-vs-fasttrace", "compaction", "tlas",
-                                                 "trace", "gigarays"};
+  static const std::vector<std::string> names = {"build",      "duplication", "fastbuild-vs-fasttrace",
+                                                 "compaction", "tlas",        "trace",
+                                                 "gigarays",   "alpha"};
   return names;
 }
 

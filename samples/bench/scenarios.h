@@ -24,5 +24,8 @@ nlohmann::json runTlasScenario(BenchEnv& env);
 nlohmann::json runTraceScenario(BenchEnv& env);
 // The thesis's stress (many rays per pixel, all hit) and miss scenarios: the device's raw trace rate.
 nlohmann::json runGigaRaysScenario(BenchEnv& env);
+// Shadow pass GPU time with 0%, 10%, 50% and 100% of a leaf canopy's triangles alpha-tested (any-hit), against
+// the all-opaque scene.
+nlohmann::json runAlphaScenario(BenchEnv& env);
 
 }  // namespace rbbench
