@@ -329,9 +329,9 @@ TEST_CASE("pass memory follows the enabled effects at run time", "[adapter][memo
   CHECK(fx.reflectionPass() == nullptr);
   CHECK(fx.shadowDenoiser() == nullptr);  // hard shadows are never denoised
 
-  REQUIRE(fx.applyPreset(rb::Preset::Ultra).ok());  // all effects, soft shadows: two denoisers
+  REQUIRE(fx.applyPreset(rb::Preset::Ultra).ok());  // the thesis's three effects, soft shadows: two denoisers
   const rb::MemoryStats all = settle();
-  CHECK(fx.desc().effects == rb::kAllEffects);
+  CHECK(fx.desc().effects == rb::kThesisEffects);
   CHECK(fx.aoPass() != nullptr);
   CHECK(fx.reflectionPass() != nullptr);
   CHECK(fx.shadowDenoiser() != nullptr);
