@@ -7,6 +7,8 @@
 namespace rbAdapter {
 namespace se = sample_engine;
 namespace {
+static_assert(uint32_t(se::AlphaMode::Mask) == uint32_t(rb::AlphaMode::Mask) &&
+              uint32_t(se::AlphaMode::Blend) == uint32_t(rb::AlphaMode::Blend));
 
 std::string message(const char* what, const rb::Error& e) {
   return std::string(what) + ": " + rb::toString(e.code) + ": " + e.message;
@@ -37,10 +39,8 @@ void convertMaterials(const se::Scene& scene, std::span<const se::GpuTexture> gp
     r.metallicRoughnessTexture = slot(m.metallicRoughnessTexture, false);
     r.emissiveTexture = slot(m.emissiveTexture, true);
     std::memcpy(r.emissive, &m.emissiveFactor[0], sizeof(r.emissive));
-    // Cut-outs and blending, with the UVs the engine samples (its loader bakes texture transforms into them).
-    r.alphaMode = m.alphaMode == se::AlphaMode::Mask    ? rb::AlphaMode::Mask
-                  : m.alphaMode == se::AlphaMode::Blend ? rb::AlphaMode::Blend
-                                                        : rb::AlphaMode::Opaque;
+    // Cut-outs and blending (same enumerator order), with the UVs the engine samples (texture transforms baked).
+    r.alphaMode = rb::AlphaMode(uint32_t(m.alphaMode));
     r.alphaCutoff = m.alphaMode == se::AlphaMode::Mask ? std::max(m.alphaCutoff, 1e-6f) : 0.0f;  // 0 = default
     out.push_back(r);
   }
