@@ -10,9 +10,11 @@
 // No BRDF and no albedo: the engine multiplies by its diffuse colour (Lambert: albedo / pi * E).
 //
 // How (ManyLightSettings::mode):
-//   Stochastic  a fixed number of shadow rays per pixel whatever the light count. Per ray, the pixel draws
-//               candidates from the lights that can reach its screen tile and keeps one in proportion to its
-//               unshadowed contribution there (resampled importance sampling), then traces one shadow ray to it.
+//   Stochastic  a fixed number of shadow rays per pixel whatever the light count. Each ray keeps one of the
+//               lights that can reach the pixel's screen tile in proportion to its unshadowed contribution there
+//               and traces one shadow ray to it. The pixel weighs every listed light when its tile lists at most
+//               ManyLightSettings::candidates (exactly proportional), else that many drawn uniformly from the list
+//               (resampled importance sampling); the rays share the weighed candidates.
 //               Unbiased in the mean; noisy per frame (give the output to a Denoiser made with
 //               DenoiserDesc::signal = DenoiseSignal::Rgb). Where the tile holds no more lights than rays,
 //               every light gets its own ray instead (exact, no noise).
@@ -50,7 +52,9 @@ inline constexpr uint32_t kMaxLights = 65536;
 inline constexpr uint32_t kMaxTileLights = 256;     // lights one tile lists; more = candidates from all
 inline constexpr uint32_t kManyLightTileSize = 16;  // pixels per tile side
 inline constexpr uint32_t kDefaultLightRays = 1;    // shadow rays per pixel in Stochastic mode
-inline constexpr uint32_t kDefaultLightCandidates = 8;
+// Lights weighed per pixel: up to this many in a tile, selection is exactly proportional to the unshadowed
+// contribution; each costs a few ALU operations and no ray.
+inline constexpr uint32_t kDefaultLightCandidates = 32;
 
 // One light of the engine's list: the geometry and softness of rb::Light, with colour and intensity in
 // KHR_lights_punctual's units. Defaults are glTF's (colour white, intensity 1, inner cone angle 0).
@@ -72,7 +76,7 @@ enum class ManyLightMode : uint32_t {
 struct ManyLightSettings {
   ManyLightMode mode = ManyLightMode::Stochastic;
   uint32_t raysPerPixel = 0;  // Stochastic: 0 = kDefaultLightRays; at most 64
-  uint32_t candidates = 0;    // Stochastic: lights weighed per ray; 0 = kDefaultLightCandidates; at most 64
+  uint32_t candidates = 0;    // Stochastic: lights weighed per pixel; 0 = kDefaultLightCandidates; at most 64
   // Alpha-tested geometry (see ShadowSettings::materials); nullptr = every surface casts a solid shadow.
   const MaterialTable* materials = nullptr;
 };
