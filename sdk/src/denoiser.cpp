@@ -32,6 +32,7 @@ void multiply(const double a[16], const double b[16], double out[16]) {
 
 struct Denoiser::Impl {
   Context& ctx;
+  DenoiseSignal signal = DenoiseSignal::Scalar;
   ComputePipeline temporal, atrous;
   VkSampler sampler = VK_NULL_HANDLE;
   // 0,1: history ping-pong (RG16F); 2,3: view distance ping-pong (R32F); 4,5: spatial ping-pong (R16F);
@@ -56,8 +57,19 @@ struct Denoiser::Impl {
 Denoiser::Denoiser(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Denoiser::~Denoiser() = default;
 
-Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context) {
+Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context) { return create(context, DenoiserDesc{}); }
+
+Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const DenoiserDesc& desc) {
+  if (desc.signal != DenoiseSignal::Scalar && desc.signal != DenoiseSignal::Rgb) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "Denoiser: DenoiserDesc::signal has an unknown value " + std::to_string(uint32_t(desc.signal)) +
+                     "; use DenoiseSignal::Scalar or DenoiseSignal::Rgb"};
+  }
+  if (desc.signal == DenoiseSignal::Rgb) {
+    return Error{ErrorCode::NotReady, VK_SUCCESS, "Denoiser: DenoiseSignal::Rgb is not implemented yet on this branch"};
+  }
   auto impl = std::make_unique<Impl>(context);
+  impl->signal = desc.signal;
   const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
   auto sampled = [&](uint32_t b) {
     return VkDescriptorSetLayoutBinding{b, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs, nullptr};
@@ -90,6 +102,7 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context) {
 
 void Denoiser::resetHistory() { impl_->historyValid = false; }
 const DenoiseOutputs& Denoiser::outputs() const { return impl_->outputs; }
+DenoiseSignal Denoiser::signal() const { return impl_->signal; }
 PassStats Denoiser::stats() const { return impl_->metrics.latest(impl_->ctx); }
 
 Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,

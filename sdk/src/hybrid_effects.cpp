@@ -114,6 +114,7 @@ struct HybridEffects::Impl {
   std::unique_ptr<Denoiser> aoDenoiser;
   std::unique_ptr<ReflectionPass> reflection;
   std::unique_ptr<ManyLightPass> localLights;
+  std::unique_ptr<Denoiser> localLightDenoiser;
   // The engine's materials, shared by every pass: reflection hits shade with them, and shadow, AO and
   // reflection rays alpha-test non-opaque geometry with them. The table (GPU memory) exists only while a pass
   // does; the engine's last setMaterials is kept here to fill it when one is created.
@@ -322,12 +323,14 @@ const TlasInfo& HybridEffects::lastTlas() const { return impl_->tlas; }
 void HybridEffects::resetHistory() {
   if (impl_->shadowDenoiser) impl_->shadowDenoiser->resetHistory();
   if (impl_->aoDenoiser) impl_->aoDenoiser->resetHistory();
+  if (impl_->localLightDenoiser) impl_->localLightDenoiser->resetHistory();
 }
 
 HybridStats HybridEffects::stats() const {
   const Impl& a = *impl_;
-  return {statsOf(a.shadow),     statsOf(a.shadowDenoiser), statsOf(a.ao),
-          statsOf(a.aoDenoiser), statsOf(a.reflection),     statsOf(a.localLights)};
+  return {
+      statsOf(a.shadow),      statsOf(a.shadowDenoiser),    statsOf(a.ao), statsOf(a.aoDenoiser), statsOf(a.reflection),
+      statsOf(a.localLights), statsOf(a.localLightDenoiser)};
 }
 
 MemoryStats HybridEffects::memoryStats() const {
@@ -345,5 +348,6 @@ const ReflectionPass* HybridEffects::reflectionPass() const { return impl_->refl
 const ManyLightPass* HybridEffects::localLightPass() const { return impl_->localLights.get(); }
 const Denoiser* HybridEffects::shadowDenoiser() const { return impl_->shadowDenoiser.get(); }
 const Denoiser* HybridEffects::aoDenoiser() const { return impl_->aoDenoiser.get(); }
+const Denoiser* HybridEffects::localLightDenoiser() const { return impl_->localLightDenoiser.get(); }
 
 }  // namespace rb

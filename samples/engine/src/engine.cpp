@@ -151,6 +151,8 @@ void Engine::setPrepassHook(PrepassHook hook) { impl_->hook = std::move(hook); }
 PassTimings Engine::lastTimings() const { return impl_->timings; }
 ShadowMapStats Engine::lastShadowMapStats() const { return impl_->shadowStats; }
 uint64_t Engine::frameNumber() const { return impl_->frameCounter; }
+std::span<const FrameLight> Engine::frameLights() const { return impl_->frameLights; }
+LocalShadowStats Engine::lastLocalShadowStats() const { return impl_->localShadowStats; }
 
 // ---------------------------------------------------------------------------------------------------------
 // Scene
@@ -415,6 +417,15 @@ Result<std::vector<float>> Engine::readbackShadowVisibility() {
 
 Result<std::vector<float>> Engine::readbackSsao() {
   return readEffectImage(*this, *impl_, impl_->targets.ssao, impl_->ssaoRendered, "readbackSsao");
+}
+
+Result<std::vector<glm::vec4>> Engine::readbackLocalLightIrradiance() {
+  using R = Result<std::vector<glm::vec4>>;
+  if (Status s = waitIdle(); !s) return R::failure(s.error);
+  if (!impl_->frameRendered || !impl_->localIrradianceRendered)
+    return R::failure("readbackLocalLightIrradiance: the last frame did not produce it; set "
+                      "FrameParams::outputLocalLightIrradiance");
+  return R::failure("readbackLocalLightIrradiance: not implemented yet");
 }
 
 Result<std::vector<glm::vec3>> Engine::readbackDeformedPositions(uint32_t deformedIndex) {

@@ -98,6 +98,10 @@ struct Engine::Impl {
   std::optional<uint32_t> lastSubmittedSlot;
   PassTimings timings;
   ShadowMapStats shadowStats;  // of the last submitted frame
+  // KHR lights: the last frame's placement (rest pose after loadScene()) and what it drew.
+  std::vector<FrameLight> frameLights;
+  LocalShadowStats localShadowStats;
+  bool localIrradianceRendered = false;  // the last submitted frame wrote targets.localIrradiance
   uint64_t timingsFrameNumber = 0;
 
   ~Impl();

@@ -1,6 +1,8 @@
 // Scene bounds and the "finalize" step that makes every mesh complete enough to upload.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "sample_engine/scene.h"
 
@@ -131,6 +133,62 @@ void finalizeScene(Scene& scene) {
     finalizeMesh(m);
   }
   std::erase_if(scene.instances, [&](const Instance& i) { return i.mesh >= scene.meshes.size(); });
+}
+
+namespace {
+
+std::string lightNumber(float v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", double(v));
+  return buf;
+}
+
+bool finiteNonNegative(float v) { return std::isfinite(v) && v >= 0.0f; }
+
+}  // namespace
+
+Status checkLight(const PunctualLight& light, size_t index) {
+  const std::string where = "light " + std::to_string(index) + (light.name.empty() ? "" : " '" + light.name + "'");
+  using T = PunctualLight::Type;
+  if (light.type != T::Directional && light.type != T::Point && light.type != T::Spot)
+    return Status::failure(where + ": type = " + std::to_string(uint32_t(light.type)) +
+                           ": unknown (directional, point or spot)");
+  for (int c = 0; c < 3; ++c)
+    if (!finiteNonNegative(light.color[c]))
+      return Status::failure(where + ": color[" + std::to_string(c) + "] = " + lightNumber(light.color[c]) +
+                             ": it must be finite and >= 0 (linear RGB)");
+  if (!finiteNonNegative(light.intensity))
+    return Status::failure(where + ": intensity = " + lightNumber(light.intensity) +
+                           ": it must be finite and >= 0 (candela or lux)");
+  if (!(light.range == 0.0f || (std::isfinite(light.range) && light.range > 0.0f)))
+    return Status::failure(where + ": range = " + lightNumber(light.range) +
+                           ": it must be > 0 (or 0 / absent for an unlimited range)");
+  if (light.type == T::Spot) {
+    constexpr float kHalfPi = 1.57079632679f;
+    if (!(std::isfinite(light.outerConeAngle) && light.outerConeAngle > 0.0f && light.outerConeAngle <= kHalfPi))
+      return Status::failure(where + ": spot.outerConeAngle = " + lightNumber(light.outerConeAngle) +
+                             ": it must be in (0, pi/2] radians");
+    if (!(std::isfinite(light.innerConeAngle) && light.innerConeAngle >= 0.0f &&
+          light.innerConeAngle < light.outerConeAngle))
+      return Status::failure(where + ": spot.innerConeAngle = " + lightNumber(light.innerConeAngle) +
+                             ": it must be in [0, outerConeAngle = " + lightNumber(light.outerConeAngle) + ") radians");
+  }
+  return Status::success();
+}
+
+Status checkLights(const Scene& scene) {
+  if (scene.lights.size() > kMaxPunctualLights)
+    return Status::failure("lights: " + std::to_string(scene.lights.size()) +
+                           " lights, more than kMaxPunctualLights = " + std::to_string(kMaxPunctualLights) +
+                           "; merge or drop some");
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    if (Status s = checkLight(scene.lights[i], i); !s) return s;
+    const PunctualLight& l = scene.lights[i];
+    if (l.node >= 0 && size_t(l.node) >= scene.nodes.size())
+      return Status::failure("light " + std::to_string(i) + ": node = " + std::to_string(l.node) +
+                             " is out of range (the scene has " + std::to_string(scene.nodes.size()) + " nodes)");
+  }
+  return Status::success();
 }
 
 }  // namespace sample_engine

@@ -80,6 +80,12 @@ uint32_t appendScene(Scene& dst, const Scene& src, const glm::mat4& placement) {
     if (inst.skin >= 0) inst.skin += int(skinBase);
     dst.instances.push_back(inst);
   }
+  for (PunctualLight light : src.lights) {
+    if (light.node >= 0) light.node += nodeBase;
+    else
+      light.transform = placement * light.transform;
+    dst.lights.push_back(std::move(light));
+  }
   return animationBase;
 }
 

@@ -1,8 +1,10 @@
-// Denoising for single-channel ray-traced signals (shadow visibility, AO): temporal accumulation with
+// Denoising for ray-traced signals: single-channel ones (shadow visibility, AO) and RGB HDR ones (the
+// many-light irradiance of ManyLightPass), chosen by DenoiserDesc::signal. Temporal accumulation with
 // reprojection (camera motion, or the engine's motion vectors when GBufferDesc::motionVectors is given),
-// followed by an edge-aware a-trous spatial filter guided by depth and normals. Each signal needs its own
-// Denoiser (it keeps that signal's history). The raw input is left untouched, so raw and denoised are both
-// available.
+// followed by an edge-aware a-trous spatial filter guided by depth and normals. For an RGB signal the filter
+// also tracks the luminance variance over time (SVGF, Schied et al. 2017) and stops at differences larger than
+// that noise, so a converged or noise-free signal passes nearly unchanged. Each signal needs its own Denoiser (it
+// keeps that signal's history). The raw input is left untouched, so raw and denoised are both available.
 //
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipelines, history and
 // output images and measurement objects are handed to the Context's deferred release (see context.h) and
@@ -19,6 +21,17 @@
 
 namespace rb {
 
+// What a Denoiser filters.
+enum class DenoiseSignal : uint32_t {
+  Scalar = 0,  // default: R16/R32 .r (shadow visibility, AO); output R16_SFLOAT
+  Rgb,         // RGBA16F/RGBA32F .rgb, HDR (e.g. ManyLightOutputs::irradiance); output R16G16B16A16_SFLOAT, a = 1
+};
+
+// Fixed for the denoiser's life (its history and images follow it). Zero-initialised = a scalar denoiser.
+struct DenoiserDesc {
+  DenoiseSignal signal = DenoiseSignal::Scalar;
+};
+
 struct DenoiseSettings {
   bool disableTemporal = false;    // false = accumulate over frames
   bool disableSpatial = false;     // false = run the a-trous filter
@@ -26,15 +39,17 @@ struct DenoiseSettings {
   uint32_t maxHistoryFrames = 0;   // 0 = 32: the running mean forgets more slowly than this
   float depthSigma = 0.0f;         // 0 = 0.005: plane-distance tolerance relative to view distance, per step
   float normalPower = 0.0f;        // 0 = 32: exponent of the normal similarity weight
-  // Rays per pixel behind the signal, when it is a fraction of binary rays (shadow visibility, binary AO):
-  // the spatial filter then knows the noise exactly and keeps every edge that is not noise. 0 = unknown:
-  // the noise is estimated from the 3x3 neighbourhood, which also blurs thin noise-free features.
+  // Scalar signals: rays per pixel behind the signal, when it is a fraction of binary rays (shadow visibility,
+  // binary AO): the spatial filter then knows the noise exactly and keeps every edge that is not noise.
+  // 0 = unknown: the noise is estimated from the 3x3 neighbourhood, which also blurs thin noise-free features.
+  // Rgb signals ignore it: their noise is the luminance variance measured over the accumulated frames.
   uint32_t raysPerPixel = 0;
 };
 
 // Owned by the denoiser, left in SHADER_READ_ONLY_OPTIMAL after record().
 struct DenoiseOutputs {
-  VkImage denoised = VK_NULL_HANDLE;  // R16_SFLOAT
+  // DenoiseSignal::Scalar: R16_SFLOAT (.r). DenoiseSignal::Rgb: R16G16B16A16_SFLOAT (.rgb, a = 1).
+  VkImage denoised = VK_NULL_HANDLE;
   VkImageView denoisedView = VK_NULL_HANDLE;
   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   uint32_t width = 0, height = 0;
@@ -42,19 +57,24 @@ struct DenoiseOutputs {
 
 class Denoiser {
  public:
-  static Result<std::unique_ptr<Denoiser>> create(Context& context);
+  static Result<std::unique_ptr<Denoiser>> create(Context& context, const DenoiserDesc& desc);
+  static Result<std::unique_ptr<Denoiser>> create(Context& context);  // = DenoiseSignal::Scalar
   // Retires its Vulkan objects to the context, without waiting: the images of outputs() stay valid for
   // the frames already recorded.
   ~Denoiser();
 
-  // `signal`: an R16/R32 float image view with the noisy value in .r, in SHADER_READ_ONLY_OPTIMAL (the
-  // outputs of ShadowPass and AoPass are). The G-buffer is the one the signal was traced from.
+  // `signal`, in SHADER_READ_ONLY_OPTIMAL (the outputs of ShadowPass, AoPass and ManyLightPass are):
+  //   Scalar: an R16/R32 float image view with the noisy value in .r.
+  //   Rgb: an RGBA16F/RGBA32F image view with the noisy HDR value in .rgb (.a is ignored). A VkImageView does
+  //        not tell its format, so this cannot be checked: a one-channel view would read as red only.
+  // The G-buffer is the one the signal was traced from.
   Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, VkImageView signal,
                 const DenoiseSettings& settings = {});
   // Forget the history (after a camera cut or a scene change).
   void resetHistory();
   const DenoiseOutputs& outputs() const;
-  PassStats stats() const;  // GPU time (rays are 0: the denoiser traces none)
+  DenoiseSignal signal() const;  // the DenoiserDesc::signal it was created with
+  PassStats stats() const;       // GPU time (rays are 0: the denoiser traces none)
 
   struct Impl;
 

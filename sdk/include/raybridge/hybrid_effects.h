@@ -16,8 +16,8 @@
 //                                                       // compute shaders
 //
 // Order inside record(): pending BLAS work and the TLAS (when it builds one) -> shadows [-> denoiser] -> AO
-// [-> denoiser] -> local lights -> reflections. Only what the description enables exists: a disabled effect has no
-// pass, no denoiser, no image and traces no ray; hard shadows (one ray) are never denoised.
+// [-> denoiser] -> local lights [-> denoiser] -> reflections. Only what the description enables exists: a disabled
+// effect has no pass, no denoiser, no image and traces no ray; hard shadows (one ray) are never denoised.
 //
 // Lifetime: setDesc()/applyPreset() and the destructor retire passes to the Context's deferred release (see
 // context.h), so switching effects mid-run needs no wait-idle. Destroy it before its Context and before the
@@ -76,6 +76,9 @@ struct LocalLightEffectSettings {
   ManyLightMode mode = ManyLightMode::Stochastic;  // Exact = one ray per light per pixel (few lights, references)
   uint32_t raysPerPixel = 0;                       // Stochastic: 0 = kDefaultLightRays
   uint32_t candidates = 0;                         // Stochastic: 0 = kDefaultLightCandidates
+  // false = Stochastic output is denoised (an RGB Denoiser, HybridEffectsDesc::denoiser's settings); Exact is
+  // never denoised: it has no noise.
+  bool disableDenoiser = false;
 };
 
 // What runs. A zero-initialised description is valid: no effect, nothing allocated, nothing traced.
@@ -85,7 +88,8 @@ struct HybridEffectsDesc {
   AoEffectSettings ao;
   ReflectionEffectSettings reflections;
   LocalLightEffectSettings localLights;
-  DenoiseSettings denoiser;  // shared by the shadow and AO denoisers (raysPerPixel is filled in per signal)
+  // Shared by the shadow, AO and local light denoisers (raysPerPixel is filled in per scalar signal).
+  DenoiseSettings denoiser;
   // Build the TLAS with camera-relative origin (TlasBuildOptions::originOffset = the G-buffer's camera
   // position), so precision holds far from the world origin. Only used when record() builds the TLAS.
   bool worldSpaceTlas = false;  // false = camera-relative (recommended)
@@ -139,16 +143,17 @@ struct HybridOutputs {
   EffectImage shadow, shadowRaw;  // R16_SFLOAT visibility, 1 = lit
   EffectImage ao, aoRaw;          // R16_SFLOAT open fraction, 1 = open
   EffectImage reflection;         // R16G16B16A16_SFLOAT radiance, a = 1 where rays were traced
-  // R16G16B16A16_SFLOAT shadowed diffuse irradiance of the local lights (ManyLightOutputs). Not denoised yet:
-  // localLights = localLightsRaw.
+  // R16G16B16A16_SFLOAT shadowed diffuse irradiance of the local lights (ManyLightOutputs): localLights is
+  // denoised in Stochastic mode unless LocalLightEffectSettings::disableDenoiser; else it is localLightsRaw.
   EffectImage localLights, localLightsRaw;
 };
 
 // Per-pass measurements of the latest recordings whose frames have finished (zero for what does not exist).
 struct HybridStats {
-  PassStats shadow, shadowDenoise, ao, aoDenoise, reflection, localLights;
+  PassStats shadow, shadowDenoise, ao, aoDenoise, reflection, localLights, localLightsDenoise;
   double totalGpuMs() const {
-    return shadow.gpuMs + shadowDenoise.gpuMs + ao.gpuMs + aoDenoise.gpuMs + reflection.gpuMs + localLights.gpuMs;
+    return shadow.gpuMs + shadowDenoise.gpuMs + ao.gpuMs + aoDenoise.gpuMs + reflection.gpuMs + localLights.gpuMs +
+           localLightsDenoise.gpuMs;
   }
   uint64_t totalRays() const { return shadow.rays + ao.rays + reflection.rays + localLights.rays; }
 };
@@ -181,7 +186,7 @@ class HybridEffects {
   Status record(VkCommandBuffer cmd, const HybridFrame& frame);
   const HybridOutputs& outputs() const;
   const TlasInfo& lastTlas() const;  // the TLAS the latest record() traced
-  // Forget the denoisers' history (camera cut, scene change).
+  // Forget the denoisers' history (camera cut, scene change): shadows, AO and local lights.
   void resetHistory();
 
   HybridStats stats() const;
@@ -197,6 +202,7 @@ class HybridEffects {
   const ManyLightPass* localLightPass() const;
   const Denoiser* shadowDenoiser() const;
   const Denoiser* aoDenoiser() const;
+  const Denoiser* localLightDenoiser() const;  // nullptr unless Stochastic local lights are denoised
 
   struct Impl;
 

@@ -138,6 +138,45 @@ struct ShadowMapStats {
   uint64_t frameNumber = 0;  // Engine::frameNumber() of that frame; 0 before the first frame
 };
 
+// One punctual light as this frame places it (node animation applied), world space.
+// Plain data: not thread-safe.
+struct FrameLight {
+  PunctualLight::Type type = PunctualLight::Type::Point;
+  uint32_t light = 0;                      // Scene::lights index
+  glm::dvec3 position{0.0};                // world (double: large worlds)
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // the way the light travels = node's -Z in world, normalized
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;
+  float range = 0.0f;                                                        // 0 = unlimited
+  float innerConeAngle = 0.0f, outerConeAngle = kDefaultSpotOuterConeAngle;  // radians
+};
+
+// Raster shadows for local (KHR) lights.
+inline constexpr uint32_t kMaxShadowedLocalLights = 8;
+inline constexpr uint32_t kDefaultMaxShadowedLocalLights = 4;
+inline constexpr uint32_t kDefaultLocalShadowMapSize = 512;
+inline constexpr uint32_t kMinLocalShadowMapSize = 64;  // mapSize is clamped to [min, max]
+inline constexpr uint32_t kMaxLocalShadowMapSize = 4096;
+// The KHR lights (Scene::lights) of a frame. Every light is drawn; the `maxShadowedLights` strongest get shadow
+// maps, the others are unshadowed. Plain data: not thread-safe.
+struct LocalLightSettings {
+  bool enabled = true;  // false: KHR lights are not drawn at all by the engine (sun only)
+  // Strongest lights that get shadow maps, clamped to kMaxShadowedLocalLights; 0 = none.
+  uint32_t maxShadowedLights = kDefaultMaxShadowedLocalLights;
+  // Texels per side of each map (per cube face for points), clamped to [kMinLocalShadowMapSize,
+  // kMaxLocalShadowMapSize].
+  uint32_t mapSize = kDefaultLocalShadowMapSize;
+  uint32_t pcfKernelSize = 3;                                                  // as ShadowSettings::pcfKernelSize
+  float depthBiasConstant = 1.5f, depthBiasSlope = 2.0f, normalOffset = 1.5f;  // as ShadowSettings
+};
+// What a rendered frame did with the KHR lights (Engine::lastLocalShadowStats()).
+struct LocalShadowStats {
+  uint32_t lights = 0;          // lights drawn (0 when LocalLightSettings::enabled is off)
+  uint32_t shadowedLights = 0;  // of them, the ones with a shadow map this frame
+  uint32_t shadowViews = 0;     // shadow-map views drawn (1 per spot / directional, 6 per point)
+  uint64_t frameNumber = 0;     // Engine::frameNumber() of that frame; 0 before the first frame
+};
+
 // The engine's own screen-space ambient occlusion (Crytek / LearnOpenGL hemisphere kernel with range check),
 // computed from the pre-pass depth and geometric normals into an R16F image (1 = open). The lighting pass
 // multiplies its ambient terms by it unless LightingInputs::ambientOcclusion is set; it is computed whenever
@@ -180,6 +219,11 @@ struct LightingInputs {
   // (constant sky * AO, or the reflection probe when enabled), e.g. where a ray-traced pass traced nothing.
   // The engine weights the result by its Fresnel/roughness environment BRDF.
   VkImageView reflection = VK_NULL_HANDLE;
+  // RGBA16F, rgb = shadowed diffuse irradiance E from all KHR lights (no BRDF, no albedo; units as
+  // PunctualLight). When set, the engine's local-light diffuse becomes albedo*(1-metallic)/pi * E (as its sun
+  // diffuse convention), its local shadow maps are not drawn, and its local-light specular is scaled by
+  // the ratio lum(E) / lum(E_unshadowed) clamped to [0,1] (ratio estimator, Heitz et al. 2018).
+  VkImageView localLightIrradiance = VK_NULL_HANDLE;
 };
 
 // Everything a frame needs besides the scene.
@@ -193,6 +237,10 @@ struct FrameParams {
   LightingInputs lightingInputs;  // the pre-pass hook may change these for the frame
   SsaoSettings ssao;
   ReflectionProbeSettings reflectionProbe;
+  LocalLightSettings localLights;
+  // Also writes the engine's own (shadow-mapped) KHR-light irradiance E to an RGBA16F image for
+  // readbackLocalLightIrradiance().
+  bool outputLocalLightIrradiance = false;
   // Also writes the shadow-map sun visibility the lighting uses (PCF, and 0 where the shading normal faces
   // away from the sun; 1 on background) into an R16F image for readbackShadowVisibility().
   bool outputShadowVisibility = false;
@@ -261,6 +309,8 @@ struct PrepassHookInfo {
   float ambientIntensity = 0.0f;
   // This frame's world transform per Scene::instances entry (node animation applied).
   std::span<const glm::mat4> instanceTransforms;
+  // This frame's lights, Scene::lights order (empty if none or LocalLightSettings::enabled is off).
+  std::span<const FrameLight> lights;
   // The deforming instances; this frame's deformation submission rewrites their buffers. Empty for a
   // scene without skinned or morphed instances.
   std::span<const DeformedInstance> deformedInstances;
@@ -332,10 +382,12 @@ struct PassTimings {
   double hookMs = 0.0;              // whatever the hook recorded
   double lightingMs = 0.0;          // opaque lighting and the blended surfaces after it
   double tonemapMs = 0.0;
-  double deformMs = 0.0;       // the deformation submission (skinning / morphing); 0 when nothing deforms
-  bool probeCaptured = false;  // this frame captured the reflection probe
-  bool valid = false;          // false until a frame with timestamps has completed
-  uint64_t frameNumber = 0;    // Engine::frameNumber() of the frame these timings belong to
+  double deformMs = 0.0;           // the deformation submission (skinning / morphing); 0 when nothing deforms
+  double localShadowMs = 0.0;      // local shadow maps (0 when none drawn)
+  double localIrradianceMs = 0.0;  // outputLocalLightIrradiance pass
+  bool probeCaptured = false;      // this frame captured the reflection probe
+  bool valid = false;              // false until a frame with timestamps has completed
+  uint64_t frameNumber = 0;        // Engine::frameNumber() of the frame these timings belong to
 };
 
 // A mesh as uploaded. Positions are R32G32B32_SFLOAT, tightly packed (stride 12) in their own buffer.
@@ -450,6 +502,14 @@ class Engine {
   // that frame did not produce them (FrameParams::outputShadowVisibility / SsaoSettings::enabled).
   Result<std::vector<float>> readbackShadowVisibility();  // 1 = lit, 0 = shadowed
   Result<std::vector<float>> readbackSsao();              // 1 = open (blurred when SsaoSettings::blur)
+  // The last frame's engine KHR-light irradiance E (rgb, a = 1), row-major renderSize(), top row first (waits
+  // for it). Fails naming FrameParams::outputLocalLightIrradiance when that frame did not produce it.
+  Result<std::vector<glm::vec4>> readbackLocalLightIrradiance();
+
+  // --- KHR lights ---
+  // The last rendered frame's lights (rest pose before the first), Scene::lights order.
+  std::span<const FrameLight> frameLights() const;
+  LocalShadowStats lastLocalShadowStats() const;  // known at submission, no wait
 
   struct Impl;
 

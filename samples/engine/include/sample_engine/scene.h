@@ -14,6 +14,8 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "sample_engine/result.h"
+
 namespace sample_engine {
 
 // A morph target (glTF): per-vertex deltas the target adds to the bind pose, scaled by its weight.
@@ -215,6 +217,24 @@ struct Bounds {
   }
 };
 
+// A KHR_lights_punctual light. Units are the spec's: intensity in candela (point, spot) or lux (directional).
+// It shines along its node's local -Z (spot, directional) from the node's origin (point, spot).
+// Scene::lights holds them; the engine lights every one of them (engine.h, LocalLightSettings).
+inline constexpr float kDefaultSpotOuterConeAngle = 0.78539816339f;  // pi / 4, the glTF default
+inline constexpr uint32_t kMaxPunctualLights = 4096;                 // per scene; more is a load error
+struct PunctualLight {
+  enum class Type : uint32_t { Directional = 0, Point, Spot };
+  std::string name;
+  Type type = Type::Point;
+  glm::vec3 color{1.0f};                              // linear RGB, >= 0
+  float intensity = 1.0f;                             // finite, >= 0
+  float range = 0.0f;                                 // 0 = unlimited (no range window); else > 0
+  float innerConeAngle = 0.0f;                        // spot, radians, in [0, outer)
+  float outerConeAngle = kDefaultSpotOuterConeAngle;  // spot, radians, in (inner, pi/2]
+  int32_t node = -1;          // Scene::nodes index it hangs from (animated with it); -1 = use `transform`
+  glm::mat4 transform{1.0f};  // world transform when node < 0 (procedural scenes)
+};
+
 struct Scene {
   std::vector<MeshData> meshes;
   std::vector<Material> materials;  // at least one is added by finalizeScene() if empty
@@ -225,6 +245,9 @@ struct Scene {
   std::vector<Node> nodes;  // empty for a static scene
   std::vector<Skin> skins;
   std::vector<Animation> animations;
+  // KHR_lights_punctual lights (glTF root `lights`, placed by the nodes that reference them) and the ones a
+  // procedural builder adds; at most kMaxPunctualLights, each valid for checkLight().
+  std::vector<PunctualLight> lights;
 
   // World-space bounds over all instances (transformed mesh AABBs, rest pose).
   Bounds bounds() const;
@@ -235,12 +258,21 @@ struct Scene {
   std::string describeAnimations() const;
 };
 
-// Appends src's meshes, materials, textures, nodes, skins, animations and instances to dst, under a new
-// root node (named "placement") whose matrix is `placement`; instances without a node get placement *
-// transform. Every append is an independent copy (its own nodes, skins and animations, so the engine gives
+// Appends src's meshes, materials, textures, nodes, skins, animations, instances and lights to dst, under a new
+// root node (named "placement") whose matrix is `placement`; instances and lights without a node get
+// placement * transform. Every append is an independent copy (its own nodes, skins and animations, so the engine gives
 // its deforming instances their own buffers): this is how a scene holds K animated characters. dst keeps its
 // own camera and sun. Returns the index in dst.animations of src's first animation.
 uint32_t appendScene(Scene& dst, const Scene& src, const glm::mat4& placement);
+
+// Checks one light against the ranges PunctualLight documents (type known, colour and intensity finite and
+// >= 0, range 0 or > 0, spot cones 0 <= inner < outer <= pi/2). The error names the light index and the
+// field, e.g. "light 3 'lamp': intensity = -1: it must be finite and >= 0 (candela or lux)". The node index
+// is checked by checkLights(), which knows the scene.
+Status checkLight(const PunctualLight& light, size_t index);
+// Every light of the scene (checkLight(), node in range, at most kMaxPunctualLights). loadScene() and the glTF
+// loader call it.
+Status checkLights(const Scene& scene);
 
 // Fills missing normals/UVs/tangents, clamps material and texture indices, adds a default material if needed,
 // and reads an AlphaMode beyond Blend as Opaque and a non-finite alphaCutoff as 0.5.
