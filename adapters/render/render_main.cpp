@@ -1,6 +1,6 @@
 // raybridge-render: one headless image of a scene with the sample engine, in raster mode (the engine's shadow
-// map, SSAO and reflection probe) or hybrid mode (Raybridge's ray-traced shadows, AO and reflections through
-// the adapter), plus optional dumps and stats.
+// maps, SSAO and reflection probe) or hybrid mode (Raybridge's ray-traced shadows, AO, reflections and shadowed
+// local lights through the adapter), plus optional dumps and stats.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -151,10 +151,14 @@ int main(int argc, char** argv) {
     params.sun = *engine.scene().sun;
   params.sun.direction = glm::normalize(params.sun.direction);
 
-  const ResolvedEffects fx = resolve(o);
+  ResolvedEffects fx = resolve(o);
+  // The scene's punctual lights are shadowed by Raybridge with any preset but none, unless --effects leaves them out
+  // (no light, no pass).
+  const size_t lightCount = engine.scene().lights.size();
+  if (!o.effects && lightCount && o.preset != rb::Preset::None) fx.hybrid.effects |= rb::kEffectLocalLights;
   const rb::EffectSet effects = fx.hybrid.effects;
   const bool wantShadows = effects & rb::kEffectShadows, wantAo = effects & rb::kEffectAo,
-             wantReflections = effects & rb::kEffectReflections;
+             wantReflections = effects & rb::kEffectReflections, wantLights = effects & rb::kEffectLocalLights;
   std::unique_ptr<rbAdapter::Adapter> adapter;
   if (hybrid) {
     rbAdapter::AdapterConfig ac;
@@ -177,6 +181,9 @@ int main(int argc, char** argv) {
     params.reflectionProbe.enabled = wantReflections;
     params.outputShadowVisibility = o.dump;
   }
+  // The engine's own shadowed irradiance of the punctual lights (shadow maps for the strongest few), for lights.exr
+  // wherever Raybridge does not compute it.
+  params.outputLocalLightIrradiance = o.dump && lightCount && !(hybrid && wantLights);
   std::unique_ptr<FrameCapture> capture;
   if (o.dump) {
     auto c = FrameCapture::create(engine);
@@ -198,8 +205,10 @@ int main(int argc, char** argv) {
       images = {{"shadow", fo.shadow.image, 1},
                 {"ao", fo.ao.image, 1},
                 {"ao_raw", fo.aoRaw.image, 1},
-                {"reflection", fo.reflection.image, 4}};
+                {"reflection", fo.reflection.image, 4},
+                {"lights", fo.localLights.image, 4}};
       if (fo.shadowRaw.image != fo.shadow.image) images.push_back({"shadow_raw", fo.shadowRaw.image, 1});  // denoised
+      if (fo.localLightsRaw.image != fo.localLights.image) images.push_back({"lights_raw", fo.localLightsRaw.image, 4});
     }
     if (se::Status s = capture->record(info, geometric ? info.geometricNormal : info.normalRoughness, images); !s)
       captureError = s.error;
@@ -243,7 +252,8 @@ int main(int argc, char** argv) {
   // Statistics. The SDK resolves a pass's GPU time kFramesInFlight frames after recording it.
   nlohmann::json stats;
   const double engineTotal = timings.shadowMs + timings.probeMs + timings.prepassMs + timings.ssaoMs +
-                             timings.shadowVisibilityMs + timings.hookMs + timings.lightingMs + timings.tonemapMs;
+                             timings.shadowVisibilityMs + timings.hookMs + timings.lightingMs + timings.tonemapMs +
+                             timings.localShadowMs + timings.localIrradianceMs;
   stats["mode"] = hybrid ? "hybrid" : "raster";
   stats["width"] = o.width;
   stats["height"] = o.height;
@@ -281,6 +291,27 @@ int main(int argc, char** argv) {
       {"reflection_rays_per_pixel",
        wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays)
                        : 0u}};
+  {
+    const se::LocalShadowStats ls = engine.lastLocalShadowStats();
+    uint32_t byType[3] = {0, 0, 0};
+    for (const se::PunctualLight& l : engine.scene().lights) ++byType[uint32_t(l.type)];
+    const bool traced = hybrid && wantLights;
+    const rb::LocalLightEffectSettings& ll = fx.hybrid.localLights;
+    stats["lights"] = {{"count", lightCount},
+                       {"directional", byType[0]},
+                       {"point", byType[1]},
+                       {"spot", byType[2]},
+                       {"shadowed_by", !lightCount ? "none"
+                                       : traced    ? "raybridge"
+                                                   : "engine shadow maps for the strongest lights"},
+                       {"mode", !traced ? "raster"
+                                : ll.mode == rb::ManyLightMode::Exact ? "exact"
+                                                                      : "stochastic"},
+                       {"rays_per_pixel", traced && ll.mode == rb::ManyLightMode::Stochastic ? ll.raysPerPixel : 0u},
+                       {"denoised", traced && adapter && adapter->effects().localLightDenoiser() != nullptr},
+                       {"shadow_mapped_lights", traced ? 0u : ls.shadowedLights},
+                       {"shadow_map_views", traced ? 0u : ls.shadowViews}};
+  }
   if (!hybrid) {
     const se::ShadowMapStats sm = engine.lastShadowMapStats();
     stats["effects"]["raster_counterparts"] = {{"shadows", sm.enabled ? "shadow map" : "none (unshadowed sun)"},
@@ -298,6 +329,8 @@ int main(int argc, char** argv) {
                             {"hook", timings.hookMs},
                             {"lighting", timings.lightingMs},
                             {"tonemap", timings.tonemapMs},
+                            {"local_shadow_maps", timings.localShadowMs},
+                            {"local_irradiance_output", timings.localIrradianceMs},
                             {"frame_total", engineTotal}};
   uint64_t sceneTriangles = 0;
   for (const se::Instance& inst : engine.scene().instances)
@@ -326,7 +359,9 @@ int main(int argc, char** argv) {
         {"shadow_denoise", fxo.shadowDenoiser() ? &es.shadowDenoise : nullptr},
         {"ao", fxo.aoPass() ? &es.ao : nullptr},
         {"ao_denoise", fxo.aoDenoiser() ? &es.aoDenoise : nullptr},
-        {"reflection", fxo.reflectionPass() ? &es.reflection : nullptr}};
+        {"reflection", fxo.reflectionPass() ? &es.reflection : nullptr},
+        {"local_lights", fxo.localLightPass() ? &es.localLights : nullptr},
+        {"local_lights_denoise", fxo.localLightDenoiser() ? &es.localLightsDenoise : nullptr}};
     std::printf("Raybridge (%s):", effectSetToString(effects).c_str());
     for (const auto& [name, p] : all) {
       if (!p) continue;
@@ -394,6 +429,18 @@ int main(int argc, char** argv) {
     writeCaptured("ao", 1);
     writeCaptured("ao_raw", 1);
     writeCaptured("reflection", 4);
+    writeCaptured("lights", 4);
+    writeCaptured("lights_raw", 4);
+    // The engine's own irradiance of the punctual lights (raster mode, or hybrid without the lights effect).
+    if (e.empty() && params.outputLocalLightIrradiance) {
+      auto irradiance = engine.readbackLocalLightIrradiance();
+      if (!irradiance) e = irradiance.error;
+      else
+        e = write("lights.exr", toExr(f, std::vector<float>(&irradiance.value[0].x, &irradiance.value[0].x +
+                                                                                       4 * irradiance.value.size()),
+                                      4)),
+        written.push_back("lights.exr");
+    }
     // Raster: the engine's shadow-map visibility and SSAO.
     if (e.empty() && !hybrid) {
       auto visibility = engine.readbackShadowVisibility();

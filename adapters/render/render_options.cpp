@@ -11,8 +11,9 @@ namespace {
 
 constexpr uint32_t kMaxSize = 16384;  // the engine's render-target limit
 
-const std::vector<std::string> kEffectNames = {"shadows", "ao", "reflections"};  // bit i = name i
-static_assert(rb::kEffectShadows == 1 && rb::kEffectAo == 2 && rb::kEffectReflections == 4);
+const std::vector<std::string> kEffectNames = {"shadows", "ao", "reflections", "lights"};  // bit i = name i
+static_assert(rb::kEffectShadows == 1 && rb::kEffectAo == 2 && rb::kEffectReflections == 4 &&
+              rb::kEffectLocalLights == 8);
 
 // One line per preset, from the SDK's table: what it traces and what raster mode draws instead.
 std::string presetTable() {
@@ -119,8 +120,9 @@ void addOptions(CLI::App& app, RenderOptions& o) {
            parseEffectSet(value, set);
            o.effects = set;
          },
-         "effects to run, comma-separated from shadows,ao,reflections, or none\n"
-         "(overrides the preset's set, keeps its quality settings)")
+         "effects to run, comma-separated from shadows,ao,reflections,lights, or none\n"
+         "(overrides the preset's set, keeps its quality settings; default: the preset's,\n"
+         "plus lights when the scene has KHR_lights_punctual lights, except with preset none)")
       ->type_name("LIST")
       ->check(effectSetValidator());
   app.add_option_function<float>(
@@ -155,8 +157,14 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "reflection rays per glossy pixel (default 4)")
       ->type_name("N")
       ->check(rbCli::wholeNumber(1, 64));
+  app.add_option_function<uint32_t>(
+         "--light-rays", [&o](const uint32_t& v) { o.lightRays = v; },
+         "shadow rays per pixel shared by the scene's punctual lights, 0 = exact: one\n"
+         "ray per light that reaches the pixel (default 4)")
+      ->type_name("N")
+      ->check(rbCli::zeroOrWholeNumber(1, 64, "exact"));
   app.add_flag_callback(
-      "--no-denoise", [&o] { o.denoise = false; }, "use the raw shadow and AO images (default: denoised)");
+      "--no-denoise", [&o] { o.denoise = false; }, "use the raw shadow, AO and local-light images (default: denoised)");
   app.add_option_function<uint32_t>(
          "--shadow-map-size", [&o](const uint32_t& v) { o.shadowMapSize = v; },
          "raster mode's shadow map, texels squared, 0 = none (default: the preset's)")
@@ -180,7 +188,8 @@ void addOptions(CLI::App& app, RenderOptions& o) {
                "also depth.exr (distance from the eye, 0 = sky), normal.exr (world normal used\n"
                "by the passes), shadow.exr (sun visibility the lighting used; plus shadow_raw.exr\n"
                "when denoised), ao.exr (AO the lighting used; plus ao_raw.exr in hybrid mode),\n"
-               "reflection.exr (hybrid), stats.json");
+               "reflection.exr (hybrid), lights.exr (shadowed irradiance E of the scene's punctual\n"
+               "lights, no BRDF or albedo, no sun; plus lights_raw.exr when denoised), stats.json");
   app.add_option("--frames", o.frames, "frames to render, the last is reported (default 3)")
       ->type_name("N")
       ->check(rbCli::wholeNumber(1, 100000));
@@ -274,6 +283,11 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.range = o.aoRange ? *o.aoRange : rb::kDefaultAoRange;
   h.ao.estimator = o.aoEstimator;
   h.ao.disableDenoiser = !o.denoise;
+
+  const uint32_t lightRays = o.lightRays ? *o.lightRays : kDefaultLightRays;
+  h.localLights.mode = lightRays ? rb::ManyLightMode::Stochastic : rb::ManyLightMode::Exact;
+  h.localLights.raysPerPixel = lightRays;
+  h.localLights.disableDenoiser = !o.denoise;
 
   h.reflections.roughnessThreshold = o.reflectionRoughness ? *o.reflectionRoughness : kDefaultReflectionRoughness;
   h.reflections.raysPerPixel = o.reflectionRays ? *o.reflectionRays : kDefaultReflectionRays;

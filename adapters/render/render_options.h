@@ -34,7 +34,10 @@ struct RenderOptions {
   rb::AoEstimator aoEstimator = rb::AoEstimator::Binary;  // --ao-estimator binary|distance
   std::optional<float> reflectionRoughness;               // --reflection-roughness threshold; else the default below
   std::optional<uint32_t> reflectionRays;                 // --reflection-rays; else the default below
-  bool denoise = true;                                    // --no-denoise
+  // --light-rays: shadow rays per pixel shared by the scene's KHR_lights_punctual lights; 0 = exact (one ray per
+  // light that reaches the pixel). Else kDefaultLightRays below.
+  std::optional<uint32_t> lightRays;
+  bool denoise = true;  // --no-denoise
   // Raster mode's shadow map: --shadow-map-size (0 = none, else 1024..8192) and --pcf (taps per axis, 1..9);
   // else the preset's raster counterpart.
   std::optional<uint32_t> shadowMapSize;
@@ -62,11 +65,15 @@ struct RenderOptions {
 // reflects, glossy pixels average 4 rays.
 inline constexpr float kDefaultReflectionRoughness = 0.5f;
 inline constexpr uint32_t kDefaultReflectionRays = 4;
+// The render command's local-light rays (the SDK's default is 1): where a screen tile is reached by at most this many
+// lights (most of the demo's), every light gets its own ray, exact; elsewhere 4 sampled rays, denoised.
+inline constexpr uint32_t kDefaultLightRays = 4;
 
 // What the preset and the explicit options amount to. Ray counts, the AO range and the reflection threshold are
 // explicit; hybrid.shadows.softAngularRadiusDegrees stays 0 (the SDK's 0.5) unless --sun-radius gives one.
 struct ResolvedEffects {
-  // What --mode hybrid runs: the preset's effects and rays, overridden by the explicit options.
+  // What --mode hybrid runs: the preset's effects and rays, overridden by the explicit options. The local lights
+  // effect is not in any preset: main() adds it when the scene has punctual lights and --effects is not given.
   rb::HybridEffectsDesc hybrid;
   // What --mode raster draws: the preset's shadow map/PCF, overridden by --shadow-map-size/--pcf.
   rb::RasterShadowDesc raster;
@@ -74,10 +81,10 @@ struct ResolvedEffects {
 };
 ResolvedEffects resolve(const RenderOptions& options);
 
-// "shadows,ao,reflections" (any order and subset; "" or "none" = no effect) -> EffectSet. Returns "" or an
-// error naming the bad item ("'bogus' in 'shadows,bogus' is not an effect (shadows, ao, reflections)").
+// "shadows,ao,reflections,lights" (any order and subset; "" or "none" = no effect) -> EffectSet. Returns "" or an
+// error naming the bad item ("'bogus' in 'shadows,bogus' is not an effect (shadows, ao, reflections, lights)").
 std::string parseEffectSet(std::string_view text, rb::EffectSet& out);
-// "shadows,ao,reflections" in that order; "" for no effect.
+// "shadows,ao,reflections,lights" in that order; "" for no effect.
 std::string effectSetToString(rb::EffectSet effects);
 
 // Parses argv; returns an error message naming the option and the bad value, or "" on success (options.help is

@@ -68,6 +68,27 @@ bool nonOpaque(const se::Scene& scene, const se::GpuMesh& mesh) {
   return mesh.material < scene.materials.size() && scene.materials[mesh.material].alphaMode != se::AlphaMode::Opaque;
 }
 
+// This frame's KHR_lights_punctual lights as the SDK's light list. The engine's direction is the way the light
+// travels (node -Z); the SDK's directional light points towards the light. Angles: radians -> degrees.
+void convertLights(std::span<const se::FrameLight> lights, std::vector<rb::LightSource>& out) {
+  out.resize(lights.size());
+  for (size_t i = 0; i < lights.size(); ++i) {
+    const se::FrameLight& l = lights[i];
+    rb::LightSource& r = out[i];
+    r.light.type = l.type == se::PunctualLight::Type::Directional ? rb::LightType::Directional
+                   : l.type == se::PunctualLight::Type::Spot      ? rb::LightType::Spot
+                                                                  : rb::LightType::Point;
+    const glm::vec3 d = r.light.type == rb::LightType::Directional ? -l.direction : l.direction;
+    std::copy_n(&d[0], 3, r.light.direction);
+    std::copy_n(&l.position[0], 3, r.light.position);
+    r.light.range = l.range;
+    r.light.spotOuterAngleDegrees = glm::degrees(l.outerConeAngle);
+    r.spotInnerAngleDegrees = glm::degrees(l.innerConeAngle);
+    std::copy_n(&l.color[0], 3, r.color);
+    r.intensity = l.intensity;
+  }
+}
+
 }  // namespace
 
 void configureEngine(se::EngineConfig& config, rb::RequiredFeatures& features) {
@@ -92,6 +113,7 @@ struct Adapter::Impl {
   std::vector<rb::MeshHandle> deformed;  // parallel to engine.deformedInstances(): dynamic BLASes
   std::vector<rb::Instance> instances;
   std::vector<uint32_t> instanceSource;  // Scene::instances index of each entry of `instances`
+  std::vector<rb::LightSource> lights;   // this frame's punctual lights (local lights effect)
   std::string error;
 
   explicit Impl(se::Engine& e) : engine(e) {}
@@ -209,12 +231,14 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   std::copy_n(&info.skyColor[0], 3, f.skyRadiance);
   f.ambientIntensity = info.ambientIntensity;
   f.flags = rb::kFrameExplicitLighting;  // the engine's own values, zeros included
+  if (a.fx->desc().effects & rb::kEffectLocalLights) convertLights(info.lights, a.lights), f.localLights = a.lights;
   if (rb::Status s = a.fx->record(info.commandBuffer, f); !s)
     return keepFirst(a.error, message("HybridEffects::record", s.error()));
   const rb::HybridOutputs& out = a.fx->outputs();  // SHADER_READ_ONLY_OPTIMAL, as LightingInputs requires
   inputs.sunVisibility = out.shadow.view;
   inputs.ambientOcclusion = out.ao.view;
   inputs.reflection = out.reflection.view;
+  inputs.localLightIrradiance = out.localLights.view;  // replaces the engine's local lights and their shadow maps
 }
 
 se::PrepassHook Adapter::prepassHook() {

@@ -93,7 +93,9 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"stray", "unexpected argument 'stray'"},
       {"--preset nonsense", "--preset: 'nonsense' is not a preset (none, hard-shadows, ao, ao16, reflections, "
                             "soft-shadows, soft-shadows8, low, medium, high, ultra)"},
-      {"--effects shadows,bogus", "--effects: 'bogus' in 'shadows,bogus' is not an effect (shadows, ao, reflections)"},
+      {"--effects shadows,bogus",
+       "--effects: 'bogus' in 'shadows,bogus' is not an effect (shadows, ao, reflections, lights)"},
+      {"--light-rays 65", "--light-rays: 65 is outside 1..64 (or 0 = exact)"},
       {"--ao-rays 0", "--ao-rays: 0 is outside 1..4096"},
       {"--ao-range -1", "--ao-range: -1 must be greater than 0"},
       {"--ao-range abc", "--ao-range: 'abc' is not a number"},
@@ -141,18 +143,21 @@ TEST_CASE("raybridge-render: --preset high --dump writes every effect image and 
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
   for (const char* name : {"final.png", "final.exr", "depth.exr", "normal.exr", "shadow.exr", "shadow_raw.exr",
-                           "ao.exr", "ao_raw.exr", "reflection.exr", "stats.json"}) {
+                           "ao.exr", "ao_raw.exr", "reflection.exr", "lights.exr", "stats.json"}) {
     INFO(name);
     CHECK(fs::file_size(dir / name) > 0);
   }
   const nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir / "stats.json"));
   CHECK(stats["mode"] == "hybrid");
   CHECK(stats["preset"] == "high");
-  CHECK(stats["effects"]["enabled"] == "shadows,ao,reflections");
+  // The demo scene's punctual lights add the local lights effect to the preset's.
+  CHECK(stats["effects"]["enabled"] == "shadows,ao,reflections,lights");
+  CHECK(stats["lights"]["count"].get<uint32_t>() >= 4);
+  CHECK(stats["lights"]["shadowed_by"] == "raybridge");
   CHECK(stats["width"] == w);
   CHECK(stats["rays_traced"].get<uint64_t>() > 0);
   const nlohmann::json& passes = stats["raybridge"]["passes"];
-  for (const char* pass : {"shadow", "ao", "reflection"}) {
+  for (const char* pass : {"shadow", "ao", "reflection", "local_lights"}) {
     INFO(pass);
     REQUIRE(passes.contains(pass));
     CHECK(passes[pass]["rays"].get<uint64_t>() > 0);
@@ -400,6 +405,7 @@ TEST_CASE("all eleven presets render in both modes; raster mode follows the pres
       CHECK(passes.contains("shadow") == bool(want.effects & rb::kEffectShadows));
       CHECK(passes.contains("ao") == bool(want.effects & rb::kEffectAo));
       CHECK(passes.contains("reflection") == bool(want.effects & rb::kEffectReflections));
+      CHECK(passes.contains("local_lights") == (preset != rb::Preset::None));  // the demo's punctual lights
       // Soft shadows (more than one ray) are denoised, hard ones never; the reported rays per pixel are the table's.
       CHECK(passes.contains("shadow_denoise") == (want.shadowRaysPerPixel > 1));
       if (want.effects & rb::kEffectShadows) CHECK(stats["sun"]["rays_per_pixel"] == want.shadowRaysPerPixel);

@@ -37,7 +37,8 @@ struct Options {
 const char* kKeys =
     "keys: drag = orbit, scroll = zoom, W/A/S/D/Q/E = move (Shift = faster), F1 = overlay on/off\n"
     "      M = mode raster (shadow map, SSAO, probe) <-> hybrid (Raybridge), P = next preset,\n"
-    "      H = shadows hard <-> soft, O = ambient occlusion on/off, R = reflections on/off, N = denoise on/off,\n"
+    "      H = shadows hard <-> soft, O = ambient occlusion on/off, R = reflections on/off, L = local lights\n"
+    "      (the scene's punctual lights, shadowed by Raybridge) on/off, N = denoise on/off,\n"
     "      Left/Right = sun azimuth, Up/Down = sun elevation, Space = pause/resume the animation, Esc = quit\n";
 
 int fail(const std::string& message) {
@@ -133,7 +134,7 @@ struct Keys {
 std::string effectsToString(rb::EffectSet set) {
   std::string s;
   for (auto [bit, name] : {std::pair{rb::kEffectShadows, "shadows"}, std::pair{rb::kEffectAo, "ao"},
-                           std::pair{rb::kEffectReflections, "reflections"}})
+                           std::pair{rb::kEffectReflections, "reflections"}, std::pair{rb::kEffectLocalLights, "lights"}})
     if (set & bit) s += (s.empty() ? "" : ",") + std::string(name);
   return s.empty() ? "none" : s;
 }
@@ -179,6 +180,9 @@ int main(int argc, char** argv) {
 
   rbAdapter::AdapterConfig adapterConfig;
   adapterConfig.preset = o.preset;
+  // The scene's punctual lights are shadowed by Raybridge on top of any preset (L toggles them).
+  bool localLights = !engine.scene().lights.empty();
+  if (localLights) adapterConfig.effects.effects = rb::kEffectLocalLights;
   auto adapter = rbAdapter::Adapter::create(engine, adapterConfig);
   if (!adapter) return fail("adapter: " + adapter.error);
   rbAdapter::Adapter& rt = *adapter.value;
@@ -233,11 +237,14 @@ int main(int argc, char** argv) {
   };
   auto applyPreset = [&](rb::Preset p) {
     preset = p;
-    setDesc(rb::withPreset(fx.desc(), p));
+    rb::HybridEffectsDesc d = rb::withPreset(fx.desc(), p);
+    if (localLights) d.effects |= rb::kEffectLocalLights;
+    setDesc(d);
   };
   auto toggleEffects = [&](rb::EffectSet bits) {
     rb::HybridEffectsDesc d = fx.desc();
     d.effects ^= bits;
+    if (bits & rb::kEffectLocalLights) localLights = d.effects & rb::kEffectLocalLights;
     setDesc(d);
   };
   auto toggleSoftShadows = [&] {
@@ -327,6 +334,7 @@ int main(int argc, char** argv) {
       if (keys.pressed(GLFW_KEY_H)) toggleSoftShadows();
       if (keys.pressed(GLFW_KEY_O)) toggleEffects(rb::kEffectAo);
       if (keys.pressed(GLFW_KEY_R)) toggleEffects(rb::kEffectReflections);
+      if (keys.pressed(GLFW_KEY_L)) toggleEffects(rb::kEffectLocalLights);
       if (keys.pressed(GLFW_KEY_N)) toggleDenoise();
       if (keys.pressed(GLFW_KEY_P)) applyPreset(rb::Preset((uint32_t(preset) + 1) % rb::kPresetCount));
     }

@@ -64,6 +64,8 @@ PanelRequests drawPanel(const PanelModel& m) {
   effectToggle("AO (O)", rb::kEffectAo, m, r);
   ImGui::SameLine();
   effectToggle("reflections (R)", rb::kEffectReflections, m, r);
+  ImGui::SameLine();
+  effectToggle("lights (L)", rb::kEffectLocalLights, m, r);
   bool soft = m.shadowRays > 1;
   if (ImGui::Checkbox("soft shadows (H)", &soft)) r.toggleSoftShadows = true;
   ImGui::SameLine();
@@ -93,6 +95,8 @@ PanelRequests drawPanel(const PanelModel& m) {
       passRow("  AO", s.ao.gpuMs, &s.ao);
       passRow("  AO denoise", s.aoDenoise.gpuMs);
       passRow("  reflections", s.reflection.gpuMs, &s.reflection);
+      passRow("  local lights", s.localLights.gpuMs, &s.localLights);
+      passRow("  local lights denoise", s.localLightsDenoise.gpuMs);
       passRow("lighting (engine)", t.lightingMs);
       passRow("tonemap (engine)", t.tonemapMs);
       ImGui::EndTable();
