@@ -1,10 +1,13 @@
 // raybridge-render: one headless image of a scene with the sample engine, in raster mode (the engine's shadow
 // maps, SSAO and reflection probe) or hybrid mode (Raybridge's ray-traced shadows, AO, reflections and shadowed
 // local lights through the adapter), plus optional dumps and stats.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -75,6 +78,24 @@ se::ImageRGBA32F toExr(const CapturedFrame& f, const std::vector<float>& values,
   for (size_t i = 0; i < size_t(f.width) * f.height; ++i) {
     for (int c = 0; c < 3; ++c) img.pixels[i * 4 + c] = values[i * channels + (channels == 1 ? 0 : c)];
     img.pixels[i * 4 + 3] = 1.0f;
+  }
+  return img;
+}
+
+// lights.png: irradiance E (lux) shown as E / (1 + E) per channel, sRGB-encoded. The mapping is fixed, so pictures
+// of different renders compare (no per-image exposure).
+se::ImageRGBA8 irradiancePicture(const se::ImageRGBA32F& e) {
+  se::ImageRGBA8 img;
+  img.width = e.width, img.height = e.height;
+  img.pixels.resize(size_t(e.width) * e.height * 4);
+  for (size_t i = 0; i < img.pixels.size(); ++i) {
+    if (i % 4 == 3) {
+      img.pixels[i] = 255;
+      continue;
+    }
+    const float v = std::max(e.pixels[i], 0.0f), c = v / (1.0f + v);
+    const float srgb = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+    img.pixels[i] = uint8_t(std::clamp(srgb, 0.0f, 1.0f) * 255.0f + 0.5f);
   }
   return img;
 }
@@ -304,7 +325,7 @@ int main(int argc, char** argv) {
                        {"shadowed_by", !lightCount ? "none"
                                        : traced    ? "raybridge"
                                                    : "engine shadow maps for the strongest lights"},
-                       {"mode", !traced ? "raster"
+                       {"mode", !traced                               ? "raster"
                                 : ll.mode == rb::ManyLightMode::Exact ? "exact"
                                                                       : "stochastic"},
                        {"rays_per_pixel", traced && ll.mode == rb::ManyLightMode::Stochastic ? ll.raysPerPixel : 0u},
@@ -432,14 +453,19 @@ int main(int argc, char** argv) {
     writeCaptured("lights", 4);
     writeCaptured("lights_raw", 4);
     // The engine's own irradiance of the punctual lights (raster mode, or hybrid without the lights effect).
+    std::optional<se::ImageRGBA32F> lights;
+    if (auto it = f.images.find("lights"); it != f.images.end()) lights = toExr(f, it->second, 4);
     if (e.empty() && params.outputLocalLightIrradiance) {
       auto irradiance = engine.readbackLocalLightIrradiance();
       if (!irradiance) e = irradiance.error;
-      else
-        e = write("lights.exr", toExr(f, std::vector<float>(&irradiance.value[0].x, &irradiance.value[0].x +
-                                                                                       4 * irradiance.value.size()),
-                                      4)),
-        written.push_back("lights.exr");
+      std::vector<float> values;
+      for (const glm::vec4& v : irradiance.value) values.insert(values.end(), {v.r, v.g, v.b, v.a});
+      if (e.empty()) lights = toExr(f, values, 4), e = write("lights.exr", *lights), written.push_back("lights.exr");
+    }
+    if (e.empty() && lights) {
+      se::Status s = se::writePng((out / "lights.png").string(), irradiancePicture(*lights));
+      e = s ? std::string() : s.error;
+      written.push_back("lights.png");
     }
     // Raster: the engine's shadow-map visibility and SSAO.
     if (e.empty() && !hybrid) {

@@ -2,7 +2,8 @@
 // the device (configureEngine), registers the engine's meshes from its own buffers (deforming instances as
 // dynamic BLASes, on the engine's async compute queue in the async modes), describes its pre-pass as an
 // rb::GBufferDesc, hands its KHR_lights_punctual lights to the local lights effect and lets an rb::HybridEffects
-// front end record the effects, whose outputs become the engine's LightingInputs. Frame: shadow map -> pre-pass -> [hook: beginFrame, BLAS work, TLAS, effects] -> lighting.
+// front end record the effects, whose outputs become the engine's LightingInputs. Frame: shadow map -> pre-pass ->
+// [hook: beginFrame, BLAS work, TLAS, effects] -> lighting.
 //
 //   rb::RequiredFeatures features;                       // must outlive Engine::create()
 //   rbAdapter::configureEngine(config, features);        // config: the engine's EngineConfig

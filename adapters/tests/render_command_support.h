@@ -48,7 +48,9 @@ inline std::vector<float> readExrRgb(const std::filesystem::path& path, int& wid
   std::vector<float> rgb(size_t(width) * height * 3);
   Imf::FrameBuffer fb;
   for (int c = 0; c < 3; ++c)
-    fb.insert(c == 0 ? "R" : c == 1 ? "G" : "B",
+    fb.insert(c == 0   ? "R"
+              : c == 1 ? "G"
+                       : "B",
               Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(rgb.data() + c - 3 * (dw.min.x + dw.min.y * width)),
                          3 * sizeof(float), 3 * sizeof(float) * width));
   file.setFrameBuffer(fb);

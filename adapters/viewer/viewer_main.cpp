@@ -133,8 +133,9 @@ struct Keys {
 
 std::string effectsToString(rb::EffectSet set) {
   std::string s;
-  for (auto [bit, name] : {std::pair{rb::kEffectShadows, "shadows"}, std::pair{rb::kEffectAo, "ao"},
-                           std::pair{rb::kEffectReflections, "reflections"}, std::pair{rb::kEffectLocalLights, "lights"}})
+  for (auto [bit, name] :
+       {std::pair{rb::kEffectShadows, "shadows"}, std::pair{rb::kEffectAo, "ao"},
+        std::pair{rb::kEffectReflections, "reflections"}, std::pair{rb::kEffectLocalLights, "lights"}})
     if (set & bit) s += (s.empty() ? "" : ",") + std::string(name);
   return s.empty() ? "none" : s;
 }

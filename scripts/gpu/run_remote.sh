@@ -2,7 +2,8 @@
 # Runs the benchmark and the tests on the GPU machine (NVIDIA, no Vulkan loader, no network) from the folder
 # .devcarry/ that scripts/gpu/prepare.sh assembled and the device tool carried. Run from the repository root:
 #
-#   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, render, effects, animated (default all)
+#   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, render, effects, animated, lights
+#                                                          (default all)
 #
 # Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
 # tests_gpu.log, effects_gpu.json, effects_gpu.log, render_gpu.tar.gz (render logs, stats.json and final.png
@@ -21,7 +22,7 @@ set -u
 
 MODE="${1:-all}"
 for m in ${MODE//,/ }; do
-  case "$m" in all|bench|tests|render|effects|animated) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, render, effects or animated" >&2; exit 2 ;; esac
+  case "$m" in all|bench|tests|render|effects|animated|lights) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, render, effects, animated or lights" >&2; exit 2 ;; esac
 done
 want() { [ "$MODE" = all ] || [[ ",$MODE," == *",$1,"* ]]; }
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -217,6 +218,31 @@ if want animated; then
   grep -E '^\| |^device|stress|All tests passed|test cases|FAILED|SKIPPED|validation' "$OUT/animated_gpu.log" | head -n 80
 fi
 
+# ---- lights: the many-light benchmark at 2560x1440 with the raw-rate probe in the same run, then the demo scene's
+# punctual lights at 2560x1440 (times: raster with shadow maps, exact, 1 and 4 rays) and at 960x540 (lights.png
+# pictures of the same variants). Validation off.
+if want lights; then
+  : >"$OUT/lights_gpu.log"
+  if [ -x "$RT/probe/probe" ]; then
+    RAYBRIDGE_VALIDATION=0 step probe 60 "$OUT/lights_gpu.log" "$RT/probe/probe" --width 2560 --height 1440 \
+      --rays 64 --k 10 --ground-tiles 64 --reps 7
+  fi
+  RAYBRIDGE_VALIDATION=0 step "lights bench" 240 "$OUT/lights_gpu.log" "$RT/bin/raybridge-bench" --scenario lights \
+    ${RB_LIGHTS_ARGS:-} --out "$OUT/lights_bench_gpu.json"
+  LDIR="$(mktemp -d)"
+  for size in "2560 1440" "960 540"; do
+    read -r lw lh <<<"$size"
+    for variant in "raster|--mode raster --preset hard-shadows" "exact|--effects lights --light-rays 0" \
+                   "rays1|--effects lights --light-rays 1" "rays4|--effects lights --light-rays 4"; do
+      name="${variant%%|*}_${lw}"
+      read -r -a vargs <<<"${variant#*|}"
+      RAYBRIDGE_VALIDATION=0 step "lights $name" 60 "$OUT/lights_gpu.log" \
+        "$RT/bin/raybridge-render" --width "$lw" --height "$lh" --frames 16 --dump "${vargs[@]}" --out "$LDIR/$name"
+    done
+  done
+  grep -E '^\| |stress|engine GPU ms|Raybridge:' "$OUT/lights_gpu.log" | head -n 80
+  tar -C "$LDIR" -czf "$OUT/lights_render_gpu.tar.gz" --exclude='*.exr' . 2>/dev/null
+fi
 # ---- tests (validation on) ---------------------------------------------------------------------------------
 if want tests; then
   : >"$OUT/tests_gpu.log"
