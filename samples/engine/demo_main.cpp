@@ -181,9 +181,9 @@ int writeEffects(const Options& o, Engine& engine) {
 void printTimings(const PassTimings& t) {
   if (!t.valid) return;
   std::printf("GPU ms: deform %.2f  shadow %.2f  probe %.2f%s  prepass %.2f  ssao %.2f  shadow-vis %.2f  hook %.2f"
-              "  lighting %.2f  tonemap %.2f\n",
+              "  local-shadow %.2f  local-irradiance %.2f  lighting %.2f  tonemap %.2f\n",
               t.deformMs, t.shadowMs, t.probeMs, t.probeCaptured ? " (captured)" : "", t.prepassMs, t.ssaoMs,
-              t.shadowVisibilityMs, t.hookMs, t.lightingMs, t.tonemapMs);
+              t.shadowVisibilityMs, t.hookMs, t.localShadowMs, t.localIrradianceMs, t.lightingMs, t.tonemapMs);
 }
 
 int runHeadless(const Options& o) {

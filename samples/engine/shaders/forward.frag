@@ -10,6 +10,9 @@
 #include "common.glsl"
 #include "surface.glsl"
 #include "shadow_sampling.glsl"
+#define LOCAL_LIGHT_SET 2
+#define LOCAL_LIGHT_BINDING 5
+#include "local_lights.glsl"
 
 layout(set = 2, binding = 0) uniform sampler2DShadow shadowMap;
 layout(set = 2, binding = 1) uniform sampler2D externalVisibility;
@@ -17,10 +20,30 @@ layout(set = 2, binding = 2) uniform sampler2D externalAo;
 layout(set = 2, binding = 3) uniform sampler2D externalReflection;
 // Reflection probe (engine-captured cubemap with mips); a 1x1 black cube when no probe is in use.
 layout(set = 2, binding = 4) uniform samplerCube probeCube;
+// Bindings 5-7: local_lights.glsl. External KHR-light irradiance E (LightingInputs::localLightIrradiance).
+layout(set = 2, binding = 8) uniform sampler2D externalLocalIrradiance;
 
 layout(location = 0) out vec4 outColor;
 
 const float PI = 3.14159265358979;
+
+float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+
+// GGX specular (D * Vis * F) and the Lambert diffuse of one light direction, as the sun's.
+void brdf(Surface s, vec3 f0, vec3 l, out vec3 specular, out vec3 diffuse) {
+  vec3 h = normalize(l + s.v);
+  float nDotL = max(dot(s.n, l), 0.0);
+  float nDotV = max(dot(s.n, s.v), 1e-4);
+  float nDotH = max(dot(s.n, h), 0.0);
+  float vDotH = max(dot(s.v, h), 0.0);
+  float a = s.roughness * s.roughness;
+  float a2 = a * a;
+  float d = a2 / (PI * pow(nDotH * nDotH * (a2 - 1.0) + 1.0, 2.0));
+  float vis = 0.5 / (nDotL * sqrt(nDotV * nDotV * (1.0 - a2) + a2) + nDotV * sqrt(nDotL * nDotL * (1.0 - a2) + a2) + 1e-7);
+  vec3 f = f0 + (1.0 - f0) * pow(1.0 - vDotH, 5.0);
+  specular = d * vis * f;
+  diffuse = (1.0 - f) * (1.0 - s.metallic) * s.baseColor / PI;
+}
 
 // Karis' analytic approximation of the split-sum environment BRDF.
 vec3 environmentBrdf(vec3 f0, float roughness, float nDotV) {
@@ -79,6 +102,33 @@ void main() {
     reflected = mix(reflected, ext.rgb, clamp(ext.a, 0.0, 1.0));
   }
   color += reflected * specularWeight;
+  // KHR lights: every light, shadow-mapped where it has a map this frame. With an external irradiance E the
+  // diffuse is albedo * (1 - metallic) / pi * E and the specular the unshadowed one scaled by
+  // lum(E) / lum(E_unshadowed) (ratio estimator).
+  if (localLightCount() > 0u) {
+    vec3 own = vec3(0.0), specularUnshadowed = vec3(0.0), unshadowedE = vec3(0.0);
+    for (uint i = 0u; i < localLightCount(); ++i) {
+      vec3 li;
+      vec3 incident = localLightIncidence(i, inEyeRelativePos, li);
+      float nDotLi = dot(s.n, li);
+      if (nDotLi <= 0.0 || all(equal(incident, vec3(0.0)))) continue;
+      vec3 e = incident * nDotLi;
+      vec3 spec, diff;
+      brdf(s, f0, li, spec, diff);
+      float shadow = localLightShadow(i, inEyeRelativePos, s.ng);
+      own += (diff + spec) * e * shadow;
+      specularUnshadowed += spec * e;
+      unshadowedE += e;
+    }
+    if (screenInputs && frame.localLights.y != 0u) {
+      vec3 givenE = max(texture(externalLocalIrradiance, screenUv).rgb, vec3(0.0));
+      float lu = luminance(unshadowedE);
+      float ratio = lu > 0.0 ? clamp(luminance(givenE) / lu, 0.0, 1.0) : 0.0;
+      color += s.baseColor * (1.0 - s.metallic) / PI * givenE + specularUnshadowed * ratio;
+    } else {
+      color += own;
+    }
+  }
   color += s.emissive;
   outColor = vec4(color, blended ? clamp(s.alpha, 0.0, 1.0) : 1.0);
 }

@@ -16,4 +16,7 @@ layout(set = 0, binding = 0) uniform FrameUniforms {
   uvec4 inputs;       // x: sun visibility image, y: AO image (external or SSAO), z: external reflection (1 = bound)
   mat4 invProj;
   vec4 probe;         // x: 1 = sample the reflection probe, y: its last mip level
+  // x: KHR lights in the light buffer (0 = none: LocalLightSettings::enabled off, the probe capture),
+  // y: 1 = LightingInputs::localLightIrradiance bound
+  uvec4 localLights;
 } frame;

@@ -1,6 +1,7 @@
 // The default demo scene: a small colonnade on a checkered ground with a few test objects chosen to show
 // what a ray-tracing add-on changes (sharp metal, mirrors, contact shadows under arches, a leaf canopy's
-// alpha-tested dappled shadow).
+// alpha-tested dappled shadow) and a handful of coloured KHR lights in the shade.
+#include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "sample_engine/procedural.h"
@@ -94,6 +95,38 @@ void addPergola(Scene& s, glm::vec2 centre) {
   }
 }
 
+PunctualLight localLight(const char* name, PunctualLight::Type type, glm::vec3 position, glm::vec3 color,
+                         float intensity, float range) {
+  PunctualLight l;
+  l.name = name;
+  l.type = type;
+  l.color = color;
+  l.intensity = intensity;
+  l.range = range;
+  // Local -Z turned to world -Y: spots shine straight down (points do not care).
+  l.transform = glm::rotate(glm::translate(glm::mat4(1.0f), position), -glm::half_pi<float>(), glm::vec3(1, 0, 0));
+  return l;
+}
+
+// A few coloured KHR lights (candela, windowed by their range) that make sense in the scene: a warm lantern
+// under the pergola, two spots under the arches, small glows by the red sphere and the copper cylinder. Their
+// irradiance on the ground below them (1.5-2.5 lux) stays below the sun's 3.5, so the sunlit image is not
+// blown out; they show best in the shade (under the canopy, behind the objects).
+void addLocalLights(Scene& s) {
+  using T = PunctualLight::Type;
+  s.lights.push_back(localLight("pergola lantern", T::Point, {-7.8f, 2.1f, 5.4f}, {1.0f, 0.72f, 0.42f}, 8.0f, 7.0f));
+  PunctualLight left = localLight("left arch spot", T::Spot, {-4.5f, 3.2f, -3.5f}, {0.55f, 0.75f, 1.0f}, 24.0f, 9.0f);
+  left.innerConeAngle = 0.3f;
+  left.outerConeAngle = 0.6f;
+  s.lights.push_back(left);
+  PunctualLight right = localLight("right arch spot", T::Spot, {4.5f, 3.2f, -3.5f}, {1.0f, 0.6f, 0.35f}, 24.0f, 9.0f);
+  right.innerConeAngle = 0.3f;
+  right.outerConeAngle = 0.6f;
+  s.lights.push_back(right);
+  s.lights.push_back(localLight("sphere glow", T::Point, {0.6f, 0.35f, 2.3f}, {1.0f, 0.35f, 0.6f}, 1.2f, 3.0f));
+  s.lights.push_back(localLight("copper glow", T::Point, {5.4f, 1.6f, 3.2f}, {0.35f, 1.0f, 0.7f}, 3.0f, 4.0f));
+}
+
 }  // namespace
 
 Scene makeDefaultDemoScene() {
@@ -144,6 +177,8 @@ Scene makeDefaultDemoScene() {
   // the camera) throws the canopy's dappled shadow to the right, onto open ground in front of the mirror box,
   // in the camera's view. Sight lines to the columns and test objects pass right of it or behind its rear edge.
   addPergola(s, {-7.8f, 5.4f});
+
+  addLocalLights(s);
 
   s.camera = Camera{
       .eye = {0.0f, 4.2f, 12.5f}, .target = {0.0f, 1.2f, 0.0f}, .fovYDegrees = 50.0f, .zNear = 0.1f, .zFar = 200.0f};

@@ -22,13 +22,15 @@ std::string Engine::Impl::init(const EngineConfig& config) {
 
   // Per frame: frame uniforms, lighting inputs, tonemap input and the three effect passes' inputs.
   constexpr uint32_t kSetsPerFrame = 6;
-  constexpr uint32_t kSamplersPerFrame = kLightingSetBindings + 1 + 3 * kScreenSetBindings;
+  // The lighting set also holds the KHR light buffer (storage) and the local shadow views (uniform).
+  constexpr uint32_t kSamplersPerFrame = kLightingSetSamplers + 1 + 3 * kScreenSetBindings;
   const VkDevice dev = ctx.device;
-  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, kFramesInFlight},
-                                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kSamplersPerFrame * kFramesInFlight}};
+  VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 * kFramesInFlight},
+                                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kSamplersPerFrame * kFramesInFlight},
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kFramesInFlight}};
   VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pci.maxSets = kSetsPerFrame * kFramesInFlight;
-  pci.poolSizeCount = 2;
+  pci.poolSizeCount = 3;
   pci.pPoolSizes = sizes;
   SE_VK_TRY(vkCreateDescriptorPool(dev, &pci, nullptr, &framePool));
 
@@ -81,7 +83,7 @@ std::string Engine::Impl::init(const EngineConfig& config) {
       SE_VK_TRY(vkCreateQueryPool(dev, &qci, nullptr, &f.timestamps));
     }
   }
-  return {};
+  return createLocalLights();
 }
 
 Engine::Impl::~Impl() {
@@ -91,6 +93,7 @@ Engine::Impl::~Impl() {
     destroyTargets();
     destroyOverlay();
     gpu.destroy(targets.shadowMap);
+    destroyLocalLights();
     if (sceneLoaded) destroyScene(gpu, scene);
     deformer.destroy();
     for (FrameResources& f : frames) {
@@ -164,15 +167,19 @@ Status Engine::loadScene(const Scene& scene) {
     impl_->deformer.unload();
     if (impl_->sceneLoaded) destroyScene(impl_->gpu, impl_->scene);
     impl_->sceneLoaded = true;  // partially uploaded resources are destroyed like a full scene
-    std::string e = uploadScene(impl_->gpu, impl_->ctx, impl_->pipelines, impl_->defaults, scene, impl_->pose,
-                                impl_->scene);
+    impl_->frameLights.clear();
+    std::string e = checkLights(scene).error;
+    if (e.empty())
+      e = uploadScene(impl_->gpu, impl_->ctx, impl_->pipelines, impl_->defaults, scene, impl_->pose, impl_->scene);
     // The rest pose until the first frame; the deformed buffers start as the bind pose.
     if (e.empty()) e = impl_->pose.evaluate(impl_->scene.cpu, 0.0, {}, true).error;
     if (e.empty()) e = impl_->deformer.load(impl_->scene, impl_->pose);
+    if (e.empty()) placeLights(impl_->scene.cpu, impl_->pose.nodeWorld(), impl_->frameLights);
     if (!e.empty()) {
       impl_->deformer.unload();
       destroyScene(impl_->gpu, impl_->scene);
       impl_->sceneLoaded = false;
+      impl_->frameLights.clear();
       return Status::failure("loadScene: " + e);
     }
     return Status::success();
@@ -217,10 +224,10 @@ std::string Engine::Impl::createShadowMap(uint32_t size) {
 
 void Engine::Impl::destroyTargets() {
   for (Image* i : {&targets.depth, &targets.normalRoughness, &targets.geometricNormal, &targets.hdr, &targets.ldr,
-                   &targets.ssaoRaw, &targets.ssao, &targets.shadowVisibility})
+                   &targets.ssaoRaw, &targets.ssao, &targets.shadowVisibility, &targets.localIrradiance})
     gpu.destroy(*i);
   destroyOverlayFramebuffer();
-  ssaoRendered = shadowVisibilityRendered = false;
+  ssaoRendered = shadowVisibilityRendered = localIrradianceRendered = false;
   targets.extent = {};
 }
 
@@ -260,7 +267,9 @@ void Engine::Impl::collectTimings(FrameResources& frame) {
   timings.ssaoMs = ms(kTsPrepassEnd, kTsSsaoEnd);
   timings.shadowVisibilityMs = ms(kTsSsaoEnd, kTsShadowVisibilityEnd);
   timings.hookMs = ms(kTsShadowVisibilityEnd, kTsHookEnd);
-  timings.lightingMs = ms(kTsHookEnd, kTsLightingEnd);
+  timings.localShadowMs = ms(kTsHookEnd, kTsLocalShadowEnd);
+  timings.localIrradianceMs = ms(kTsLocalShadowEnd, kTsLocalIrradianceEnd);
+  timings.lightingMs = ms(kTsLocalIrradianceEnd, kTsLightingEnd);
   timings.tonemapMs = ms(kTsLightingEnd, kTsTonemapEnd);
   timings.deformMs = deformMs;
   timings.probeCaptured = frame.probeCaptured;
@@ -425,7 +434,19 @@ Result<std::vector<glm::vec4>> Engine::readbackLocalLightIrradiance() {
   if (!impl_->frameRendered || !impl_->localIrradianceRendered)
     return R::failure("readbackLocalLightIrradiance: the last frame did not produce it; set "
                       "FrameParams::outputLocalLightIrradiance");
-  return R::failure("readbackLocalLightIrradiance: not implemented yet");
+  std::vector<uint8_t> raw;
+  if (std::string e = readImage(*impl_, impl_->targets.localIrradiance, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 8,
+                                raw);
+      !e.empty())
+    return R::failure("readbackLocalLightIrradiance: " + e);
+  std::vector<glm::vec4> out(raw.size() / 8);
+  for (size_t i = 0; i < out.size(); ++i)
+    for (int c = 0; c < 4; ++c) {
+      uint16_t h;
+      std::memcpy(&h, &raw[i * 8 + size_t(c) * 2], 2);
+      out[i][c] = halfToFloat(h);
+    }
+  return R::success(std::move(out));
 }
 
 Result<std::vector<glm::vec3>> Engine::readbackDeformedPositions(uint32_t deformedIndex) {

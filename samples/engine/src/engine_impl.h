@@ -8,8 +8,10 @@
 #include "deformer.h"
 #include "gpu_memory.h"
 #include "gpu_scene.h"
+#include "local_lights.h"
 #include "pipelines.h"
 #include "reflection_probe.h"
+#include "render_utils.h"
 #include "sample_engine/engine.h"
 #include "vk_context.h"
 
@@ -24,6 +26,8 @@ enum TimestampSlot : uint32_t {
   kTsSsaoEnd,
   kTsShadowVisibilityEnd,
   kTsHookEnd,
+  kTsLocalShadowEnd,
+  kTsLocalIrradianceEnd,
   kTsLightingEnd,
   kTsTonemapEnd,
   kTsCount
@@ -41,6 +45,11 @@ struct FrameResources {
   VkDescriptorSet ssaoSet = VK_NULL_HANDLE;  // screen-pass inputs (Pipelines::screenSetLayout)
   VkDescriptorSet ssaoBlurSet = VK_NULL_HANDLE;
   VkDescriptorSet shadowVisibilitySet = VK_NULL_HANDLE;
+  // KHR lights (local_lights.cpp): the light buffer and shadow views the lighting reads, one FrameUniforms copy
+  // per local shadow view (its lightViewProj replaced) and their sets, the irradiance output's inputs.
+  detail::Buffer localLightBuffer, localShadowBuffer, shadowViewUniforms;
+  std::array<VkDescriptorSet, detail::kMaxLocalShadowViews> shadowViewSets{};
+  VkDescriptorSet localIrradianceSet = VK_NULL_HANDLE;
   VkQueryPool timestamps = VK_NULL_HANDLE;
   bool timingsPending = false;  // submitted with timestamps, not read back yet
   bool probeCaptured = false;   // this frame recorded a probe capture
@@ -56,6 +65,12 @@ struct RenderTargets {
   detail::Image shadowMap;
   // Effect images (kEffectFormat, left in SHADER_READ_ONLY_OPTIMAL), created on first use at this extent.
   detail::Image ssaoRaw, ssao, shadowVisibility;
+  // KHR lights: 6 depth layers per shadowed light (a 1x1 one-layer placeholder without any), one view per layer
+  // for rendering; kept in SHADER_READ_ONLY_OPTIMAL between passes. The irradiance output (RGBA16F).
+  detail::Image localShadowMaps;
+  std::vector<VkImageView> localShadowLayerViews;
+  uint32_t localShadowMapSize = 0, localShadowLayers = 0;
+  detail::Image localIrradiance;
   VkExtent2D extent{};
   uint32_t shadowMapSize = 0;
 };
@@ -122,6 +137,19 @@ struct Engine::Impl {
   std::string ensureEffectImages(const FrameParams& params);
   void recordSsao(FrameResources& frame, const SsaoSettings& settings);
   void recordShadowVisibility(FrameResources& frame);
+
+  // local_lights.cpp: per-frame light buffers and shadow-view sets (init), the local shadow maps (recreated
+  // when the settings change, waiting for the GPU), and after the hook: the light buffers, the shadow views of
+  // the strongest lights and, on request, the irradiance output (writes kTsLocalShadowEnd/IrradianceEnd).
+  VkDescriptorPool localLightPool = VK_NULL_HANDLE;
+  VkDeviceSize shadowViewStride = 0;
+  std::string createLocalLights();
+  void destroyLocalLights();
+  void destroyLocalShadowMaps();
+  std::string prepareLocalShadowMaps(const LocalLightSettings& settings);
+  detail::LocalLightBindings localLightBindings(const FrameResources& frame) const;
+  void recordLocalLights(FrameResources& frame, const FrameParams& params, const detail::FrameUniforms& uniforms,
+                         const LightingInputs& inputs);
 
   // swapchain.cpp
   std::string createSwapchain(uint32_t width, uint32_t height);

@@ -1,5 +1,5 @@
-// One frame: shadow map -> [probe capture] -> pre-pass -> [SSAO] -> [shadow visibility] -> hook -> lighting
-// (opaque, then blended) -> tonemap (-> blit to the swapchain).
+// One frame: shadow map -> [probe capture] -> pre-pass -> [SSAO] -> [shadow visibility] -> hook -> [local
+// shadow maps] -> [local-light irradiance] -> lighting (opaque, then blended) -> tonemap (-> blit to the swapchain).
 #include <algorithm>
 #include <cstring>
 
@@ -52,6 +52,14 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   if (params.reflectionProbe.enabled)
     if (std::string e = probe.prepare(probeResolution); !e.empty()) return "reflection probe: " + e;
   if (std::string e = ensureEffectImages(params); !e.empty()) return "effect images: " + e;
+  if (std::string e = prepareLocalShadowMaps(params.localLights); !e.empty()) return "local shadow maps: " + e;
+  if (params.outputLocalLightIrradiance && !targets.localIrradiance.image)
+    if (std::string e = gpu.createImage({kNormalFormat, targets.extent,
+                                         VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                             VK_IMAGE_USAGE_TRANSFER_SRC_BIT},
+                                        targets.localIrradiance);
+        !e.empty())
+      return "local-light irradiance image: " + e;
   if (std::string e = prepareOverlay(); !e.empty()) return "overlay: " + e;
   const uint32_t slot = currentFrame;
   FrameResources& frame = frames[slot];
@@ -77,6 +85,10 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
     if (deformer.active())
       if (std::string e = deformer.submit(slot, frameNumber, pose); !e.empty()) return "renderFrame: " + e;
   }
+  // The KHR lights follow their nodes; off, they are not drawn and the hook sees none.
+  if (sceneLoaded && params.localLights.enabled) placeLights(scene.cpu, pose.nodeWorld(), frameLights);
+  else
+    frameLights.clear();
 
   // --- Uniforms ---
   const VkExtent2D extent = targets.extent;
@@ -174,6 +186,7 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   frameRendered = true;
   ssaoRendered = params.ssao.enabled;
   shadowVisibilityRendered = params.outputShadowVisibility;
+  localIrradianceRendered = params.outputLocalLightIrradiance;
   shadowStats = ShadowMapStats{shadowsOn, shadowsOn ? shadowSize : 0u, taps, frame.frameNumber};
 
   if (imageIndex) {
@@ -239,7 +252,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
   frame.probeCaptured = captureProbe;
   if (captureProbe) {
     probe.recordCapture(cmd, uint32_t(&frame - frames.data()), uniformsIn, probeKey, haveScene ? &scene : nullptr,
-                        targets.shadowMap.view, defaults);
+                        targets.shadowMap.view, defaults, localLightBindings(frame));
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 0, 1, &frame.frameSet, 0,
                             nullptr);
   }
@@ -314,6 +327,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     info.skyColor = glm::vec3(uniformsIn.sky);
     info.ambientIntensity = uniformsIn.sky.w;
     if (haveScene) info.instanceTransforms = scene.instanceTransforms;
+    info.lights = frameLights;
     info.deformedInstances = deformer.instances();
     info.deformSemaphore = deformer.semaphore();
     info.deformValue = deformer.active() ? frame.frameNumber : 0;
@@ -327,6 +341,11 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
   }
   timestamp(kTsHookEnd);
 
+  // (3b) KHR lights, after the hook so that its LightingInputs::localLightIrradiance is known: the light
+  // buffers, the shadow maps of the strongest lights (skipped under an external irradiance unless the engine's
+  // own is requested) and the irradiance output. Writes kTsLocalShadowEnd and kTsLocalIrradianceEnd.
+  recordLocalLights(frame, params, uniformsIn, inputs);
+
   // External inputs win over the engine's own SSAO; the probe stays bound under an external reflection, as
   // the environment term where the reflection's alpha (coverage) is below 1.
   const VkImageView ao = inputs.ambientOcclusion ? inputs.ambientOcclusion
@@ -337,6 +356,8 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
   u.inputs = glm::uvec4(inputs.sunVisibility != VK_NULL_HANDLE, ao != VK_NULL_HANDLE,
                         inputs.reflection != VK_NULL_HANDLE, 0u);
   u.probe = glm::vec4(useProbe ? 1.0f : 0.0f, probe.maxLod(), 0.0f, 0.0f);
+  u.localLights = glm::uvec4(params.localLights.enabled ? uint32_t(frameLights.size()) : 0u,
+                             inputs.localLightIrradiance != VK_NULL_HANDLE, 0u, 0u);
   std::memcpy(frame.uniforms.mapped, &u, sizeof(u));  // host-coherent; the submission makes it visible
   writeImageDescriptors(
       ctx.device, frame.lightingSet,
@@ -345,6 +366,13 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
        {pipelines.screenSampler, ao ? ao : defaults.white.view, kReadLayout},
        {pipelines.screenSampler, inputs.reflection ? inputs.reflection : defaults.black.view, kReadLayout},
        {pipelines.cubeSampler, useProbe ? probe.view() : probe.fallbackView(), kReadLayout}});
+  writeLocalLightDescriptors(ctx.device, pipelines, frame.lightingSet, kLightingLocalLightBinding,
+                             localLightBindings(frame));
+  writeImageDescriptors(ctx.device, frame.lightingSet,
+                        {{pipelines.screenSampler,
+                          inputs.localLightIrradiance ? inputs.localLightIrradiance : defaults.black.view,
+                          kReadLayout}},
+                        8);
   writeImageDescriptors(ctx.device, frame.tonemapSet, {{pipelines.nearestSampler, targets.hdr.view, kReadLayout}});
 
   // (4) Forward lighting: EQUAL test against the pre-pass depth, background keeps the sky clear color; then the

@@ -24,7 +24,7 @@ using detail::readIndices;
 // The extensions a file may list in extensionsRequired. KHR_mesh_quantization needs nothing beyond the
 // accessor reader's integer and normalized formats.
 const char* const kSupportedExtensions[] = {"KHR_mesh_quantization", "KHR_texture_transform",
-                                            "KHR_materials_emissive_strength"};
+                                            "KHR_materials_emissive_strength", "KHR_lights_punctual"};
 
 const char* modeName(int mode) {
   switch (mode) {
@@ -95,6 +95,7 @@ struct Loader {
   std::set<std::pair<int, uint32_t>> checkedSkins;      // (skin, Scene mesh) pairs already validated
   std::vector<UvMapping> bakedUv;                       // per glTF material: the mapping baked into its UVs
   std::string error;                                    // the first fatal problem
+  std::vector<PunctualLight> lights;                    // per KHR_lights_punctual light, checked, unplaced
 
   void fail(std::string message) {
     if (error.empty()) error = std::move(message);
@@ -416,6 +417,64 @@ struct Loader {
     return list;
   }
 
+  // KHR_lights_punctual: tinygltf parses the root `lights` (applying the spec's defaults); the raw extension
+  // value tells a given range (which must be > 0) from an absent one (unlimited).
+  void convertLights() {
+    const tinygltf::Value* rawLights = nullptr;
+    if (auto it = model.extensions.find("KHR_lights_punctual"); it != model.extensions.end() && it->second.IsObject())
+      if (it->second.Has("lights") && it->second.Get("lights").IsArray()) rawLights = &it->second.Get("lights");
+    if (model.lights.size() > kMaxPunctualLights)
+      return fail("KHR_lights_punctual: " + std::to_string(model.lights.size()) +
+                  " lights, more than the engine's kMaxPunctualLights = " + std::to_string(kMaxPunctualLights));
+    for (size_t i = 0; i < model.lights.size(); ++i) {
+      const tinygltf::Light& in = model.lights[i];
+      const std::string where = "KHR_lights_punctual light " + std::to_string(i) + " '" + in.name + "'";
+      PunctualLight out;
+      out.name = in.name;
+      if (in.type == "directional") out.type = PunctualLight::Type::Directional;
+      else if (in.type == "point")
+        out.type = PunctualLight::Type::Point;
+      else if (in.type == "spot")
+        out.type = PunctualLight::Type::Spot;
+      else
+        return fail(where + ": type = '" + in.type + "': unknown (directional, point or spot)");
+      if (!in.color.empty()) {
+        if (in.color.size() != 3)
+          return fail(where + ": color has " + std::to_string(in.color.size()) +
+                      " components; it needs 3 (linear RGB)");
+        out.color = glm::vec3(float(in.color[0]), float(in.color[1]), float(in.color[2]));
+      }
+      out.intensity = float(in.intensity);
+      out.range = float(in.range);
+      const bool rangeGiven = rawLights && i < rawLights->ArrayLen() && rawLights->Get(int(i)).IsObject() &&
+                              rawLights->Get(int(i)).Has("range");
+      if (rangeGiven && !(in.range > 0.0))
+        return fail(where + ": range = " + std::to_string(in.range) +
+                    ": it must be > 0 when given (absent = unlimited)");
+      out.innerConeAngle = float(in.spot.innerConeAngle);
+      out.outerConeAngle = float(in.spot.outerConeAngle);
+      if (Status s = checkLight(out, i); !s) return fail("KHR_lights_punctual " + s.error);
+      lights.push_back(std::move(out));
+    }
+  }
+
+  // The light a node places (its KHR_lights_punctual.light), or -1.
+  int nodeLight(const tinygltf::Node& node, const std::string& name) {
+    auto it = node.extensions.find("KHR_lights_punctual");
+    if (it == node.extensions.end()) return -1;
+    if (!it->second.IsObject() || !it->second.Has("light") || !it->second.Get("light").IsInt()) {
+      fail(name + ": extensions.KHR_lights_punctual.light must be an integer light index");
+      return -1;
+    }
+    const int light = it->second.Get("light").GetNumberAsInt();
+    if (light < 0 || size_t(light) >= lights.size()) {
+      fail(name + ": KHR_lights_punctual light " + std::to_string(light) + " is out of range (the file has " +
+           std::to_string(lights.size()) + " lights)");
+      return -1;
+    }
+    return light;
+  }
+
   void visit(int nodeIndex, const glm::mat4& parent, int depth) {
     if (!error.empty()) return;
     if (nodeIndex < 0 || nodeIndex >= int(model.nodes.size()))
@@ -458,6 +517,16 @@ struct Loader {
       cam.zFar = p.zfar > p.znear ? float(p.zfar) : cam.zNear * 100000.0f;
       result.scene.camera = cam;
     }
+    if (const int light = nodeLight(node, name); light >= 0) {
+      if (result.scene.lights.size() >= kMaxPunctualLights)
+        return fail(name + ": more than kMaxPunctualLights = " + std::to_string(kMaxPunctualLights) +
+                    " placed KHR_lights_punctual lights");
+      PunctualLight placed = lights[size_t(light)];
+      placed.node = nodeIndex;
+      placed.transform = world;
+      result.scene.lights.push_back(std::move(placed));
+    }
+    if (!error.empty()) return;
     for (int child : node.children) visit(child, world, depth + 1);
   }
 };
@@ -489,13 +558,18 @@ SceneLoadResult loadGltf(const std::string& path) {
           std::end(kSupportedExtensions)) {
         result.error = "glTF '" + path + "' requires extension " + required +
                        ", which the sample engine does not support (it supports KHR_mesh_quantization, "
-                       "KHR_texture_transform and KHR_materials_emissive_strength)";
+                       "KHR_texture_transform, KHR_materials_emissive_strength and KHR_lights_punctual)";
         return result;
       }
-    Loader loader{model, result, {}, {}, {}, {}, {}};
+    Loader loader{model, result, {}, {}, {}, {}, {}, {}};
     if (std::string e = detail::convertNodes(model, result.scene); !e.empty()) loader.fail(e);
     if (std::string e = detail::convertSkins(model, result.scene); !e.empty()) loader.fail(e);
     if (std::string e = detail::convertAnimations(model, result.scene, result.warnings); !e.empty()) loader.fail(e);
+    if (!loader.error.empty()) {
+      result.error = "glTF '" + path + "': " + loader.error;
+      return result;
+    }
+    loader.convertLights();
     if (!loader.error.empty()) {
       result.error = "glTF '" + path + "': " + loader.error;
       return result;

@@ -1,5 +1,7 @@
 #include "gpu_memory.h"
 
+#include <algorithm>
+
 #include "vk_check.h"
 
 namespace sample_engine::detail {
@@ -137,7 +139,7 @@ std::string Gpu::createImage(const ImageDesc& desc, Image& out) {
   out.format = desc.format;
   out.extent = desc.extent;
   out.mipLevels = desc.mipLevels;
-  out.layers = desc.cube ? 6 : 1;
+  out.layers = desc.cube ? 6 : std::max(desc.arrayLayers, 1u);
   VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   ci.flags = (desc.altViewFormat != VK_FORMAT_UNDEFINED ? VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT : 0) |
              (desc.cube ? VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT : 0);
@@ -161,7 +163,9 @@ std::string Gpu::createImage(const ImageDesc& desc, Image& out) {
   SE_VK_TRY(vkBindImageMemory(device_, out.image, out.memory, 0));
   VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   vi.image = out.image;
-  vi.viewType = desc.cube ? VK_IMAGE_VIEW_TYPE_CUBE : VK_IMAGE_VIEW_TYPE_2D;
+  vi.viewType = desc.cube              ? VK_IMAGE_VIEW_TYPE_CUBE
+                : desc.arrayLayers > 0 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
+                                       : VK_IMAGE_VIEW_TYPE_2D;
   vi.format = desc.format;
   vi.subresourceRange = {desc.aspect, 0, desc.mipLevels, 0, out.layers};
   SE_VK_TRY(vkCreateImageView(device_, &vi, nullptr, &out.view));

@@ -37,7 +37,8 @@ struct ImageDesc {
   VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT;
   uint32_t mipLevels = 1;
   VkFormat altViewFormat = VK_FORMAT_UNDEFINED;  // creates a MUTABLE_FORMAT image with a second view
-  bool cube = false;  // 6 layers, CUBE_COMPATIBLE, `view` is a cube view (per-face views are the caller's)
+  bool cube = false;         // 6 layers, CUBE_COMPATIBLE, `view` is a cube view (per-face views are the caller's)
+  uint32_t arrayLayers = 0;  // (not cube) 0 = a plain 2D image; else that many layers and a 2D-array `view`
 };
 
 // One device-local buffer of a Gpu::createBuffers() batch.

@@ -30,6 +30,10 @@ VkDescriptorSetLayoutBinding samplerBinding(uint32_t binding) {
   return {binding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
 }
 
+VkDescriptorSetLayoutBinding bufferBinding(uint32_t binding, VkDescriptorType type) {
+  return {binding, type, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+}
+
 enum class VertexInput {
   None,          // fullscreen passes
   Positions,     // binding 0 only
@@ -170,8 +174,15 @@ std::string Pipelines::create(VkDevice device) {
                       {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3), samplerBinding(4)},
                       materialSetLayout));
   check(makeSetLayout(device,
-                      {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3), samplerBinding(4)},
+                      {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3), samplerBinding(4),
+                       samplerBinding(5), bufferBinding(6, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
+                       bufferBinding(7, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER), samplerBinding(8)},
                       lightingSetLayout));
+  check(makeSetLayout(device,
+                      {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3),
+                       bufferBinding(4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
+                       bufferBinding(5, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER)},
+                      localIrradianceSetLayout));
   check(makeSetLayout(device, {samplerBinding(0)}, tonemapSetLayout));
   check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3)},
                       screenSetLayout));
@@ -196,11 +207,17 @@ std::string Pipelines::create(VkDevice device) {
   lci.pSetLayouts = screenSets;
   lci.pPushConstantRanges = &screenRange;
   SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &screenLayout));
+  VkDescriptorSetLayout irradianceSets[2] = {frameSetLayout, localIrradianceSetLayout};
+  lci.pSetLayouts = irradianceSets;
+  lci.pushConstantRangeCount = 0;
+  lci.pPushConstantRanges = nullptr;
+  SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &localIrradianceLayout));
 
   VkShaderModule meshVert = VK_NULL_HANDLE, shadowVert = VK_NULL_HANDLE, shadowAlphaVert = VK_NULL_HANDLE,
                  shadowAlphaFrag = VK_NULL_HANDLE, prepassFrag = VK_NULL_HANDLE, forwardFrag = VK_NULL_HANDLE,
                  fullscreenVert = VK_NULL_HANDLE, tonemapFrag = VK_NULL_HANDLE, ssaoFrag = VK_NULL_HANDLE,
-                 ssaoBlurFrag = VK_NULL_HANDLE, shadowVisibilityFrag = VK_NULL_HANDLE;
+                 ssaoBlurFrag = VK_NULL_HANDLE, shadowVisibilityFrag = VK_NULL_HANDLE,
+                 localIrradianceFrag = VK_NULL_HANDLE;
   check(makeModule(device, spirv::mesh_vert, meshVert));
   check(makeModule(device, spirv::shadow_vert, shadowVert));
   check(makeModule(device, spirv::shadow_alpha_vert, shadowAlphaVert));
@@ -212,6 +229,7 @@ std::string Pipelines::create(VkDevice device) {
   check(makeModule(device, spirv::ssao_frag, ssaoFrag));
   check(makeModule(device, spirv::ssao_blur_frag, ssaoBlurFrag));
   check(makeModule(device, spirv::shadow_visibility_frag, shadowVisibilityFrag));
+  check(makeModule(device, spirv::local_irradiance_frag, localIrradianceFrag));
   if (e.empty()) {
     // The shadow map keeps culling off whatever Material::doubleSided says: doubleSided is about which side
     // the camera may see, not about what blocks light. A single-sided wall, roof or leaf whose back faces the
@@ -284,9 +302,14 @@ std::string Pipelines::create(VkDevice device) {
     check(makePipeline(device, d, ssaoBlur));
     d.frag = shadowVisibilityFrag;
     check(makePipeline(device, d, shadowVisibility));
+    d.colorFormats = {kNormalFormat};
+    d.layout = localIrradianceLayout;
+    d.frag = localIrradianceFrag;
+    check(makePipeline(device, d, localIrradiance));
   }
-  for (VkShaderModule m : {meshVert, shadowVert, shadowAlphaVert, shadowAlphaFrag, prepassFrag, forwardFrag,
-                           fullscreenVert, tonemapFrag, ssaoFrag, ssaoBlurFrag, shadowVisibilityFrag})
+  for (VkShaderModule m :
+       {meshVert, shadowVert, shadowAlphaVert, shadowAlphaFrag, prepassFrag, forwardFrag, fullscreenVert, tonemapFrag,
+        ssaoFrag, ssaoBlurFrag, shadowVisibilityFrag, localIrradianceFrag})
     if (m) vkDestroyShaderModule(device, m, nullptr);
   if (!e.empty()) return e;
 
@@ -302,12 +325,12 @@ std::string Pipelines::create(VkDevice device) {
 
 void Pipelines::destroy(VkDevice device) {
   for (VkPipeline p : {shadow, shadowAlpha, prepass, prepassMasked, forward, forwardMasked, blend, tonemap,
-                       probeCapture, probeCaptureMasked, ssao, ssaoBlur, shadowVisibility})
+                       probeCapture, probeCaptureMasked, ssao, ssaoBlur, shadowVisibility, localIrradiance})
     if (p) vkDestroyPipeline(device, p, nullptr);
-  for (VkPipelineLayout l : {sceneLayout, tonemapLayout, screenLayout})
+  for (VkPipelineLayout l : {sceneLayout, tonemapLayout, screenLayout, localIrradianceLayout})
     if (l) vkDestroyPipelineLayout(device, l, nullptr);
-  for (VkDescriptorSetLayout l :
-       {frameSetLayout, materialSetLayout, lightingSetLayout, tonemapSetLayout, screenSetLayout})
+  for (VkDescriptorSetLayout l : {frameSetLayout, materialSetLayout, lightingSetLayout, tonemapSetLayout,
+                                  screenSetLayout, localIrradianceSetLayout})
     if (l) vkDestroyDescriptorSetLayout(device, l, nullptr);
   for (VkSampler s : {materialSampler, screenSampler, shadowSampler, nearestSampler, cubeSampler})
     if (s) vkDestroySampler(device, s, nullptr);

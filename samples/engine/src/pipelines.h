@@ -19,6 +19,8 @@ struct FrameUniforms {
   glm::uvec4 inputs;
   glm::mat4 invProj;
   glm::vec4 probe;  // x: 1 = sample the reflection probe, y: its last mip level
+  // x: KHR lights in the light buffer (0 = none: local lights off, the probe capture), y: 1 = external E bound
+  glm::uvec4 localLights;
 };
 
 // Mirror of DrawConstants in shaders/common.glsl (push constants, vertex + fragment; std430 layout).
@@ -50,7 +52,14 @@ inline constexpr VkFormat kLdrFormat = VK_FORMAT_R8G8B8A8_SRGB;
 inline constexpr VkFormat kEffectFormat = VK_FORMAT_R16_SFLOAT;
 inline constexpr uint32_t kScreenSetBindings = 4;    // combined image samplers of a fullscreen pass (set 1)
 inline constexpr uint32_t kMaterialSetBindings = 5;  // base colour, metallic-roughness, normal, emissive, occlusion
-inline constexpr uint32_t kLightingSetBindings = 5;
+// Lighting set (set 2 of the scene passes): 0 sun shadow map, 1 sun visibility, 2 AO, 3 reflection, 4 probe cube,
+// 5 local shadow maps (2D array, comparison), 6 KHR light buffer (storage), 7 local shadow views (uniform),
+// 8 external local-light irradiance.
+inline constexpr uint32_t kLightingSetBindings = 9;
+inline constexpr uint32_t kLightingSetSamplers = 7;
+inline constexpr uint32_t kLightingLocalLightBinding = 5;  // the three bindings of shaders/local_lights.glsl
+// The local-irradiance pass's set 1: 0 depth, 1 shading normal, 2 geometric normal, 3-5 local_lights.glsl.
+inline constexpr uint32_t kLocalIrradianceLocalLightBinding = 3;
 
 // Mirror of SsaoConstants in shaders/ssao.frag and ssao_blur.frag (push constants of the fullscreen passes).
 struct SsaoConstants {
@@ -70,9 +79,11 @@ struct Pipelines {
   VkDescriptorSetLayout lightingSetLayout = VK_NULL_HANDLE;
   VkDescriptorSetLayout tonemapSetLayout = VK_NULL_HANDLE;
   VkDescriptorSetLayout screenSetLayout = VK_NULL_HANDLE;
+  VkDescriptorSetLayout localIrradianceSetLayout = VK_NULL_HANDLE;
   VkPipelineLayout sceneLayout = VK_NULL_HANDLE;
   VkPipelineLayout tonemapLayout = VK_NULL_HANDLE;
   VkPipelineLayout screenLayout = VK_NULL_HANDLE;
+  VkPipelineLayout localIrradianceLayout = VK_NULL_HANDLE;  // set 0 frame uniforms, set 1 localIrradianceSetLayout
   // Scene pipelines come in pairs: OPAQUE draws, and MASK draws (*Masked: the alpha test's discard, which the
   // opaque ones lack so that their depth writes keep early depth tests). BLEND draws use `blend` (and the
   // shadow map's alpha-tested variant). Camera passes take cull mode and front face per draw (dynamic state,
@@ -92,9 +103,10 @@ struct Pipelines {
   VkPipeline ssao = VK_NULL_HANDLE;
   VkPipeline ssaoBlur = VK_NULL_HANDLE;
   VkPipeline shadowVisibility = VK_NULL_HANDLE;
-  VkSampler materialSampler = VK_NULL_HANDLE;  // trilinear, repeat
-  VkSampler screenSampler = VK_NULL_HANDLE;    // bilinear, clamp: external screen-space inputs
-  VkSampler shadowSampler = VK_NULL_HANDLE;    // comparison LESS_OR_EQUAL, bilinear PCF
+  VkPipeline localIrradiance = VK_NULL_HANDLE;  // fullscreen, RGBA16F: the engine's KHR-light irradiance E
+  VkSampler materialSampler = VK_NULL_HANDLE;   // trilinear, repeat
+  VkSampler screenSampler = VK_NULL_HANDLE;     // bilinear, clamp: external screen-space inputs
+  VkSampler shadowSampler = VK_NULL_HANDLE;     // comparison LESS_OR_EQUAL, bilinear PCF
   VkSampler nearestSampler = VK_NULL_HANDLE;
   VkSampler cubeSampler = VK_NULL_HANDLE;  // trilinear, clamp: reflection probe
 

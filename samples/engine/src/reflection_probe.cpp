@@ -61,11 +61,12 @@ std::string ReflectionProbe::create(Gpu& gpu, const VulkanContext& ctx, const Pi
   const VkDeviceSize align = std::max<VkDeviceSize>(ctx.properties.limits.minUniformBufferOffsetAlignment, 1);
   uniformStride_ = (sizeof(FrameUniforms) + align - 1) / align * align;
 
-  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 6 * kFramesInFlight},
-                                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kLightingSetBindings * kFramesInFlight}};
+  VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 7 * kFramesInFlight},
+                                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kLightingSetSamplers * kFramesInFlight},
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kFramesInFlight}};
   VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pci.maxSets = 7 * kFramesInFlight;
-  pci.poolSizeCount = 2;
+  pci.poolSizeCount = 3;
   pci.pPoolSizes = sizes;
   SE_VK_TRY(vkCreateDescriptorPool(device_, &pci, nullptr, &pool_));
   for (SlotResources& slot : slots_) {
@@ -174,7 +175,8 @@ std::string ReflectionProbe::prepare(uint32_t resolution) {
 }
 
 void ReflectionProbe::recordCapture(VkCommandBuffer cmd, uint32_t slot, const FrameUniforms& base, const ProbeKey& key,
-                                    const GpuScene* scene, VkImageView shadowMap, const DefaultImages& defaults) {
+                                    const GpuScene* scene, VkImageView shadowMap, const DefaultImages& defaults,
+                                    const LocalLightBindings& localLights) {
   const Pipelines& p = *pipelines_;
   SlotResources& res = slots_[slot];
   const uint32_t size = cube_.extent.width;
@@ -196,8 +198,9 @@ void ReflectionProbe::recordCapture(VkCommandBuffer cmd, uint32_t slot, const Fr
     u.lightViewProj = key.lightViewProj;  // the same shadow-map texels as the camera's, probe-relative
     u.cameraPos = glm::vec4(key.position, 1.0f);
     u.viewport = glm::vec4(float(size), float(size), 1.0f / float(size), 1.0f / float(size));
-    u.inputs = glm::uvec4(0u);  // own shadow map, no AO, constant-sky reflections
-    u.probe = glm::vec4(0.0f);  // never samples itself
+    u.inputs = glm::uvec4(0u);       // own shadow map, no AO, constant-sky reflections
+    u.probe = glm::vec4(0.0f);       // never samples itself
+    u.localLights = glm::uvec4(0u);  // no KHR lights (a known limitation: their buffer is camera-relative)
     std::memcpy(static_cast<char*>(res.uniforms.mapped) + f * uniformStride_, &u, sizeof(u));
   }
   writeImageDescriptors(device_, res.lightingSet,
@@ -206,6 +209,9 @@ void ReflectionProbe::recordCapture(VkCommandBuffer cmd, uint32_t slot, const Fr
                          {p.screenSampler, defaults.white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
                          {p.screenSampler, defaults.black.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
                          {p.cubeSampler, fallback_.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}});
+  writeLocalLightDescriptors(device_, p, res.lightingSet, kLightingLocalLightBinding, localLights);
+  writeImageDescriptors(device_, res.lightingSet,
+                        {{p.screenSampler, defaults.black.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}}, 8);
 
   // Earlier frames may still sample the cube (same queue, so the barrier's source scope covers them).
   imageBarrier(cmd, cube_.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,

@@ -8,6 +8,7 @@
 #include "gpu_memory.h"
 #include "gpu_scene.h"
 #include "pipelines.h"
+#include "render_utils.h"
 #include "sample_engine/engine.h"
 #include "vk_context.h"
 
@@ -44,8 +45,11 @@ class ReflectionProbe {
   // sky and shadow-map settings of the frame, `key` the position and the probe-relative light matrix (the
   // faces are rendered relative to the probe position); `shadowMap` must be in SHADER_READ_ONLY_OPTIMAL.
   // Binds set 0 and set 2 of Pipelines::sceneLayout: the caller rebinds its own afterwards.
+  // `localLights`: bound for the lighting set's layout only; the capture draws no KHR lights (its uniforms
+  // say 0 lights: their buffer holds camera-relative positions).
   void recordCapture(VkCommandBuffer cmd, uint32_t slot, const FrameUniforms& base, const ProbeKey& key,
-                     const GpuScene* scene, VkImageView shadowMap, const DefaultImages& defaults);
+                     const GpuScene* scene, VkImageView shadowMap, const DefaultImages& defaults,
+                     const LocalLightBindings& localLights);
 
   bool captured() const { return captured_; }
   // The captured cube (SHADER_READ_ONLY_OPTIMAL after a capture), or a 1x1 black cube bound when no probe

@@ -148,11 +148,12 @@ void drawBlended(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p,
   }
 }
 
-void writeImageDescriptors(VkDevice device, VkDescriptorSet set, const std::vector<VkDescriptorImageInfo>& infos) {
+void writeImageDescriptors(VkDevice device, VkDescriptorSet set, const std::vector<VkDescriptorImageInfo>& infos,
+                           uint32_t firstBinding) {
   std::vector<VkWriteDescriptorSet> writes(infos.size(), {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET});
   for (size_t i = 0; i < infos.size(); ++i) {
     writes[i].dstSet = set;
-    writes[i].dstBinding = uint32_t(i);
+    writes[i].dstBinding = firstBinding + uint32_t(i);
     writes[i].descriptorCount = 1;
     writes[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     writes[i].pImageInfo = &infos[i];
@@ -169,6 +170,26 @@ void drawFullscreen(VkCommandBuffer cmd, const Pipelines& p, VkPipeline pipeline
   vkCmdPushConstants(cmd, p.screenLayout, VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(constants), &constants);
   vkCmdDraw(cmd, 3, 1, 0, 0);
   vkCmdEndRendering(cmd);
+}
+
+void writeLocalLightDescriptors(VkDevice device, const Pipelines& p, VkDescriptorSet set, uint32_t firstBinding,
+                                const LocalLightBindings& b) {
+  const VkDescriptorImageInfo image{p.shadowSampler, b.shadowMaps, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  const VkDescriptorBufferInfo lights{b.lights, 0, b.lightsSize}, shadows{b.shadows, 0, b.shadowsSize};
+  VkWriteDescriptorSet w[3];
+  for (uint32_t i = 0; i < 3; ++i) {
+    w[i] = VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w[i].dstSet = set;
+    w[i].dstBinding = firstBinding + i;
+    w[i].descriptorCount = 1;
+  }
+  w[0].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  w[0].pImageInfo = &image;
+  w[1].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  w[1].pBufferInfo = &lights;
+  w[2].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  w[2].pBufferInfo = &shadows;
+  vkUpdateDescriptorSets(device, 3, w, 0, nullptr);
 }
 
 }  // namespace sample_engine::detail

@@ -54,8 +54,22 @@ void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, D
 void drawBlended(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, const glm::dvec3& origin,
                  ViewHandedness view = ViewHandedness::Camera);
 
-// Writes infos[i] to binding i of `set` (combined image samplers).
-void writeImageDescriptors(VkDevice device, VkDescriptorSet set, const std::vector<VkDescriptorImageInfo>& infos);
+// Writes infos[i] to binding firstBinding + i of `set` (combined image samplers).
+void writeImageDescriptors(VkDevice device, VkDescriptorSet set, const std::vector<VkDescriptorImageInfo>& infos,
+                           uint32_t firstBinding = 0);
+
+// What the three descriptors of shaders/local_lights.glsl bind: the local shadow maps (2D array, SHADER_READ_ONLY
+// OPTIMAL), the frame's KHR light buffer and its shadow views.
+struct LocalLightBindings {
+  VkImageView shadowMaps = VK_NULL_HANDLE;
+  VkBuffer lights = VK_NULL_HANDLE;
+  VkDeviceSize lightsSize = 0;
+  VkBuffer shadows = VK_NULL_HANDLE;
+  VkDeviceSize shadowsSize = 0;
+};
+// Writes them to bindings firstBinding .. firstBinding + 2 of `set`.
+void writeLocalLightDescriptors(VkDevice device, const Pipelines& p, VkDescriptorSet set, uint32_t firstBinding,
+                                const LocalLightBindings& bindings);
 
 // Binds `pipeline` (a fullscreen pipeline of Pipelines::screenLayout) with `frameSet` / `inputSet` and
 // `constants`, and draws one triangle into `target` (cleared to 1: "open" / "lit" for the effect images).

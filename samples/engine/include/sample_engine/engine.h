@@ -1,6 +1,6 @@
 // The sample forward engine: owns a Vulkan 1.3 instance/device/queue, renders a Scene with
 //   shadow map -> [probe capture] -> depth+normal pre-pass -> [SSAO] -> [shadow visibility] -> [pre-pass hook]
-//   -> forward PBR lighting -> blended surfaces -> tonemap
+//   -> [local shadow maps] -> [local-light irradiance] -> forward PBR lighting -> blended surfaces -> tonemap
 // into an offscreen image (read back to the CPU) and optionally presents it to a swapchain.
 //
 // Materials (scene.h): glTF metallic-roughness with base colour, metallic-roughness, normal, emissive and
@@ -22,6 +22,13 @@
 //     the winding flipped for model matrices with a negative determinant); the shadow map never culls.
 // Mip-mapped MASK textures are not coverage-corrected (thin cut-outs thin out at a distance), and blended
 // surfaces are sorted per instance, not per triangle.
+//
+// Punctual lights (Scene::lights, KHR_lights_punctual): every frame places them with the animated nodes
+// (frameLights()) and writes them into a per-frame storage buffer; the lighting adds all of them (a loop over
+// every light per pixel: the engine's limitation for many lights). The strongest LocalLightSettings::
+// maxShadowedLights get shadow maps (spot: one perspective view, point: six, directional: one orthographic),
+// drawn after the pre-pass hook so that an external LightingInputs::localLightIrradiance can skip them; the
+// others are unshadowed. outputLocalLightIrradiance writes the engine's own E for readback.
 //
 // Animated scenes (glTF node animation, skins, morph targets): each frame first evaluates the animation on
 // the CPU (FrameParams::time / animations / restPose), then, when the scene has deforming (skinned and/or
@@ -151,7 +158,15 @@ struct FrameLight {
   float innerConeAngle = 0.0f, outerConeAngle = kDefaultSpotOuterConeAngle;  // radians
 };
 
-// Raster shadows for local (KHR) lights.
+// Raster shadows for local (KHR) lights: maps for the strongest ones, in a 2D array of 6 layers per shadowed light
+// (a spot with an outer cone up to pi/3 uses one perspective view over its cone, a wider spot or a point six
+// 90-degree views, a directional light one orthographic view over the scene's bounding sphere like the sun's).
+// "Strongest" = the largest unshadowed irradiance estimate at the eye: luminance(color) * intensity, divided
+// for point and spot lights by the squared distance to the eye (at least 1), ignoring the cone, the range and
+// any cosine; ties keep Scene::lights order; black or zero-intensity lights never get a map. The maps are drawn
+// after the pre-pass hook and skipped when it sets LightingInputs::localLightIrradiance (unless
+// FrameParams::outputLocalLightIrradiance wants the engine's own E). Changing the count or size recreates them,
+// waiting for the GPU first.
 inline constexpr uint32_t kMaxShadowedLocalLights = 8;
 inline constexpr uint32_t kDefaultMaxShadowedLocalLights = 4;
 inline constexpr uint32_t kDefaultLocalShadowMapSize = 512;
@@ -169,7 +184,7 @@ struct LocalLightSettings {
   uint32_t pcfKernelSize = 3;                                                  // as ShadowSettings::pcfKernelSize
   float depthBiasConstant = 1.5f, depthBiasSlope = 2.0f, normalOffset = 1.5f;  // as ShadowSettings
 };
-// What a rendered frame did with the KHR lights (Engine::lastLocalShadowStats()).
+// What a rendered frame did with the KHR lights (Engine::lastLocalShadowStats()). Plain data: not thread-safe.
 struct LocalShadowStats {
   uint32_t lights = 0;          // lights drawn (0 when LocalLightSettings::enabled is off)
   uint32_t shadowedLights = 0;  // of them, the ones with a shadow map this frame
@@ -239,7 +254,9 @@ struct FrameParams {
   ReflectionProbeSettings reflectionProbe;
   LocalLightSettings localLights;
   // Also writes the engine's own (shadow-mapped) KHR-light irradiance E to an RGBA16F image for
-  // readbackLocalLightIrradiance().
+  // readbackLocalLightIrradiance(): a fullscreen pass after the local shadow maps (so after the hook), from the
+  // pre-pass depth, with the cosine of the SHADING normal (normalRoughness) and the shadow lookup offset along
+  // the geometric normal; background 0. Draws the local shadow maps even under an external irradiance.
   bool outputLocalLightIrradiance = false;
   // Also writes the shadow-map sun visibility the lighting uses (PCF, and 0 where the shading normal faces
   // away from the sun; 1 on background) into an R16F image for readbackShadowVisibility().
@@ -309,7 +326,8 @@ struct PrepassHookInfo {
   float ambientIntensity = 0.0f;
   // This frame's world transform per Scene::instances entry (node animation applied).
   std::span<const glm::mat4> instanceTransforms;
-  // This frame's lights, Scene::lights order (empty if none or LocalLightSettings::enabled is off).
+  // This frame's lights, Scene::lights order (empty if none or LocalLightSettings::enabled is off). The local
+  // shadow maps are drawn after the hook.
   std::span<const FrameLight> lights;
   // The deforming instances; this frame's deformation submission rewrites their buffers. Empty for a
   // scene without skinned or morphed instances.
@@ -507,7 +525,8 @@ class Engine {
   Result<std::vector<glm::vec4>> readbackLocalLightIrradiance();
 
   // --- KHR lights ---
-  // The last rendered frame's lights (rest pose before the first), Scene::lights order.
+  // The last rendered frame's lights (rest pose before the first), Scene::lights order; empty after a frame
+  // with LocalLightSettings::enabled off.
   std::span<const FrameLight> frameLights() const;
   LocalShadowStats lastLocalShadowStats() const;  // known at submission, no wait
 

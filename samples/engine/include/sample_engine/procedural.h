@@ -49,7 +49,9 @@ TextureData makeLeafTexture(uint32_t size, uint32_t seed, float openFraction = k
 // Ground plane with a checker texture, six columns, two arches, spheres and boxes with varied materials:
 // a low-roughness gold sphere, a mirror box and a mirror floor patch among them. Left of the colonnade stands
 // a wooden pergola under a leaf canopy (alpha-tested cards textured by makeLeafTexture(), AlphaMode::Mask),
-// whose dappled shadow falls on the ground in the camera's view. Has a camera and a sun.
+// whose dappled shadow falls on the ground in the camera's view. Five coloured KHR lights (Scene::lights: a
+// lantern under the pergola, a spot under each arch, two small glows) light the shade modestly. Has a camera
+// and a sun.
 Scene makeDefaultDemoScene();
 
 }  // namespace sample_engine
