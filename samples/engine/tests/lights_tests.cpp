@@ -440,6 +440,11 @@ TEST_CASE("a blocker between a shadow-mapped light and the ground darkens the pi
   uint32_t views = 1, minShadowed = 100;
   const char* what = "spot";
   SECTION("spot") {}
+  float range = 0.0f;
+  SECTION("spot with a range (casters beyond it are culled)") {
+    range = 4.6f;
+    what = "ranged spot";
+  }
   SECTION("wide spot: six views") {
     inner = 1.0f;
     outer = 1.3f;
@@ -460,6 +465,7 @@ TEST_CASE("a blocker between a shadow-mapped light and the ground darkens the pi
   PunctualLight light = lightAt(type, lightPos, intensity);
   light.innerConeAngle = inner;
   light.outerConeAngle = outer;
+  light.range = range;
   // The directional light slants towards -x, so its shadow falls beside the box, in the camera's view.
   const glm::vec3 travel = type == PunctualLight::Type::Directional ? glm::normalize(glm::vec3(-0.6f, -1.0f, 0.0f))
                                                                     : glm::vec3(0, -1, 0);
