@@ -6,6 +6,7 @@
 
 #include "compute_pipeline.h"
 #include "context_impl.h"
+#include "denoise_rgb_interface.glsl"
 #include "gbuffer_sampler.h"
 #include "image_barriers.h"
 #include "pass_constants.h"
@@ -28,6 +29,10 @@ void multiply(const double a[16], const double b[16], double out[16]) {
   }
 }
 
+// A-trous iterations of an RGB signal when DenoiseSettings::spatialIterations is 0: steps 1, 2, 4 and 8 (a
+// 61x61 footprint), SVGF's reach for a few rays per pixel; the noise-aware weights keep it from over-blurring.
+constexpr uint32_t kDefaultRgbIterations = 4;
+
 }  // namespace
 
 struct Denoiser::Impl {
@@ -35,8 +40,8 @@ struct Denoiser::Impl {
   DenoiseSignal signal = DenoiseSignal::Scalar;
   ComputePipeline temporal, atrous;
   VkSampler sampler = VK_NULL_HANDLE;
-  // 0,1: history ping-pong (RG16F); 2,3: view distance ping-pong (R32F); 4,5: spatial ping-pong (R16F);
-  // 6: this frame's temporal result (R16F)
+  // Scalar: 0,1: history ping-pong (RG16F); 2,3: view distance ping-pong (R32F); 4,5: spatial ping-pong
+  // (R16F); 6: this frame's temporal result (R16F). Rgb: see recordRgb.
   PassImages images;
   PassMetrics metrics;
   DenoiseOutputs outputs;
@@ -65,9 +70,6 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
                  "Denoiser: DenoiserDesc::signal has an unknown value " + std::to_string(uint32_t(desc.signal)) +
                      "; use DenoiseSignal::Scalar or DenoiseSignal::Rgb"};
   }
-  if (desc.signal == DenoiseSignal::Rgb) {
-    return Error{ErrorCode::NotReady, VK_SUCCESS, "Denoiser: DenoiseSignal::Rgb is not implemented yet on this branch"};
-  }
   auto impl = std::make_unique<Impl>(context);
   impl->signal = desc.signal;
   const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -77,22 +79,42 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
   auto storage = [&](uint32_t b) {
     return VkDescriptorSetLayoutBinding{b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, nullptr};
   };
-  Result<ComputePipeline> t =
-      ComputePipeline::create(context, SpirvModule::of(spirv::denoise_temporal_comp),
-                              {sampled(RB_TEMPORAL_BINDING_DEPTH), sampled(RB_TEMPORAL_BINDING_MOTION),
-                               sampled(RB_TEMPORAL_BINDING_SIGNAL), sampled(RB_TEMPORAL_BINDING_HISTORY_IN),
-                               sampled(RB_TEMPORAL_BINDING_DISTANCE_IN), storage(RB_TEMPORAL_BINDING_HISTORY_OUT),
-                               storage(RB_TEMPORAL_BINDING_DISTANCE_OUT), storage(RB_TEMPORAL_BINDING_VALUE_OUT)},
-                              sizeof(DenoiseConstants), "denoiser temporal");
-  if (!t) return t.error();
-  impl->temporal = t.value();
-  Result<ComputePipeline> a =
-      ComputePipeline::create(context, SpirvModule::of(spirv::denoise_atrous_comp),
-                              {sampled(RB_ATROUS_BINDING_DEPTH), sampled(RB_ATROUS_BINDING_NORMAL),
-                               sampled(RB_ATROUS_BINDING_SIGNAL_IN), storage(RB_ATROUS_BINDING_SIGNAL_OUT)},
-                              sizeof(DenoiseConstants), "denoiser a-trous");
-  if (!a) return a.error();
-  impl->atrous = a.value();
+  if (desc.signal == DenoiseSignal::Rgb) {
+    Result<ComputePipeline> t = ComputePipeline::create(
+        context, SpirvModule::of(spirv::denoise_rgb_temporal_comp),
+        {sampled(RB_RGB_TEMPORAL_BINDING_DEPTH), sampled(RB_RGB_TEMPORAL_BINDING_MOTION),
+         sampled(RB_RGB_TEMPORAL_BINDING_SIGNAL), sampled(RB_RGB_TEMPORAL_BINDING_HISTORY_IN),
+         sampled(RB_RGB_TEMPORAL_BINDING_MOMENTS_IN), sampled(RB_RGB_TEMPORAL_BINDING_DISTANCE_IN),
+         storage(RB_RGB_TEMPORAL_BINDING_HISTORY_OUT), storage(RB_RGB_TEMPORAL_BINDING_MOMENTS_OUT),
+         storage(RB_RGB_TEMPORAL_BINDING_DISTANCE_OUT), storage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT)},
+        sizeof(DenoiseConstants), "denoiser RGB temporal");
+    if (!t) return t.error();
+    impl->temporal = t.value();
+    Result<ComputePipeline> a =
+        ComputePipeline::create(context, SpirvModule::of(spirv::denoise_rgb_atrous_comp),
+                                {sampled(RB_RGB_ATROUS_BINDING_DEPTH), sampled(RB_RGB_ATROUS_BINDING_NORMAL),
+                                 sampled(RB_RGB_ATROUS_BINDING_SIGNAL_IN), storage(RB_RGB_ATROUS_BINDING_SIGNAL_OUT)},
+                                sizeof(DenoiseConstants), "denoiser RGB a-trous");
+    if (!a) return a.error();
+    impl->atrous = a.value();
+  } else {
+    Result<ComputePipeline> t =
+        ComputePipeline::create(context, SpirvModule::of(spirv::denoise_temporal_comp),
+                                {sampled(RB_TEMPORAL_BINDING_DEPTH), sampled(RB_TEMPORAL_BINDING_MOTION),
+                                 sampled(RB_TEMPORAL_BINDING_SIGNAL), sampled(RB_TEMPORAL_BINDING_HISTORY_IN),
+                                 sampled(RB_TEMPORAL_BINDING_DISTANCE_IN), storage(RB_TEMPORAL_BINDING_HISTORY_OUT),
+                                 storage(RB_TEMPORAL_BINDING_DISTANCE_OUT), storage(RB_TEMPORAL_BINDING_VALUE_OUT)},
+                                sizeof(DenoiseConstants), "denoiser temporal");
+    if (!t) return t.error();
+    impl->temporal = t.value();
+    Result<ComputePipeline> a =
+        ComputePipeline::create(context, SpirvModule::of(spirv::denoise_atrous_comp),
+                                {sampled(RB_ATROUS_BINDING_DEPTH), sampled(RB_ATROUS_BINDING_NORMAL),
+                                 sampled(RB_ATROUS_BINDING_SIGNAL_IN), storage(RB_ATROUS_BINDING_SIGNAL_OUT)},
+                                sizeof(DenoiseConstants), "denoiser a-trous");
+    if (!a) return a.error();
+    impl->atrous = a.value();
+  }
   Result<VkSampler> s = createNearestSampler(context);
   if (!s) return s.error();
   impl->sampler = s.value();
@@ -104,6 +126,124 @@ void Denoiser::resetHistory() { impl_->historyValid = false; }
 const DenoiseOutputs& Denoiser::outputs() const { return impl_->outputs; }
 DenoiseSignal Denoiser::signal() const { return impl_->signal; }
 PassStats Denoiser::stats() const { return impl_->metrics.latest(impl_->ctx); }
+
+namespace {
+
+// The RGB path (DenoiseSignal::Rgb), SVGF-style. The temporal pass always runs: it measures the noise the
+// a-trous weights need (with disableTemporal it ignores the history). The a-trous steps then ping-pong between
+// the two spatial images, the temporal result being the first of them; the last dispatch writes a = 1.
+Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
+                 const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags, const double camera[3]) {
+  Context& ctx = s.ctx;
+  // 0,1: colour history ping-pong (rgb mean, a frames); 2,3: view distance ping-pong; 4,5: luminance moments
+  // ping-pong (RG32F: the second moment of HDR values overflows half floats); 6,7: the temporal result and the
+  // a-trous ping-pong (rgb, a: standard deviation of the luminance; a = 1 in the output).
+  std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history A"},
+                                         {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history B"},
+                                         {VK_FORMAT_R32_SFLOAT, "denoiser RGB distance A"},
+                                         {VK_FORMAT_R32_SFLOAT, "denoiser RGB distance B"},
+                                         {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB moments A"},
+                                         {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB moments B"},
+                                         {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial A"},
+                                         {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial B"}};
+  bool resized = s.images.size() == 0 || s.images[0].width != g.width || s.images[0].height != g.height;
+  if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
+  if (resized) s.historyValid = false;
+  const PassImages& im = s.images;
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
+  const uint32_t cur = s.parity, prev = 1 - s.parity;
+
+  s.metrics.beginRecording(ctx, cmd);
+  s.metrics.writeStart(ctx, cmd);
+  std::vector<VkImageMemoryBarrier> barriers;
+  auto barrier = [&](const GpuImage& img, VkImageLayout from, VkImageLayout to, VkAccessFlags src, VkAccessFlags dst) {
+    barriers.push_back(colorImageBarrier(img.image, from, to, src, dst));
+  };
+  auto flush = [&](VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) {
+    vk.vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, static_cast<uint32_t>(barriers.size()),
+                            barriers.data());
+    barriers.clear();
+  };
+  const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | cs |
+                                       VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
+  const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  const VkImageLayout gen = VK_IMAGE_LAYOUT_GENERAL;
+  const VkAccessFlags read = VK_ACCESS_SHADER_READ_BIT, write = VK_ACCESS_SHADER_WRITE_BIT;
+  const bool historyUsable = !settings.disableTemporal && s.historyValid;
+  if (!historyUsable) {
+    // Nothing valid to read: give last frame's images a defined layout for the descriptor reads.
+    for (uint32_t base : {0u, 2u, 4u}) barrier(im[base + prev], VK_IMAGE_LAYOUT_UNDEFINED, ro, 0, read);
+  }
+  for (uint32_t base : {0u, 2u, 4u}) barrier(im[base + cur], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
+  barrier(im[6], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
+  barrier(im[7], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
+  flush(readers, cs);
+
+  const uint32_t iterations = settings.disableSpatial
+                                  ? 0u
+                                  : (settings.spatialIterations ? settings.spatialIterations : kDefaultRgbIterations);
+  pc.flags = flags | (historyUsable ? RB_DN_HISTORY : 0u) | (iterations == 0 ? RB_DN_RGB_FINAL : 0u);
+  pc.maxHistoryFrames = settings.disableTemporal ? 1u : (settings.maxHistoryFrames ? settings.maxHistoryFrames : 32u);
+  for (int i = 0; i < 16; ++i) pc.previousViewProjection[i] = static_cast<float>(s.previousViewProjection[i]);
+  for (int i = 0; i < 3; ++i) pc.cameraDelta[i] = static_cast<float>(camera[i] - s.previousCamera[i]);
+  {
+    DescriptorWrites w;
+    w.sampledImage(RB_RGB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
+    const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
+    w.sampledImage(RB_RGB_TEMPORAL_BINDING_MOTION, motion.view, s.sampler, readLayout(motion));
+    w.sampledImage(RB_RGB_TEMPORAL_BINDING_SIGNAL, signal, s.sampler, ro);
+    w.sampledImage(RB_RGB_TEMPORAL_BINDING_HISTORY_IN, im[prev].view, s.sampler, ro);
+    w.sampledImage(RB_RGB_TEMPORAL_BINDING_DISTANCE_IN, im[2 + prev].view, s.sampler, ro);
+    w.sampledImage(RB_RGB_TEMPORAL_BINDING_MOMENTS_IN, im[4 + prev].view, s.sampler, ro);
+    w.storageImage(RB_RGB_TEMPORAL_BINDING_HISTORY_OUT, im[cur].view);
+    w.storageImage(RB_RGB_TEMPORAL_BINDING_DISTANCE_OUT, im[2 + cur].view);
+    w.storageImage(RB_RGB_TEMPORAL_BINDING_MOMENTS_OUT, im[4 + cur].view);
+    w.storageImage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT, im[6].view);
+    s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
+  }
+  for (uint32_t base : {0u, 2u, 4u}) barrier(im[base + cur], gen, ro, write, read);
+  barrier(im[6], gen, ro, write, read);
+  flush(cs, readers);
+  // A history written without temporal filtering holds one frame only: the next frame starts afresh anyway.
+  s.historyValid = !settings.disableTemporal;
+  s.parity = prev;
+
+  const GpuImage* last = &im[6];
+  for (uint32_t i = 0; i < iterations; ++i) {
+    const GpuImage& in = im[6 + (i % 2)];
+    const GpuImage& out = im[6 + ((i + 1) % 2)];
+    if (i >= 1) {
+      // Writing the image read one step earlier (the temporal result or an a-trous step).
+      barrier(out, ro, gen, read, write);
+      flush(cs, cs);
+    }
+    pc.flags = flags | (i + 1 == iterations ? RB_DN_RGB_FINAL : 0u);
+    pc.atrousStep = 1u << i;
+    DescriptorWrites w;
+    w.sampledImage(RB_RGB_ATROUS_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
+    w.sampledImage(RB_RGB_ATROUS_BINDING_NORMAL, g.normal.view, s.sampler, readLayout(g.normal));
+    w.sampledImage(RB_RGB_ATROUS_BINDING_SIGNAL_IN, in.view, s.sampler, ro);
+    w.storageImage(RB_RGB_ATROUS_BINDING_SIGNAL_OUT, out.view);
+    s.atrous.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
+    barrier(out, gen, ro, write, read);
+    flush(cs, readers);
+    last = &out;
+  }
+  if (iterations == 0) {
+    // The second spatial image was not written: keep its layout known.
+    barrier(im[7], gen, ro, 0, read);
+    flush(cs, readers);
+  }
+  s.metrics.writeEnd(ctx, cmd);
+  s.outputs.denoised = last->image;
+  s.outputs.denoisedView = last->view;
+  s.outputs.width = g.width;
+  s.outputs.height = g.height;
+  return {};
+}
+
+}  // namespace
 
 Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
                         const DenoiseSettings& settings) {
@@ -146,6 +286,14 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   viewRot[15] = 1.0;
   double viewProjection[16];
   multiply(proj, viewRot, viewProjection);
+  if (s.signal == DenoiseSignal::Rgb) {
+    Status st = recordRgb(s, cmd, g, signal, settings, pc, flags, camera);
+    if (st) {
+      std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
+      std::memcpy(s.previousCamera, camera, sizeof camera);
+    }
+    return st;
+  }
 
   std::vector<PassImages::Spec> specs = {
       {VK_FORMAT_R16G16_SFLOAT, "denoiser history A"},   {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},

@@ -160,20 +160,30 @@ struct HybridEffects::Impl {
       return s;
     if (!shadow || desc.shadows.disableDenoiser) shadowDenoiser.reset();
     if (!ao || desc.ao.disableDenoiser) aoDenoiser.reset();
+    if (!localLightsDenoised()) localLightDenoiser.reset();
     return syncMaterialTable();
   }
 
+  // Stochastic local lights are noisy; the exact mode has no noise to remove.
+  bool localLightsDenoised() const {
+    return localLights && desc.localLights.mode == ManyLightMode::Stochastic && !desc.localLights.disableDenoiser;
+  }
+
   // The denoiser of one signal: created when wanted, retired when not; `out` becomes its output when it runs.
-  // `rays`: binary rays behind the signal (DenoiseSettings::raysPerPixel; 0 = estimate the noise).
+  // `rays`: binary rays behind a scalar signal (DenoiseSettings::raysPerPixel; 0 = estimate the noise).
   Status denoise(std::unique_ptr<Denoiser>& slot, bool wanted, const char* what, VkCommandBuffer cmd,
-                 const GBufferDesc& gbuffer, VkImageView signal, uint32_t rays, EffectImage& out) {
-    if (Status st = ensure(slot, wanted, what, [&] { return Denoiser::create(ctx); }); !st) return st;
+                 const GBufferDesc& gbuffer, VkImageView signal, uint32_t rays, EffectImage& out,
+                 DenoiseSignal kind = DenoiseSignal::Scalar) {
+    DenoiserDesc dd;
+    dd.signal = kind;
+    if (Status st = ensure(slot, wanted, what, [&] { return Denoiser::create(ctx, dd); }); !st) return st;
     if (!slot) return {};
     DenoiseSettings d = desc.denoiser;
-    d.raysPerPixel = rays;
+    d.raysPerPixel = kind == DenoiseSignal::Scalar ? rays : 0u;
     if (Status st = slot->record(cmd, gbuffer, signal, d); !st) return wrap(what, st.error());
     const DenoiseOutputs& dn = slot->outputs();
-    out = image(dn.denoised, dn.denoisedView, VK_FORMAT_R16_SFLOAT, dn.layout, dn.width, dn.height);
+    const VkFormat format = kind == DenoiseSignal::Rgb ? VK_FORMAT_R16G16B16A16_SFLOAT : VK_FORMAT_R16_SFLOAT;
+    out = image(dn.denoised, dn.denoisedView, format, dn.layout, dn.width, dn.height);
     return {};
   }
 
@@ -194,7 +204,8 @@ Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridF
   const ManyLightOutputs& o = localLights->outputs();
   outputs.localLights = outputs.localLightsRaw = image(o.irradiance, o.irradianceView, VK_FORMAT_R16G16B16A16_SFLOAT,
                                                        o.layout, o.width, o.height);
-  return {};
+  return denoise(localLightDenoiser, localLightsDenoised(), "Denoiser (local lights)", cmd, f.gbuffer, o.irradianceView,
+                 0, outputs.localLights, DenoiseSignal::Rgb);
 }
 
 Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame& f) {

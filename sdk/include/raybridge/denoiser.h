@@ -33,12 +33,16 @@ struct DenoiserDesc {
 };
 
 struct DenoiseSettings {
-  bool disableTemporal = false;    // false = accumulate over frames
-  bool disableSpatial = false;     // false = run the a-trous filter
-  uint32_t spatialIterations = 0;  // 0 = 2 (steps 1 and 2: a 13x13 footprint; 3 over-blurs 4-ray AO)
-  uint32_t maxHistoryFrames = 0;   // 0 = 32: the running mean forgets more slowly than this
-  float depthSigma = 0.0f;         // 0 = 0.005: plane-distance tolerance relative to view distance, per step
-  float normalPower = 0.0f;        // 0 = 32: exponent of the normal similarity weight
+  // false = accumulate over frames. Rgb: true still runs the temporal dispatch (it measures the noise), without
+  // history.
+  bool disableTemporal = false;
+  bool disableSpatial = false;  // false = run the a-trous filter
+  // 0 = 2 for Scalar (steps 1 and 2: a 13x13 footprint; 3 over-blurs 4-ray AO), 4 for Rgb (steps 1 to 8: its
+  // weights follow the measured noise, so the wider reach only blurs where the signal is still noisy). At most 6.
+  uint32_t spatialIterations = 0;
+  uint32_t maxHistoryFrames = 0;  // 0 = 32: the running mean forgets more slowly than this
+  float depthSigma = 0.0f;        // 0 = 0.005: plane-distance tolerance relative to view distance, per step
+  float normalPower = 0.0f;       // 0 = 32: exponent of the normal similarity weight
   // Scalar signals: rays per pixel behind the signal, when it is a fraction of binary rays (shadow visibility,
   // binary AO): the spatial filter then knows the noise exactly and keeps every edge that is not noise.
   // 0 = unknown: the noise is estimated from the 3x3 neighbourhood, which also blurs thin noise-free features.

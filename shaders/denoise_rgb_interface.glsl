@@ -1,0 +1,27 @@
+// The numbers the RGB denoiser's C++ (sdk/src/denoiser.cpp) and its shaders must agree on: descriptor bindings
+// and the flag bits it adds to DenoiseConstants::flags (above the RB_DN_* of raybridge_shader_interface.glsl).
+// Only #defines, so the one file is included by both.
+#ifndef RAYBRIDGE_DENOISE_RGB_INTERFACE_GLSL
+#define RAYBRIDGE_DENOISE_RGB_INTERFACE_GLSL
+
+// Temporal pass (denoise_rgb_temporal.comp).
+#define RB_RGB_TEMPORAL_BINDING_DEPTH 0
+#define RB_RGB_TEMPORAL_BINDING_MOTION 1  // the depth image again without motion vectors
+#define RB_RGB_TEMPORAL_BINDING_SIGNAL 2
+#define RB_RGB_TEMPORAL_BINDING_HISTORY_IN 3  // rgb: mean colour, a: frames accumulated
+#define RB_RGB_TEMPORAL_BINDING_MOMENTS_IN 4  // luminance mean and mean square
+#define RB_RGB_TEMPORAL_BINDING_DISTANCE_IN 5
+#define RB_RGB_TEMPORAL_BINDING_HISTORY_OUT 6
+#define RB_RGB_TEMPORAL_BINDING_MOMENTS_OUT 7
+#define RB_RGB_TEMPORAL_BINDING_DISTANCE_OUT 8
+#define RB_RGB_TEMPORAL_BINDING_VALUE_OUT 9  // rgb: accumulated colour, a: its luminance's standard deviation
+// A-trous pass (denoise_rgb_atrous.comp).
+#define RB_RGB_ATROUS_BINDING_DEPTH 0
+#define RB_RGB_ATROUS_BINDING_NORMAL 1
+#define RB_RGB_ATROUS_BINDING_SIGNAL_IN 2
+#define RB_RGB_ATROUS_BINDING_SIGNAL_OUT 3
+
+// This dispatch writes the denoiser's output: a = 1 instead of the standard deviation.
+#define RB_DN_RGB_FINAL 0x100u
+
+#endif
