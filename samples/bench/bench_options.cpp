@@ -35,9 +35,10 @@ void addOptions(CLI::App& app, BenchOptions& o) {
   app.add_option("--scenes", o.scenesDir,
                  "folder of glTF models, one per subfolder (default: ../shared/scenes beside the\nsource tree)")
       ->type_name("DIR");
-  app.add_option("--images", o.imagesDir,
-                 "folder (existing) for tonemapped PNGs of the lights scenario's 256-light case:\nexact, raw and "
-                 "denoised (default: none)")
+  app.add_option(
+         "--images", o.imagesDir,
+         "folder (created if missing) for tonemapped PNGs of the lights scenario's 256-light case:\nexact, raw and "
+         "denoised (default: none)")
       ->type_name("DIR");
 }
 

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <optional>
 
@@ -126,6 +127,14 @@ nlohmann::json runLightsScenario(BenchEnv& env) {
     env.progress("lights: check failed: " + m);
     failures.push_back(m);
   };
+
+  // The pictures' folder first, so that a bad path fails before the measurements rather than after them.
+  const std::string& imagesDir = env.options().imagesDir;
+  if (!imagesDir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(imagesDir, ec);
+    if (ec) throw BenchFailure("lights: cannot create the --images folder " + imagesDir + ": " + ec.message());
+  }
 
   // ---- the scene, its BLASes and the TLAS of every frame ----
   const LightFieldScene scene = makeLightFieldScene(z.scene);
@@ -457,11 +466,10 @@ nlohmann::json runLightsScenario(BenchEnv& env) {
   printSummary(summary);
 
   // ---- pictures for the docs ----
-  const std::string& dir = env.options().imagesDir;
-  if (!dir.empty() && !pictures.exact.empty()) {
+  if (!imagesDir.empty() && !pictures.exact.empty()) {
     // One exposure for all, from the reference, so that the pictures compare.
     const double exposure = ratio(3.0, imageStats(pictures.exact, cpu.surface).mean);
-    const std::string prefix = dir + "/lights_" + std::to_string(kTargetLights) + "_";
+    const std::string prefix = imagesDir + "/lights_" + std::to_string(kTargetLights) + "_";
     writeTonemappedPng(prefix + "exact.png", pictures.exact, w, h, exposure);
     writeTonemappedPng(prefix + "raw_" + std::to_string(kTargetRays) + "rpp.png", pictures.raw, w, h, exposure);
     if (!pictures.denoised1.empty()) {
