@@ -1,5 +1,7 @@
 // Images the scenarios handle outside the SDK: engine-side sampled images uploaded from the host (G-buffers,
 // textures), readbacks of pass outputs, and tonemapped PNGs of HDR results for the docs.
+//
+// Thread safety: what takes a BenchEnv submits to its queue, so it runs on the thread that drives the BenchEnv.
 #pragma once
 
 #include <cstdint>

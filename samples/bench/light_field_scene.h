@@ -5,13 +5,15 @@
 // Light rule (makeLightField): the lights are spread uniformly over the floor, so that about kLightCoverage of
 // them reach any floor point whatever N, each light's range is
 //     range(N) = floorSide * sqrt(kLightCoverage / (pi * N))        (every light reaches everything below 24)
-// and its intensity is set so that, unshadowed over an unbounded floor, it adds kMeanIrradiance / N to the
-// floor's mean irradiance:
+// and its intensity is set so that, unshadowed over an unbounded floor, it adds kMeanIrradiance / N times its
+// colour (a saturated hue, brightest channel 1) to the floor's mean irradiance:
 //     intensity = kMeanIrradiance * floorSide^2 / (N * G),  G = integral over the floor of falloff * cos
 //               = 2 pi * integral over theta in [0, pi/2) of sin(theta) * window(h / cos theta) * cone(theta)
 // (theta from the vertical, h the light's height, window and cone those of many_light_pass.h). The images of
 // every N then have about the same mean irradiance (less the shadows and what falls off the floor's edges),
 // and the per-pixel light count, hence the exact mode's cost, is bounded.
+//
+// Thread safety: plain data and pure functions of their arguments.
 #pragma once
 
 #include <raybridge/many_light_pass.h>

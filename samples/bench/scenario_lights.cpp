@@ -299,6 +299,8 @@ nlohmann::json runLightsScenario(BenchEnv& env) {
     nlohmann::json exactRow = {{"lights", count},
                                {"range_m", field.range},
                                {"spot_lights", field.spotLights},
+                               {"min_intensity_cd", field.minIntensity},
+                               {"max_intensity_cd", field.maxIntensity},
                                {"mode", "exact"},
                                {"rays_per_pixel", nullptr},
                                {"gpu_ms", median(exactMs)},
