@@ -150,6 +150,7 @@ bool makeLightFieldGBuffer(const LightFieldScene& scene, const LightFieldCamera&
   g.depth.assign(pixels, 0.0f);
   g.normal.assign(4 * pixels, 0.0f);
   g.surface.assign(pixels, 0);
+  g.position.assign(3 * pixels, 0.0f);
   for (uint32_t y = 0; y < height; ++y) {
     for (uint32_t x = 0; x < width; ++x) {
       const size_t i = size_t(y) * width + x;
@@ -179,7 +180,10 @@ bool makeLightFieldGBuffer(const LightFieldScene& scene, const LightFieldCamera&
       Vec3 n = normalized(cross({v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]},
                                 {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]}));
       if (dot(n, dir) > 0.0) n = {-n[0], -n[1], -n[2]};  // facing the viewer, as rasterised
-      for (int k = 0; k < 3; ++k) g.normal[4 * i + k] = float(n[k]);
+      for (int k = 0; k < 3; ++k) {
+        g.normal[4 * i + k] = float(n[k]);
+        g.position[3 * i + k] = float(camera.eye[k] + t * dir[k]);
+      }
       g.surface[i] = 1;
       ++g.surfacePixels;
     }
@@ -227,6 +231,65 @@ LightField makeLightField(const LightFieldScene& scene, uint32_t count) {
     f.lights.push_back(l);
   }
   return f;
+}
+
+std::vector<float> referenceIrradiance(const LightFieldScene& scene, const LightFieldGBuffer& g,
+                                       const std::vector<rb::LightSource>& lights) {
+  constexpr double kOriginOffset = 1e-3;  // metres along the normal: clear of the surface the point lies on
+  const size_t pixels = g.surface.size();
+  std::vector<float> out(4 * pixels, 0.0f);
+  // Whether the segment from o along unit d up to tMax crosses a pillar (slab test). The floor cannot occlude:
+  // lights and surface points are at or above it.
+  auto occluded = [&](const Vec3& o, const Vec3& d, double tMax) {
+    for (const Pillar& p : scene.pillars) {
+      double t0 = 0.0, t1 = tMax;
+      for (int k = 0; k < 3 && t0 <= t1; ++k) {
+        if (std::fabs(d[k]) < 1e-12) {
+          if (o[k] < p.min[k] || o[k] > p.max[k]) t0 = t1 + 1.0;
+          continue;
+        }
+        double a = (p.min[k] - o[k]) / d[k], b = (p.max[k] - o[k]) / d[k];
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, b);
+      }
+      if (t0 <= t1) return true;
+    }
+    return false;
+  };
+  for (size_t i = 0; i < pixels; ++i) {
+    if (!g.surface[i]) continue;
+    out[4 * i + 3] = 1.0f;
+    const Vec3 n = {g.normal[4 * i], g.normal[4 * i + 1], g.normal[4 * i + 2]};
+    const Vec3 p = {g.position[3 * i], g.position[3 * i + 1], g.position[3 * i + 2]};
+    const Vec3 o = {p[0] + n[0] * kOriginOffset, p[1] + n[1] * kOriginOffset, p[2] + n[2] * kOriginOffset};
+    double e[3] = {0, 0, 0};
+    for (const rb::LightSource& s : lights) {
+      const rb::Light& l = s.light;
+      Vec3 toLight = {l.position[0] - p[0], l.position[1] - p[1], l.position[2] - p[2]};
+      const double distance = std::sqrt(dot(toLight, toLight));
+      toLight = {toLight[0] / distance, toLight[1] / distance, toLight[2] / distance};
+      const double cosine = dot(n, toLight);
+      if (cosine <= 0.0) continue;
+      double falloff = 1.0 / (distance * distance);
+      if (l.range > 0.0f) falloff *= std::clamp(1.0 - std::pow(distance / l.range, 4.0), 0.0, 1.0);
+      if (l.type == rb::LightType::Spot) {
+        const double cosOuter = std::cos(double(l.spotOuterAngleDegrees) * kPi / 180.0);
+        const double cosInner = std::cos(double(s.spotInnerAngleDegrees) * kPi / 180.0);
+        const Vec3 axis = normalized({l.direction[0], l.direction[1], l.direction[2]});
+        const double c = std::clamp((-dot(toLight, axis) - cosOuter) / std::max(1e-3, cosInner - cosOuter), 0.0, 1.0);
+        falloff *= c * c;
+      }
+      if (falloff <= 0.0) continue;
+      Vec3 d = {l.position[0] - o[0], l.position[1] - o[1], l.position[2] - o[2]};
+      const double reach = std::sqrt(dot(d, d));
+      d = {d[0] / reach, d[1] / reach, d[2] / reach};
+      if (occluded(o, d, reach)) continue;
+      for (int c = 0; c < 3; ++c) e[c] += double(s.color[c]) * s.intensity * cosine * falloff;
+    }
+    for (int c = 0; c < 3; ++c) out[4 * i + c] = float(e[c]);
+  }
+  return out;
 }
 
 }  // namespace rbbench

@@ -75,6 +75,7 @@ struct LightFieldGBuffer {
   float projection[16] = {};
   std::vector<float> depth;      // width * height
   std::vector<float> normal;     // 4 floats per pixel
+  std::vector<float> position;   // world-space hit point, 3 floats per pixel (0 for sky)
   std::vector<uint8_t> surface;  // 1 where the pixel sees the scene
   uint64_t surfacePixels = 0;
 };
@@ -92,5 +93,11 @@ struct LightField {
 };
 // `count` lights by the rule at the top of this file, deterministic for a seed; none inside a pillar.
 LightField makeLightField(const LightFieldScene& scene, uint32_t count);
+
+// The shadowed irradiance of many_light_pass.h at every surface pixel of `gbuffer`, computed on the CPU (shadow
+// rays against the pillars' boxes, in double), RGBA like ManyLightOutputs::irradiance (a = 1; sky all 0). An
+// independent check of the G-buffer, the light conversion and the pass; costs pixels * lights * pillars.
+std::vector<float> referenceIrradiance(const LightFieldScene& scene, const LightFieldGBuffer& gbuffer,
+                                       const std::vector<rb::LightSource>& lights);
 
 }  // namespace rbbench
