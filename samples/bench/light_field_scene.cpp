@@ -151,6 +151,7 @@ bool makeLightFieldGBuffer(const LightFieldScene& scene, const LightFieldCamera&
   g.normal.assign(4 * pixels, 0.0f);
   g.surface.assign(pixels, 0);
   g.position.assign(3 * pixels, 0.0f);
+  g.instance.assign(pixels, ~0u);
   for (uint32_t y = 0; y < height; ++y) {
     for (uint32_t x = 0; x < width; ++x) {
       const size_t i = size_t(y) * width + x;
@@ -185,6 +186,7 @@ bool makeLightFieldGBuffer(const LightFieldScene& scene, const LightFieldCamera&
         g.position[3 * i + k] = float(camera.eye[k] + t * dir[k]);
       }
       g.surface[i] = 1;
+      g.instance[i] = instance;
       ++g.surfacePixels;
     }
   }
@@ -233,11 +235,16 @@ LightField makeLightField(const LightFieldScene& scene, uint32_t count) {
   return f;
 }
 
-std::vector<float> referenceIrradiance(const LightFieldScene& scene, const LightFieldGBuffer& g,
-                                       const std::vector<rb::LightSource>& lights) {
+CpuIrradiance referenceIrradiance(const LightFieldScene& scene, const LightFieldGBuffer& g,
+                                  const std::vector<rb::LightSource>& lights) {
   constexpr double kOriginOffset = 1e-3;  // metres along the normal: clear of the surface the point lies on
   const size_t pixels = g.surface.size();
-  std::vector<float> out(4 * pixels, 0.0f);
+  CpuIrradiance r;
+  r.rgba.assign(4 * pixels, 0.0f);
+  r.lit.assign(pixels, 0);
+  r.visible.assign(pixels, 0);
+  r.interior.assign(pixels, 0);
+  std::vector<float>& out = r.rgba;
   // Whether the segment from o along unit d up to tMax crosses a pillar (slab test). The floor cannot occlude:
   // lights and surface points are at or above it.
   auto occluded = [&](const Vec3& o, const Vec3& d, double tMax) {
@@ -264,7 +271,9 @@ std::vector<float> referenceIrradiance(const LightFieldScene& scene, const Light
     const Vec3 p = {g.position[3 * i], g.position[3 * i + 1], g.position[3 * i + 2]};
     const Vec3 o = {p[0] + n[0] * kOriginOffset, p[1] + n[1] * kOriginOffset, p[2] + n[2] * kOriginOffset};
     double e[3] = {0, 0, 0};
-    for (const rb::LightSource& s : lights) {
+    for (size_t k = 0; k < lights.size(); ++k) {
+      const rb::LightSource& s = lights[k];
+      const uint32_t bit = k < 32 ? 1u << k : 0u;
       const rb::Light& l = s.light;
       Vec3 toLight = {l.position[0] - p[0], l.position[1] - p[1], l.position[2] - p[2]};
       const double distance = std::sqrt(dot(toLight, toLight));
@@ -281,15 +290,31 @@ std::vector<float> referenceIrradiance(const LightFieldScene& scene, const Light
         falloff *= c * c;
       }
       if (falloff <= 0.0) continue;
+      r.lit[i] |= bit;
       Vec3 d = {l.position[0] - o[0], l.position[1] - o[1], l.position[2] - o[2]};
       const double reach = std::sqrt(dot(d, d));
       d = {d[0] / reach, d[1] / reach, d[2] / reach};
       if (occluded(o, d, reach)) continue;
+      r.visible[i] |= bit;
       for (int c = 0; c < 3; ++c) e[c] += double(s.color[c]) * s.intensity * cosine * falloff;
     }
     for (int c = 0; c < 3; ++c) out[4 * i + c] = float(e[c]);
   }
-  return out;
+  const int w = int(g.width), h = int(g.height);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * w + x;
+      bool same = g.surface[i] != 0;
+      for (int dy = -1; dy <= 1 && same; ++dy) {
+        for (int dx = -1; dx <= 1 && same; ++dx) {
+          const size_t j = size_t(std::clamp(y + dy, 0, h - 1)) * w + size_t(std::clamp(x + dx, 0, w - 1));
+          same = g.instance[j] == g.instance[i] && r.lit[j] == r.lit[i] && r.visible[j] == r.visible[i];
+        }
+      }
+      r.interior[i] = same;
+    }
+  }
+  return r;
 }
 
 }  // namespace rbbench

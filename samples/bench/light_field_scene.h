@@ -73,10 +73,11 @@ struct LightFieldGBuffer {
   uint32_t width = 0, height = 0;
   float view[16] = {};
   float projection[16] = {};
-  std::vector<float> depth;      // width * height
-  std::vector<float> normal;     // 4 floats per pixel
-  std::vector<float> position;   // world-space hit point, 3 floats per pixel (0 for sky)
-  std::vector<uint8_t> surface;  // 1 where the pixel sees the scene
+  std::vector<float> depth;        // width * height
+  std::vector<float> normal;       // 4 floats per pixel
+  std::vector<float> position;     // world-space hit point, 3 floats per pixel (0 for sky)
+  std::vector<uint32_t> instance;  // instance hit (0 = floor, k = pillars[k - 1]); ~0u for sky
+  std::vector<uint8_t> surface;    // 1 where the pixel sees the scene
   uint64_t surfacePixels = 0;
 };
 // `hitDistance` and `hitIds` are PrimaryRayPass's targets read back (distance 0 on a miss; primitive id and
@@ -94,10 +95,19 @@ struct LightField {
 // `count` lights by the rule at the top of this file, deterministic for a seed; none inside a pillar.
 LightField makeLightField(const LightFieldScene& scene, uint32_t count);
 
-// The shadowed irradiance of many_light_pass.h at every surface pixel of `gbuffer`, computed on the CPU (shadow
-// rays against the pillars' boxes, in double), RGBA like ManyLightOutputs::irradiance (a = 1; sky all 0). An
-// independent check of the G-buffer, the light conversion and the pass; costs pixels * lights * pillars.
-std::vector<float> referenceIrradiance(const LightFieldScene& scene, const LightFieldGBuffer& gbuffer,
-                                       const std::vector<rb::LightSource>& lights);
+// The shadowed irradiance of many_light_pass.h at every surface pixel of a G-buffer, computed on the CPU (shadow
+// rays against the pillars' boxes, in double): an independent check of the G-buffer, the light conversion and
+// the pass; costs pixels * lights * pillars.
+struct CpuIrradiance {
+  std::vector<float> rgba;  // like ManyLightOutputs::irradiance: a = 1 on surfaces; sky all 0
+  // Per pixel, bit k: light k reaches the point before shadows (lit) / and its shadow ray is free (visible).
+  // Filled for up to 32 lights.
+  std::vector<uint32_t> lit, visible;
+  // 1 where the 3x3 neighbourhood sees the same surface with the same lit and visible lights: away from shadow and
+  // silhouette edges, where a pixel centre may fall on either side in float and in double.
+  std::vector<uint8_t> interior;
+};
+CpuIrradiance referenceIrradiance(const LightFieldScene& scene, const LightFieldGBuffer& gbuffer,
+                                  const std::vector<rb::LightSource>& lights);
 
 }  // namespace rbbench
