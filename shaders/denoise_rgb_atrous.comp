@@ -2,22 +2,24 @@
 #extension GL_GOOGLE_include_directive : require
 // One iteration of the edge-aware a-trous wavelet filter for an RGB signal (SVGF, Schied et al. 2017): the
 // 5x5 B3-spline kernel with holes of `step` pixels of denoise_atrous.comp, with the same depth and normal
-// weights, and a luminance weight whose tolerance is the signal's own noise: .a carries the standard deviation
-// of the luminance (from the temporal pass), blurred over 3x3 for the weight and carried through each
-// iteration as the standard deviation of the weighted mean. Where it is ~0 (converged, noise-free) only
-// neighbours of nearly the same luminance count, so the pixel stays nearly as it is.
+// weights, and a colour weight whose tolerance is the signal's own noise: .a carries the colour's standard
+// deviation (from the temporal pass), blurred over 3x3 for the weight and carried through each iteration as the
+// standard deviation of the weighted mean. Where it is ~0 (converged, noise-free) only neighbours of nearly
+// the same colour count, so the pixel stays nearly as it is. The colour difference is the RGB distance, not
+// SVGF's luminance difference: pools of differently coloured light of similar brightness stay apart.
 #include "denoise_rgb_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = RB_RGB_ATROUS_BINDING_DEPTH) uniform sampler2D gDepth;
 layout(set = 0, binding = RB_RGB_ATROUS_BINDING_NORMAL) uniform sampler2D gNormal;
-layout(set = 0, binding = RB_RGB_ATROUS_BINDING_SIGNAL_IN) uniform sampler2D signalIn;  // rgb, a: std deviation
+layout(set = 0, binding = RB_RGB_ATROUS_BINDING_SIGNAL_IN) uniform sampler2D signalIn;  // rgb, a: its deviation
 layout(set = 0, binding = RB_RGB_ATROUS_BINDING_SIGNAL_OUT, rgba16f) uniform writeonly image2D signalOut;
 
 const float kKernel[3] = float[3](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
 const float kGauss3[2] = float[2](1.0 / 2.0, 1.0 / 4.0);
-// SVGF's luminance tolerance in standard deviations.
-const float kLuminanceSigma = 4.0;
+// The colour tolerance in standard deviations (SVGF's luminance one is 4; the difference of two colours is
+// measured here, as a distance in RGB, which is larger).
+const float kColourSigma = 2.5;
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -43,9 +45,8 @@ void main() {
       variance += kGauss3[abs(x)] * kGauss3[abs(y)] * s * s;
     }
   }
-  float lum = rbDnLuminance(centre.rgb);
-  // The floor keeps a noise-free pixel's weight finite: differences below 0.1% of its luminance count as equal.
-  float sigmaLum = kLuminanceSigma * sqrt(variance) + 1e-3 * lum + 1e-6;
+  // The floor keeps a noise-free pixel's weight finite: a difference of 0.1% of its colour weighs 1/e.
+  float floorSigma = 1e-3 * length(centre.rgb) + 1e-6;
   float depthSigma = pc.depthSigma;
   float normalPower = pc.normalPower;
   vec3 sum = vec3(0.0);
@@ -60,8 +61,11 @@ void main() {
       vec3 qn = rbDnNormal(texelFetch(gNormal, q, 0));
       float planeDistance = abs(dot(qp - p, n)) / (length(p) * depthSigma * float(step) + 1e-6);
       vec4 qv = texelFetch(signalIn, q, 0);
-      float w = kKernel[abs(dx)] * kKernel[abs(dy)] *
-                exp(-planeDistance - abs(rbDnLuminance(qv.rgb) - lum) / sigmaLum) *
+      // The tolerance takes both pixels' noise: with the centre's alone a rare bright sample (high variance)
+      // would spread into its neighbours while they (low variance) took none of it back, and its energy
+      // would be lost; a shared tolerance keeps the filter's mean (the colour of a rarely chosen light).
+      float sigma = kColourSigma * sqrt(0.5 * (variance + qv.a * qv.a)) + floorSigma;
+      float w = kKernel[abs(dx)] * kKernel[abs(dy)] * exp(-planeDistance - length(qv.rgb - centre.rgb) / sigma) *
                 pow(max(dot(n, qn), 0.0), normalPower);
       sum += w * qv.rgb;
       varianceSum += w * w * qv.a * qv.a;

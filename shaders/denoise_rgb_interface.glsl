@@ -9,12 +9,10 @@
 #define RB_RGB_TEMPORAL_BINDING_MOTION 1  // the depth image again without motion vectors
 #define RB_RGB_TEMPORAL_BINDING_SIGNAL 2
 #define RB_RGB_TEMPORAL_BINDING_HISTORY_IN 3  // rgb: mean colour, a: frames accumulated
-#define RB_RGB_TEMPORAL_BINDING_MOMENTS_IN 4  // luminance mean and mean square
-#define RB_RGB_TEMPORAL_BINDING_DISTANCE_IN 5
-#define RB_RGB_TEMPORAL_BINDING_HISTORY_OUT 6
-#define RB_RGB_TEMPORAL_BINDING_MOMENTS_OUT 7
-#define RB_RGB_TEMPORAL_BINDING_DISTANCE_OUT 8
-#define RB_RGB_TEMPORAL_BINDING_VALUE_OUT 9  // rgb: accumulated colour, a: its luminance's standard deviation
+#define RB_RGB_TEMPORAL_BINDING_SURFACE_IN 4  // x: view distance, y: variance of one frame's colour
+#define RB_RGB_TEMPORAL_BINDING_HISTORY_OUT 5
+#define RB_RGB_TEMPORAL_BINDING_SURFACE_OUT 6
+#define RB_RGB_TEMPORAL_BINDING_VALUE_OUT 7  // rgb: accumulated colour, a: its standard deviation
 // A-trous pass (denoise_rgb_atrous.comp).
 #define RB_RGB_ATROUS_BINDING_DEPTH 0
 #define RB_RGB_ATROUS_BINDING_NORMAL 1

@@ -68,13 +68,10 @@ int run(const BenchOptions& options) {
   doc["date"] = utcNow();
   doc["commandLine"] = options.commandLine;
   doc["device"] = deviceJson(env);
-  doc["options"] = {{"scenario", options.scenario},
-                    {"quick", options.quick},
-                    {"full", options.full},
-                    {"width", env.sizes().width},
-                    {"height", env.sizes().height},
-                    {"scenesDir", options.scenesDir},
-                    {"framesInFlight", env.ctx().framesInFlight()}};
+  doc["options"] = {{"scenario", options.scenario},   {"quick", options.quick},
+                    {"full", options.full},           {"width", env.sizes().width},
+                    {"height", env.sizes().height},   {"scenesDir", options.scenesDir},
+                    {"imagesDir", options.imagesDir}, {"framesInFlight", env.ctx().framesInFlight()}};
   doc["gltfModels"] = nlohmann::json::array();
   for (const GltfModel& m : models) {
     doc["gltfModels"].push_back({{"name", m.name},
@@ -99,6 +96,7 @@ int run(const BenchOptions& options) {
       {"trace", [&] { return runTraceScenario(env); }},
       {"gigarays", [&] { return runGigaRaysScenario(env); }},
       {"alpha", [&] { return runAlphaScenario(env); }},
+      {"lights", [&] { return runLightsScenario(env); }},
   };
   // A failing scenario is reported and the others still run (a GPU session is too costly to lose whole).
   std::vector<std::string> failures;

@@ -8,7 +8,7 @@ namespace rbbench {
 const std::vector<std::string>& scenarioNames() {
   static const std::vector<std::string> names = {"build",      "duplication", "fastbuild-vs-fasttrace",
                                                  "compaction", "tlas",        "trace",
-                                                 "gigarays",   "alpha"};
+                                                 "gigarays",   "alpha",       "lights"};
   return names;
 }
 
@@ -34,6 +34,11 @@ void addOptions(CLI::App& app, BenchOptions& o) {
       ->type_name("SUBSTR");
   app.add_option("--scenes", o.scenesDir,
                  "folder of glTF models, one per subfolder (default: ../shared/scenes beside the\nsource tree)")
+      ->type_name("DIR");
+  app.add_option(
+         "--images", o.imagesDir,
+         "folder (created if missing) for tonemapped PNGs of the lights scenario's 256-light case:\nexact, raw and "
+         "denoised (default: none)")
       ->type_name("DIR");
 }
 

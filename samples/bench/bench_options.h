@@ -16,6 +16,7 @@ struct BenchOptions {
   uint32_t height = 0;
   std::string device;       // substring of the device name; empty = $RAYBRIDGE_DEVICE or automatic
   std::string scenesDir;    // glTF models, one folder each; default <source>/../shared/scenes
+  std::string imagesDir;    // lights scenario's pictures (PNG); empty = none
   std::string commandLine;  // as typed, for the report
   bool help = false;
 };

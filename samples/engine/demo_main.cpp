@@ -236,6 +236,8 @@ int runHeadless(const Options& o) {
   if (!o.effectsPrefix.empty())
     if (int rc = writeEffects(o, engine); rc != 0) return rc;
   printTimings(engine.lastTimings());
+  const LocalShadowStats local = engine.lastLocalShadowStats();
+  std::printf("KHR lights: %u, shadow-mapped %u (%u views)\n", local.lights, local.shadowedLights, local.shadowViews);
   if (o.validation) std::printf("validation errors: %u\n", engine.validationErrorCount());
   return o.validation && engine.validationErrorCount() > 0 ? 2 : 0;
 }
@@ -327,6 +329,8 @@ int runWindow(const Options& o) {
   }
   engine.waitIdle();
   printTimings(engine.lastTimings());
+  const LocalShadowStats local = engine.lastLocalShadowStats();
+  std::printf("KHR lights: %u, shadow-mapped %u (%u views)\n", local.lights, local.shadowedLights, local.shadowViews);
   if (o.validation) std::printf("validation errors: %u\n", engine.validationErrorCount());
   return o.validation && engine.validationErrorCount() > 0 ? 2 : 0;
 }

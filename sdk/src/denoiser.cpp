@@ -84,9 +84,8 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
         context, SpirvModule::of(spirv::denoise_rgb_temporal_comp),
         {sampled(RB_RGB_TEMPORAL_BINDING_DEPTH), sampled(RB_RGB_TEMPORAL_BINDING_MOTION),
          sampled(RB_RGB_TEMPORAL_BINDING_SIGNAL), sampled(RB_RGB_TEMPORAL_BINDING_HISTORY_IN),
-         sampled(RB_RGB_TEMPORAL_BINDING_MOMENTS_IN), sampled(RB_RGB_TEMPORAL_BINDING_DISTANCE_IN),
-         storage(RB_RGB_TEMPORAL_BINDING_HISTORY_OUT), storage(RB_RGB_TEMPORAL_BINDING_MOMENTS_OUT),
-         storage(RB_RGB_TEMPORAL_BINDING_DISTANCE_OUT), storage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT)},
+         sampled(RB_RGB_TEMPORAL_BINDING_SURFACE_IN), storage(RB_RGB_TEMPORAL_BINDING_HISTORY_OUT),
+         storage(RB_RGB_TEMPORAL_BINDING_SURFACE_OUT), storage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT)},
         sizeof(DenoiseConstants), "denoiser RGB temporal");
     if (!t) return t.error();
     impl->temporal = t.value();
@@ -135,15 +134,13 @@ namespace {
 Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
                  const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags, const double camera[3]) {
   Context& ctx = s.ctx;
-  // 0,1: colour history ping-pong (rgb mean, a frames); 2,3: view distance ping-pong; 4,5: luminance moments
-  // ping-pong (RG32F: the second moment of HDR values overflows half floats); 6,7: the temporal result and the
-  // a-trous ping-pong (rgb, a: standard deviation of the luminance; a = 1 in the output).
+  // 0,1: colour history ping-pong (rgb mean, a frames); 2,3: surface ping-pong (view distance, variance of one
+  // frame's colour: RG32F, a variance of HDR values overflows half floats); 4,5: the temporal result and the
+  // a-trous ping-pong (rgb, a: the colour's standard deviation; a = 1 in the output).
   std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history A"},
                                          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history B"},
-                                         {VK_FORMAT_R32_SFLOAT, "denoiser RGB distance A"},
-                                         {VK_FORMAT_R32_SFLOAT, "denoiser RGB distance B"},
-                                         {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB moments A"},
-                                         {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB moments B"},
+                                         {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB surface A"},
+                                         {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB surface B"},
                                          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial A"},
                                          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial B"}};
   bool resized = s.images.size() == 0 || s.images[0].width != g.width || s.images[0].height != g.height;
@@ -173,11 +170,11 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   const bool historyUsable = !settings.disableTemporal && s.historyValid;
   if (!historyUsable) {
     // Nothing valid to read: give last frame's images a defined layout for the descriptor reads.
-    for (uint32_t base : {0u, 2u, 4u}) barrier(im[base + prev], VK_IMAGE_LAYOUT_UNDEFINED, ro, 0, read);
+    for (uint32_t base : {0u, 2u}) barrier(im[base + prev], VK_IMAGE_LAYOUT_UNDEFINED, ro, 0, read);
   }
-  for (uint32_t base : {0u, 2u, 4u}) barrier(im[base + cur], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
-  barrier(im[6], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
-  barrier(im[7], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
+  for (uint32_t base : {0u, 2u}) barrier(im[base + cur], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
+  barrier(im[4], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
+  barrier(im[5], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
   flush(readers, cs);
 
   const uint32_t iterations = settings.disableSpatial
@@ -194,25 +191,23 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_MOTION, motion.view, s.sampler, readLayout(motion));
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_SIGNAL, signal, s.sampler, ro);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_HISTORY_IN, im[prev].view, s.sampler, ro);
-    w.sampledImage(RB_RGB_TEMPORAL_BINDING_DISTANCE_IN, im[2 + prev].view, s.sampler, ro);
-    w.sampledImage(RB_RGB_TEMPORAL_BINDING_MOMENTS_IN, im[4 + prev].view, s.sampler, ro);
+    w.sampledImage(RB_RGB_TEMPORAL_BINDING_SURFACE_IN, im[2 + prev].view, s.sampler, ro);
     w.storageImage(RB_RGB_TEMPORAL_BINDING_HISTORY_OUT, im[cur].view);
-    w.storageImage(RB_RGB_TEMPORAL_BINDING_DISTANCE_OUT, im[2 + cur].view);
-    w.storageImage(RB_RGB_TEMPORAL_BINDING_MOMENTS_OUT, im[4 + cur].view);
-    w.storageImage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT, im[6].view);
+    w.storageImage(RB_RGB_TEMPORAL_BINDING_SURFACE_OUT, im[2 + cur].view);
+    w.storageImage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT, im[4].view);
     s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
   }
-  for (uint32_t base : {0u, 2u, 4u}) barrier(im[base + cur], gen, ro, write, read);
-  barrier(im[6], gen, ro, write, read);
+  for (uint32_t base : {0u, 2u}) barrier(im[base + cur], gen, ro, write, read);
+  barrier(im[4], gen, ro, write, read);
   flush(cs, readers);
   // A history written without temporal filtering holds one frame only: the next frame starts afresh anyway.
   s.historyValid = !settings.disableTemporal;
   s.parity = prev;
 
-  const GpuImage* last = &im[6];
+  const GpuImage* last = &im[4];
   for (uint32_t i = 0; i < iterations; ++i) {
-    const GpuImage& in = im[6 + (i % 2)];
-    const GpuImage& out = im[6 + ((i + 1) % 2)];
+    const GpuImage& in = im[4 + (i % 2)];
+    const GpuImage& out = im[4 + ((i + 1) % 2)];
     if (i >= 1) {
       // Writing the image read one step earlier (the temporal result or an a-trous step).
       barrier(out, ro, gen, read, write);
@@ -232,7 +227,7 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   }
   if (iterations == 0) {
     // The second spatial image was not written: keep its layout known.
-    barrier(im[7], gen, ro, 0, read);
+    barrier(im[5], gen, ro, 0, read);
     flush(cs, readers);
   }
   s.metrics.writeEnd(ctx, cmd);

@@ -261,10 +261,12 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
     out.instancesByAlpha[size_t(mode)].push_back(uint32_t(i));  // finalizeScene: Opaque, Mask or Blend
   }
   out.meshCenters.resize(s.meshes.size());
+  out.meshRadii.resize(s.meshes.size());
   for (size_t m = 0; m < s.meshes.size(); ++m) {
     Bounds local;
     for (const glm::vec3& p : s.meshes[m].positions) local.extend(p);
     out.meshCenters[m] = local.valid() ? local.center() : glm::vec3(0.0f);
+    out.meshRadii[m] = local.valid() ? local.radius() : 0.0f;
   }
 
   // --- Textures ---

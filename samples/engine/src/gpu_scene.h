@@ -41,6 +41,7 @@ struct GpuScene {
   // each pass draws and with which pipeline.
   std::array<std::vector<uint32_t>, 3> instancesByAlpha;
   std::vector<glm::vec3> meshCenters;  // per mesh: its bounding-box centre (local), for sorting BLEND draws
+  std::vector<float> meshRadii;        // per mesh: half its bounding-box diagonal (local), for culling casters
   // Per Scene instance, what the raster passes draw: this frame's world transform, and the position /
   // attribute buffers (the mesh's, or the instance's deformed buffers).
   std::vector<glm::mat4> instanceTransforms;

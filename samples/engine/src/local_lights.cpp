@@ -300,7 +300,12 @@ void Engine::Impl::recordLocalLights(FrameResources& frame, const FrameParams& p
                                 &frame.shadowViewSets[layer], 0, nullptr);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.shadow);
         vkCmdSetDepthBias(cmd, settings.depthBiasConstant, 0.0f, settings.depthBiasSlope);
-        if (sceneLoaded) drawScene(cmd, scene, pipelines, DrawPass::Shadow, {}, eye);
+        // Casters beyond a point or spot light's range cannot shadow anything it lights.
+        const FrameLight& light = frameLights[shadowed[s]];
+        const glm::vec4 reach = light.type != PunctualLight::Type::Directional && light.range > 0.0f
+                                    ? glm::vec4(glm::vec3(light.position - eye), light.range)
+                                    : glm::vec4(0.0f);
+        if (sceneLoaded) drawScene(cmd, scene, pipelines, DrawPass::Shadow, {}, eye, ViewHandedness::Camera, reach);
         vkCmdEndRendering(cmd);
       }
     }

@@ -81,8 +81,28 @@ const Material& materialOf(const GpuScene& scene, uint32_t i) {
 
 }  // namespace
 
+namespace {
+
+// Whether instance i can touch `sphere` (relative to origin; w <= 0 = everything can). Deforming instances
+// always can: their bind-pose bounds say nothing about this frame's shape. A caster wholly outside a light's
+// range sphere cannot block a receiver inside it (the segment between them stays inside the sphere).
+bool reaches(const GpuScene& scene, uint32_t i, const glm::dvec3& origin, const glm::vec4& sphere) {
+  if (sphere.w <= 0.0f || deforms(scene.cpu, scene.cpu.instances[i])) return true;
+  const glm::mat4& world = scene.instanceTransforms[i];
+  const uint32_t mesh = scene.cpu.instances[i].mesh;
+  const glm::dvec3 center = glm::dvec3(glm::dmat4(world) * glm::dvec4(scene.meshCenters[mesh], 1.0)) - origin;
+  const float scale = std::max(
+      {glm::length(glm::vec3(world[0])), glm::length(glm::vec3(world[1])), glm::length(glm::vec3(world[2]))});
+  const double reach = double(sphere.w) + double(scene.meshRadii[mesh]) * double(scale);
+  const glm::dvec3 d = center - glm::dvec3(sphere);
+  return glm::dot(d, d) <= reach * reach;
+}
+
+}  // namespace
+
 void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass,
-               const PassPipelines& pipelines, const glm::dvec3& origin, ViewHandedness view) {
+               const PassPipelines& pipelines, const glm::dvec3& origin, ViewHandedness view,
+               const glm::vec4& casterSphere) {
   const auto& opaque = scene.instancesByAlpha[size_t(AlphaMode::Opaque)];
   const auto& masked = scene.instancesByAlpha[size_t(AlphaMode::Mask)];
   const auto& blended = scene.instancesByAlpha[size_t(AlphaMode::Blend)];
@@ -92,7 +112,7 @@ void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, D
     auto draw = [&](const std::vector<uint32_t>& list, VkPipeline pipeline, bool positionsOnly) {
       bool bound = false;
       for (uint32_t i : list) {
-        if (!drawable(scene, i)) continue;
+        if (!drawable(scene, i) || !reaches(scene, i, origin, casterSphere)) continue;
         if (!bound) vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
         bound = true;
         drawInstance(cmd, scene, p, i, rebasedTransform(scene.instanceTransforms[i], origin), positionsOnly,

@@ -44,8 +44,11 @@ glm::mat4 rebasedTransform(const glm::mat4& world, const glm::dvec3& origin);
 // and push constants, and in camera passes the face culling of each draw (Material::doubleSided, the model
 // matrix's handedness, `view`). Shadow ignores `pipelines` and `view`. Set 0 (and set 2 for Lighting) must
 // already be bound; for Shadow, the depth bias must be set.
+// `casterSphere` (Shadow only; xyz relative to `origin`, w radius; w <= 0 = none): rigid instances whose
+// bounding sphere misses it are not drawn (a range-limited light's shadow views skip what it cannot reach).
 void drawScene(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p, DrawPass pass,
-               const PassPipelines& pipelines, const glm::dvec3& origin, ViewHandedness view = ViewHandedness::Camera);
+               const PassPipelines& pipelines, const glm::dvec3& origin, ViewHandedness view = ViewHandedness::Camera,
+               const glm::vec4& casterSphere = glm::vec4(0.0f));
 
 // The BLEND draws with Pipelines::blend, back to front by the distance from `origin` to each instance's
 // bounding-box centre (this frame's transform; ties keep the scene's order). A double-sided one is drawn

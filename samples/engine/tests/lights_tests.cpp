@@ -440,6 +440,11 @@ TEST_CASE("a blocker between a shadow-mapped light and the ground darkens the pi
   uint32_t views = 1, minShadowed = 100;
   const char* what = "spot";
   SECTION("spot") {}
+  float range = 0.0f;
+  SECTION("spot with a range (casters beyond it are culled)") {
+    range = 4.6f;
+    what = "ranged spot";
+  }
   SECTION("wide spot: six views") {
     inner = 1.0f;
     outer = 1.3f;
@@ -460,9 +465,10 @@ TEST_CASE("a blocker between a shadow-mapped light and the ground darkens the pi
   PunctualLight light = lightAt(type, lightPos, intensity);
   light.innerConeAngle = inner;
   light.outerConeAngle = outer;
+  light.range = range;
   // The directional light slants towards -x, so its shadow falls beside the box, in the camera's view.
-  const glm::vec3 travel =
-      type == PunctualLight::Type::Directional ? glm::normalize(glm::vec3(-0.6f, -1.0f, 0.0f)) : glm::vec3(0, -1, 0);
+  const glm::vec3 travel = type == PunctualLight::Type::Directional ? glm::normalize(glm::vec3(-0.6f, -1.0f, 0.0f))
+                                                                    : glm::vec3(0, -1, 0);
   if (type == PunctualLight::Type::Directional)
     light.transform = glm::inverse(glm::lookAt(glm::vec3(0.0f), travel, glm::vec3(0, 0, 1)));  // local -Z = travel
   scene.lights.push_back(light);
@@ -562,5 +568,46 @@ TEST_CASE("KHR lights brighten the HDR frame; an external irradiance replaces th
   }
   engine->setPrepassHook({});
   CHECK(engine->readbackLocalLightIrradiance().error.find("outputLocalLightIrradiance") != std::string::npos);
+  CHECK(engine->validationErrorCount() == 0);
+}
+
+TEST_CASE("the strongest lights get the shadow maps; the others stay unshadowed", "[lights][shadow]") {
+  auto engine = makeEngine();
+  const glm::vec3 center(0.2f, 1.5f, -0.6f), size(1.0f, 0.2f, 0.8f);
+  Scene scene = groundScene(true, center, size);
+  // Light 0 is weaker at the eye than light 1 (a quarter of the intensity, about as far): only light 1 gets
+  // the one map.
+  const glm::vec3 weakPos(1.6f, 3.5f, -1.2f), strongPos(-0.8f, 3.5f, -0.3f);
+  scene.lights.push_back(lightAt(PunctualLight::Type::Point, weakPos, 5.0f));
+  scene.lights.push_back(lightAt(PunctualLight::Type::Point, strongPos, 20.0f));
+  const std::vector<glm::vec4> e = renderIrradiance(*engine, scene, groundParams(1));
+  CHECK(engine->lastLocalShadowStats().lights == 2);
+  CHECK(engine->lastLocalShadowStats().shadowedLights == 1);
+  const glm::vec3 lo = center - size * 0.5f, hi = center + size * 0.5f, margin(0.12f, 0.0f, 0.12f);
+  uint32_t strongBlocked = 0, weakBlocked = 0, wrong = 0;
+  for (uint32_t y = 0; y < kHeight; ++y)
+    for (uint32_t x = 0; x < kWidth; ++x) {
+      const Ray ray = pixelRay(groundCamera(), x, y);
+      glm::vec3 p;
+      if (!groundHit(ray, p) || hitsBox(ray.origin, p, lo - 0.01f, hi + 0.01f)) continue;
+      const float weak = analyticE(scene.lights[0], weakPos, {0, -1, 0}, p);
+      const float strong = analyticE(scene.lights[1], strongPos, {0, -1, 0}, p);
+      const float got = e[y * kWidth + x].r;
+      const bool inStrong = hitsBox(p, strongPos, lo + margin, hi - margin);
+      const bool nearStrong = hitsBox(p, strongPos, lo - margin, hi + margin);
+      const bool inWeak = hitsBox(p, weakPos, lo + margin, hi - margin);
+      const bool nearWeak = hitsBox(p, weakPos, lo - margin, hi + margin);
+      if (inStrong && !nearWeak) {  // the shadow-mapped light is blocked: only the weak one remains
+        ++strongBlocked;
+        if (std::abs(got - weak) > 0.02f * weak) ++wrong;
+      } else if (inWeak && !nearStrong) {  // the unshadowed light's "shadow": it still lights the ground
+        ++weakBlocked;
+        if (std::abs(got - (weak + strong)) > 0.01f * (weak + strong)) ++wrong;
+      }
+    }
+  INFO("blocked for the strong light " << strongBlocked << ", for the weak one " << weakBlocked);
+  CHECK(strongBlocked > 50);
+  CHECK(weakBlocked > 50);
+  CHECK(wrong == 0);
   CHECK(engine->validationErrorCount() == 0);
 }

@@ -38,7 +38,7 @@
 // Add-ons (e.g. a ray-tracing adapter) plug in through four small things:
 //   * EngineConfig: extra device extensions / feature chain, so they can share the engine's device;
 //   * setPrepassHook(): called with the frame's command buffer between the pre-pass and the lighting pass;
-//   * LightingInputs: external sun-visibility / AO / reflection images the lighting pass samples.
+//   * LightingInputs: external sun-visibility / AO / reflection / KHR-light irradiance images the lighting samples.
 //   * setOverlayHook(): called with the frame's command buffer after the tonemap pass, to draw a UI on top.
 //
 // Thread safety: Engine is not thread-safe; call it from one thread at a time (the hook runs on the thread
