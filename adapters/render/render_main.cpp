@@ -467,6 +467,11 @@ int main(int argc, char** argv) {
       e = s ? std::string() : s.error;
       written.push_back("lights.png");
     }
+    if (auto it = f.images.find("lights_raw"); e.empty() && it != f.images.end()) {
+      se::Status s = se::writePng((out / "lights_raw.png").string(), irradiancePicture(toExr(f, it->second, 4)));
+      e = s ? std::string() : s.error;
+      written.push_back("lights_raw.png");
+    }
     // Raster: the engine's shadow-map visibility and SSAO.
     if (e.empty() && !hybrid) {
       auto visibility = engine.readbackShadowVisibility();

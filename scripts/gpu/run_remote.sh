@@ -219,7 +219,7 @@ if want animated; then
 fi
 
 # ---- lights: the many-light benchmark at 2560x1440 with the raw-rate probe in the same run, then the demo scene's
-# punctual lights at 2560x1440 (times: raster with shadow maps, exact, 1 and 4 rays) and at 960x540 (lights.png
+# punctual lights at 2560x1440 (times: raster with shadow maps, exact, 1 and 4 rays) and at 640x360 (lights.png
 # pictures of the same variants). Validation off.
 if want lights; then
   : >"$OUT/lights_gpu.log"
@@ -230,7 +230,7 @@ if want lights; then
   RAYBRIDGE_VALIDATION=0 step "lights bench" 240 "$OUT/lights_gpu.log" "$RT/bin/raybridge-bench" --scenario lights \
     ${RB_LIGHTS_ARGS:-} --out "$OUT/lights_bench_gpu.json"
   LDIR="$(mktemp -d)"
-  for size in "2560 1440" "960 540"; do
+  for size in "2560 1440" "640 360"; do
     read -r lw lh <<<"$size"
     for variant in "raster|--mode raster --preset hard-shadows" "exact|--effects lights --light-rays 0" \
                    "rays1|--effects lights --light-rays 1" "rays4|--effects lights --light-rays 4"; do
