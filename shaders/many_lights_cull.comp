@@ -1,8 +1,9 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_ballot : require
 // ManyLightPass, step 1: per 16x16-pixel tile (one workgroup), the bounding box of the tile's surface points and
-// the lights whose range and cone can reach it, in light order (a prefix sum per chunk of 64 lights, so the list
-// is the same on every run). More than RB_ML_MAX_TILE_LIGHTS: the tile is marked to sample all lights. Sky-only
+// the lights whose range and cone can reach it, in light order (per chunk of 64 lights a prefix count from subgroup
+// ballots, so the list is the same on every run and a chunk costs two barriers). More than RB_ML_MAX_TILE_LIGHTS: the tile is marked to sample all lights. Sky-only
 // tiles list none.
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ManyLightPushConstants { ManyLightConstants pc; };
@@ -16,7 +17,7 @@ layout(set = 0, binding = RB_ML_CULL_BINDING_TILES, std430) writeonly buffer Til
 
 shared vec3 boxMin[64];
 shared vec3 boxMax[64];
-shared uint scan[64];
+shared uint subgroupCounts[64];  // lights reaching the tile per subgroup of the current chunk
 shared uint packedList[RB_ML_MAX_TILE_LIGHTS / 2];
 
 // Whether a light can reach some point of the box [lo, hi].
@@ -73,21 +74,24 @@ void main() {
   bool empty = lo.x > hi.x;
   uint total = 0u;
   bool overflow = false;
+  // Lights go to invocations by subgroup, then lane, so that the count before an invocation is the counts of the
+  // lower subgroups plus its exclusive ballot count: light order, whatever the subgroup size.
+  uint lane = gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;
   for (uint chunk = 0u; chunk < pc.lightCount && !empty; chunk += 64u) {
-    uint index = chunk + tid;
-    uint flag = index < pc.lightCount && reaches(lights[index], lo, hi) ? 1u : 0u;
-    scan[tid] = flag;
+    uint index = chunk + lane;
+    bool flag = index < pc.lightCount && reaches(lights[index], lo, hi);
+    uvec4 ballot = subgroupBallot(flag);
+    if (subgroupElect()) subgroupCounts[gl_SubgroupID] = subgroupBallotBitCount(ballot);
     barrier();
-    for (uint s = 1u; s < 64u; s <<= 1) {  // inclusive Hillis-Steele prefix sum
-      uint add = tid >= s ? scan[tid - s] : 0u;
-      barrier();
-      scan[tid] += add;
-      barrier();
+    uint before = 0u, chunkTotal = 0u;
+    for (uint g = 0u; g < gl_NumSubgroups; ++g) {
+      if (g < gl_SubgroupID) before += subgroupCounts[g];
+      chunkTotal += subgroupCounts[g];
     }
-    uint slot = total + scan[tid] - flag;
-    if (flag != 0u && slot < RB_ML_MAX_TILE_LIGHTS)
+    uint slot = total + before + subgroupBallotExclusiveBitCount(ballot);
+    if (flag && slot < RB_ML_MAX_TILE_LIGHTS)
       atomicOr(packedList[slot >> 1], (index & 0xFFFFu) << ((slot & 1u) * 16u));
-    total += scan[63];
+    total += chunkTotal;
     barrier();
     if (total > RB_ML_MAX_TILE_LIGHTS) {
       overflow = true;

@@ -255,9 +255,8 @@ nlohmann::json runLightsScenario(BenchEnv& env) {
     for (int round = 0; round < 2; ++round) {
       uint32_t warmUp = 1;
       if (round == 1) {
-        const double estimate = std::max(*std::min_element(t.pass.begin(), t.pass.end()) +
-                                             (t.denoise.empty() ? 0.0 : t.denoise.front()),
-                                         0.01);
+        const double estimate = std::max(
+            *std::min_element(t.pass.begin(), t.pass.end()) + (t.denoise.empty() ? 0.0 : t.denoise.front()), 0.01);
         warmUp = uint32_t(std::clamp(kWarmUpMs / estimate, 1.0, 2000.0));
       }
       std::vector<std::array<uint32_t, 3>> marks;
@@ -269,8 +268,7 @@ nlohmann::json runLightsScenario(BenchEnv& env) {
           const uint32_t a = timed ? timer.mark(cmd) : 0;
           check(pass->record(cmd, gbuffer, tlas, lights, settings), "ManyLightPass::record");
           const uint32_t b = timed ? timer.mark(cmd) : 0;
-          if (withDenoiser)
-            check(denoiser->record(cmd, gbuffer, pass->outputs().irradianceView), "Denoiser::record");
+          if (withDenoiser) check(denoiser->record(cmd, gbuffer, pass->outputs().irradianceView), "Denoiser::record");
           if (timed) marks.push_back({a, b, withDenoiser ? timer.mark(cmd) : b});
         }
       });

@@ -58,6 +58,14 @@ Status checkFeatures(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
   need(v12.timelineSemaphore, "timelineSemaphore");
   need(as.accelerationStructure, "accelerationStructure");
   need(rt.rayTracingPipeline, "rayTracingPipeline");
+  // The many-light tile culling counts the lights of a tile with subgroup ballots (every ray tracing driver seen
+  // has them: NVIDIA, AMD, Intel, lavapipe).
+  VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &subgroup};
+  vk.vkGetPhysicalDeviceProperties2(physicalDevice, &p2);
+  need((subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+           (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT),
+       "subgroup ballot operations in compute shaders");
   if (!missing.empty()) {
     return Error{ErrorCode::MissingFeature, VK_SUCCESS,
                  "device '" + deviceName + "' does not support the features Raybridge needs: " + missing};
