@@ -17,6 +17,8 @@ layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SURFACE_IN) uniform sampler2D 
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_HISTORY_OUT, rgba16f) uniform writeonly image2D historyOut;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SURFACE_OUT, rg32f) uniform writeonly image2D surfaceOut;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_VALUE_OUT, rgba16f) uniform writeonly image2D valueOut;
+layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_GUIDE_OUT, rg32ui) uniform writeonly uimage2D guideOut;
+layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_NORMAL) uniform sampler2D gNormal;
 
 float squared(vec3 v) { return dot(v, v); }
 
@@ -75,10 +77,12 @@ void main() {
     imageStore(historyOut, ip, vec4(value, 0.0));
     imageStore(surfaceOut, ip, vec4(0.0));
     imageStore(valueOut, ip, vec4(value, final ? 1.0 : 0.0));
+    imageStore(guideOut, ip, uvec4(0u));
     return;
   }
   vec3 rel = rbDnCameraRelative(pixel, depth);
   float dist = length(rel);
+  imageStore(guideOut, ip, uvec4(rbDnPackGuide(dist, rbDnNormal(texelFetch(gNormal, ip, 0))), 0u, 0u));
   vec2 prevPixel;
   vec3 prevRel = rel + pc.cameraDelta;
   if ((pc.flags & RB_DN_MOTION) != 0u) {

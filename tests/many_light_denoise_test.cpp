@@ -130,7 +130,7 @@ TEST_CASE("RGB denoising leaves a noise-free signal (the exact mode) nearly unch
   CHECK(run.raw[0] == run.raw[1]);  // the exact mode is deterministic
   // One frame has no history: the noise is estimated from the neighbourhood, which mistakes a little of the
   // lighting's curvature for noise. With a history the variance is measured: ~0 here.
-  CHECK(e1 <= 0.025);
+  CHECK(e1 <= 0.02);
   CHECK(e8 <= 0.005);
   // Spatial filtering alone (no history, the noise estimated from the neighbourhood) is just as careful.
   rb::DenoiseSettings spatialOnly;
@@ -138,7 +138,7 @@ TEST_CASE("RGB denoising leaves a noise-free signal (the exact mode) nearly unch
   DenoisedFrames spatial = runFrames(fx, room.scene, room.cpu, lights, exactMode(), 1, {1}, true, spatialOnly);
   const double eSpatial = relativeRmse(spatial.denoised[0], spatial.raw[0], surface);
   INFO("spatial only: " << eSpatial);
-  CHECK(eSpatial <= 0.025);
+  CHECK(eSpatial <= 0.02);
 }
 
 TEST_CASE("RGB denoising keeps the colour of a red and a blue light", "[many_lights][denoise]") {
@@ -173,15 +173,20 @@ TEST_CASE("RGB denoising keeps the colour of a red and a blue light", "[many_lig
                   << " denoised " << e);
     CHECK(std::fabs(r - 1.0) <= 0.03);
     CHECK(std::fabs(b - 1.0) <= 0.03);
-    // And against the frame's own raw means: filtering moves colour around but neither makes nor loses it.
-    CHECK(std::fabs(channelMean(d, 0) / channelMean(run.raw[k], 0) - 1.0) <= 0.02);
-    CHECK(std::fabs(channelMean(d, 2) / channelMean(run.raw[k], 2) - 1.0) <= 0.02);
+    // And against the frame's own raw means: filtering moves colour around but hardly makes or loses any (the
+    // first frame's rare bright samples lose a little; with a history they are averaged over time first).
+    const double rawTolerance = k == 0 ? 0.04 : 0.02;
+    INFO("denoised/raw red " << channelMean(d, 0) / channelMean(run.raw[k], 0) << ", blue "
+                             << channelMean(d, 2) / channelMean(run.raw[k], 2));
+    CHECK(std::fabs(channelMean(d, 0) / channelMean(run.raw[k], 0) - 1.0) <= rawTolerance);
+    CHECK(std::fabs(channelMean(d, 2) / channelMean(run.raw[k], 2) - 1.0) <= rawTolerance);
     CHECK(channelMean(d, 1) <= 1e-3 * (red + blue));  // no green made up
     CHECK(e < raw);
   }
 }
 
-TEST_CASE("the effects front end denoises stochastic local lights, not exact ones", "[many_lights][denoise][hybrid]") {
+TEST_CASE("the effects front end denoises stochastic local lights, not exact ones",
+          "[many_lights][denoise][hybrid_effects]") {
   GpuFixture fx;
   RoomSetup room(96, 72);
   const std::vector<rb::LightSource> lights = manyRoomLights();

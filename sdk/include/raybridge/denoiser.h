@@ -37,8 +37,9 @@ struct DenoiseSettings {
   // history.
   bool disableTemporal = false;
   bool disableSpatial = false;  // false = run the a-trous filter
-  // 0 = 2 for Scalar (steps 1 and 2: a 13x13 footprint; 3 over-blurs 4-ray AO), 4 for Rgb (steps 1 to 8: its
-  // weights follow the measured noise, so the wider reach only blurs where the signal is still noisy). At most 6.
+  // 0 = 2 for Scalar (steps 1 and 2: a 13x13 footprint; 3 over-blurs 4-ray AO), 5 for Rgb (3x3 taps at steps 1 to
+  // 16: its weights follow the measured noise, so the wide reach only blurs where the signal is still noisy).
+  // At most 6.
   uint32_t spatialIterations = 0;
   uint32_t maxHistoryFrames = 0;  // 0 = 32: the running mean forgets more slowly than this
   float depthSigma = 0.0f;        // 0 = 0.005: plane-distance tolerance relative to view distance, per step
