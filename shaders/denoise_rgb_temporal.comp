@@ -1,11 +1,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // Temporal accumulation of an RGB signal with reprojection (as denoise_temporal.comp: the same surface found
-// where it was last frame, read bilinearly; a running mean over up to `max history` frames), plus the running variance of one
-// frame's colour (Welford's recurrence: no cancellation, so a converged or noise-free pixel reads ~0; SVGF,
-// Schied et al. 2017, keeps raw moments instead). Writes the accumulated colour with its standard deviation in
-// .a: the variance of one frame (from the history, or from the neighbourhood while the history is short)
-// divided by the frames averaged, so the spatial filter knows how noisy the mean still is.
+// where it was last frame, here read bilinearly; a running mean over up to `max history` frames), plus the
+// running variance of one frame's colour (Welford's recurrence: no cancellation, so a converged or noise-free
+// pixel reads ~0; SVGF, Schied et al. 2017, keeps raw moments instead). Writes the accumulated colour with its
+// standard deviation in .a: the variance of one frame (from the history, or from the neighbourhood while the
+// history is short) divided by the frames averaged, so the spatial filter knows how noisy the mean still is.
+// It also writes the guide image of the a-trous steps.
 #include "denoise_rgb_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
