@@ -46,12 +46,12 @@ void main() {
   int step = int(pc.atrousStep);
   float tolerance = length(p) * pc.depthSigma * float(step) + 1e-6;
 
-  // The taps, with their geometric weights first: the noise level the colour weight uses is the mean variance
-  // of the taps on the same surface, so a pixel whose few frames happened to agree still takes its
-  // neighbours' noise level, and the other side of an edge lends none.
+  // The taps, with their geometric weights first: the centre's noise level for the colour weight is the mean
+  // variance of the taps on the same surface (a weighted sum here), so a pixel whose few frames happened
+  // to agree still takes its neighbours' noise level, and the other side of an edge lends none.
   vec4 values[9];
   float geometric[9];
-  float variance = 0.0, varianceWeights = 0.0;
+  float tapVariances = 0.0, varianceWeights = 0.0;
   for (int k = 0; k < 9; ++k) {
     ivec2 o = ivec2(k % 3 - 1, k / 3 - 1);
     ivec2 q = ip + o * step;
@@ -67,10 +67,9 @@ void main() {
               pow(max(dot(n, rbDnGuideNormal(qg)), 0.0), pc.normalPower);
     values[k] = texelFetch(signalIn, q, 0);
     geometric[k] = w;
-    variance += w * values[k].a * values[k].a;
+    tapVariances += w * values[k].a * values[k].a;
     varianceWeights += w;
   }
-  variance /= varianceWeights;  // > 0: the centre's own weight is
   // The floor keeps a noise-free pixel's weight finite: a difference of 0.1% of its colour weighs 1/e.
   float floorSigma = 1e-3 * length(centre.rgb) + 1e-6;
   vec3 sum = vec3(0.0);
@@ -78,10 +77,13 @@ void main() {
   for (int k = 0; k < 9; ++k) {
     if (geometric[k] == 0.0) continue;
     vec4 qv = values[k];
-    // The tolerance takes both pixels' noise: with the centre's alone a rare bright sample (high variance)
-    // would spread into its neighbours while they (low variance) took none of it back, and its energy would
-    // be lost; a shared tolerance keeps the filter's mean (the colour of a rarely chosen light).
-    float sigma = kColourSigma * sqrt(0.5 * (variance + qv.a * qv.a)) + floorSigma;
+    // The tolerance is the smaller of the two pixels' noise, the centre's taken without this tap: a pixel
+    // mixes with a neighbour only when both are that noisy. A bright, noisy pixel (a light's hot spot, a rare
+    // sample) then neither spreads into quiet neighbours nor is averaged away while they take none of it back,
+    // which would lose its energy (the colour of a rarely chosen light).
+    float others = varianceWeights - geometric[k];
+    float centreVariance = others > 1e-6 ? (tapVariances - geometric[k] * qv.a * qv.a) / others : centre.a * centre.a;
+    float sigma = kColourSigma * sqrt(min(centreVariance, qv.a * qv.a)) + floorSigma;
     float w = geometric[k] * exp(-length(qv.rgb - centre.rgb) / sigma);
     sum += w * qv.rgb;
     varianceSum += w * w * qv.a * qv.a;

@@ -327,3 +327,31 @@ TEST_CASE("RGB temporal accumulation reprojects through camera motion", "[many_l
   // The history survives the motion: eight frames do nearly as well as eight still ones (0.06-0.08 here).
   CHECK(eMoving < 0.6 * eOne);
 }
+
+
+TEST_CASE("RGB denoising keeps a light's hot spot where it is", "[many_lights][denoise]") {
+  GpuFixture fx;
+  RoomSetup room;
+  // The room's 32 lights and a bright one 5 cm above the box's top: a few very bright, noisy pixels (the
+  // candidates often miss that light) among quiet ones.
+  std::vector<rb::LightSource> lights = manyRoomLights();
+  lights.push_back(pointLight({2.5, 1.25, 1.5}, {1.0f, 1.0f, 1.0f}, 2.0f, 2.0f));
+  const std::vector<uint8_t> surface = surfaceOf(room.cpu);
+  std::vector<float> exact = runFrames(fx, room.scene, room.cpu, lights, exactMode(), 1, {1}, false).raw[0];
+  DenoisedFrames run = runFrames(fx, room.scene, room.cpu, lights, stochastic(4), 16, {16});
+  const std::vector<float>& d = run.denoised[0];
+  float hottest = 0.0f;
+  for (size_t i = 0; i < surface.size(); ++i)
+    if (surface[i]) hottest = std::max(hottest, exact[4 * i + 1]);
+  // Pixels away from the hot spot that came out far brighter than they are: the hot spot spread into them.
+  uint32_t spread = 0, quiet = 0;
+  for (size_t i = 0; i < surface.size(); ++i) {
+    if (!surface[i] || exact[4 * i + 1] > 0.05f * hottest) continue;
+    ++quiet;
+    spread += d[4 * i + 1] > 1.5f * exact[4 * i + 1] + 0.003f * hottest;
+  }
+  std::printf("[many_lights][denoise] hot spot %.1f: %u of %u quiet pixels brightened by it\n", hottest, spread, quiet);
+  INFO("hottest " << hottest << ", quiet pixels " << quiet << ", brightened " << spread);
+  CHECK(hottest > 50.0f);
+  CHECK(spread <= 2);  // a tolerance from the mean of the two pixels' noise brightened 13 here
+}
