@@ -1,6 +1,7 @@
 // The RGB denoiser on the many-light pass's irradiance: against the exact mode, denoised stochastic output is
-// well below the raw error after one frame and far below it after sixteen still frames; a noise-free (exact)
-// input comes through nearly unchanged; colour is kept; and the effects front end denoises its local lights.
+// well below the raw error after one frame and far below it after sixteen still frames (or eight moving ones); a
+// noise-free (exact) input comes through nearly unchanged; colour is kept; a light's hot spot stays where it is;
+// and the effects front end denoises its stochastic local lights.
 #include <catch2/catch_test_macros.hpp>
 
 #include <glm/glm.hpp>
