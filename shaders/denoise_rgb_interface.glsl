@@ -13,11 +13,12 @@
 #define RB_RGB_TEMPORAL_BINDING_HISTORY_OUT 5
 #define RB_RGB_TEMPORAL_BINDING_SURFACE_OUT 6
 #define RB_RGB_TEMPORAL_BINDING_VALUE_OUT 7  // rgb: accumulated colour, a: its standard deviation
+#define RB_RGB_TEMPORAL_BINDING_GUIDE_OUT 8  // the a-trous steps' geometry (denoise_rgb_common.glsl)
+#define RB_RGB_TEMPORAL_BINDING_NORMAL 9
 // A-trous pass (denoise_rgb_atrous.comp).
-#define RB_RGB_ATROUS_BINDING_DEPTH 0
-#define RB_RGB_ATROUS_BINDING_NORMAL 1
-#define RB_RGB_ATROUS_BINDING_SIGNAL_IN 2
-#define RB_RGB_ATROUS_BINDING_SIGNAL_OUT 3
+#define RB_RGB_ATROUS_BINDING_GUIDE 0
+#define RB_RGB_ATROUS_BINDING_SIGNAL_IN 1
+#define RB_RGB_ATROUS_BINDING_SIGNAL_OUT 2
 
 // This dispatch writes the denoiser's output: a = 1 instead of the standard deviation.
 #define RB_DN_RGB_FINAL 0x100u

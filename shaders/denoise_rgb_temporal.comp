@@ -1,11 +1,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // Temporal accumulation of an RGB signal with reprojection (as denoise_temporal.comp: the same surface found
-// where it was last frame, a running mean over up to `max history` frames), plus the running variance of one
-// frame's colour (Welford's recurrence: no cancellation, so a converged or noise-free pixel reads ~0; SVGF,
-// Schied et al. 2017, keeps raw moments instead). Writes the accumulated colour with its standard deviation in
-// .a: the variance of one frame (from the history, or from the neighbourhood while the history is short)
-// divided by the frames averaged, so the spatial filter knows how noisy the mean still is.
+// where it was last frame, here read bilinearly; a running mean over up to `max history` frames), plus the
+// running variance of one frame's colour (Welford's recurrence: no cancellation, so a converged or noise-free
+// pixel reads ~0; SVGF, Schied et al. 2017, keeps raw moments instead). Writes the accumulated colour with its
+// standard deviation in .a: the variance of one frame (from the history, or from the neighbourhood while the
+// history is short) divided by the frames averaged, so the spatial filter knows how noisy the mean still is.
+// It also writes the guide image of the a-trous steps.
 #include "denoise_rgb_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -17,6 +18,8 @@ layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SURFACE_IN) uniform sampler2D 
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_HISTORY_OUT, rgba16f) uniform writeonly image2D historyOut;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SURFACE_OUT, rg32f) uniform writeonly image2D surfaceOut;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_VALUE_OUT, rgba16f) uniform writeonly image2D valueOut;
+layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_GUIDE_OUT, rg32ui) uniform writeonly uimage2D guideOut;
+layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_NORMAL) uniform sampler2D gNormal;
 
 float squared(vec3 v) { return dot(v, v); }
 
@@ -75,10 +78,12 @@ void main() {
     imageStore(historyOut, ip, vec4(value, 0.0));
     imageStore(surfaceOut, ip, vec4(0.0));
     imageStore(valueOut, ip, vec4(value, final ? 1.0 : 0.0));
+    imageStore(guideOut, ip, uvec4(0u));
     return;
   }
   vec3 rel = rbDnCameraRelative(pixel, depth);
   float dist = length(rel);
+  imageStore(guideOut, ip, uvec4(rbDnPackGuide(dist, rbDnNormal(texelFetch(gNormal, ip, 0))), 0u, 0u));
   vec2 prevPixel;
   vec3 prevRel = rel + pc.cameraDelta;
   if ((pc.flags & RB_DN_MOTION) != 0u) {
@@ -90,16 +95,34 @@ void main() {
   vec3 accumulated = value;
   float variance = 0.0;  // of one frame's colour, over the frames accumulated
   float frames = 1.0;
-  ivec2 pp = ivec2(floor(prevPixel));
-  if ((pc.flags & RB_DN_HISTORY) != 0u && all(greaterThanEqual(pp, ivec2(0))) && all(lessThan(pp, ivec2(pc.size)))) {
-    vec2 prevSurface = texelFetch(surfaceIn, pp, 0).xy;
-    // The same surface: its distance from last frame's camera matches what was stored there.
-    if (prevSurface.x > 0.0 && abs(prevSurface.x - length(prevRel)) <= 0.02 * length(prevRel) + 1e-3) {
-      vec4 h = texelFetch(historyIn, pp, 0);
-      frames = min(h.a + 1.0, float(pc.maxHistoryFrames));
+  if ((pc.flags & RB_DN_HISTORY) != 0u) {
+    // Bilinear over the four history texels around the reprojected point, each kept only where it holds the
+    // same surface (its distance from last frame's camera matches); nearest-texel reprojection would drift and
+    // blur the history by up to half a pixel every frame the camera moves.
+    vec2 f = prevPixel - 0.5;
+    ivec2 base = ivec2(floor(f));
+    vec2 t = f - vec2(base);
+    float expected = length(prevRel);
+    vec4 h = vec4(0.0);
+    float v = 0.0, weights = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      ivec2 o = ivec2(k & 1, k >> 1);
+      ivec2 pp = base + o;
+      if (any(lessThan(pp, ivec2(0))) || any(greaterThanEqual(pp, ivec2(pc.size)))) continue;
+      vec2 prevSurface = texelFetch(surfaceIn, pp, 0).xy;
+      if (!(prevSurface.x > 0.0 && abs(prevSurface.x - expected) <= 0.02 * expected + 1e-3)) continue;
+      float w = (o.x == 1 ? t.x : 1.0 - t.x) * (o.y == 1 ? t.y : 1.0 - t.y);
+      h += w * texelFetch(historyIn, pp, 0);
+      v += w * prevSurface.y;
+      weights += w;
+    }
+    if (weights > 1e-3) {
+      h /= weights;
+      v /= weights;
+      frames = min(floor(h.a + 0.5) + 1.0, float(pc.maxHistoryFrames));
       float alpha = 1.0 / frames;
       accumulated = mix(h.rgb, value, alpha);
-      variance = (1.0 - alpha) * (prevSurface.y + alpha * squared(value - h.rgb));
+      variance = (1.0 - alpha) * (v + alpha * squared(value - h.rgb));
     }
   }
   imageStore(historyOut, ip, vec4(accumulated, frames));

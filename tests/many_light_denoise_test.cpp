@@ -1,6 +1,7 @@
 // The RGB denoiser on the many-light pass's irradiance: against the exact mode, denoised stochastic output is
-// well below the raw error after one frame and far below it after sixteen still frames; a noise-free (exact)
-// input comes through nearly unchanged; colour is kept; and the effects front end denoises its local lights.
+// well below the raw error after one frame and far below it after sixteen still frames (or eight moving ones); a
+// noise-free (exact) input comes through nearly unchanged; colour is kept; a light's hot spot stays where it is;
+// and the effects front end denoises its stochastic local lights.
 #include <catch2/catch_test_macros.hpp>
 
 #include <glm/glm.hpp>
@@ -20,12 +21,11 @@ struct DenoisedFrames {
   std::vector<std::vector<float>> raw, denoised;
 };
 
-// `frames` still frames of the many-light pass and, unless `denoise` is false, an RGB denoiser after it. Each
+// One frame per view of the many-light pass and, unless `denoise` is false, an RGB denoiser after it. Each
 // frame is its own Context frame, so the pass draws new random numbers (its seed follows the frame index).
-DenoisedFrames runFrames(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu,
-                         const std::vector<rb::LightSource>& lights, const rb::ManyLightSettings& settings,
-                         uint32_t frames, const std::vector<uint32_t>& readAt, bool denoise = true,
-                         const rb::DenoiseSettings& dn = {}) {
+DenoisedFrames runViews(GpuFixture& fx, const TestScene& scene, const std::vector<CpuGBuffer>& views,
+                        const std::vector<rb::LightSource>& lights, const rb::ManyLightSettings& settings,
+                        const std::vector<uint32_t>& readAt, bool denoise = true, const rb::DenoiseSettings& dn = {}) {
   auto service = rb::AccelerationStructureService::create(fx.ctx());
   RB_REQUIRE_OK(service);
   auto pass = rb::ManyLightPass::create(fx.ctx());
@@ -36,10 +36,10 @@ DenoisedFrames runFrames(GpuFixture& fx, const TestScene& scene, const CpuGBuffe
   RB_REQUIRE_OK(denoiser);
   CHECK(denoiser.value()->signal() == rb::DenoiseSignal::Rgb);
   BuiltScene built = buildScene(fx, *service.value(), scene);
-  GpuGBuffer gbuffer(fx, cpu);
-  const rb::GBufferDesc g = gbuffer.desc();
   DenoisedFrames out;
-  for (uint32_t f = 1; f <= frames; ++f) {
+  for (uint32_t f = 1; f <= views.size(); ++f) {
+    GpuGBuffer gbuffer(fx, views[f - 1]);
+    const rb::GBufferDesc g = gbuffer.desc();
     fx.runFrame([&](VkCommandBuffer cmd) {
       auto tlas = service.value()->recordTlasBuild(cmd, built.instances, gbuffer.cameraRelativeTlas());
       RB_REQUIRE_OK(tlas);
@@ -58,6 +58,14 @@ DenoisedFrames runFrames(GpuFixture& fx, const TestScene& scene, const CpuGBuffe
   (void)fx.device().waitIdle();
   destroyScene(fx, built);
   return out;
+}
+
+// `frames` still frames.
+DenoisedFrames runFrames(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu,
+                         const std::vector<rb::LightSource>& lights, const rb::ManyLightSettings& settings,
+                         uint32_t frames, const std::vector<uint32_t>& readAt, bool denoise = true,
+                         const rb::DenoiseSettings& dn = {}) {
+  return runViews(fx, scene, std::vector<CpuGBuffer>(frames, cpu), lights, settings, readAt, denoise, dn);
 }
 
 rb::ManyLightSettings exactMode() {
@@ -130,7 +138,7 @@ TEST_CASE("RGB denoising leaves a noise-free signal (the exact mode) nearly unch
   CHECK(run.raw[0] == run.raw[1]);  // the exact mode is deterministic
   // One frame has no history: the noise is estimated from the neighbourhood, which mistakes a little of the
   // lighting's curvature for noise. With a history the variance is measured: ~0 here.
-  CHECK(e1 <= 0.025);
+  CHECK(e1 <= 0.02);
   CHECK(e8 <= 0.005);
   // Spatial filtering alone (no history, the noise estimated from the neighbourhood) is just as careful.
   rb::DenoiseSettings spatialOnly;
@@ -138,7 +146,7 @@ TEST_CASE("RGB denoising leaves a noise-free signal (the exact mode) nearly unch
   DenoisedFrames spatial = runFrames(fx, room.scene, room.cpu, lights, exactMode(), 1, {1}, true, spatialOnly);
   const double eSpatial = relativeRmse(spatial.denoised[0], spatial.raw[0], surface);
   INFO("spatial only: " << eSpatial);
-  CHECK(eSpatial <= 0.025);
+  CHECK(eSpatial <= 0.02);
 }
 
 TEST_CASE("RGB denoising keeps the colour of a red and a blue light", "[many_lights][denoise]") {
@@ -173,15 +181,20 @@ TEST_CASE("RGB denoising keeps the colour of a red and a blue light", "[many_lig
                   << " denoised " << e);
     CHECK(std::fabs(r - 1.0) <= 0.03);
     CHECK(std::fabs(b - 1.0) <= 0.03);
-    // And against the frame's own raw means: filtering moves colour around but neither makes nor loses it.
-    CHECK(std::fabs(channelMean(d, 0) / channelMean(run.raw[k], 0) - 1.0) <= 0.02);
-    CHECK(std::fabs(channelMean(d, 2) / channelMean(run.raw[k], 2) - 1.0) <= 0.02);
+    // And against the frame's own raw means: filtering moves colour around but hardly makes or loses any (the
+    // first frame's rare bright samples lose a little; with a history they are averaged over time first).
+    const double rawTolerance = k == 0 ? 0.04 : 0.02;
+    INFO("denoised/raw red " << channelMean(d, 0) / channelMean(run.raw[k], 0) << ", blue "
+                             << channelMean(d, 2) / channelMean(run.raw[k], 2));
+    CHECK(std::fabs(channelMean(d, 0) / channelMean(run.raw[k], 0) - 1.0) <= rawTolerance);
+    CHECK(std::fabs(channelMean(d, 2) / channelMean(run.raw[k], 2) - 1.0) <= rawTolerance);
     CHECK(channelMean(d, 1) <= 1e-3 * (red + blue));  // no green made up
     CHECK(e < raw);
   }
 }
 
-TEST_CASE("the effects front end denoises stochastic local lights, not exact ones", "[many_lights][denoise][hybrid]") {
+TEST_CASE("the effects front end denoises stochastic local lights, not exact ones",
+          "[many_lights][denoise][hybrid_effects]") {
   GpuFixture fx;
   RoomSetup room(96, 72);
   const std::vector<rb::LightSource> lights = manyRoomLights();
@@ -252,7 +265,8 @@ TEST_CASE("the effects front end denoises stochastic local lights, not exact one
     for (uint32_t i = 0; i < fx.ctx().framesInFlight(); ++i) fx.ctx().beginFrame();
     (void)fx.device().waitIdle();
     CHECK(fxs.stats().localLightsDenoise.gpuMs == 0.0);
-    CHECK(fxs.memoryStats().of(rb::MemoryCategory::PassImages) < imagesWithDenoiser);
+    // The denoiser's images (denoiser.h: 56 bytes per pixel) went with it.
+    CHECK(imagesWithDenoiser - fxs.memoryStats().of(rb::MemoryCategory::PassImages) >= 56ull * w * h);
 
     // Exact mode has no noise: never denoised.
     desc.localLights.disableDenoiser = false;
@@ -285,4 +299,60 @@ TEST_CASE("a denoiser description with an unknown signal fails naming the field"
   auto scalar = rb::Denoiser::create(fx.ctx());
   RB_REQUIRE_OK(scalar);
   CHECK(scalar.value()->signal() == rb::DenoiseSignal::Scalar);
+}
+
+TEST_CASE("RGB temporal accumulation reprojects through camera motion", "[many_lights][denoise][temporal]") {
+  GpuFixture fx;
+  TestScene scene = makeRoom();
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  // Eight frames while the camera slides sideways; the reference is the exact mode at the last view.
+  std::vector<CpuGBuffer> views;
+  for (int i = 0; i < 8; ++i) {
+    SyntheticView v = roomView(128, 96);
+    v.eye.x += 0.06 * i;
+    v.target.x += 0.06 * i;
+    views.push_back(traceGBuffer(embree, v));
+  }
+  const CpuGBuffer& last = views.back();
+  const std::vector<rb::LightSource> lights = manyRoomLights();
+  const std::vector<uint8_t> surface = surfaceOf(last);
+  std::vector<float> exact = runFrames(fx, scene, last, lights, exactMode(), 1, {1}, false).raw[0];
+  DenoisedFrames moving = runViews(fx, scene, views, lights, stochastic(4), {8});
+  DenoisedFrames still = runFrames(fx, scene, last, lights, stochastic(4), 1, {1});
+  const double eMoving = relativeRmse(moving.denoised[0], exact, surface);
+  const double eOne = relativeRmse(still.denoised[0], exact, surface);
+  std::printf("[many_lights][denoise] camera sliding over 8 frames: relative RMSE %.4f (one frame: %.4f)\n", eMoving,
+              eOne);
+  INFO("after 8 reprojected frames " << eMoving << ", after 1 frame " << eOne);
+  // The history survives the motion: eight frames do nearly as well as eight still ones (0.06-0.08 here).
+  CHECK(eMoving < 0.6 * eOne);
+}
+
+
+TEST_CASE("RGB denoising keeps a light's hot spot where it is", "[many_lights][denoise]") {
+  GpuFixture fx;
+  RoomSetup room;
+  // The room's 32 lights and a bright one 5 cm above the box's top: a few very bright, noisy pixels (the
+  // candidates often miss that light) among quiet ones.
+  std::vector<rb::LightSource> lights = manyRoomLights();
+  lights.push_back(pointLight({2.5, 1.25, 1.5}, {1.0f, 1.0f, 1.0f}, 2.0f, 2.0f));
+  const std::vector<uint8_t> surface = surfaceOf(room.cpu);
+  std::vector<float> exact = runFrames(fx, room.scene, room.cpu, lights, exactMode(), 1, {1}, false).raw[0];
+  DenoisedFrames run = runFrames(fx, room.scene, room.cpu, lights, stochastic(4), 16, {16});
+  const std::vector<float>& d = run.denoised[0];
+  float hottest = 0.0f;
+  for (size_t i = 0; i < surface.size(); ++i)
+    if (surface[i]) hottest = std::max(hottest, exact[4 * i + 1]);
+  // Pixels away from the hot spot that came out far brighter than they are: the hot spot spread into them.
+  uint32_t spread = 0, quiet = 0;
+  for (size_t i = 0; i < surface.size(); ++i) {
+    if (!surface[i] || exact[4 * i + 1] > 0.05f * hottest) continue;
+    ++quiet;
+    spread += d[4 * i + 1] > 1.5f * exact[4 * i + 1] + 0.003f * hottest;
+  }
+  std::printf("[many_lights][denoise] hot spot %.1f: %u of %u quiet pixels brightened by it\n", hottest, spread, quiet);
+  INFO("hottest " << hottest << ", quiet pixels " << quiet << ", brightened " << spread);
+  CHECK(hottest > 50.0f);
+  CHECK(spread <= 2);  // a tolerance from the mean of the two pixels' noise brightened 13 here
 }

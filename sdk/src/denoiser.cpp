@@ -29,9 +29,10 @@ void multiply(const double a[16], const double b[16], double out[16]) {
   }
 }
 
-// A-trous iterations of an RGB signal when DenoiseSettings::spatialIterations is 0: steps 1, 2, 4 and 8 (a
-// 61x61 footprint), SVGF's reach for a few rays per pixel; the noise-aware weights keep it from over-blurring.
-constexpr uint32_t kDefaultRgbIterations = 4;
+// A-trous iterations of an RGB signal when DenoiseSettings::spatialIterations is 0: 3x3 taps at steps 1 to 16
+// (a 63x63 footprint), SVGF's reach for a few rays per pixel; the noise-aware weights keep it from
+// over-blurring.
+constexpr uint32_t kDefaultRgbIterations = 5;
 
 }  // namespace
 
@@ -85,15 +86,16 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
         {sampled(RB_RGB_TEMPORAL_BINDING_DEPTH), sampled(RB_RGB_TEMPORAL_BINDING_MOTION),
          sampled(RB_RGB_TEMPORAL_BINDING_SIGNAL), sampled(RB_RGB_TEMPORAL_BINDING_HISTORY_IN),
          sampled(RB_RGB_TEMPORAL_BINDING_SURFACE_IN), storage(RB_RGB_TEMPORAL_BINDING_HISTORY_OUT),
-         storage(RB_RGB_TEMPORAL_BINDING_SURFACE_OUT), storage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT)},
+         storage(RB_RGB_TEMPORAL_BINDING_SURFACE_OUT), storage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT),
+         storage(RB_RGB_TEMPORAL_BINDING_GUIDE_OUT), sampled(RB_RGB_TEMPORAL_BINDING_NORMAL)},
         sizeof(DenoiseConstants), "denoiser RGB temporal");
     if (!t) return t.error();
     impl->temporal = t.value();
-    Result<ComputePipeline> a =
-        ComputePipeline::create(context, SpirvModule::of(spirv::denoise_rgb_atrous_comp),
-                                {sampled(RB_RGB_ATROUS_BINDING_DEPTH), sampled(RB_RGB_ATROUS_BINDING_NORMAL),
-                                 sampled(RB_RGB_ATROUS_BINDING_SIGNAL_IN), storage(RB_RGB_ATROUS_BINDING_SIGNAL_OUT)},
-                                sizeof(DenoiseConstants), "denoiser RGB a-trous");
+    Result<ComputePipeline> a = ComputePipeline::create(context, SpirvModule::of(spirv::denoise_rgb_atrous_comp),
+                                                        {sampled(RB_RGB_ATROUS_BINDING_GUIDE),
+                                                         sampled(RB_RGB_ATROUS_BINDING_SIGNAL_IN),
+                                                         storage(RB_RGB_ATROUS_BINDING_SIGNAL_OUT)},
+                                                        sizeof(DenoiseConstants), "denoiser RGB a-trous");
     if (!a) return a.error();
     impl->atrous = a.value();
   } else {
@@ -136,13 +138,15 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   Context& ctx = s.ctx;
   // 0,1: colour history ping-pong (rgb mean, a frames); 2,3: surface ping-pong (view distance, variance of one
   // frame's colour: RG32F, a variance of HDR values overflows half floats); 4,5: the temporal result and the
-  // a-trous ping-pong (rgb, a: the colour's standard deviation; a = 1 in the output).
+  // a-trous ping-pong (rgb, a: the colour's standard deviation; a = 1 in the output); 6: the guide (distance and
+  // normal, see denoise_rgb_common.glsl).
   std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history A"},
                                          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history B"},
                                          {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB surface A"},
                                          {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB surface B"},
                                          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial A"},
-                                         {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial B"}};
+                                         {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial B"},
+                                         {VK_FORMAT_R32G32_UINT, "denoiser RGB guide"}};
   bool resized = s.images.size() == 0 || s.images[0].width != g.width || s.images[0].height != g.height;
   if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
   if (resized) s.historyValid = false;
@@ -175,6 +179,7 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   for (uint32_t base : {0u, 2u}) barrier(im[base + cur], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
   barrier(im[4], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
   barrier(im[5], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
+  barrier(im[6], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
   flush(readers, cs);
 
   const uint32_t iterations = settings.disableSpatial
@@ -195,10 +200,13 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
     w.storageImage(RB_RGB_TEMPORAL_BINDING_HISTORY_OUT, im[cur].view);
     w.storageImage(RB_RGB_TEMPORAL_BINDING_SURFACE_OUT, im[2 + cur].view);
     w.storageImage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT, im[4].view);
+    w.storageImage(RB_RGB_TEMPORAL_BINDING_GUIDE_OUT, im[6].view);
+    w.sampledImage(RB_RGB_TEMPORAL_BINDING_NORMAL, g.normal.view, s.sampler, readLayout(g.normal));
     s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
   }
   for (uint32_t base : {0u, 2u}) barrier(im[base + cur], gen, ro, write, read);
   barrier(im[4], gen, ro, write, read);
+  barrier(im[6], gen, ro, write, read);
   flush(cs, readers);
   // A history written without temporal filtering holds one frame only: the next frame starts afresh anyway.
   s.historyValid = !settings.disableTemporal;
@@ -216,8 +224,7 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
     pc.flags = flags | (i + 1 == iterations ? RB_DN_RGB_FINAL : 0u);
     pc.atrousStep = 1u << i;
     DescriptorWrites w;
-    w.sampledImage(RB_RGB_ATROUS_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
-    w.sampledImage(RB_RGB_ATROUS_BINDING_NORMAL, g.normal.view, s.sampler, readLayout(g.normal));
+    w.sampledImage(RB_RGB_ATROUS_BINDING_GUIDE, im[6].view, s.sampler, ro);
     w.sampledImage(RB_RGB_ATROUS_BINDING_SIGNAL_IN, in.view, s.sampler, ro);
     w.storageImage(RB_RGB_ATROUS_BINDING_SIGNAL_OUT, out.view);
     s.atrous.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);

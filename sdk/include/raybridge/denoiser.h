@@ -1,10 +1,16 @@
 // Denoising for ray-traced signals: single-channel ones (shadow visibility, AO) and RGB HDR ones (the
 // many-light irradiance of ManyLightPass), chosen by DenoiserDesc::signal. Temporal accumulation with
 // reprojection (camera motion, or the engine's motion vectors when GBufferDesc::motionVectors is given),
-// followed by an edge-aware a-trous spatial filter guided by depth and normals. For an RGB signal the filter
-// also tracks the luminance variance over time (SVGF, Schied et al. 2017) and stops at differences larger than
-// that noise, so a converged or noise-free signal passes nearly unchanged. Each signal needs its own Denoiser (it
-// keeps that signal's history). The raw input is left untouched, so raw and denoised are both available.
+// followed by an edge-aware a-trous spatial filter guided by depth and normals. Each signal needs its own
+// Denoiser (it keeps that signal's history). The raw input is left untouched, so raw and denoised are both
+// available.
+//
+// RGB signals (SVGF-style, Schied et al. 2017): the temporal pass reprojects bilinearly and keeps, beside the
+// mean colour, the running variance of one frame's colour (from the 3x3 windows around the pixel while the
+// history is shorter than 4 frames); the a-trous steps (3x3 taps, 5 by default) stop at colour differences larger
+// than the remaining noise of the mean, so a converged or noise-free signal passes nearly unchanged, and filter
+// in the signal's own domain (no albedo demodulation: ManyLightPass's irradiance has none). One temporal and
+// DenoiseSettings::spatialIterations a-trous dispatches; 56 bytes of images per pixel (197 MiB at 2560x1440).
 //
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipelines, history and
 // output images and measurement objects are handed to the Context's deferred release (see context.h) and
@@ -37,8 +43,9 @@ struct DenoiseSettings {
   // history.
   bool disableTemporal = false;
   bool disableSpatial = false;  // false = run the a-trous filter
-  // 0 = 2 for Scalar (steps 1 and 2: a 13x13 footprint; 3 over-blurs 4-ray AO), 4 for Rgb (steps 1 to 8: its
-  // weights follow the measured noise, so the wider reach only blurs where the signal is still noisy). At most 6.
+  // 0 = 2 for Scalar (steps 1 and 2: a 13x13 footprint; 3 over-blurs 4-ray AO), 5 for Rgb (3x3 taps at steps 1 to
+  // 16: its weights follow the measured noise, so the wide reach only blurs where the signal is still noisy).
+  // At most 6.
   uint32_t spatialIterations = 0;
   uint32_t maxHistoryFrames = 0;  // 0 = 32: the running mean forgets more slowly than this
   float depthSigma = 0.0f;        // 0 = 0.005: plane-distance tolerance relative to view distance, per step
@@ -46,7 +53,7 @@ struct DenoiseSettings {
   // Scalar signals: rays per pixel behind the signal, when it is a fraction of binary rays (shadow visibility,
   // binary AO): the spatial filter then knows the noise exactly and keeps every edge that is not noise.
   // 0 = unknown: the noise is estimated from the 3x3 neighbourhood, which also blurs thin noise-free features.
-  // Rgb signals ignore it: their noise is the luminance variance measured over the accumulated frames.
+  // Rgb signals ignore it: their noise is the colour variance measured over the accumulated frames.
   uint32_t raysPerPixel = 0;
 };
 
