@@ -82,7 +82,10 @@ void main() {
     // sample) then neither spreads into quiet neighbours nor is averaged away while they take none of it back,
     // which would lose its energy (the colour of a rarely chosen light).
     float others = varianceWeights - geometric[k];
-    float centreVariance = others > 1e-6 ? (tapVariances - geometric[k] * qv.a * qv.a) / others : centre.a * centre.a;
+    // max(0): the difference can round below zero (it did on the H200, whose fused multiply-adds round otherwise
+    // than lavapipe: the square root then made every pixel NaN).
+    float centreVariance =
+        others > 1e-6 ? max((tapVariances - geometric[k] * qv.a * qv.a) / others, 0.0) : centre.a * centre.a;
     float sigma = kColourSigma * sqrt(min(centreVariance, qv.a * qv.a)) + floorSigma;
     float w = geometric[k] * exp(-length(qv.rgb - centre.rgb) / sigma);
     sum += w * qv.rgb;

@@ -420,7 +420,9 @@ TEST_CASE("spot cone falloff and the range window are glTF's, zero outside the c
       ++inside;
       const float unwindowed = light.intensity * std::max(glm::normalize(toLight).y, 0.0f) / glm::dot(toLight, toLight);
       if (want < 0.98f * unwindowed) ++falloff;  // pixels where the cone edge / range window is at work
-      if (std::abs(got - want) > 0.01f * want + 1e-4f) ++bad;
+      // 1%, plus an absolute term for the range window's edge, where E falls steeply: there the surface point's
+      // reconstruction from depth (about 1e-4 m) moves E by up to ~1e-3 (14 pixels on the H200 with 1e-4).
+      if (std::abs(got - want) > 0.01f * want + 2e-3f) ++bad;
     }
   INFO("inside " << inside << ", outside " << outside << ", in the falloff " << falloff);
   CHECK(inside > 300);
@@ -497,7 +499,7 @@ TEST_CASE("a blocker between a shadow-mapped light and the ground darkens the pi
           if (!ok) ++wrongShadowed;
         } else if (!hitsBox(p, source(p), lo - margin, hi + margin)) {
           ++lit;
-          if (std::abs(got - want) > 0.01f * want) ++wrongLit;
+          if (std::abs(got - want) > 0.01f * want + 2e-3f) ++wrongLit;  // the range window's edge, as above
         }
       }
     INFO("shadowed " << shadowed << " (wrong " << wrongShadowed << "), lit " << lit << " (wrong " << wrongLit << ")");
