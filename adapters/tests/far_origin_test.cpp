@@ -25,6 +25,7 @@
 
 #include "gltf_document_builder.h"
 #include "render_command_support.h"
+#include "unit_cube_gltf.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -33,7 +34,6 @@ using rbRenderTest::readExrRed;
 namespace {
 
 constexpr uint32_t kWidth = 192, kHeight = 108;
-constexpr int kUnsignedShort = 5123, kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 
 // Boxes as nodes scaling and placing one unit cube (-0.5..0.5), under a root node at `offset`. Every number is a
 // multiple of 1/64, so world positions are exact in float up to 32 km and the renders differ only by how the
@@ -50,31 +50,8 @@ const Box kBoxes[] = {
 
 std::string writeScene(const fs::path& path, const glm::dvec3& offset) {
   pose_reference::GltfDocumentBuilder b;
+  rbRenderTest::addUnitCubeMesh(b);
   json& doc = b.document();
-  std::vector<float> positions, normals;
-  std::vector<uint16_t> indices;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (float sign : {-1.0f, 1.0f}) {
-      glm::vec3 n(0.0f), u(0.0f), v(0.0f);
-      n[axis] = sign;
-      u[(axis + 1) % 3] = 1.0f;
-      v[(axis + 2) % 3] = 1.0f;
-      if (sign < 0) std::swap(u, v);  // counter-clockwise seen from outside
-      const uint16_t first = uint16_t(positions.size() / 3);
-      for (glm::vec2 c : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
-        const glm::vec3 p = 0.5f * (n + c.x * u + c.y * v);
-        positions.insert(positions.end(), {p.x, p.y, p.z});
-        normals.insert(normals.end(), {n.x, n.y, n.z});
-      }
-      for (int k : {0, 1, 2, 0, 2, 3}) indices.push_back(uint16_t(first + k));
-    }
-  }
-  const json attributes = {{"POSITION", b.addFloats(positions, 3, kArrayBuffer, true)},
-                           {"NORMAL", b.addFloats(normals, 3, kArrayBuffer)}};
-  const int indexAccessor = b.addIntegers(indices, 1, kUnsignedShort, kElementArrayBuffer, false);
-  doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {0.7, 0.7, 0.7, 1.0}}}}}});
-  doc["meshes"] = json::array(
-      {{{"primitives", json::array({{{"attributes", attributes}, {"indices", indexAccessor}, {"material", 0}}})}}});
   json nodes = json::array({{{"name", "root"}, {"translation", {offset.x, offset.y, offset.z}}}});
   json children = json::array();
   for (const Box& box : kBoxes) {

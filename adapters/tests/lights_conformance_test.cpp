@@ -22,6 +22,7 @@
 #include "embree_reference.h"
 #include "gltf_document_builder.h"
 #include "render_command_support.h"
+#include "unit_cube_gltf.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -29,7 +30,6 @@ using nlohmann::json;
 namespace {
 
 constexpr uint32_t kWidth = 160, kHeight = 120;
-constexpr int kUnsignedShort = 5123, kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 
 struct Box {
   glm::vec3 center, size;
@@ -60,31 +60,8 @@ const TestLight kLights[] = {
 
 std::string writeRoom(const fs::path& path) {
   pose_reference::GltfDocumentBuilder b;
+  rbRenderTest::addUnitCubeMesh(b);
   json& doc = b.document();
-  std::vector<float> positions, normals;
-  std::vector<uint16_t> indices;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (float sign : {-1.0f, 1.0f}) {
-      glm::vec3 n(0.0f), u(0.0f), v(0.0f);
-      n[axis] = sign;
-      u[(axis + 1) % 3] = 1.0f;
-      v[(axis + 2) % 3] = 1.0f;
-      if (sign < 0) std::swap(u, v);  // counter-clockwise seen from outside
-      const uint16_t first = uint16_t(positions.size() / 3);
-      for (glm::vec2 c : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
-        const glm::vec3 p = 0.5f * (n + c.x * u + c.y * v);
-        positions.insert(positions.end(), {p.x, p.y, p.z});
-        normals.insert(normals.end(), {n.x, n.y, n.z});
-      }
-      for (int k : {0, 1, 2, 0, 2, 3}) indices.push_back(uint16_t(first + k));
-    }
-  }
-  const json attributes = {{"POSITION", b.addFloats(positions, 3, kArrayBuffer, true)},
-                           {"NORMAL", b.addFloats(normals, 3, kArrayBuffer)}};
-  const int indexAccessor = b.addIntegers(indices, 1, kUnsignedShort, kElementArrayBuffer, false);
-  doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {0.7, 0.7, 0.7, 1.0}}}}}});
-  doc["meshes"] = json::array(
-      {{{"primitives", json::array({{{"attributes", attributes}, {"indices", indexAccessor}, {"material", 0}}})}}});
   json nodes = json::array(), roots = json::array(), lights = json::array();
   for (const Box& box : kBoxes) {
     roots.push_back(nodes.size());
@@ -149,19 +126,9 @@ struct Reference {
 Reference traceReference() {
   rbtest::EmbreeScene embree;
   rbsamples::CpuMesh cube;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (float sign : {-1.0f, 1.0f}) {
-      glm::vec3 n(0.0f), u(0.0f), v(0.0f);
-      n[axis] = sign, u[(axis + 1) % 3] = 1.0f, v[(axis + 2) % 3] = 1.0f;
-      if (sign < 0) std::swap(u, v);
-      const uint32_t first = uint32_t(cube.positions.size() / 3);
-      for (glm::vec2 c : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
-        const glm::vec3 p = 0.5f * (n + c.x * u + c.y * v);
-        cube.positions.insert(cube.positions.end(), {p.x, p.y, p.z});
-      }
-      for (uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) cube.indices.push_back(first + k);
-    }
-  }
+  const rbRenderTest::UnitCube unit = rbRenderTest::makeUnitCube();  // the same cube as the glTF's
+  cube.positions = unit.positions;
+  cube.indices.assign(unit.indices.begin(), unit.indices.end());
   for (uint32_t i = 0; i < std::size(kBoxes); ++i) {
     const Box& b = kBoxes[i];
     const float m[12] = {b.size.x, 0, 0, b.center.x, 0, b.size.y, 0, b.center.y, 0, 0, b.size.z, b.center.z};
