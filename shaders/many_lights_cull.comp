@@ -20,21 +20,24 @@ shared vec3 boxMax[64];
 shared uint subgroupCounts[64];  // lights reaching the tile per subgroup of the current chunk
 shared uint packedList[RB_ML_MAX_TILE_LIGHTS / 2];
 
-// Whether a light can reach some point of the box [lo, hi].
-bool reaches(GpuLight light, vec3 lo, vec3 hi) {
-  if (light.type == RB_LIGHT_DIRECTIONAL) return true;
-  vec3 nearest = clamp(light.position, lo, hi);
-  vec3 d = nearest - light.position;
-  if (light.range > 0.0 && dot(d, d) > light.range * light.range) return false;
-  if (light.type == RB_LIGHT_SPOT) {
-    // The cone against the box's bounding sphere: outside when the angle to its centre exceeds the cone's
-    // half-angle by more than the sphere's angular radius.
-    vec3 c = 0.5 * (lo + hi) - light.position;
-    float r = 0.5 * length(hi - lo), dist = length(c);
-    if (dist > r) {
-      float angle = acos(clamp(dot(c / dist, light.direction), -1.0, 1.0));
-      if (angle - asin(min(r / dist, 1.0)) > acos(clamp(light.cosOuter, -1.0, 1.0))) return false;
-    }
+// Whether light `index` can reach some point of the box [lo, hi]. The range test reads the light's first 16 bytes
+// only (directional lights have range 0): most lights of a large list are out of range of a tile, and every tile
+// tests every light, so the rest of the 64-byte record is read for the few that pass.
+bool reaches(uint index, vec3 lo, vec3 hi) {
+  vec3 position = lights[index].position;
+  float range = lights[index].range;
+  if (range > 0.0) {
+    vec3 d = clamp(position, lo, hi) - position;
+    if (dot(d, d) > range * range) return false;
+  }
+  if (lights[index].type != RB_LIGHT_SPOT) return true;
+  // The cone against the box's bounding sphere: outside when the angle to its centre exceeds the cone's
+  // half-angle by more than the sphere's angular radius.
+  vec3 c = 0.5 * (lo + hi) - position;
+  float r = 0.5 * length(hi - lo), dist = length(c);
+  if (dist > r) {
+    float angle = acos(clamp(dot(c / dist, lights[index].direction), -1.0, 1.0));
+    if (angle - asin(min(r / dist, 1.0)) > acos(clamp(lights[index].cosOuter, -1.0, 1.0))) return false;
   }
   return true;
 }
@@ -79,7 +82,7 @@ void main() {
   uint lane = gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;
   for (uint chunk = 0u; chunk < pc.lightCount && !empty; chunk += 64u) {
     uint index = chunk + lane;
-    bool flag = index < pc.lightCount && reaches(lights[index], lo, hi);
+    bool flag = index < pc.lightCount && reaches(index, lo, hi);
     uvec4 ballot = subgroupBallot(flag);
     if (subgroupElect()) subgroupCounts[gl_SubgroupID] = subgroupBallotBitCount(ballot);
     barrier();
