@@ -333,6 +333,17 @@ TEST_CASE("raybridge-render --camera-path renders the path's end and reports it"
   size_t moved = 0;
   for (size_t i = 0; i < a.size(); ++i) moved += std::abs(a[i] - s[i]) > 1e-2f * (1.0f + std::abs(a[i]));
   CHECK(moved > a.size() / 10);
+  // --fps past the path's end: frame 1 at 1 / 0.5 = 2 s is clamped to the end, 1.25 s.
+  {
+    const std::string out = renderOutput("--camera-path \"" + pathFile.string() + "\" --out \"" +
+                                             (dir / "clamped").string() +
+                                             "\" --fps 0.5 --width 16 --height 16 --frames 2 --mode raster "
+                                             "--preset none --dump",
+                                         status);
+    INFO(out);
+    REQUIRE(status == 0);
+  }
+  CHECK(readJson(dir / "clamped" / "stats.json")["camera_path"]["time_s"] == 1.25);
 }
 
 TEST_CASE("raybridge-render --camera-path: bad uses name the option and the file", "[camera_path][render][bad-input]") {
@@ -364,5 +375,16 @@ TEST_CASE("raybridge-render --camera-path: bad uses name the option and the file
     INFO(out);
     CHECK(status != 0);
     CHECK(out.find("keyframe 0: \"orientation\" has zero length") != std::string::npos);
+  }
+  {
+    // Looking straight down (-90 degrees about X): no up vector for the engine's +Y-up camera.
+    const fs::path down = dir / "down.json";
+    std::ofstream(down) << R"({"version":1,"keyframes":[{"position":[0,8,0],"orientation":[-0.7071067811865476,0,0,)"
+                        << R"(0.7071067811865476]}]})";
+    const std::string out = renderOutput("--camera-path \"" + down.string() + "\"" + common, status);
+    INFO(out);
+    CHECK(status != 0);
+    CHECK(out.find("--camera-path: at t = 0") != std::string::npos);
+    CHECK(out.find("straight up or down") != std::string::npos);
   }
 }
