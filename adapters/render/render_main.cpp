@@ -319,6 +319,9 @@ int main(int argc, char** argv) {
   if (se::Status s = se::writeExr((out / "final.exr").string(), hdr.value); !s) return fail(s.error);
   std::printf("wrote %s and %s (%ux%u, %s)\n", (out / "final.png").c_str(), (out / "final.exr").c_str(), o.width,
               o.height, hybrid ? "hybrid" : "raster");
+  if (!o.cameraPath.empty())
+    std::printf("camera path %s: %zu keyframes, %.3f s; the captured frame is at %.3f s\n", o.cameraPath.c_str(),
+                cameraPath.keys.size(), pathDuration, capturedPathTime);
 
   // Statistics. The SDK resolves a pass's GPU time kFramesInFlight frames after recording it.
   nlohmann::json stats;
