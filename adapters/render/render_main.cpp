@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "animated_scene.h"
+#include "camera_path.h"
 #include "frame_capture.h"
 #include "raybridge_sample_engine_adapter.h"
 #include "render_options.h"
@@ -50,6 +51,14 @@ se::Result<se::Scene> loadScene(const RenderOptions& o, std::vector<se::Animatio
   return R::success(std::move(r.scene));
 }
 
+// Near/far of a camera the options place: fitted to the scene bounds seen from its eye.
+void fitDepthRange(se::Camera& c, const se::Bounds& bounds) {
+  const float radius = bounds.valid() ? std::max(bounds.radius(), 1e-3f) : 1.0f;
+  const float distance = bounds.valid() ? glm::length(c.eye - bounds.center()) : 0.0f;
+  c.zFar = distance + radius * 2.0f;
+  c.zNear = std::clamp(distance - radius * 1.5f, c.zFar * 1e-4f, c.zFar * 0.1f);
+}
+
 // The camera of the options, else the scene's, else one framed on the bounds; near/far fitted to the bounds.
 se::Camera chooseCamera(const RenderOptions& o, const se::Scene& scene, const se::Bounds& bounds, std::string& source) {
   if (!o.eye) {
@@ -61,11 +70,30 @@ se::Camera chooseCamera(const RenderOptions& o, const se::Scene& scene, const se
   c.eye = *o.eye;
   c.target = *o.target;
   c.fovYDegrees = o.fovYDegrees;
-  const float radius = bounds.valid() ? std::max(bounds.radius(), 1e-3f) : 1.0f;
-  const float distance = bounds.valid() ? glm::length(c.eye - bounds.center()) : 0.0f;
-  c.zFar = distance + radius * 2.0f;
-  c.zNear = std::clamp(distance - radius * 1.5f, c.zFar * 1e-4f, c.zFar * 0.1f);
+  fitDepthRange(c, bounds);
   return c;
+}
+
+// The camera on the path at time t. se::Camera is eye, target and fov with up = +Y, so the orientation's roll
+// about the view direction cannot be represented and is ignored; a view straight up or down has no defined
+// up and is an error naming the time.
+se::Result<se::Camera> pathCamera(const rbCameraPath::CameraPath& path, double t, const se::Bounds& bounds) {
+  const rbCameraPath::CameraPose pose = path.at(t);
+  const std::array<double, 3> f = pose.forward();
+  if (std::abs(f[1]) > 0.9999)
+    return se::Result<se::Camera>::failure(
+        "--camera-path: at t = " + std::to_string(t) +
+        " s the camera looks straight up or down; the engine's camera keeps +Y up, so tilt the orientation a little");
+  const glm::dvec3 eye(pose.position[0], pose.position[1], pose.position[2]);
+  // The target is as far as the eye is from the origin (at least 1): far from the origin a unit step would lose
+  // the direction's precision in float.
+  const double reach = std::max(1.0, glm::length(eye));
+  se::Camera c;
+  c.eye = glm::vec3(eye);
+  c.target = glm::vec3(eye + glm::dvec3(f[0], f[1], f[2]) * reach);
+  c.fovYDegrees = float(pose.fovYDegrees);
+  fitDepthRange(c, bounds);
+  return se::Result<se::Camera>::success(c);
 }
 
 nlohmann::json vec(const glm::vec3& v) { return {v.x, v.y, v.z}; }
@@ -132,6 +160,10 @@ int main(int argc, char** argv) {
   std::vector<se::AnimationPlayback> characterPlaybacks;  // --characters: one animation per character
   auto scene = loadScene(o, characterPlaybacks);          // before any Vulkan work, so bad input fails fast
   if (!scene) return fail(scene.error);
+  rbCameraPath::CameraPath cameraPath;
+  if (!o.cameraPath.empty())
+    if (std::string e = rbCameraPath::loadCameraPath(o.cameraPath, cameraPath); !e.empty())
+      return fail("--camera-path: " + e);
 
   // The same device in both modes (Raybridge's extensions enabled), so raster and hybrid compare like for like.
   rb::RequiredFeatures features;
@@ -167,6 +199,7 @@ int main(int argc, char** argv) {
   }
   std::string cameraSource;
   params.camera = chooseCamera(o, engine.scene(), engine.sceneBounds(), cameraSource);
+  if (!o.cameraPath.empty()) cameraSource = "path";
   if (o.sun) params.sun.direction = glm::normalize(*o.sun);
   else if (engine.scene().sun)
     params.sun = *engine.scene().sun;
@@ -240,11 +273,27 @@ int main(int argc, char** argv) {
   auto frameTime = [&](uint32_t k) {
     return o.fps ? std::max(0.0, o.time - double(o.frames - 1 - k) / *o.fps) : o.time;
   };
+  // --camera-path: frame k at k/(N-1) of the path (the last frame at its end), or k/fps clamped to the end.
+  const double pathDuration = cameraPath.totalDuration();
+  auto pathTime = [&](uint32_t k) {
+    return o.fps ? std::min(double(k) / *o.fps, pathDuration)
+                 : double(k) * pathDuration / double(std::max(o.frames - 1, 1u));
+  };
+  double capturedPathTime = 0.0;
+  auto placeCamera = [&](uint32_t k) -> se::Status {
+    if (o.cameraPath.empty()) return se::Status::success();
+    capturedPathTime = pathTime(k);
+    auto camera = pathCamera(cameraPath, capturedPathTime, engine.sceneBounds());
+    if (!camera) return se::Status::failure(camera.error);
+    params.camera = camera.value;
+    return se::Status::success();
+  };
   // With --dump the last frame also copies its pre-pass and effect images; the timings reported are those of
   // the frame before it, which has no capture copies.
   const uint32_t plain = capture && o.frames > 1 ? o.frames - 1 : o.frames;
   for (uint32_t f = 0; f < plain; ++f) {
     params.time = frameTime(f);
+    if (se::Status s = placeCamera(f); !s) return fail(s.error);
     if (se::Status s = engine.renderFrame(params); !s) return fail(s.error);
   }
   if (se::Status s = engine.waitIdle(); !s) return fail(s.error);
@@ -252,6 +301,7 @@ int main(int argc, char** argv) {
   if (capture) {
     captureNext = true;
     params.time = frameTime(o.frames - 1);
+    if (se::Status s = placeCamera(o.frames - 1); !s) return fail(s.error);
     if (se::Status s = engine.renderFrame(params); !s) return fail(s.error);
   }
   auto ldr = engine.readbackLdr();  // waits for the GPU
@@ -269,6 +319,9 @@ int main(int argc, char** argv) {
   if (se::Status s = se::writeExr((out / "final.exr").string(), hdr.value); !s) return fail(s.error);
   std::printf("wrote %s and %s (%ux%u, %s)\n", (out / "final.png").c_str(), (out / "final.exr").c_str(), o.width,
               o.height, hybrid ? "hybrid" : "raster");
+  if (!o.cameraPath.empty())
+    std::printf("camera path %s: %zu keyframes, %.3f s; the captured frame is at %.3f s\n", o.cameraPath.c_str(),
+                cameraPath.keys.size(), pathDuration, capturedPathTime);
 
   // Statistics. The SDK resolves a pass's GPU time kFramesInFlight frames after recording it.
   nlohmann::json stats;
@@ -295,6 +348,11 @@ int main(int argc, char** argv) {
                      {"z_near", params.camera.zNear},
                      {"z_far", params.camera.zFar},
                      {"source", cameraSource}};
+  if (!o.cameraPath.empty())
+    stats["camera_path"] = {{"file", o.cameraPath},
+                            {"keyframes", cameraPath.keys.size()},
+                            {"duration_s", pathDuration},
+                            {"time_s", capturedPathTime}};
   const rb::HybridEffectsDesc& hd = fx.hybrid;
   const uint32_t shadowRays = hd.shadows.raysPerPixel ? hd.shadows.raysPerPixel : 1u;  // the engine's sun has no size
   stats["sun"] = {{"direction", vec(params.sun.direction)},

@@ -95,6 +95,12 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "scene bounds)")
       ->type_name("ex,ey,ez,tx,ty,tz,fovy")
       ->check(rbCli::numberList(7));
+  app.add_option("--camera-path", o.cameraPath,
+                 "camera keyframes (JSON: position, orientation quaternion, duration; see\n"
+                 "samples/common/camera_path.h); frame k of --frames N is at k/(N-1) of the path,\n"
+                 "or at k/F seconds with --fps F; the last frame is captured (not with --camera)")
+      ->type_name("FILE.json")
+      ->check(rbCli::nonEmpty("file name"));
   app.add_option_function<std::string>(
          "--sun",
          [&o](const std::string& value) {
@@ -303,6 +309,7 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
   CLI::App app{"", "raybridge-render"};
   addOptions(app, o);
   if (std::string e = rbCli::parse(app, argc, argv, o.help); !e.empty() || o.help) return e;
+  if (!o.cameraPath.empty() && o.eye) return "--camera-path and --camera both set the camera; give only one of them";
   if (o.characters && !o.scene.empty())
     return "--characters: adds characters to the demo scene; it cannot be combined with --scene";
   if (!o.charactersFrom.empty() && !o.characters) return "--characters-from needs --characters N";

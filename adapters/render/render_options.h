@@ -23,6 +23,10 @@ struct RenderOptions {
   // Eye, target, vertical fov in degrees; empty = the scene's own camera, else framed on the scene bounds.
   std::optional<glm::vec3> eye, target;
   float fovYDegrees = 0.0f;
+  // --camera-path FILE: the camera follows the JSON keyframes of samples/common/camera_path.h (not with --camera).
+  // Frame k of `frames` is at path time k * total / max(frames - 1, 1), or k / fps with --fps (clamped to the
+  // path's end); the captured frame is the last. Empty = no path.
+  std::string cameraPath;
   std::optional<glm::vec3> sun;  // towards the sun; empty = the scene's sun, else the engine's default
   // Effects and their quality: the preset gives defaults, explicit options win (see resolve()).
   rb::Preset preset = rb::Preset::High;
