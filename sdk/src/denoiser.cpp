@@ -34,6 +34,21 @@ void multiply(const double a[16], const double b[16], double out[16]) {
 // over-blurring.
 constexpr uint32_t kDefaultRgbIterations = 5;
 
+// The image barriers of one step of either record path, gathered and recorded as one vkCmdPipelineBarrier.
+struct BarrierBatch {
+  const DeviceFunctions& vk;
+  VkCommandBuffer cmd;
+  std::vector<VkImageMemoryBarrier> barriers;
+  void add(const GpuImage& img, VkImageLayout from, VkImageLayout to, VkAccessFlags src, VkAccessFlags dst) {
+    barriers.push_back(colorImageBarrier(img.image, from, to, src, dst));
+  }
+  void flush(VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) {
+    vk.vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, static_cast<uint32_t>(barriers.size()),
+                            barriers.data());
+    barriers.clear();
+  }
+};
+
 }  // namespace
 
 struct Denoiser::Impl {
@@ -156,15 +171,11 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
 
   s.metrics.beginRecording(ctx, cmd);
   s.metrics.writeStart(ctx, cmd);
-  std::vector<VkImageMemoryBarrier> barriers;
+  BarrierBatch batch{vk, cmd};
   auto barrier = [&](const GpuImage& img, VkImageLayout from, VkImageLayout to, VkAccessFlags src, VkAccessFlags dst) {
-    barriers.push_back(colorImageBarrier(img.image, from, to, src, dst));
+    batch.add(img, from, to, src, dst);
   };
-  auto flush = [&](VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) {
-    vk.vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, static_cast<uint32_t>(barriers.size()),
-                            barriers.data());
-    barriers.clear();
-  };
+  auto flush = [&](VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) { batch.flush(srcStage, dstStage); };
   const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
   const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | cs |
                                        VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
@@ -312,15 +323,11 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   s.metrics.beginRecording(ctx, cmd);
   s.metrics.writeStart(ctx, cmd);
   // The images written this frame start undefined; last frame's history and distance are read as they are.
-  std::vector<VkImageMemoryBarrier> barriers;
+  BarrierBatch batch{vk, cmd};
   auto barrier = [&](const GpuImage& img, VkImageLayout from, VkImageLayout to, VkAccessFlags src, VkAccessFlags dst) {
-    barriers.push_back(colorImageBarrier(img.image, from, to, src, dst));
+    batch.add(img, from, to, src, dst);
   };
-  auto flush = [&](VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) {
-    vk.vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, static_cast<uint32_t>(barriers.size()),
-                            barriers.data());
-    barriers.clear();
-  };
+  auto flush = [&](VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) { batch.flush(srcStage, dstStage); };
   const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
   const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | cs |
                                        VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
