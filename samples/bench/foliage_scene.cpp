@@ -3,32 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "scene_math.h"
+
 namespace rbbench {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kCanopyMargin = 2.0;  // metres of leaves beyond the outermost shadow ray path
-
-using Vec3 = std::array<double, 3>;
-
-Vec3 normalized(Vec3 v) {
-  double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-  return {v[0] / l, v[1] / l, v[2] / l};
-}
-Vec3 cross(Vec3 a, Vec3 b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
-
-// SplitMix64: the same cards on every platform (std distributions are implementation-defined).
-struct Random {
-  uint64_t state;
-  double next() {
-    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return double(z >> 11) * (1.0 / 9007199254740992.0);  // [0, 1)
-  }
-};
 
 }  // namespace
 
@@ -110,7 +91,7 @@ FoliageCards makeFoliageCards(const FoliageView& v, const AnalyticGBuffer& g, ui
   out.positions.reserve(size_t(cards) * 12);
   out.texcoords.reserve(size_t(cards) * 8);
   out.indices.reserve(size_t(cards) * 6);
-  Random rng{0x5eed1eafull};
+  SplitMix64 rng{0x5eed1eafull};
   const double half = 0.5 * out.cardSide;
   struct Card {
     uint64_t morton;

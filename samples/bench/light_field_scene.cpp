@@ -3,39 +3,17 @@
 #include <algorithm>
 #include <cmath>
 
+#include "scene_math.h"
+
 namespace rbbench {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kLightMinHeight = 0.8, kLightMaxHeight = 3.0;  // metres: under most pillar tops
 constexpr double kLightClearance = 0.5;                         // metres kept from any pillar
 constexpr float kSpotOuterDegrees = 55.0f, kSpotInnerDegrees = 35.0f;
 constexpr uint32_t kSpotEvery = 4;
 constexpr uint32_t kNormalisationSteps = 2048;  // midpoint rule over theta
-
-// SplitMix64: the same scene on every platform (std distributions are implementation-defined).
-struct Random {
-  uint64_t state;
-  double next() {
-    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return double(z >> 11) * (1.0 / 9007199254740992.0);  // [0, 1)
-  }
-  double in(double lo, double hi) { return lo + (hi - lo) * next(); }
-};
-
-using Vec3 = std::array<double, 3>;
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3 normalized(const Vec3& v) {
-  const double l = std::sqrt(dot(v, v));
-  return {v[0] / l, v[1] / l, v[2] / l};
-}
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
 
 // Integral over an unbounded floor of falloff * cos for unit intensity (see the header), in square metres.
 double floorIntegral(double height, double range, bool spot) {
@@ -83,7 +61,7 @@ LightFieldScene makeLightFieldScene(const LightFieldDesc& desc) {
   const float unitMin[3] = {0, 0, 0}, unitMax[3] = {1, 1, 1};
   s.box = rbsamples::makeBox(unitMin, unitMax, desc.boxCells);
   s.instanceTransforms.push_back({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0});
-  Random rng{desc.seed};
+  SplitMix64 rng{desc.seed};
   const double cell = double(desc.floorSide) / desc.pillarsPerSide;
   for (uint32_t r = 0; r < desc.pillarsPerSide; ++r) {
     for (uint32_t c = 0; c < desc.pillarsPerSide; ++c) {
@@ -197,7 +175,7 @@ LightField makeLightField(const LightFieldScene& scene, uint32_t count) {
   LightField f;
   const double side = scene.desc.floorSide;
   f.range = float(side * std::sqrt(kLightCoverage / (kPi * std::max(count, 1u))));
-  Random rng{scene.desc.seed ^ (0x9e3779b97f4a7c15ull * (uint64_t(count) + 1))};
+  SplitMix64 rng{scene.desc.seed ^ (0x9e3779b97f4a7c15ull * (uint64_t(count) + 1))};
   auto insidePillar = [&](double x, double y, double z) {
     for (const Pillar& p : scene.pillars) {
       if (x > p.min[0] - kLightClearance && x < p.max[0] + kLightClearance && z > p.min[2] - kLightClearance &&
