@@ -508,27 +508,25 @@ int main(int argc, char** argv) {
     writeCaptured("ao", 1);
     writeCaptured("ao_raw", 1);
     writeCaptured("reflection", 4);
-    writeCaptured("lights", 4);
-    writeCaptured("lights_raw", 4);
+    // The shadowed irradiance of the punctual lights: the EXR and, beside it, its fixed-mapping picture.
+    auto writeLights = [&](const std::string& name, const se::ImageRGBA32F& img) {
+      if (!e.empty()) return;
+      e = write((name + ".exr").c_str(), img);
+      if (!e.empty()) return;
+      se::Status s = se::writePng((out / (name + ".png")).string(), irradiancePicture(img));
+      e = s ? std::string() : s.error;
+      written.push_back(name + ".exr"), written.push_back(name + ".png");
+    };
+    // Hybrid: Raybridge's (and its raw image where denoised), as captured in the hook.
+    for (const char* name : {"lights", "lights_raw"})
+      if (auto it = f.images.find(name); it != f.images.end()) writeLights(name, toExr(f, it->second, 4));
     // The engine's own irradiance of the punctual lights (raster mode, or hybrid without the lights effect).
-    std::optional<se::ImageRGBA32F> lights;
-    if (auto it = f.images.find("lights"); it != f.images.end()) lights = toExr(f, it->second, 4);
     if (e.empty() && params.outputLocalLightIrradiance) {
       auto irradiance = engine.readbackLocalLightIrradiance();
       if (!irradiance) e = irradiance.error;
       std::vector<float> values;
       for (const glm::vec4& v : irradiance.value) values.insert(values.end(), {v.r, v.g, v.b, v.a});
-      if (e.empty()) lights = toExr(f, values, 4), e = write("lights.exr", *lights), written.push_back("lights.exr");
-    }
-    if (e.empty() && lights) {
-      se::Status s = se::writePng((out / "lights.png").string(), irradiancePicture(*lights));
-      e = s ? std::string() : s.error;
-      written.push_back("lights.png");
-    }
-    if (auto it = f.images.find("lights_raw"); e.empty() && it != f.images.end()) {
-      se::Status s = se::writePng((out / "lights_raw.png").string(), irradiancePicture(toExr(f, it->second, 4)));
-      e = s ? std::string() : s.error;
-      written.push_back("lights_raw.png");
+      if (e.empty()) writeLights("lights", toExr(f, values, 4));
     }
     // Raster: the engine's shadow-map visibility and SSAO.
     if (e.empty() && !hybrid) {
