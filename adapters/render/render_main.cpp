@@ -14,6 +14,8 @@
 #include "animated_scene.h"
 #include "camera_path.h"
 #include "frame_capture.h"
+#include "frame_series.h"
+#include "perf_scene.h"
 #include "raybridge_sample_engine_adapter.h"
 #include "render_options.h"
 #include "sample_engine/gltf_loader.h"
@@ -31,9 +33,19 @@ int fail(const std::string& message, int code = 1) {
 
 se::Result<se::Scene> loadScene(const RenderOptions& o, std::vector<se::AnimationPlayback>& playbacks) {
   using R = se::Result<se::Scene>;
+  const std::string modelsDir = o.modelsFrom.empty() ? std::string(RAYBRIDGE_SOURCE_DIR) + "/../shared/scenes"
+                                                     : o.modelsFrom;
+  if (o.perfScene) {
+    PerfSceneInfo info;
+    auto perf = makePerfScene(modelsDir, info);
+    if (!perf) return R::failure("--perf-scene: " + perf.error);
+    if (!info.missing.empty())
+      std::fprintf(stderr, "warning: --perf-scene: not found in %s, left out: %s\n", modelsDir.c_str(),
+                   info.missing.c_str());
+    return perf;
+  }
   if (o.characters) {
-    const std::string dir = o.charactersFrom.empty() ? std::string(RAYBRIDGE_SOURCE_DIR) + "/../shared/scenes"
-                                                     : o.charactersFrom;
+    const std::string& dir = modelsDir;
     // In front of the demo's objects, facing its camera's view (the benchmark centres them on the scene).
     auto animated = rbAnimated::makeAnimatedScene(dir, o.characters, glm::vec2(0.0f, 5.5f));
     if (!animated) return R::failure("--characters: " + animated.error);
@@ -97,6 +109,29 @@ se::Result<se::Camera> pathCamera(const rbCameraPath::CameraPath& path, double t
 }
 
 nlohmann::json vec(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+
+// The engine's whole frame on the GPU: every pass it timed.
+double frameTotalMs(const se::PassTimings& t) {
+  return t.shadowMs + t.probeMs + t.prepassMs + t.ssaoMs + t.shadowVisibilityMs + t.hookMs + t.lightingMs +
+         t.tonemapMs + t.localShadowMs + t.localIrradianceMs;
+}
+
+// The SDK's passes by their stats.json names; with `effects`, only those the front end runs.
+std::vector<std::pair<const char*, const rb::PassStats*>> namedPassStats(const rb::HybridStats& es,
+                                                                         const rb::HybridEffects* effects = nullptr) {
+  const std::pair<const char*, const rb::PassStats*> all[] = {
+      {"shadow", !effects || effects->shadowPass() ? &es.shadow : nullptr},
+      {"shadow_denoise", !effects || effects->shadowDenoiser() ? &es.shadowDenoise : nullptr},
+      {"ao", !effects || effects->aoPass() ? &es.ao : nullptr},
+      {"ao_denoise", !effects || effects->aoDenoiser() ? &es.aoDenoise : nullptr},
+      {"reflection", !effects || effects->reflectionPass() ? &es.reflection : nullptr},
+      {"local_lights", !effects || effects->localLightPass() ? &es.localLights : nullptr},
+      {"local_lights_denoise", !effects || effects->localLightDenoiser() ? &es.localLightsDenoise : nullptr}};
+  std::vector<std::pair<const char*, const rb::PassStats*>> out;
+  for (const auto& e : all)
+    if (e.second) out.push_back(e);
+  return out;
+}
 
 se::ImageRGBA32F toExr(const CapturedFrame& f, const std::vector<float>& values, int channels) {
   se::ImageRGBA32F img;
@@ -288,6 +323,20 @@ int main(int argc, char** argv) {
     params.camera = camera.value;
     return se::Status::success();
   };
+  // Every frame's GPU times as they resolve (the engine's after its fence, the SDK's kFramesInFlight later), for
+  // the percentiles of stats.json's frame_series.
+  FrameSeries series;
+  auto collectTimings = [&] {
+    const se::PassTimings t = engine.lastTimings();
+    if (t.valid) {
+      series.add("frame_gpu_ms", t.frameNumber, frameTotalMs(t));
+      series.add("hook_gpu_ms", t.frameNumber, t.hookMs);
+    }
+    if (!adapter) return;
+    const rb::HybridStats es = adapter->effects().stats();
+    for (const auto& [name, p] : namedPassStats(es))
+      if (p->frame) series.add(std::string(name) + "_gpu_ms", p->frame, p->gpuMs);
+  };
   // With --dump the last frame also copies its pre-pass and effect images; the timings reported are those of
   // the frame before it, which has no capture copies.
   const uint32_t plain = capture && o.frames > 1 ? o.frames - 1 : o.frames;
@@ -295,8 +344,10 @@ int main(int argc, char** argv) {
     params.time = frameTime(f);
     if (se::Status s = placeCamera(f); !s) return fail(s.error);
     if (se::Status s = engine.renderFrame(params); !s) return fail(s.error);
+    collectTimings();
   }
   if (se::Status s = engine.waitIdle(); !s) return fail(s.error);
+  collectTimings();
   const se::PassTimings timings = engine.lastTimings();  // without capture copies
   if (capture) {
     captureNext = true;
@@ -319,19 +370,23 @@ int main(int argc, char** argv) {
   if (se::Status s = se::writeExr((out / "final.exr").string(), hdr.value); !s) return fail(s.error);
   std::printf("wrote %s and %s (%ux%u, %s)\n", (out / "final.png").c_str(), (out / "final.exr").c_str(), o.width,
               o.height, hybrid ? "hybrid" : "raster");
+  if (const nlohmann::json fs = series.summary(); fs.contains("frame_gpu_ms"))
+    std::printf("over %d frames after %u warm-up frames: frame GPU ms p50 %.2f p99 %.2f; hook p50 %.2f p99 %.2f\n",
+                fs["frames"].get<int>(), kFrameSeriesWarmupFrames, fs["frame_gpu_ms"]["p50"].get<double>(),
+                fs["frame_gpu_ms"]["p99"].get<double>(), fs["hook_gpu_ms"]["p50"].get<double>(),
+                fs["hook_gpu_ms"]["p99"].get<double>());
   if (!o.cameraPath.empty())
     std::printf("camera path %s: %zu keyframes, %.3f s; the captured frame is at %.3f s\n", o.cameraPath.c_str(),
                 cameraPath.keys.size(), pathDuration, capturedPathTime);
 
   // Statistics. The SDK resolves a pass's GPU time kFramesInFlight frames after recording it.
   nlohmann::json stats;
-  const double engineTotal = timings.shadowMs + timings.probeMs + timings.prepassMs + timings.ssaoMs +
-                             timings.shadowVisibilityMs + timings.hookMs + timings.lightingMs + timings.tonemapMs +
-                             timings.localShadowMs + timings.localIrradianceMs;
+  const double engineTotal = frameTotalMs(timings);
   stats["mode"] = hybrid ? "hybrid" : "raster";
   stats["width"] = o.width;
   stats["height"] = o.height;
   stats["frames"] = o.frames;
+  stats["frame_series"] = series.summary();
   stats["animation"] = {{"time", o.time},
                         {"fps", o.fps ? nlohmann::json(*o.fps) : nlohmann::json(nullptr)},
                         {"index", animation},
@@ -339,6 +394,7 @@ int main(int argc, char** argv) {
                         {"deformed_instances", engine.deformedInstances().size()}};
   stats["gbuffer_normals"] = o.geometricNormals ? "geometric" : "shading";
   stats["scene"] = o.characters      ? "procedural demo scene with " + std::to_string(o.characters) + " characters"
+                   : o.perfScene     ? "performance scene"
                    : o.scene.empty() ? "procedural demo scene"
                                      : o.scene;
   stats["device"] = {{"name", engine.deviceInfo().name}};
@@ -433,17 +489,8 @@ int main(int argc, char** argv) {
     memory["total"] = mem.total();
     nlohmann::json passes = nlohmann::json::object();
     uint64_t rays = 0;
-    const std::pair<const char*, const rb::PassStats*> all[] = {
-        {"shadow", fxo.shadowPass() ? &es.shadow : nullptr},
-        {"shadow_denoise", fxo.shadowDenoiser() ? &es.shadowDenoise : nullptr},
-        {"ao", fxo.aoPass() ? &es.ao : nullptr},
-        {"ao_denoise", fxo.aoDenoiser() ? &es.aoDenoise : nullptr},
-        {"reflection", fxo.reflectionPass() ? &es.reflection : nullptr},
-        {"local_lights", fxo.localLightPass() ? &es.localLights : nullptr},
-        {"local_lights_denoise", fxo.localLightDenoiser() ? &es.localLightsDenoise : nullptr}};
     std::printf("Raybridge (%s):", effectSetToString(effects).c_str());
-    for (const auto& [name, p] : all) {
-      if (!p) continue;
+    for (const auto& [name, p] : namedPassStats(es, &fxo)) {
       passes[name] = {
           {"gpu_ms", p->gpuMs}, {"rays", p->rays}, {"rays_per_second", p->raysPerSecond()}, {"frame", p->frame}};
       rays += p->rays;

@@ -217,7 +217,13 @@ void addOptions(CLI::App& app, RenderOptions& o) {
                  "each playing its first animation at its own offset")
       ->type_name("N")
       ->check(rbCli::wholeNumber(1, 1000));
-  app.add_option("--characters-from", o.charactersFrom, "where their glTF folders are (default ../shared/scenes)")
+  app.add_flag("--perf-scene", o.perfScene,
+               "the performance scene instead of the demo: the shared static glTF models, each\n"
+               "instanced on a ring around the centre, on a finely tessellated ground (about\n"
+               "3M triangles in 400 instances; docs/performance.md)");
+  app.add_option("--models-from,--characters-from", o.modelsFrom,
+                 "where the glTF folders of --characters and --perf-scene are\n"
+                 "(default ../shared/scenes)")
       ->type_name("DIR")
       ->check(rbCli::nonEmpty("folder name"));
   rbCli::addEnum(app, "--dynamic-builds", o.dynamicMode,
@@ -312,7 +318,10 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
   if (!o.cameraPath.empty() && o.eye) return "--camera-path and --camera both set the camera; give only one of them";
   if (o.characters && !o.scene.empty())
     return "--characters: adds characters to the demo scene; it cannot be combined with --scene";
-  if (!o.charactersFrom.empty() && !o.characters) return "--characters-from needs --characters N";
+  if (o.perfScene && (o.characters || !o.scene.empty()))
+    return "--perf-scene is a scene of its own; it cannot be combined with --scene or --characters";
+  if (!o.modelsFrom.empty() && !o.characters && !o.perfScene)
+    return "--models-from needs --characters N or --perf-scene";
   if (uint64_t(o.width) * o.height > uint64_t(8192) * 8192)
     return "--width/--height: " + std::to_string(o.width) + "x" + std::to_string(o.height) + " exceeds 67 megapixels";
   return {};

@@ -56,9 +56,12 @@ struct RenderOptions {
   double time = 0.0;
   std::optional<double> fps;
   std::string animation;  // --animation N|NAME; empty = the scene's first animation
-  // --characters N: N skinned characters from `charactersFrom` on the demo scene, each playing its animation.
+  // --characters N: N skinned characters from `modelsFrom` on the demo scene, each playing its animation.
   uint32_t characters = 0;
-  std::string charactersFrom;  // --characters-from DIR; empty = ../shared/scenes beside the source tree
+  // --perf-scene: the performance scene of perf_scene.h (shared models from `modelsFrom`, instanced on a finely
+  // tessellated ground) instead of the demo scene.
+  bool perfScene = false;
+  std::string modelsFrom;  // --models-from DIR (or --characters-from); empty = ../shared/scenes beside the source tree
   rb::DynamicBuildMode dynamicMode = rb::DynamicBuildMode::InFrame;  // --dynamic-builds
   std::string device;
   bool validation = false;

@@ -234,27 +234,8 @@ TEST_CASE("camera path: every bad file names the problem, the keyframe and the f
   CHECK(error.find("cannot be opened") != std::string::npos);
 }
 
-namespace {
-
-// Runs the render command with the validation layer; returns its output (stdout and stderr) and sets status.
-std::string renderOutput(const std::string& args, int& status) {
-  const std::string command = rbRenderTest::renderCommand() + " --validation " + args + " 2>&1";
-  std::string text;
-  status = -1;
-  if (FILE* p = popen(command.c_str(), "r")) {
-    char buf[512];
-    while (fgets(buf, sizeof buf, p)) text += buf;
-    status = pclose(p);
-  }
-  return text;
-}
-
-nlohmann::json readJson(const fs::path& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in, nullptr, false);
-}
-
-}  // namespace
+using rbRenderTest::readJson;
+using rbRenderTest::renderOutput;
 
 TEST_CASE("raybridge-render --camera-path renders the path's end and reports it", "[camera_path][render]") {
   const fs::path dir = tempDir("render");

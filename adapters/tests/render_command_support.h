@@ -7,10 +7,14 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 namespace rbRenderTest {
 
@@ -23,6 +27,25 @@ inline std::string renderCommand() {
 // Runs the render command with the validation layer on; returns its exit status.
 inline int runRender(const std::string& args) {
   return std::system((renderCommand() + " --validation " + args).c_str());
+}
+
+// Runs the render command with the validation layer; returns its output (stdout and stderr) and sets status.
+inline std::string renderOutput(const std::string& args, int& status) {
+  const std::string command = renderCommand() + " --validation " + args + " 2>&1";
+  std::string text;
+  status = -1;
+  if (FILE* p = popen(command.c_str(), "r")) {
+    char buf[512];
+    while (fgets(buf, sizeof buf, p)) text += buf;
+    status = pclose(p);
+  }
+  return text;
+}
+
+// The JSON file at `path`, or a discarded value (is_discarded()) when it is missing or malformed.
+inline nlohmann::json readJson(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in, nullptr, false);
 }
 
 inline std::vector<float> readExrRed(const std::filesystem::path& path, int& width, int& height) {

@@ -10,6 +10,7 @@
 #   SKIP_BUILD=1         reuse the existing build folder as it is
 #   SKIP_ENGINE=1        build without samples/engine from the start (-DRAYBRIDGE_SKIP_ENGINE=ON)
 #   SCENES_DIR=...       glTF models to carry (default ../shared/scenes beside the checkout); geometry only
+#   EXTRA_BINS="F ..."   more executables to carry into bin/ (e.g. raybridge-render-base for run_remote.sh perf)
 #
 # .devcarry/ layout (files over 2 MiB are stored gzipped as NAME.gz; run_remote.sh unpacks them):
 #   bin/      raybridge-bench, the test executables, raybridge-render and other sample executables
@@ -89,6 +90,12 @@ mapfile -t EXES < <(for d in tests samples adapters; do
     file -b "$f" | grep -q 'ELF 64-bit LSB pie executable\|ELF 64-bit LSB executable' && echo "$f"
   done | sort -u)
 [ -x "$BUILD/raybridge-render" ] && EXES+=("$BUILD/raybridge-render")
+# EXTRA_BINS="FILE ...": more executables to carry as they are, e.g. an earlier build's render command renamed
+# raybridge-render-base, the "before" of run_remote.sh perf.
+for f in ${EXTRA_BINS:-}; do
+  [ -x "$f" ] || die "EXTRA_BINS: $f is not an executable"
+  EXES+=("$f")
+done
 for f in "${EXES[@]}"; do
   name=$(basename "$f")
   [ -e "$CARRY/bin/$name" ] && die "two executables named $name"

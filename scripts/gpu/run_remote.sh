@@ -2,8 +2,8 @@
 # Runs the benchmark and the tests on the GPU machine (NVIDIA, no Vulkan loader, no network) from the folder
 # .devcarry/ that scripts/gpu/prepare.sh assembled and the device tool carried. Run from the repository root:
 #
-#   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, render, effects, animated, lights
-#                                                          (default all)
+#   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, render, effects, animated, lights,
+#                                                          perf (default all)
 #
 # Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
 # tests_gpu.log, effects_gpu.json, effects_gpu.log, render_gpu.tar.gz (render logs, stats.json and final.png
@@ -17,12 +17,15 @@
 #                       loader and drivers, e.g. lavapipe). Also implied when not running as root.
 #   RB_BENCH_ARGS=...   benchmark arguments (default: --scenario all --full)
 #   RB_TIME_BUDGET=500  seconds for the whole run
+#   RB_PERF_SIZE="2560 1440", RB_PERF_FRAMES=40, RB_PERF_PATH_FRAMES=240, RB_PERF_PRESETS="hard-shadows low medium
+#   high ultra", RB_PERF_BENCH_ARGS=--full: the perf mode's size, frames per row and along the path, presets and
+#   benchmark arguments (smaller ones for a rehearsal on lavapipe)
 #   RB_RUNTIME_DIR=DIR  where .devcarry is unpacked (default /tmp/raybridge-devcarry)
 set -u
 
 MODE="${1:-all}"
 for m in ${MODE//,/ }; do
-  case "$m" in all|bench|tests|render|effects|animated|lights) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, render, effects, animated or lights" >&2; exit 2 ;; esac
+  case "$m" in all|bench|tests|render|effects|animated|lights|perf) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, render, effects, animated, lights or perf" >&2; exit 2 ;; esac
 done
 want() { [ "$MODE" = all ] || [[ ",$MODE," == *",$1,"* ]]; }
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -242,6 +245,61 @@ if want lights; then
   done
   grep -E '^\| |stress|engine GPU ms|Raybridge:' "$OUT/lights_gpu.log" | head -n 80
   tar -C "$LDIR" -czf "$OUT/lights_render_gpu.tar.gz" --exclude='*.exr' . 2>/dev/null
+fi
+# ---- perf: docs/performance.md. The probe on ~100k and ~1M triangles, then the performance scene (--perf-scene,
+# ~3M triangles) and the demo scene at 2560x1440 per preset (hybrid; raster for low and ultra), the fly-through
+# along scripts/gpu/perf_flythrough.json (raster and hybrid), the TLAS and trace benchmarks; perf_report.py writes
+# perf_gpu.json. With bin/raybridge-render-base (an earlier build carried by prepare.sh's EXTRA_BINS), every hybrid
+# row is rendered by it too, right after the current one, as the "before" of docs/performance.md. Validation off.
+if want perf; then
+  : >"$OUT/perf_gpu.log"
+  PDIR="$(mktemp -d)"
+  PFRAMES="${RB_PERF_FRAMES:-40}"
+  if [ -x "$RT/probe/probe" ]; then
+    for k in 10 32; do
+      RAYBRIDGE_VALIDATION=0 step "probe k$k" 60 "$OUT/probe_gpu.log" "$RT/probe/probe" --width 2560 --height 1440 \
+        --rays 64 --k "$k" --ground-tiles 64 --reps 7
+    done
+  fi
+  read -r PW PH <<<"${RB_PERF_SIZE:-2560 1440}"
+  perf_render() {  # NAME BINARY ARGS...
+    local name="$1" bin="$2"
+    shift 2
+    RAYBRIDGE_VALIDATION=0 step "perf $name" 90 "$OUT/perf_gpu.log" "$bin" --width "$PW" --height "$PH" "$@" \
+      --out "$PDIR/$name"
+  }
+  for scene in perf demo; do
+    sargs=()
+    [ "$scene" = perf ] && sargs=(--perf-scene --models-from "$SCENES")
+    for preset in ${RB_PERF_PRESETS:-hard-shadows low medium high ultra}; do
+      perf_render "${scene}__hybrid__$preset" "$RT/bin/raybridge-render" "${sargs[@]}" --preset "$preset" \
+        --frames "$PFRAMES"
+      if [ -x "$RT/bin/raybridge-render-base" ]; then
+        perf_render "${scene}-base__hybrid__$preset" "$RT/bin/raybridge-render-base" "${sargs[@]}" --preset "$preset" \
+          --frames "$PFRAMES"
+      fi
+    done
+    for preset in low ultra; do
+      perf_render "${scene}__raster__$preset" "$RT/bin/raybridge-render" "${sargs[@]}" --mode raster \
+        --preset "$preset" --frames "$PFRAMES"
+    done
+  done
+  for mode in hybrid raster; do
+    for preset in low ultra; do
+      perf_render "perf__${mode}__${preset}__path" "$RT/bin/raybridge-render" --perf-scene --models-from "$SCENES" \
+        --mode "$mode" --preset "$preset" --camera-path "$ROOT/scripts/gpu/perf_flythrough.json" \
+        --frames "${RB_PERF_PATH_FRAMES:-240}"
+    done
+  done
+  read -r -a PBENCH <<<"${RB_PERF_BENCH_ARGS:---full}"
+  RAYBRIDGE_VALIDATION=0 step "perf tlas bench" 150 "$OUT/perf_gpu.log" "$RT/bin/raybridge-bench" --scenario tlas \
+    "${PBENCH[@]}" --out "$OUT/perf_tlas_gpu.json"
+  RAYBRIDGE_VALIDATION=0 step "perf trace bench" 90 "$OUT/perf_gpu.log" "$RT/bin/raybridge-bench" --scenario trace \
+    "${PBENCH[@]}" --out "$OUT/perf_trace_gpu.json"
+  step "perf report" 30 "$OUT/perf_gpu.log" python3 "$ROOT/scripts/perf_report.py" --probe-log "$OUT/probe_gpu.log" \
+    --renders "$PDIR" --command "bash scripts/gpu/run_remote.sh perf" --out "$OUT/perf_gpu.json"
+  grep -E '^(perf|demo)|trace (primary|stress)|GPU ms|^in place|^device copy|^copy' "$OUT/perf_gpu.log" | head -n 80
+  tar -C "$PDIR" -czf "$OUT/perf_render_gpu.tar.gz" --exclude='*.exr' --exclude='*.png' . 2>/dev/null
 fi
 # ---- tests (validation on) ---------------------------------------------------------------------------------
 if want tests; then
