@@ -10,7 +10,6 @@
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ReflectionPushConstants { ReflectionConstants pc; };
 #include "pass_inputs.glsl"
-#include "ray_counters.glsl"
 #include "reflection_common.glsl"
 #include "light_list.glsl"
 
@@ -67,8 +66,7 @@ void main() {
     shadowHit = -1.0;
     traceRayEXT(tlas, flags, 0xFF, 0, 0, 1, origin, 0.0, toSun, 1e30, 1);
     sunVisible = shadowHit == 0.0 ? 1.0 : 0.0;
-    // Shadow rays from hits are the pass's rays too.
-    rbCountRays(gl_LaunchIDEXT.xy, 1u);
+    ++payload.shadowRays;  // the pass's rays too: counted by the ray generation shader
   }
   // Local lights: irradiance E from one resampled light (see the top), shadowed.
   vec3 localIrradiance = vec3(0.0);
@@ -96,7 +94,7 @@ void main() {
       shadowHit = -1.0;
       float tMax = keptDistance >= 1e29 ? 1e30 : 0.999 * keptDistance;
       traceRayEXT(tlas, flags, 0xFF, 0, 0, 1, origin, 0.0, keptDir, tMax, 1);
-      rbCountRays(gl_LaunchIDEXT.xy, 1u);
+      ++payload.shadowRays;
       if (shadowHit == 0.0) localIrradiance = keptE * (weightSum * float(count) / (float(m) * keptWeight));
     }
   }

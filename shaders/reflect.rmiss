@@ -5,9 +5,7 @@
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ReflectionPushConstants { ReflectionConstants pc; };
 
-struct ReflectionPayload {
-  vec3 radiance;
-};
+#include "reflection_payload.glsl"
 layout(location = 0) rayPayloadInEXT ReflectionPayload payload;
 
 void main() { payload.radiance = pc.skyRadiance; }

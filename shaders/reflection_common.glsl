@@ -3,10 +3,7 @@
 #ifndef RAYBRIDGE_REFLECTION_COMMON_GLSL
 #define RAYBRIDGE_REFLECTION_COMMON_GLSL
 
+#include "reflection_payload.glsl"
 #include "shading_records.glsl"
-
-struct ReflectionPayload {
-  vec3 radiance;
-};
 
 #endif

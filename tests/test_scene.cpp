@@ -32,7 +32,8 @@ rb::PrimaryRayCamera conformanceCamera(float verticalFovDegrees) {
   return cam;
 }
 
-BuiltScene buildScene(GpuFixture& fx, rb::AccelerationStructureService& service, const TestScene& scene) {
+BuiltScene buildScene(GpuFixture& fx, rb::AccelerationStructureService& service, const TestScene& scene,
+                      const rb::TlasBuildOptions& options) {
   BuiltScene b;
   for (const rbsamples::CpuMesh& m : scene.meshes) {
     b.uploads.push_back(fx.upload(m));
@@ -52,7 +53,7 @@ BuiltScene buildScene(GpuFixture& fx, rb::AccelerationStructureService& service,
     auto pending = service.recordPendingWork(cmd);
     RB_REQUIRE_OK(pending);
     REQUIRE(pending.value() == 0);
-    auto tlas = service.recordTlasBuild(cmd, b.instances);
+    auto tlas = service.recordTlasBuild(cmd, b.instances, options);
     RB_REQUIRE_OK(tlas);
     b.tlas = tlas.value();
   });

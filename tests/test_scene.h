@@ -37,7 +37,9 @@ struct BuiltScene {
   std::vector<rb::Instance> instances;
   rb::TlasInfo tlas;
 };
-BuiltScene buildScene(GpuFixture& fx, rb::AccelerationStructureService& service, const TestScene& scene);
+// Uploads and registers the meshes, builds them and a TLAS over the instances with `options`.
+BuiltScene buildScene(GpuFixture& fx, rb::AccelerationStructureService& service, const TestScene& scene,
+                      const rb::TlasBuildOptions& options = {});
 void destroyScene(GpuFixture& fx, BuiltScene& built);
 void addToEmbree(EmbreeScene& embree, const TestScene& scene);
 

@@ -88,6 +88,88 @@ TEST_CASE("TLAS refits when only transforms change and rebuilds when the meshes 
   destroyScene(fx, built);
 }
 
+namespace {
+
+// The bytes of `buffer` (the TLAS's shading records, host-visible or device-local), through a copy into a host
+// buffer recorded after the frame's TLAS build.
+std::vector<uint8_t> copyBack(GpuFixture& fx, VkBuffer buffer, VkDeviceSize bytes) {
+  auto readback = rb::createBuffer(fx.ctx(), bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, rb::MemoryLocation::HostVisible,
+                                   rb::MemoryCategory::PassBuffers, "test readback");
+  RB_REQUIRE_OK(readback);
+  rb::GpuBuffer host = readback.value();
+  fx.runAndSettle([&](VkCommandBuffer cmd) {
+    const VkBufferCopy region{0, 0, bytes};
+    fx.vk().vkCmdCopyBuffer(cmd, buffer, host.buffer, 1, &region);
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    fx.vk().vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0, nullptr,
+                                 0, nullptr);
+  });
+  const auto* p = static_cast<const uint8_t*>(host.mapped);
+  std::vector<uint8_t> out(p, p + bytes);
+  rb::destroyBuffer(fx.ctx(), host);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("every instance upload and build preference traces like Embree, with the same shading records",
+          "[as][tlas][embree]") {
+  // Lavapipe's host memory is device-local, so Auto reads in place here: CopyToDevice exercises the copy (the
+  // default on a discrete GPU) under validation, FastBuild the other build flag.
+  GpuFixture fx;
+  const TestScene scene = makeConformanceScene();
+  struct Variant {
+    const char* name;
+    rb::TlasInstanceUpload upload;
+    rb::TlasBuildPreference preference;
+  };
+  std::vector<uint8_t> inPlaceRecords;
+  VkDeviceSize inPlaceTlasBytes = 0;
+  for (const Variant& v :
+       {Variant{"in place", rb::TlasInstanceUpload::ReadInPlace, rb::TlasBuildPreference::FastTrace},
+        Variant{"device copy", rb::TlasInstanceUpload::CopyToDevice, rb::TlasBuildPreference::FastTrace},
+        Variant{"copy, fast build", rb::TlasInstanceUpload::CopyToDevice, rb::TlasBuildPreference::FastBuild}}) {
+    INFO(v.name);
+    auto service = rb::AccelerationStructureService::create(fx.ctx());
+    RB_REQUIRE_OK(service);
+    rb::TlasBuildOptions options;
+    options.instanceUpload = v.upload;
+    options.preference = v.preference;
+    options.writeShadingRecords = true;
+    BuiltScene built = buildScene(fx, *service.value(), scene, options);
+    REQUIRE(built.tlas.shadingRecords != VK_NULL_HANDLE);
+    TraceComparison c = compareFirstTrace(fx, scene, built.tlas.tlas, conformanceCamera(), 96, 64);
+    REQUIRE(c.hits > 100);
+    CHECK(double(c.hitMissAgree) / c.compared >= 0.999);
+    CHECK(double(c.distanceAgree) / c.hitsCompared >= 0.999);
+    CHECK(double(c.sameInstance) / c.hitsCompared >= 0.999);
+    const std::vector<uint8_t> records = copyBack(fx, built.tlas.shadingRecords, built.tlas.shadingRecordsBytes);
+    if (inPlaceRecords.empty()) {
+      inPlaceRecords = records;
+    } else {
+      CHECK(records == inPlaceRecords);
+    }
+    // The device copies count as TLAS memory: more than reading in place with the same build flags.
+    const VkDeviceSize tlasBytes = service.value()->stats().tlasBytes;
+    if (v.upload == rb::TlasInstanceUpload::ReadInPlace) inPlaceTlasBytes = tlasBytes;
+    if (v.upload == rb::TlasInstanceUpload::CopyToDevice && v.preference == rb::TlasBuildPreference::FastTrace)
+      CHECK(tlasBytes > inPlaceTlasBytes);
+    destroyScene(fx, built);
+  }
+  // A value outside the enum is a named error, not a build.
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  rb::TlasBuildOptions bad;
+  bad.instanceUpload = static_cast<rb::TlasInstanceUpload>(7);
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    auto t = service.value()->recordTlasBuild(cmd, {}, bad);
+    REQUIRE_FALSE(t);
+    CHECK(t.error().message.find("options.instanceUpload (7)") != std::string::npos);
+  });
+}
+
 TEST_CASE("instances of meshes still queued are skipped, never referenced", "[as][tlas]") {
   GpuFixture fx;
   rb::AsServiceDesc desc;

@@ -53,7 +53,9 @@ AccelerationStructureService::Impl::~Impl() {
     destroyBuffer(ctx, s.storage);
     destroyBuffer(ctx, s.scratch);
     destroyBuffer(ctx, s.instances);
+    destroyBuffer(ctx, s.deviceInstances);
     destroyBuffer(ctx, s.shading);
+    destroyBuffer(ctx, s.deviceShading);
   }
   for (BuildBatch& b : inFlightBatches) {
     if (b.timestamps) c.vk.vkDestroyQueryPool(c.desc.device, b.timestamps, c.allocator());
@@ -694,7 +696,7 @@ AsStats AccelerationStructureService::stats() const {
   out.tlasBytes = 0;
   for (const TlasSlot& t : s.tlasSlots) {
     out.tlasBytes += t.storage.allocatedBytes + t.scratch.allocatedBytes + t.instances.allocatedBytes +
-                     t.shading.allocatedBytes;
+                     t.deviceInstances.allocatedBytes + t.shading.allocatedBytes + t.deviceShading.allocatedBytes;
   }
   out.batches = s.timings;
   return out;

@@ -142,7 +142,10 @@ struct TlasSlot {
   GpuBuffer storage;
   GpuBuffer scratch;
   GpuBuffer instances;  // host-visible VkAccelerationStructureInstanceKHR array
-  GpuBuffer shading;    // host-visible ShadingRecord array (only with writeShadingRecords)
+  // Device-local copy of `instances` the build reads (TlasInstanceUpload::CopyToDevice); grown with it.
+  GpuBuffer deviceInstances;
+  GpuBuffer shading;        // host-visible ShadingRecord array (only with writeShadingRecords)
+  GpuBuffer deviceShading;  // its device-local copy the shaders read, like deviceInstances
   uint32_t instanceCapacity = 0;
   VkDeviceSize storageCapacity = 0;
   bool allowsUpdate = false;

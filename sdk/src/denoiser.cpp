@@ -134,7 +134,7 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
   Result<VkSampler> s = createNearestSampler(context);
   if (!s) return s.error();
   impl->sampler = s.value();
-  if (Status st = impl->metrics.init(context, "denoiser"); !st) return st.error();
+  if (Status st = impl->metrics.init(context, "denoiser", /*countsRays=*/false); !st) return st.error();
   return std::unique_ptr<Denoiser>(new Denoiser(std::move(impl)));
 }
 

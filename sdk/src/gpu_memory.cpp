@@ -21,10 +21,12 @@ void account(Context::Impl& c, MemoryCategory category, VkDeviceSize bytes, bool
 
 Result<VkDeviceMemory> allocate(Context::Impl& c, const VkMemoryRequirements& req, MemoryLocation location,
                                 bool deviceAddress, const char* what) {
-  VkMemoryPropertyFlags required = location == MemoryLocation::HostVisible
-                                       ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
-                                       : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-  int32_t type = c.findMemoryType(req.memoryTypeBits, required, required);
+  const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  const VkMemoryPropertyFlags deviceLocal = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+  const VkMemoryPropertyFlags required = location == MemoryLocation::DeviceLocal ? deviceLocal : host;
+  const VkMemoryPropertyFlags preferred = location == MemoryLocation::HostVisibleDeviceLocal ? host | deviceLocal
+                                                                                             : required;
+  int32_t type = c.findMemoryType(req.memoryTypeBits, required, preferred);
   if (type < 0 && location == MemoryLocation::DeviceLocal) type = c.findMemoryType(req.memoryTypeBits, 0, 0);
   if (type < 0) {
     return Error{ErrorCode::VulkanError, VK_ERROR_OUT_OF_DEVICE_MEMORY, std::string("no memory type fits ") + what};
@@ -71,7 +73,7 @@ Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFla
   out.memory = memory.value();
   out.allocatedBytes = req.size;
   c.vk.vkBindBufferMemory(c.desc.device, out.buffer, out.memory, 0);
-  if (location == MemoryLocation::HostVisible) {
+  if (location != MemoryLocation::DeviceLocal) {
     r = c.vk.vkMapMemory(c.desc.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
     if (r != VK_SUCCESS) {
       c.vk.vkDestroyBuffer(c.desc.device, out.buffer, c.allocator());

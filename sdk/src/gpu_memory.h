@@ -10,6 +10,10 @@ namespace rb {
 enum class MemoryLocation : uint8_t {
   DeviceLocal,  // fastest for the GPU
   HostVisible,  // host-visible and coherent, persistently mapped (upload rings, readback)
+  // Host-visible and coherent, persistently mapped, in device-local memory where the device has such a type (a
+  // BAR heap on a discrete GPU), else as HostVisible: small tables the host writes once and every ray reads (shader
+  // binding tables, materials), so that those reads do not cross the bus.
+  HostVisibleDeviceLocal,
 };
 
 struct GpuBuffer {

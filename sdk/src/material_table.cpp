@@ -103,7 +103,7 @@ Status MaterialTable::setMaterials(std::span<const Material> materials, std::spa
     if (!textures[i]) return invalid("textures[" + std::to_string(i) + "] is VK_NULL_HANDLE");
   }
   Result<GpuBuffer> buffer = createBuffer(s.ctx, materials.size() * sizeof(GpuMaterial),
-                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryLocation::HostVisible,
+                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryLocation::HostVisibleDeviceLocal,
                                           MemoryCategory::PassBuffers, "material table");
   if (!buffer) return buffer.error();
   auto* out = static_cast<GpuMaterial*>(buffer->mapped);

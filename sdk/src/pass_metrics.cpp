@@ -7,15 +7,42 @@
 
 namespace rb {
 
-Status PassMetrics::init(Context& ctx, const char* passName) {
+namespace {
+
+// The stages whose shaders add to the counters: ray tracing passes and compute passes.
+constexpr VkPipelineStageFlags kCounterShaderStages = VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR |
+                                                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+
+void memoryBarrier(const DeviceFunctions& vk, VkCommandBuffer cmd, VkPipelineStageFlags srcStages,
+                   VkAccessFlags srcAccess, VkPipelineStageFlags dstStages, VkAccessFlags dstAccess) {
+  VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  b.srcAccessMask = srcAccess;
+  b.dstAccessMask = dstAccess;
+  vk.vkCmdPipelineBarrier(cmd, srcStages, dstStages, 0, 1, &b, 0, nullptr, 0, nullptr);
+}
+
+}  // namespace
+
+Status PassMetrics::init(Context& ctx, const char* passName, bool countsRays) {
   Context::Impl& c = internal::contextImpl(ctx);
   const uint32_t slots = c.desc.framesInFlight;
-  Result<GpuBuffer> b = createBuffer(ctx, VkDeviceSize(slots) * kCountersPerFrame * sizeof(uint32_t),
-                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                     MemoryLocation::HostVisible, MemoryCategory::PassBuffers, passName);
-  if (!b) return b.error();
-  counters_ = b.value();
-  std::memset(counters_.mapped, 0, counters_.size);
+  if (countsRays) {
+    const VkDeviceSize bytes = VkDeviceSize(slots) * kCountersPerFrame * sizeof(uint32_t);
+    Result<GpuBuffer> b = createBuffer(ctx, bytes,
+                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                           VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                       MemoryLocation::DeviceLocal, MemoryCategory::PassBuffers, passName);
+    if (!b) return b.error();
+    counters_ = b.value();
+    Result<GpuBuffer> r = createBuffer(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryLocation::HostVisible,
+                                       MemoryCategory::PassBuffers, passName);
+    if (!r) {
+      destroyBuffer(ctx, counters_);
+      return r.error();
+    }
+    readback_ = r.value();
+    std::memset(readback_.mapped, 0, readback_.size);
+  }
   recordedFrame_.assign(slots, UINT64_MAX);
   timing_ = c.info.timestampsSupported;
   if (timing_) {
@@ -31,6 +58,7 @@ Status PassMetrics::init(Context& ctx, const char* passName) {
 void PassMetrics::retire(Context& ctx) {
   internal::contextImpl(ctx).retireHandle(timestamps_, &DeviceFunctions::vkDestroyQueryPool);
   retireBuffer(ctx, counters_);
+  retireBuffer(ctx, readback_);
   recordedFrame_.assign(recordedFrame_.size(), UINT64_MAX);
 }
 
@@ -45,10 +73,12 @@ void PassMetrics::collect(Context& ctx) {
     if (f == UINT64_MAX || !c.frameDone(f)) continue;
     PassStats s;
     s.frame = f;
-    const uint32_t* counts = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(counters_.mapped) +
-                                                               slot * counterBytes());
-    for (uint32_t i = 0; i < kCounterSlots; ++i) s.rays += counts[i];
-    for (uint32_t i = 0; i < kCounterSlots; ++i) s.anyHitInvocations += counts[kCounterSlots + i];
+    if (readback_.valid()) {
+      const uint32_t* counts = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(readback_.mapped) +
+                                                                 slot * counterBytes());
+      for (uint32_t i = 0; i < kCounterSlots; ++i) s.rays += counts[i];
+      for (uint32_t i = 0; i < kCounterSlots; ++i) s.anyHitInvocations += counts[kCounterSlots + i];
+    }
     if (timing_) {
       uint64_t ticks[2] = {0, 0};
       if (c.vk.vkGetQueryPoolResults(c.desc.device, timestamps_, 2 * slot, 2, sizeof ticks, ticks, sizeof(uint64_t),
@@ -65,10 +95,17 @@ void PassMetrics::beginRecording(Context& ctx, VkCommandBuffer cmd) {
   collect(ctx);
   Context::Impl& c = internal::contextImpl(ctx);
   const uint32_t slot = static_cast<uint32_t>(c.frame % c.desc.framesInFlight);
-  // The slot's previous frame is done (beginFrame contract), so the host may clear its counters now.
-  std::memset(static_cast<uint8_t*>(counters_.mapped) + slot * counterBytes(), 0, counterBytes());
   recordedFrame_[slot] = c.frame;
   if (timing_) c.vk.vkCmdResetQueryPool(cmd, timestamps_, 2 * slot, 2);
+  if (!counters_.valid()) return;
+  // After any earlier use of the counters in this command buffer (the pass recorded twice in a frame): clear, then
+  // let the shaders add.
+  memoryBarrier(c.vk, cmd, kCounterShaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT,
+                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
+  c.vk.vkCmdFillBuffer(cmd, counters_.buffer, slot * counterBytes(), counterBytes(), 0u);
+  memoryBarrier(c.vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kCounterShaderStages,
+                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 void PassMetrics::writeStart(Context& ctx, VkCommandBuffer cmd) {
@@ -78,10 +115,17 @@ void PassMetrics::writeStart(Context& ctx, VkCommandBuffer cmd) {
 }
 
 void PassMetrics::writeEnd(Context& ctx, VkCommandBuffer cmd) {
-  if (!timing_) return;
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   const uint32_t slot = static_cast<uint32_t>(ctx.frameIndex() % ctx.framesInFlight());
-  internal::deviceFunctions(ctx).vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps_,
-                                                     2 * slot + 1);
+  if (timing_) vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps_, 2 * slot + 1);
+  if (!counters_.valid()) return;
+  memoryBarrier(vk, cmd, kCounterShaderStages, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                VK_ACCESS_TRANSFER_READ_BIT);
+  const VkBufferCopy region{slot * counterBytes(), slot * counterBytes(), counterBytes()};
+  vk.vkCmdCopyBuffer(cmd, counters_.buffer, readback_.buffer, 1, &region);
+  // The host reads the copy after the frame's fence (collect()).
+  memoryBarrier(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                VK_ACCESS_HOST_READ_BIT);
 }
 
 }  // namespace rb

@@ -19,14 +19,17 @@ class PassMetrics {
   static constexpr uint32_t kCounterSlots = RB_RAY_COUNTER_SLOTS;
   static constexpr uint32_t kCountersPerFrame = 2 * kCounterSlots;
 
-  Status init(Context& ctx, const char* passName);
+  // `countsRays` = false (the denoiser): GPU time only, no counter buffers.
+  Status init(Context& ctx, const char* passName, bool countsRays = true);
   // Hands the counter buffer and the query pool to the context's deferred release (frames in flight may still
   // write them).
   void retire(Context& ctx);
 
-  // Collects finished frames, then resets this frame's slot. Call before recording the pass.
+  // Collects finished frames, then clears this frame's counters on the GPU (a fill behind a barrier). Call before
+  // recording the pass, outside a render pass.
   void beginRecording(Context& ctx, VkCommandBuffer cmd);
   void writeStart(Context& ctx, VkCommandBuffer cmd);
+  // The end timestamp, then the copy of this frame's counters to the host-visible readback buffer.
   void writeEnd(Context& ctx, VkCommandBuffer cmd);
   // The counter buffer of this frame's slot, for the shader's ray counters.
   VkBuffer counterBuffer() const { return counters_.buffer; }
@@ -40,7 +43,11 @@ class PassMetrics {
 
  private:
   void collect(Context& ctx);
-  GpuBuffer counters_;  // host-visible, framesInFlight * kCountersPerFrame uints
+  // The shaders' atomics go to device-local memory: atomics on host-visible memory cross the bus on a discrete
+  // GPU (one per pixel, which made them a measurable part of a pass; docs/performance.md). The host reads the
+  // copy in readback_ once the frame is done. Both hold framesInFlight * kCountersPerFrame uints.
+  GpuBuffer counters_;
+  GpuBuffer readback_;
   VkQueryPool timestamps_ = VK_NULL_HANDLE;
   std::vector<uint64_t> recordedFrame_;  // per slot; UINT64_MAX = nothing pending
   PassStats latest_;

@@ -150,7 +150,7 @@ Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTra
   Result<GpuBuffer> sbt =
       createBuffer(ctx, raygenSize + missSize + hitSize + base,
                    VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                   MemoryLocation::HostVisible, MemoryCategory::ShaderTables, "shader binding table");
+                   MemoryLocation::HostVisibleDeviceLocal, MemoryCategory::ShaderTables, "shader binding table");
   if (!sbt) {
     p.destroy(ctx);
     return sbt.error();

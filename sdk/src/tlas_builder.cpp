@@ -24,6 +24,14 @@ Status ensureBuffer(Context& ctx, GpuBuffer& buffer, VkDeviceSize bytes, VkBuffe
   return {};
 }
 
+// Whether the memory host-visible buffers get (gpu_memory.cpp: the first HOST_VISIBLE | HOST_COHERENT type) is
+// also device-local: an integrated GPU, a CPU driver, or a resizable BAR heap listed first.
+bool hostMemoryIsDeviceLocal(const Context::Impl& c) {
+  const VkMemoryPropertyFlags hostFlags = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  const int32_t type = c.findMemoryType(~0u, hostFlags, hostFlags);
+  return type >= 0 && (c.memoryProperties.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+}
+
 }  // namespace
 
 Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer cmd, std::span<const Instance> instances,
@@ -33,6 +41,13 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   std::lock_guard<std::mutex> lock(s.mutex);
   s.handOnDeferredRetires();
   if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "recordTlasBuild: cmd is VK_NULL_HANDLE"};
+  if (options.instanceUpload > TlasInstanceUpload::CopyToDevice ||
+      options.preference > TlasBuildPreference::FastBuild) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "recordTlasBuild: options.instanceUpload (" + std::to_string(int(options.instanceUpload)) +
+                     ") or options.preference (" + std::to_string(int(options.preference)) +
+                     ") is not one of its enum's values"};
+  }
   if (instances.size() > c.info.maxInstanceCount) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
                  "recordTlasBuild: " + std::to_string(instances.size()) + " instances exceed the device limit of " +
@@ -56,21 +71,44 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     retireBuffer(s.ctx, slot.instances);
     Status st = ensureBuffer(s.ctx, slot.instances, VkDeviceSize(capacity) * sizeof(VkAccelerationStructureInstanceKHR),
                              VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR |
-                                 VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                                 VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                              MemoryLocation::HostVisible, "TLAS instance buffer");
     if (!st) return st.error();
     slot.instanceCapacity = capacity;
+  }
+  const bool copyInstances = options.instanceUpload == TlasInstanceUpload::CopyToDevice ||
+                             (options.instanceUpload == TlasInstanceUpload::Auto && !hostMemoryIsDeviceLocal(c));
+  if (copyInstances) {
+    const VkDeviceSize need = VkDeviceSize(slot.instanceCapacity) * sizeof(VkAccelerationStructureInstanceKHR);
+    Status st = ensureBuffer(s.ctx, slot.deviceInstances, need,
+                             VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR |
+                                 VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                             MemoryLocation::DeviceLocal, "TLAS device instance buffer");
+    if (!st) return st.error();
+  } else if (slot.deviceInstances.valid()) {
+    retireBuffer(s.ctx, slot.deviceInstances);  // not read any more: held memory nothing uses
   }
 
   if (options.writeShadingRecords) {
     VkDeviceSize need = VkDeviceSize(std::max(slot.instanceCapacity, 1u)) * sizeof(ShadingRecord);
     if (slot.shading.size < need) {
       retireBuffer(s.ctx, slot.shading);
-      Status st = ensureBuffer(s.ctx, slot.shading, need, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+      Status st = ensureBuffer(s.ctx, slot.shading, need,
+                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                MemoryLocation::HostVisible, "TLAS shading records");
       if (!st) return st.error();
     }
+    if (copyInstances) {
+      // TRANSFER_SRC: the engine (or a test) may copy TlasInfo::shadingRecords, whichever buffer it is.
+      Status st = ensureBuffer(s.ctx, slot.deviceShading, need,
+                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                   VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                               MemoryLocation::DeviceLocal, "TLAS device shading records");
+      if (!st) return st.error();
+    }
   }
+  if ((!copyInstances || !options.writeShadingRecords) && slot.deviceShading.valid())
+    retireBuffer(s.ctx, slot.deviceShading);
 
   // Validate every handle before writing anything, so a bad list leaves the previous state untouched.
   for (uint32_t i = 0; i < count; ++i) {
@@ -175,7 +213,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   geometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
   geometry.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
   geometry.geometry.instances.arrayOfPointers = VK_FALSE;
-  geometry.geometry.instances.data.deviceAddress = slot.instances.address;
+  geometry.geometry.instances.data.deviceAddress = copyInstances ? slot.deviceInstances.address
+                                                                 : slot.instances.address;
 
   const bool wantUpdate = options.mode == TlasBuildMode::UpdateIfPossible;
   // A refit must start from an intact TLAS built for the same instances: the one recorded last, in whichever
@@ -190,7 +229,9 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
 
   VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
   info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
-  info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR |
+  info.flags = (options.preference == TlasBuildPreference::FastBuild
+                    ? VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR
+                    : VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR) |
                (wantUpdate ? VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR : 0);
   info.geometryCount = 1;
   info.pGeometries = &geometry;
@@ -241,6 +282,26 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   range.primitiveCount = written;
   const VkAccelerationStructureBuildRangeInfoKHR* rangePtr = &range;
 
+  if (copyInstances && written) {
+    // The build and the shaders that read this slot's device copies before (a service recorded twice into one
+    // command buffer across beginFrame()) are done before the copies overwrite them.
+    constexpr VkPipelineStageFlags readers = VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR |
+                                             VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
+    VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    before.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT;
+    before.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    c.vk.vkCmdPipelineBarrier(cmd, readers, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0, nullptr, 0, nullptr);
+    const VkBufferCopy instanceRegion{0, 0, VkDeviceSize(written) * sizeof(VkAccelerationStructureInstanceKHR)};
+    c.vk.vkCmdCopyBuffer(cmd, slot.instances.buffer, slot.deviceInstances.buffer, 1, &instanceRegion);
+    if (records) {
+      const VkBufferCopy recordRegion{0, 0, VkDeviceSize(written) * sizeof(ShadingRecord)};
+      c.vk.vkCmdCopyBuffer(cmd, slot.shading.buffer, slot.deviceShading.buffer, 1, &recordRegion);
+    }
+    VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    after.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT;
+    c.vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, readers, 0, 1, &after, 0, nullptr, 0, nullptr);
+  }
   // Earlier BLAS builds and this slot's previous use of its scratch must be complete.
   recordAsBarrier(c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
   c.vk.vkCmdBuildAccelerationStructuresKHR(cmd, 1, &info, &rangePtr);
@@ -264,7 +325,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   result.updated = source != nullptr;
   for (int i = 0; i < 3; ++i) result.originOffset[i] = options.originOffset[i];
   if (records) {
-    result.shadingRecords = slot.shading.buffer;
+    result.shadingRecords = copyInstances ? slot.deviceShading.buffer : slot.shading.buffer;
     result.shadingRecordsBytes = VkDeviceSize(std::max(written, 1u)) * sizeof(ShadingRecord);
   }
   return result;

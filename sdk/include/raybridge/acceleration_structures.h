@@ -185,8 +185,25 @@ enum class TlasBuildMode : uint8_t {
                      // (and BLAS copies: see DynamicBuildMode)
 };
 
+// Where the TLAS build reads the instance list from. The SDK writes it on the host into host-visible memory; on a
+// discrete GPU that memory sits across the bus, and a build that reads it there pays the bus's latency for every
+// instance (docs/performance.md, "TLAS").
+enum class TlasInstanceUpload : uint8_t {
+  Auto = 0,      // default: CopyToDevice where host-visible memory is not device-local, else ReadInPlace
+  ReadInPlace,   // the build reads the host-visible buffer directly (no copy, no device-local buffer)
+  CopyToDevice,  // vkCmdCopyBuffer into a device-local buffer first (one more buffer per frame slot)
+};
+
+// The build's trade-off for the TLAS (a BLAS of a static mesh is always built for fast trace).
+enum class TlasBuildPreference : uint8_t {
+  FastTrace = 0,  // default: VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR
+  FastBuild,      // VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR: for very many instances per frame
+};
+
 struct TlasBuildOptions {
   TlasBuildMode mode = TlasBuildMode::Rebuild;
+  TlasInstanceUpload instanceUpload = TlasInstanceUpload::Auto;
+  TlasBuildPreference preference = TlasBuildPreference::FastTrace;
   // Subtracted (in double precision) from every instance's translation, so a camera-relative TLAS keeps full
   // float precision far from the world origin. Default 0: world space.
   double originOffset[3] = {0.0, 0.0, 0.0};

@@ -1,0 +1,12 @@
+// The reflection rays' payload, shared by the ray generation, closest-hit and miss shaders.
+#ifndef RAYBRIDGE_REFLECTION_PAYLOAD_GLSL
+#define RAYBRIDGE_REFLECTION_PAYLOAD_GLSL
+
+struct ReflectionPayload {
+  vec3 radiance;
+  // Shadow rays the closest-hit shader traced from the hit (sun, local light): the ray generation shader counts
+  // them with its own rays in one atomic, instead of one atomic per shadow ray.
+  uint shadowRays;
+};
+
+#endif
