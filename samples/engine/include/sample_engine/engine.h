@@ -208,7 +208,8 @@ struct SsaoSettings {
   // Depth taps per pixel, clamped to [1, kMaxSsaoKernelSize] (0 = 1): floor(sqrt(kernelSize / 2)) slices (at
   // least 1), each searched with kernelSize / (2 * slices) taps per side (at least 1); 16 = 2 slices x 4 taps.
   uint32_t kernelSize = kDefaultSsaoKernelSize;
-  // World units: occluders farther away do not count (faded out over its last 20%); 0 = nothing occludes.
+  // World units: occluders farther away do not count (faded out over its last 20%); the search also stops a
+  // quarter of the render height from the pixel on screen. 0 = nothing occludes.
   float radius = kDefaultSsaoRadius;
   // World units: the horizon search starts this far above the surface along its normal, so that depth
   // quantisation on flat ground does not occlude; 0 = none, negative = 0.
