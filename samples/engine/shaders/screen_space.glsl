@@ -10,7 +10,7 @@ vec3 eyeRelativeFromDepth(vec2 uv, float depth) {
 }
 
 // View-space z of a depth value: only the z and w rows of invProj matter for a perspective projection, which
-// makes this two FMAs and a divide (the SSAO inner loop runs it once per kernel point).
+// makes this two FMAs and a divide (the SSAO horizon search runs it once per depth tap).
 float viewZFromDepth(float depth) {
   return (frame.invProj[2][2] * depth + frame.invProj[3][2]) / (frame.invProj[2][3] * depth + frame.invProj[3][3]);
 }

@@ -20,17 +20,19 @@ std::string Engine::Impl::init(const EngineConfig& config) {
   if (std::string e = defaults.create(gpu); !e.empty()) return e;
   if (std::string e = probe.create(gpu, ctx, pipelines); !e.empty()) return e;
 
-  // Per frame: frame uniforms, lighting inputs, tonemap input and the three effect passes' inputs.
+  // Per frame: frame uniforms, lighting inputs, tonemap input and the three effect passes' inputs (SSAO, its
+  // blur: one sampled and storage set each; shadow visibility).
   constexpr uint32_t kSetsPerFrame = 6;
   // The lighting set also holds the KHR light buffer (storage) and the local shadow views (uniform).
-  constexpr uint32_t kSamplersPerFrame = kLightingSetSamplers + 1 + 3 * kScreenSetBindings;
+  constexpr uint32_t kSamplersPerFrame = kLightingSetSamplers + 1 + kScreenSetBindings + 2 * kSsaoSetSamplers;
   const VkDevice dev = ctx.device;
-  VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 * kFramesInFlight},
+  VkDescriptorPoolSize sizes[4] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 * kFramesInFlight},
                                    {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kSamplersPerFrame * kFramesInFlight},
-                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kFramesInFlight}};
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kFramesInFlight},
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2 * kFramesInFlight}};
   VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pci.maxSets = kSetsPerFrame * kFramesInFlight;
-  pci.poolSizeCount = 3;
+  pci.poolSizeCount = 4;
   pci.pPoolSizes = sizes;
   SE_VK_TRY(vkCreateDescriptorPool(dev, &pci, nullptr, &framePool));
 
@@ -55,8 +57,8 @@ std::string Engine::Impl::init(const EngineConfig& config) {
         !e.empty())
       return e;
     VkDescriptorSetLayout layouts[kSetsPerFrame] = {pipelines.frameSetLayout,   pipelines.lightingSetLayout,
-                                                    pipelines.tonemapSetLayout, pipelines.screenSetLayout,
-                                                    pipelines.screenSetLayout,  pipelines.screenSetLayout};
+                                                    pipelines.tonemapSetLayout, pipelines.ssaoSetLayout,
+                                                    pipelines.ssaoSetLayout,    pipelines.screenSetLayout};
     VkDescriptorSet sets[kSetsPerFrame];
     VkDescriptorSetAllocateInfo dai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     dai.descriptorPool = framePool;

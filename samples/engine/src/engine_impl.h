@@ -42,9 +42,9 @@ struct FrameResources {
   VkDescriptorSet frameSet = VK_NULL_HANDLE;
   VkDescriptorSet lightingSet = VK_NULL_HANDLE;
   VkDescriptorSet tonemapSet = VK_NULL_HANDLE;
-  VkDescriptorSet ssaoSet = VK_NULL_HANDLE;  // screen-pass inputs (Pipelines::screenSetLayout)
+  VkDescriptorSet ssaoSet = VK_NULL_HANDLE;  // SSAO compute inputs and output (Pipelines::ssaoSetLayout)
   VkDescriptorSet ssaoBlurSet = VK_NULL_HANDLE;
-  VkDescriptorSet shadowVisibilitySet = VK_NULL_HANDLE;
+  VkDescriptorSet shadowVisibilitySet = VK_NULL_HANDLE;  // Pipelines::screenSetLayout
   // KHR lights (local_lights.cpp): the light buffer and shadow views the lighting reads, one FrameUniforms copy
   // per local shadow view (its lightViewProj replaced) and their sets, the irradiance output's inputs.
   detail::Buffer localLightBuffer, localShadowBuffer, shadowViewUniforms;
@@ -133,7 +133,7 @@ struct Engine::Impl {
                    std::optional<uint32_t> swapchainImage, bool captureProbe, const detail::ProbeKey& probeKey);
 
   // effect_passes.cpp: create the effect images a frame needs, then record the passes (each leaves its
-  // output in SHADER_READ_ONLY_OPTIMAL, visible to fragment shaders).
+  // output in SHADER_READ_ONLY_OPTIMAL, visible to fragment shaders; the SSAO images also to compute).
   std::string ensureEffectImages(const FrameParams& params);
   void recordSsao(FrameResources& frame, const SsaoSettings& settings);
   void recordShadowVisibility(FrameResources& frame);

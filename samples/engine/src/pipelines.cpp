@@ -30,6 +30,21 @@ VkDescriptorSetLayoutBinding samplerBinding(uint32_t binding) {
   return {binding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
 }
 
+VkDescriptorSetLayoutBinding computeBinding(uint32_t binding, VkDescriptorType type) {
+  return {binding, type, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+}
+
+std::string makeComputePipeline(VkDevice device, VkShaderModule module, VkPipelineLayout layout, VkPipeline& out) {
+  VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  ci.stage.module = module;
+  ci.stage.pName = "main";
+  ci.layout = layout;
+  SE_VK_TRY(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &out));
+  return {};
+}
+
 VkDescriptorSetLayoutBinding bufferBinding(uint32_t binding, VkDescriptorType type) {
   return {binding, type, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
 }
@@ -168,7 +183,8 @@ std::string Pipelines::create(VkDevice device) {
   };
   check(makeSetLayout(device,
                       {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1,
-                        VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, nullptr}},
+                        VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT | VK_SHADER_STAGE_COMPUTE_BIT,
+                        nullptr}},
                       frameSetLayout));
   check(makeSetLayout(device,
                       {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3), samplerBinding(4)},
@@ -186,6 +202,12 @@ std::string Pipelines::create(VkDevice device) {
   check(makeSetLayout(device, {samplerBinding(0)}, tonemapSetLayout));
   check(makeSetLayout(device, {samplerBinding(0), samplerBinding(1), samplerBinding(2), samplerBinding(3)},
                       screenSetLayout));
+  check(makeSetLayout(device,
+                      {computeBinding(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER),
+                       computeBinding(1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER),
+                       computeBinding(2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER),
+                       computeBinding(kSsaoOutputBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE)},
+                      ssaoSetLayout));
   if (!e.empty()) return e;
 
   VkPushConstantRange drawRange{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(DrawConstants)};
@@ -201,22 +223,25 @@ std::string Pipelines::create(VkDevice device) {
   lci.pSetLayouts = &tonemapSetLayout;
   lci.pPushConstantRanges = &tonemapRange;
   SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &tonemapLayout));
-  VkPushConstantRange screenRange{VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(SsaoConstants)};
-  VkDescriptorSetLayout screenSets[2] = {frameSetLayout, screenSetLayout};
+  VkPushConstantRange ssaoRange{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(SsaoConstants)};
+  VkDescriptorSetLayout ssaoSets[2] = {frameSetLayout, ssaoSetLayout};
   lci.setLayoutCount = 2;
+  lci.pSetLayouts = ssaoSets;
+  lci.pPushConstantRanges = &ssaoRange;
+  SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &ssaoLayout));
+  VkDescriptorSetLayout screenSets[2] = {frameSetLayout, screenSetLayout};
   lci.pSetLayouts = screenSets;
-  lci.pPushConstantRanges = &screenRange;
+  lci.pushConstantRangeCount = 0;
+  lci.pPushConstantRanges = nullptr;
   SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &screenLayout));
   VkDescriptorSetLayout irradianceSets[2] = {frameSetLayout, localIrradianceSetLayout};
   lci.pSetLayouts = irradianceSets;
-  lci.pushConstantRangeCount = 0;
-  lci.pPushConstantRanges = nullptr;
   SE_VK_TRY(vkCreatePipelineLayout(device, &lci, nullptr, &localIrradianceLayout));
 
   VkShaderModule meshVert = VK_NULL_HANDLE, shadowVert = VK_NULL_HANDLE, shadowAlphaVert = VK_NULL_HANDLE,
                  shadowAlphaFrag = VK_NULL_HANDLE, prepassFrag = VK_NULL_HANDLE, forwardFrag = VK_NULL_HANDLE,
-                 fullscreenVert = VK_NULL_HANDLE, tonemapFrag = VK_NULL_HANDLE, ssaoFrag = VK_NULL_HANDLE,
-                 ssaoBlurFrag = VK_NULL_HANDLE, shadowVisibilityFrag = VK_NULL_HANDLE,
+                 fullscreenVert = VK_NULL_HANDLE, tonemapFrag = VK_NULL_HANDLE, ssaoComp = VK_NULL_HANDLE,
+                 ssaoBlurComp = VK_NULL_HANDLE, shadowVisibilityFrag = VK_NULL_HANDLE,
                  localIrradianceFrag = VK_NULL_HANDLE;
   check(makeModule(device, spirv::mesh_vert, meshVert));
   check(makeModule(device, spirv::shadow_vert, shadowVert));
@@ -226,8 +251,8 @@ std::string Pipelines::create(VkDevice device) {
   check(makeModule(device, spirv::forward_frag, forwardFrag));
   check(makeModule(device, spirv::fullscreen_vert, fullscreenVert));
   check(makeModule(device, spirv::tonemap_frag, tonemapFrag));
-  check(makeModule(device, spirv::ssao_frag, ssaoFrag));
-  check(makeModule(device, spirv::ssao_blur_frag, ssaoBlurFrag));
+  check(makeModule(device, spirv::ssao_comp, ssaoComp));
+  check(makeModule(device, spirv::ssao_blur_comp, ssaoBlurComp));
   check(makeModule(device, spirv::shadow_visibility_frag, shadowVisibilityFrag));
   check(makeModule(device, spirv::local_irradiance_frag, localIrradianceFrag));
   if (e.empty()) {
@@ -296,20 +321,19 @@ std::string Pipelines::create(VkDevice device) {
 
     d.colorFormats = {kEffectFormat};
     d.layout = screenLayout;
-    d.frag = ssaoFrag;
-    check(makePipeline(device, d, ssao));
-    d.frag = ssaoBlurFrag;
-    check(makePipeline(device, d, ssaoBlur));
     d.frag = shadowVisibilityFrag;
     check(makePipeline(device, d, shadowVisibility));
     d.colorFormats = {kNormalFormat};
     d.layout = localIrradianceLayout;
     d.frag = localIrradianceFrag;
     check(makePipeline(device, d, localIrradiance));
+
+    check(makeComputePipeline(device, ssaoComp, ssaoLayout, ssao));
+    check(makeComputePipeline(device, ssaoBlurComp, ssaoLayout, ssaoBlur));
   }
   for (VkShaderModule m :
        {meshVert, shadowVert, shadowAlphaVert, shadowAlphaFrag, prepassFrag, forwardFrag, fullscreenVert, tonemapFrag,
-        ssaoFrag, ssaoBlurFrag, shadowVisibilityFrag, localIrradianceFrag})
+        ssaoComp, ssaoBlurComp, shadowVisibilityFrag, localIrradianceFrag})
     if (m) vkDestroyShaderModule(device, m, nullptr);
   if (!e.empty()) return e;
 
@@ -327,10 +351,10 @@ void Pipelines::destroy(VkDevice device) {
   for (VkPipeline p : {shadow, shadowAlpha, prepass, prepassMasked, forward, forwardMasked, blend, tonemap,
                        probeCapture, probeCaptureMasked, ssao, ssaoBlur, shadowVisibility, localIrradiance})
     if (p) vkDestroyPipeline(device, p, nullptr);
-  for (VkPipelineLayout l : {sceneLayout, tonemapLayout, screenLayout, localIrradianceLayout})
+  for (VkPipelineLayout l : {sceneLayout, tonemapLayout, screenLayout, ssaoLayout, localIrradianceLayout})
     if (l) vkDestroyPipelineLayout(device, l, nullptr);
   for (VkDescriptorSetLayout l : {frameSetLayout, materialSetLayout, lightingSetLayout, tonemapSetLayout,
-                                  screenSetLayout, localIrradianceSetLayout})
+                                  screenSetLayout, ssaoSetLayout, localIrradianceSetLayout})
     if (l) vkDestroyDescriptorSetLayout(device, l, nullptr);
   for (VkSampler s : {materialSampler, screenSampler, shadowSampler, nearestSampler, cubeSampler})
     if (s) vkDestroySampler(device, s, nullptr);

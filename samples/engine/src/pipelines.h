@@ -61,28 +61,39 @@ inline constexpr uint32_t kLightingLocalLightBinding = 5;  // the three bindings
 // The local-irradiance pass's set 1: 0 depth, 1 shading normal, 2 geometric normal, 3-5 local_lights.glsl.
 inline constexpr uint32_t kLocalIrradianceLocalLightBinding = 3;
 
-// Mirror of SsaoConstants in shaders/ssao.frag and ssao_blur.frag (push constants of the fullscreen passes).
+// The SSAO compute passes' set 1 (shaders/ssao_inputs.glsl): 0 depth, 1 geometric normal, 2 raw AO (the blur's
+// input) as combined image samplers, 3 the output (storage image, kEffectFormat).
+inline constexpr uint32_t kSsaoSetSamplers = 3;
+inline constexpr uint32_t kSsaoOutputBinding = 3;
+
+// Mirror of SsaoConstants in shaders/ssao_inputs.glsl (push constants of ssao.comp and ssao_blur.comp).
 struct SsaoConstants {
-  float radius;
-  float bias;
-  float power;
-  uint32_t kernelSize;
+  float radius;           // SsaoSettings::radius, world units
+  float bias;             // SsaoSettings::bias, world units along the normal
+  float power;            // SsaoSettings::power
+  uint32_t sliceCount;    // from SsaoSettings::kernelSize (see there)
+  uint32_t stepsPerSide;  // from SsaoSettings::kernelSize
 };
+static_assert(offsetof(SsaoConstants, sliceCount) == 12);
+static_assert(offsetof(SsaoConstants, stepsPerSide) == 16);
+static_assert(sizeof(SsaoConstants) == 20);
 
 struct Pipelines {
   // Scene passes: set 0 frame uniforms; set 1 material textures; set 2 lighting inputs (shadow map,
   // visibility / AO / reflection images, reflection-probe cube).
-  // Fullscreen effect passes (SSAO, its blur, shadow visibility): set 0 frame uniforms; set 1 up to
-  // kScreenSetBindings sampled images; push constants SsaoConstants.
+  // Fullscreen shadow-visibility pass: set 0 frame uniforms; set 1 up to kScreenSetBindings sampled images.
+  // SSAO compute passes: set 0 frame uniforms; set 1 ssaoSetLayout; push constants SsaoConstants.
   VkDescriptorSetLayout frameSetLayout = VK_NULL_HANDLE;
   VkDescriptorSetLayout materialSetLayout = VK_NULL_HANDLE;
   VkDescriptorSetLayout lightingSetLayout = VK_NULL_HANDLE;
   VkDescriptorSetLayout tonemapSetLayout = VK_NULL_HANDLE;
   VkDescriptorSetLayout screenSetLayout = VK_NULL_HANDLE;
+  VkDescriptorSetLayout ssaoSetLayout = VK_NULL_HANDLE;
   VkDescriptorSetLayout localIrradianceSetLayout = VK_NULL_HANDLE;
   VkPipelineLayout sceneLayout = VK_NULL_HANDLE;
   VkPipelineLayout tonemapLayout = VK_NULL_HANDLE;
   VkPipelineLayout screenLayout = VK_NULL_HANDLE;
+  VkPipelineLayout ssaoLayout = VK_NULL_HANDLE;
   VkPipelineLayout localIrradianceLayout = VK_NULL_HANDLE;  // set 0 frame uniforms, set 1 localIrradianceSetLayout
   // Scene pipelines come in pairs: OPAQUE draws, and MASK draws (*Masked: the alpha test's discard, which the
   // opaque ones lack so that their depth writes keep early depth tests). BLEND draws use `blend` (and the
@@ -100,8 +111,8 @@ struct Pipelines {
   VkPipeline tonemap = VK_NULL_HANDLE;
   VkPipeline probeCapture = VK_NULL_HANDLE;  // forward shading with its own depth test (LESS, writes)
   VkPipeline probeCaptureMasked = VK_NULL_HANDLE;
-  VkPipeline ssao = VK_NULL_HANDLE;
-  VkPipeline ssaoBlur = VK_NULL_HANDLE;
+  VkPipeline ssao = VK_NULL_HANDLE;      // compute: GTAO horizon search (shaders/ssao.comp)
+  VkPipeline ssaoBlur = VK_NULL_HANDLE;  // compute: its depth-aware 4x4 blur (shaders/ssao_blur.comp)
   VkPipeline shadowVisibility = VK_NULL_HANDLE;
   VkPipeline localIrradiance = VK_NULL_HANDLE;  // fullscreen, RGBA16F: the engine's KHR-light irradiance E
   VkSampler materialSampler = VK_NULL_HANDLE;   // trilinear, repeat

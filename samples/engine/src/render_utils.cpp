@@ -182,12 +182,11 @@ void writeImageDescriptors(VkDevice device, VkDescriptorSet set, const std::vect
 }
 
 void drawFullscreen(VkCommandBuffer cmd, const Pipelines& p, VkPipeline pipeline, VkDescriptorSet frameSet,
-                    VkDescriptorSet inputSet, const SsaoConstants& constants, VkImageView target, VkExtent2D extent) {
+                    VkDescriptorSet inputSet, VkImageView target, VkExtent2D extent) {
   beginRendering(cmd, extent, {colorAttachment(target, {{1.0f, 1.0f, 1.0f, 1.0f}})}, nullptr);
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
   VkDescriptorSet sets[2] = {frameSet, inputSet};
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.screenLayout, 0, 2, sets, 0, nullptr);
-  vkCmdPushConstants(cmd, p.screenLayout, VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(constants), &constants);
   vkCmdDraw(cmd, 3, 1, 0, 0);
   vkCmdEndRendering(cmd);
 }

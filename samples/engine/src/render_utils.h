@@ -74,10 +74,10 @@ struct LocalLightBindings {
 void writeLocalLightDescriptors(VkDevice device, const Pipelines& p, VkDescriptorSet set, uint32_t firstBinding,
                                 const LocalLightBindings& bindings);
 
-// Binds `pipeline` (a fullscreen pipeline of Pipelines::screenLayout) with `frameSet` / `inputSet` and
-// `constants`, and draws one triangle into `target` (cleared to 1: "open" / "lit" for the effect images).
-// The target must be in COLOR_ATTACHMENT_OPTIMAL.
+// Binds `pipeline` (a fullscreen pipeline of Pipelines::screenLayout) with `frameSet` / `inputSet`, and draws
+// one triangle into `target` (cleared to 1: "lit" for the effect images). The target must be in
+// COLOR_ATTACHMENT_OPTIMAL.
 void drawFullscreen(VkCommandBuffer cmd, const Pipelines& p, VkPipeline pipeline, VkDescriptorSet frameSet,
-                    VkDescriptorSet inputSet, const SsaoConstants& constants, VkImageView target, VkExtent2D extent);
+                    VkDescriptorSet inputSet, VkImageView target, VkExtent2D extent);
 
 }  // namespace sample_engine::detail

@@ -186,8 +186,10 @@ std::string VulkanContext::create(const EngineConfig& config) {
     f12.pNext = &f13;
     VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12, {}};
     vkGetPhysicalDeviceFeatures2(pd, &f2);
-    if (!f13.dynamicRendering || !f13.synchronization2 || !f12.separateDepthStencilLayouts || !f12.timelineSemaphore) {
-      reject("dynamicRendering / synchronization2 / separateDepthStencilLayouts / timelineSemaphore unsupported");
+    if (!f13.dynamicRendering || !f13.synchronization2 || !f12.separateDepthStencilLayouts || !f12.timelineSemaphore ||
+        !f2.features.shaderStorageImageExtendedFormats) {
+      reject("dynamicRendering / synchronization2 / separateDepthStencilLayouts / timelineSemaphore / "
+             "shaderStorageImageExtendedFormats unsupported");
       continue;
     }
     candidates.push_back(c);
@@ -226,6 +228,7 @@ std::string VulkanContext::create(const EngineConfig& config) {
   f13.synchronization2 = VK_TRUE;
   f12.separateDepthStencilLayouts = VK_TRUE;  // lets the pre-pass depth sit in DEPTH_READ_ONLY_OPTIMAL
   f12.timelineSemaphore = VK_TRUE;            // the deformation submission signals a timeline semaphore per frame
+  f2.features.shaderStorageImageExtendedFormats = VK_TRUE;  // the SSAO compute passes write R16F storage images
   // Required by Vulkan 1.3, so always on: the deformation pass reads and writes vertex buffers through
   // device addresses. Scene buffers expose addresses only with enableRayTracingInputs (info.bufferDeviceAddress).
   f12.bufferDeviceAddress = supported12.bufferDeviceAddress;

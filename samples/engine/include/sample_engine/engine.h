@@ -192,17 +192,30 @@ struct LocalShadowStats {
   uint64_t frameNumber = 0;     // Engine::frameNumber() of that frame; 0 before the first frame
 };
 
-// The engine's own screen-space ambient occlusion (Crytek / LearnOpenGL hemisphere kernel with range check),
-// computed from the pre-pass depth and geometric normals into an R16F image (1 = open). The lighting pass
-// multiplies its ambient terms by it unless LightingInputs::ambientOcclusion is set; it is computed whenever
-// enabled, so readbackSsao() also works next to an external AO input (e.g. to compare the two).
+// The engine's own screen-space ambient occlusion: GTAO (Jimenez et al. 2016) in compute. Per pixel, slices
+// through the view vector; in each, the pre-pass depth is searched on both sides for the highest horizon within
+// `radius`, and the cosine-weighted visible arc is integrated analytically against the pre-pass geometric
+// normal projected into the slice. The result (normalised so that an unoccluded surface is exactly 1) goes
+// into an R16F image (1 = open). The lighting pass multiplies its ambient terms by it unless
+// LightingInputs::ambientOcclusion is set; it is computed whenever enabled, so readbackSsao() also works next
+// to an external AO input (e.g. to compare the two).
+inline constexpr uint32_t kDefaultSsaoKernelSize = 16;
+inline constexpr uint32_t kMaxSsaoKernelSize = 64;
+inline constexpr float kDefaultSsaoRadius = 0.5f;
+inline constexpr float kDefaultSsaoBias = 0.025f;
 struct SsaoSettings {
   bool enabled = false;
-  uint32_t kernelSize = 16;  // samples per pixel, clamped to [1, 64]
-  float radius = 0.5f;       // hemisphere radius, world units
-  float bias = 0.025f;       // depth difference (world units) below which a sample does not occlude
-  float power = 1.0f;        // ao = (1 - occluded fraction)^power
-  bool blur = true;          // 4x4 depth/plane-aware blur that removes the 4x4 kernel-rotation pattern
+  // Depth taps per pixel, clamped to [1, kMaxSsaoKernelSize] (0 = 1): floor(sqrt(kernelSize / 2)) slices (at
+  // least 1), each searched with kernelSize / (2 * slices) taps per side (at least 1); 16 = 2 slices x 4 taps.
+  uint32_t kernelSize = kDefaultSsaoKernelSize;
+  // World units: occluders farther away do not count (faded out over its last 20%); the search also stops a
+  // quarter of the render height from the pixel on screen. 0 = nothing occludes.
+  float radius = kDefaultSsaoRadius;
+  // World units: the horizon search starts this far above the surface along its normal, so that depth
+  // quantisation on flat ground does not occlude; 0 = none, negative = 0.
+  float bias = kDefaultSsaoBias;
+  float power = 1.0f;  // ao = visibility^power; 0 = no darkening (ao = 1)
+  bool blur = true;    // 4x4 depth/plane-aware blur that removes the 4x4 slice-rotation pattern
 };
 
 // A static reflection probe: a small cubemap captured from one point with the engine's forward shading (sun,
@@ -395,7 +408,7 @@ struct PassTimings {
   double shadowMs = 0.0;
   double probeMs = 0.0;  // reflection-probe capture (0 on frames without a capture)
   double prepassMs = 0.0;
-  double ssaoMs = 0.0;              // SSAO + blur (0 when disabled)
+  double ssaoMs = 0.0;              // SSAO (GTAO) + blur, both compute (0 when disabled)
   double shadowVisibilityMs = 0.0;  // shadow-visibility output (0 unless requested)
   double hookMs = 0.0;              // whatever the hook recorded
   double lightingMs = 0.0;          // opaque lighting and the blended surfaces after it

@@ -1,27 +1,17 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// 4x4 box blur of the raw SSAO image (one full period of its 4x4 kernel-rotation pattern), restricted to
+// 4x4 box blur of the raw GTAO image (one full period of its 4x4 slice-rotation pattern), restricted to
 // neighbours close to the pixel's tangent plane so that occlusion does not bleed across silhouettes.
 #include "frame_uniforms.glsl"
 #include "screen_space.glsl"
-
-layout(set = 1, binding = 0) uniform sampler2D depthTex;
-layout(set = 1, binding = 1) uniform sampler2D normalTex;  // geometric normal (world)
-layout(set = 1, binding = 2) uniform sampler2D rawAo;
-layout(push_constant) uniform SsaoConstants {
-  float radius;
-  float bias;
-  float power;
-  uint kernelSize;
-} pc;
-
-layout(location = 0) out float outAo;
+#include "ssao_inputs.glsl"
 
 void main() {
-  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  ivec2 pixel;
+  if (!ssaoPixel(pixel)) return;
   float depth = texelFetch(depthTex, pixel, 0).r;
   if (depth >= 1.0) {
-    outAo = 1.0;
+    imageStore(outAo, pixel, vec4(1.0));
     return;
   }
   ivec2 last = ivec2(frame.viewport.xy) - 1;
@@ -39,5 +29,5 @@ void main() {
       sum += texelFetch(rawAo, q, 0).r;
       weight += 1.0;
     }
-  outAo = weight > 0.0 ? sum / weight : texelFetch(rawAo, pixel, 0).r;
+  imageStore(outAo, pixel, vec4(weight > 0.0 ? sum / weight : texelFetch(rawAo, pixel, 0).r));
 }
