@@ -108,5 +108,8 @@
 #define RB_RAY_COUNTER_SLOTS 4096
 #define RB_RAY_COUNTER_SLOT(x, y) (((x) & 63u) | (((y) & 63u) << 6))
 // Any-hit invocations are counted the same way, in the RB_RAY_COUNTER_SLOTS counters after the ray counters.
+// Then RB_RAY_COUNTER_TILE_UINTS more: the tiles a classifier traced and skipped, and padding that keeps each
+// frame's counters a multiple of 256 bytes (the largest minStorageBufferOffsetAlignment).
+#define RB_RAY_COUNTER_TILE_UINTS 64
 
 #endif
