@@ -35,7 +35,7 @@ struct ShadowConstants {
   float tanAngularRadius;    // 208: of a directional light's disk; 0 = hard shadows
   float range;               // 212: of a point or spot light; 0 = unlimited
   uint raysPerPixel;         // 216
-  uint pad0;                 // 220
+  uint launchOverTiles;      // 220: 1 = the launch covers the tile classifier's list (shadow_tiles.glsl)
 };
 
 // AoPass. 176 bytes.

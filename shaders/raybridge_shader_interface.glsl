@@ -13,6 +13,7 @@
 // Pass-specific bindings of set 0.
 #define RB_SHADOW_BINDING_VISIBILITY 5
 #define RB_SHADOW_BINDING_HIT_DISTANCE 6  // only in the module that writes it (shadow_distance.rgen)
+#define RB_SHADOW_BINDING_TILES 9         // the tile classifier's list and trace arguments (shadow_tiles.glsl)
 #define RB_AO_BINDING_OUTPUT 5
 #define RB_REFLECTION_BINDING_ROUGHNESS_METALNESS 5  // the normal image again when roughness is in normal.w
 #define RB_REFLECTION_BINDING_RADIANCE 6
@@ -73,6 +74,11 @@
 #define RB_LIGHT_POINT 1u
 #define RB_LIGHT_SPOT 2u
 
+// The shadow pass's tile classifier: tiles of RB_SHADOW_TILE_SIZE^2 pixels (one workgroup each), and the uints
+// before the tile list (a VkTraceRaysIndirectCommandKHR, padded to 16 bytes).
+#define RB_SHADOW_TILE_SIZE 8
+#define RB_SHADOW_TILE_HEADER_UINTS 4
+
 // ManyLightConstants::mode: the values of rb::ManyLightMode.
 #define RB_ML_STOCHASTIC 0u
 #define RB_ML_EXACT 1u
@@ -108,5 +114,8 @@
 #define RB_RAY_COUNTER_SLOTS 4096
 #define RB_RAY_COUNTER_SLOT(x, y) (((x) & 63u) | (((y) & 63u) << 6))
 // Any-hit invocations are counted the same way, in the RB_RAY_COUNTER_SLOTS counters after the ray counters.
+// Then RB_RAY_COUNTER_TILE_UINTS more: the tiles a classifier traced and skipped, and padding that keeps each
+// frame's counters a multiple of 256 bytes (the largest minStorageBufferOffsetAlignment).
+#define RB_RAY_COUNTER_TILE_UINTS 64
 
 #endif

@@ -1,10 +1,13 @@
 // Shadow rays from G-buffer surfaces towards a directional, point or spot light. Hard: one ray to the light's
 // centre. Soft: n rays over the light's disk (stratified Fibonacci spiral, rotated per pixel and frame).
-// No ray for sky pixels, surfaces facing away from the light, or pixels outside a spot cone or light range.
+// No ray for sky pixels, surfaces facing away from the light, or pixels outside a spot cone or light range
+// (rbShadowPixel, shared with the tile classifier). With the classifier the launch covers its tile list
+// (pc.launchOverTiles); the tiles it left out already hold their outputs.
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ShadowPushConstants { ShadowConstants pc; };
-#include "pass_inputs.glsl"
 #include "ray_counters.glsl"
+#include "shadow_pixel.glsl"
+#include "shadow_tiles.glsl"
 
 // RB_WRITE_HIT_DISTANCE (set by shadow_distance.rgen) adds the occluder-distance output. A separate module
 // rather than a specialization constant: the binding must not exist at all when the image is not allocated.
@@ -15,9 +18,6 @@ const bool kWriteHitDistance = false;
 #endif
 
 layout(set = 0, binding = RB_BINDING_TLAS) uniform accelerationStructureEXT tlas;
-layout(set = 0, binding = RB_BINDING_DEPTH) uniform sampler2D gDepth;
-layout(set = 0, binding = RB_BINDING_NORMAL) uniform sampler2D gNormal;
-layout(set = 0, binding = RB_BINDING_GEOMETRIC_NORMAL) uniform sampler2D gGeometricNormal;
 layout(set = 0, binding = RB_SHADOW_BINDING_VISIBILITY, r16f) uniform writeonly image2D outVisibility;
 #ifdef RB_WRITE_HIT_DISTANCE
 layout(set = 0, binding = RB_SHADOW_BINDING_HIT_DISTANCE, r32f) uniform writeonly image2D outHitDistance;
@@ -27,84 +27,61 @@ layout(set = 0, binding = RB_SHADOW_BINDING_HIT_DISTANCE, r32f) uniform writeonl
 layout(location = 0) rayPayloadEXT float hitT;
 
 void main() {
-  uvec2 pixel = gl_LaunchIDEXT.xy;
+  uvec2 pixel = pc.launchOverTiles != 0u ? rbShadowListedPixel(gl_LaunchIDEXT.xy) : gl_LaunchIDEXT.xy;
   if (any(greaterThanEqual(pixel, pc.gbuffer.size))) return;
   ivec2 ip = ivec2(pixel);
-  float depth = texelFetch(gDepth, ip, 0).r;
-  float visibility = 0.0;
+  ShadowPixel sp = rbShadowPixel(pixel);
+  float visibility = rbShadowUntracedVisibility(sp.kind);
   float nearest = 0.0;
   uint rays = 0u;
-  if (rbIsSky(depth)) {
-    visibility = 1.0;  // nothing to shadow; lighting ignores sky pixels anyway
-  } else {
-    vec3 n = rbDecodeNormal(texelFetch(gNormal, ip, 0), rbNormalEncoding());
-    vec3 ng = (pc.gbuffer.flags & RB_GB_GEOMETRIC_NORMAL) != 0u
-                  ? rbDecodeNormal(texelFetch(gGeometricNormal, ip, 0), rbNormalEncoding())
-                  : n;
-    vec3 facing;
-    vec3 origin = rbRayOrigin(pixel, depth, ng, facing);
-    vec3 surface = rbSurfacePoint(pixel, depth);
-    uint type = pc.lightType;
-    bool directional = type == RB_LIGHT_DIRECTIONAL;
+  if (sp.kind == RB_SHADOW_PIXEL_TRACE) {
+    vec3 origin = sp.origin;
+    vec3 toLight = sp.toLight;
+    bool directional = pc.lightType == RB_LIGHT_DIRECTIONAL;
     // The light's extent: a directional light's disk (as a slope) or a point or spot light's sphere.
     float spread = directional ? pc.tanAngularRadius : pc.lightRadius;
-    vec3 toLight;
-    float lightDistance;
-    if (directional) {
-      toLight = normalize(pc.lightDirection);
-      lightDistance = 1e30;
-    } else {
-      toLight = pc.lightPosition - surface;
-      lightDistance = length(toLight);
-      toLight /= max(lightDistance, 1e-20);
-    }
-    bool inRange = pc.range <= 0.0 || lightDistance <= pc.range;
-    bool inCone = type != RB_LIGHT_SPOT || dot(-toLight, normalize(pc.spotDirection)) >= pc.cosSpotOuterAngle;
-    // The shading normal decides: where it faces away, lighting is zero whatever a ray would find.
-    if (dot(n, toLight) > 0.0 && dot(facing, toLight) > -0.05 && inRange && inCone) {
-      uint count = max(pc.raysPerPixel, 1u);
-      uint seed = rbPcg(pixel.x + pc.gbuffer.size.x * pixel.y + rbPcg(pc.gbuffer.frameIndex));
-      float jitter = rbToUnit(seed);
-      float rotation = rbToUnit(rbPcg(seed)) * 2.0 * RB_PI;
-      vec3 t, b;
-      rbBasis(toLight, t, b);
-      uint visible = 0u;
-      // Without the distance output any occluder will do: stop at the first and skip the hit shader.
-      // Opaque fast path unless the TLAS has non-opaque geometry (alpha-tested by the any-hit shader).
-      uint flags = (pc.gbuffer.flags & RB_GB_ALPHA_TEST) != 0u ? gl_RayFlagsNoneEXT : gl_RayFlagsOpaqueEXT;
-      if (!kWriteHitDistance) flags |= gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT;
-      nearest = 1e30;
-      for (uint i = 0u; i < count; ++i) {
-        vec3 dir;
-        float tMax;
-        if (spread > 0.0) {
-          vec2 d = count == 1u ? vec2(0.0) : rbFibonacciDisk(i, count, jitter, rotation);
-          if (directional) {
-            dir = normalize(toLight + spread * (d.x * t + d.y * b));
-            tMax = 1e30;
-          } else {
-            vec3 target = pc.lightPosition + spread * (d.x * t + d.y * b);
-            dir = target - origin;
-            tMax = length(dir);
-            dir /= tMax;
-            tMax *= 0.999;
-          }
+    uint count = max(pc.raysPerPixel, 1u);
+    uint seed = rbPcg(pixel.x + pc.gbuffer.size.x * pixel.y + rbPcg(pc.gbuffer.frameIndex));
+    float jitter = rbToUnit(seed);
+    float rotation = rbToUnit(rbPcg(seed)) * 2.0 * RB_PI;
+    vec3 t, b;
+    rbBasis(toLight, t, b);
+    uint visible = 0u;
+    // Without the distance output any occluder will do: stop at the first and skip the hit shader.
+    // Opaque fast path unless the TLAS has non-opaque geometry (alpha-tested by the any-hit shader).
+    uint flags = (pc.gbuffer.flags & RB_GB_ALPHA_TEST) != 0u ? gl_RayFlagsNoneEXT : gl_RayFlagsOpaqueEXT;
+    if (!kWriteHitDistance) flags |= gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT;
+    nearest = 1e30;
+    for (uint i = 0u; i < count; ++i) {
+      vec3 dir;
+      float tMax;
+      if (spread > 0.0) {
+        vec2 d = count == 1u ? vec2(0.0) : rbFibonacciDisk(i, count, jitter, rotation);
+        if (directional) {
+          dir = normalize(toLight + spread * (d.x * t + d.y * b));
+          tMax = 1e30;
         } else {
-          dir = toLight;
-          tMax = directional ? 1e30 : 0.999 * length(pc.lightPosition - origin);
+          vec3 target = pc.lightPosition + spread * (d.x * t + d.y * b);
+          dir = target - origin;
+          tMax = length(dir);
+          dir /= tMax;
+          tMax *= 0.999;
         }
-        hitT = -1.0;  // occluded unless the miss shader runs
-        traceRayEXT(tlas, flags, 0xFF, 0, 0, 0, origin, 0.0, dir, tMax, 0);
-        if (hitT == 0.0) {
-          ++visible;
-        } else if (hitT > 0.0) {
-          nearest = min(nearest, hitT);
-        }
+      } else {
+        dir = toLight;
+        tMax = directional ? 1e30 : 0.999 * length(pc.lightPosition - origin);
       }
-      rays = count;
-      visibility = float(visible) / float(count);
-      if (nearest == 1e30) nearest = 0.0;
+      hitT = -1.0;  // occluded unless the miss shader runs
+      traceRayEXT(tlas, flags, 0xFF, 0, 0, 0, origin, 0.0, dir, tMax, 0);
+      if (hitT == 0.0) {
+        ++visible;
+      } else if (hitT > 0.0) {
+        nearest = min(nearest, hitT);
+      }
     }
+    rays = count;
+    visibility = float(visible) / float(count);
+    if (nearest == 1e30) nearest = 0.0;
   }
   imageStore(outVisibility, ip, vec4(visibility));
 #ifdef RB_WRITE_HIT_DISTANCE

@@ -58,6 +58,8 @@ Status checkFeatures(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
   need(v12.timelineSemaphore, "timelineSemaphore");
   need(as.accelerationStructure, "accelerationStructure");
   need(rt.rayTracingPipeline, "rayTracingPipeline");
+  // The shadow pass traces the tiles its classifier lists with vkCmdTraceRaysIndirectKHR.
+  need(rt.rayTracingPipelineTraceRaysIndirect, "rayTracingPipelineTraceRaysIndirect");
   // The many-light tile culling counts the lights of a tile with subgroup ballots (every ray tracing driver seen
   // has them: NVIDIA, AMD, Intel, lavapipe).
   VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
@@ -94,6 +96,7 @@ RequiredFeatures::RequiredFeatures() {
   rayTracingPipeline.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR;
   rayTracingPipeline.pNext = nullptr;
   rayTracingPipeline.rayTracingPipeline = VK_TRUE;
+  rayTracingPipeline.rayTracingPipelineTraceRaysIndirect = VK_TRUE;
 }
 
 void* RequiredFeatures::link(void* next) {

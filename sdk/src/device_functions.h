@@ -44,6 +44,7 @@ namespace rb {
   X(vkCmdCopyImageToBuffer)                                                   \
   X(vkCmdCopyBufferToImage)                                                   \
   X(vkCmdFillBuffer)                                                          \
+  X(vkCmdUpdateBuffer)                                                        \
   X(vkCmdClearColorImage)                                                     \
   X(vkCmdBindPipeline)                                                        \
   X(vkCmdPushConstants)                                                       \
@@ -71,6 +72,7 @@ namespace rb {
   X(vkCreateRayTracingPipelinesKHR)                                           \
   X(vkGetRayTracingShaderGroupHandlesKHR)                                     \
   X(vkCmdTraceRaysKHR)                                                        \
+  X(vkCmdTraceRaysIndirectKHR)                                                \
   X(vkCmdPushDescriptorSetKHR)                                                \
   X(vkCreateCommandPool)                                                      \
   X(vkDestroyCommandPool)                                                     \

@@ -54,7 +54,7 @@ struct ShadowConstants {
   float tanAngularRadius;  // directional light; 0 = hard shadows
   float range;             // point and spot lights; 0 = unlimited
   uint32_t raysPerPixel;
-  uint32_t pad0;
+  uint32_t launchOverTiles;  // 1 = the launch covers the tile classifier's list, 0 = the image
 };
 static_assert(sizeof(ShadowConstants) == 224);
 RB_ASSERT_OFFSET(ShadowConstants, gbuffer, 0);
@@ -67,6 +67,7 @@ RB_ASSERT_OFFSET(ShadowConstants, cosSpotOuterAngle, 204);
 RB_ASSERT_OFFSET(ShadowConstants, tanAngularRadius, 208);
 RB_ASSERT_OFFSET(ShadowConstants, range, 212);
 RB_ASSERT_OFFSET(ShadowConstants, raysPerPixel, 216);
+RB_ASSERT_OFFSET(ShadowConstants, launchOverTiles, 220);
 
 struct AoConstants {
   GBufferConstants gbuffer;

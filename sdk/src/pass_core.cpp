@@ -58,6 +58,10 @@ std::vector<VkDescriptorSetLayoutBinding> PassCore::commonBindings() {
 
 void PassCore::writeCommon(Context& ctx, DescriptorWrites& w, const GBufferDesc& g, const TlasInfo& tlas) const {
   w.accelerationStructure(RB_BINDING_TLAS, tlas.tlas);
+  writeGBuffer(ctx, w, g);
+}
+
+void PassCore::writeGBuffer(Context& ctx, DescriptorWrites& w, const GBufferDesc& g) const {
   w.sampledImage(RB_BINDING_DEPTH, g.depth.view, sampler, readLayout(g.depth));
   w.sampledImage(RB_BINDING_NORMAL, g.normal.view, sampler, readLayout(g.normal));
   const GBufferImage& geo = g.geometricNormal.view ? g.geometricNormal : g.normal;
@@ -109,6 +113,10 @@ void PassCore::traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWr
                            uint32_t constantBytes, const GBufferDesc& g) {
   bind(ctx, cmd, w, constants, constantBytes);
   pipeline.trace(ctx, cmd, g.width, g.height);
+  end(ctx, cmd);
+}
+
+void PassCore::end(Context& ctx, VkCommandBuffer cmd) {
   images.endWrite(ctx, cmd);
   metrics.writeEnd(ctx, cmd);
 }

@@ -38,6 +38,8 @@ struct PassCore {
   // normal, geometric normal (or the normal), ray counters. Pass-specific bindings follow.
   static std::vector<VkDescriptorSetLayoutBinding> commonBindings();
   void writeCommon(Context& ctx, DescriptorWrites& w, const GBufferDesc& g, const TlasInfo& tlas) const;
+  // The common bindings but the TLAS (depth, normals, ray counters): what a pass's tile classifier reads.
+  void writeGBuffer(Context& ctx, DescriptorWrites& w, const GBufferDesc& g) const;
   // Writes the material bindings and picks the texture set: `materials` (null = the fallback, and the TLAS is
   // traced as opaque) and the TLAS's shading records. Sets RB_GB_ALPHA_TEST in `gbufferFlags` when the TLAS
   // holds non-opaque instances and a table is given; those need shading records (an error names `passName`).
@@ -58,6 +60,16 @@ struct PassCore {
   }
   void traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
                    uint32_t constantBytes, const GBufferDesc& g);
+  // The same with the launch size read from a VkTraceRaysIndirectCommandKHR on the GPU (a tile classifier's).
+  template <typename Constants>
+  void traceIndirectAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const Constants& pc,
+                           VkDeviceAddress arguments) {
+    bind(ctx, cmd, w, &pc, sizeof pc);
+    pipeline.traceIndirect(ctx, cmd, arguments);
+    end(ctx, cmd);
+  }
+  // Makes the outputs readable and ends the measurements.
+  void end(Context& ctx, VkCommandBuffer cmd);
 };
 
 }  // namespace rb

@@ -78,6 +78,8 @@ void PassMetrics::collect(Context& ctx) {
                                                                  slot * counterBytes());
       for (uint32_t i = 0; i < kCounterSlots; ++i) s.rays += counts[i];
       for (uint32_t i = 0; i < kCounterSlots; ++i) s.anyHitInvocations += counts[kCounterSlots + i];
+      s.tilesTraced = counts[2 * kCounterSlots];  // RayCounters::tilesTraced, then tilesSkipped
+      s.tilesSkipped = counts[2 * kCounterSlots + 1];
     }
     if (timing_) {
       uint64_t ticks[2] = {0, 0};

@@ -15,9 +15,10 @@ class PassMetrics {
  public:
   // Rays are summed into 4096 counters, one per pixel of a 64x64 tile: neighbouring invocations (one warp or
   // subgroup) never add to the same address, so the atomics do not serialise (shaders/ray_counters.glsl).
-  // Any-hit invocations follow in as many counters.
+  // Any-hit invocations follow in as many counters, then a tile classifier's counts (ray_counters.glsl).
   static constexpr uint32_t kCounterSlots = RB_RAY_COUNTER_SLOTS;
-  static constexpr uint32_t kCountersPerFrame = 2 * kCounterSlots;
+  static constexpr uint32_t kCountersPerFrame = 2 * kCounterSlots + RB_RAY_COUNTER_TILE_UINTS;
+  static_assert(kCountersPerFrame * sizeof(uint32_t) % 256 == 0, "each frame's counters start 256-byte aligned");
 
   // `countsRays` = false (the denoiser): GPU time only, no counter buffers.
   Status init(Context& ctx, const char* passName, bool countsRays = true);

@@ -208,6 +208,11 @@ void RayTracingPipeline::trace(Context& ctx, VkCommandBuffer cmd, uint32_t width
                                                    height, depth);
 }
 
+void RayTracingPipeline::traceIndirect(Context& ctx, VkCommandBuffer cmd, VkDeviceAddress arguments) const {
+  internal::deviceFunctions(ctx).vkCmdTraceRaysIndirectKHR(cmd, &raygenRegion, &missRegion, &hitRegion, &callableRegion,
+                                                           arguments);
+}
+
 namespace {
 VkWriteDescriptorSet write(uint32_t binding, VkDescriptorType type) {
   VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};

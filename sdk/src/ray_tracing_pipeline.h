@@ -49,6 +49,8 @@ class RayTracingPipeline {
   void bind(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes, const void* constants,
             uint32_t constantBytes) const;
   void trace(Context& ctx, VkCommandBuffer cmd, uint32_t width, uint32_t height, uint32_t depth = 1) const;
+  // The launch size read on the GPU from a VkTraceRaysIndirectCommandKHR at `arguments` (a buffer device address).
+  void traceIndirect(Context& ctx, VkCommandBuffer cmd, VkDeviceAddress arguments) const;
 
   VkPipeline pipeline = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;

@@ -6,6 +6,7 @@
 #include "context_impl.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
+#include "tile_classifier.h"
 
 namespace rb {
 
@@ -17,9 +18,13 @@ struct ShadowPass::Impl {
   Context& ctx;
   ShadowPassDesc desc;
   PassCore core;
+  TileClassifier classifier;
   ShadowOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() { core.retire(ctx); }  // frames in flight may still trace with it
+  ~Impl() {  // frames in flight may still trace with it
+    core.retire(ctx);
+    classifier.retire(ctx);
+  }
 };
 
 ShadowPass::ShadowPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -42,8 +47,22 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
   if (desc.outputHitDistance) {
     p.bindings.push_back({RB_SHADOW_BINDING_HIT_DISTANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
   }
+  p.bindings.push_back({RB_SHADOW_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr});
   p.pushConstantBytes = sizeof(ShadowConstants);
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::shadow_rahit)); !s) return s.error();
+
+  // The classifier: the ray generation shader's bindings but the TLAS and the material bindings, in a compute
+  // stage (PassCore::writeGBuffer and writeOutputs in record() fill them).
+  std::vector<VkDescriptorSetLayoutBinding> cb;
+  for (const VkDescriptorSetLayoutBinding& b : p.bindings) {
+    if (b.binding == RB_BINDING_TLAS) continue;
+    cb.push_back({b.binding, b.descriptorType, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  }
+  const SpirvModule classify = desc.outputHitDistance ? SpirvModule::of(spirv::shadow_classify_distance_comp)
+                                                      : SpirvModule::of(spirv::shadow_classify_comp);
+  if (Status s = impl->classifier.init(context, classify, cb, sizeof(ShadowConstants), "shadow tile classifier"); !s) {
+    return s.error();
+  }
   return std::unique_ptr<ShadowPass>(new ShadowPass(std::move(impl)));
 }
 
@@ -103,12 +122,28 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   if (s.desc.outputHitDistance) specs.push_back({VK_FORMAT_R32_SFLOAT, "shadow hit distance"});
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ShadowPass", pc.gbuffer.flags); !st) return st;
+  // The tile list before begin(), so that a failed allocation records nothing.
+  if (Status st = s.classifier.ensure(s.ctx, g.width, g.height); !st) return st;
   if (Status st = s.core.begin(s.ctx, cmd, g, specs); !st) return st;
   const PassImages& images = s.core.images;
+  auto writeOutputs = [&](DescriptorWrites& writes) {
+    writes.storageImage(RB_SHADOW_BINDING_VISIBILITY, images[0].view);
+    if (s.desc.outputHitDistance) writes.storageImage(RB_SHADOW_BINDING_HIT_DISTANCE, images[1].view);
+    // Bound without the classifier too: the ray generation shader statically uses it.
+    s.classifier.writeList(writes, RB_SHADOW_BINDING_TILES);
+  };
   s.core.writeCommon(s.ctx, w, g, tlas);
-  w.storageImage(RB_SHADOW_BINDING_VISIBILITY, images[0].view);
-  if (s.desc.outputHitDistance) w.storageImage(RB_SHADOW_BINDING_HIT_DISTANCE, images[1].view);
-  s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  writeOutputs(w);
+  if (settings.disableTileClassifier) {
+    s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  } else {
+    DescriptorWrites cw;
+    s.core.writeGBuffer(s.ctx, cw, g);
+    writeOutputs(cw);
+    s.classifier.classify(s.ctx, cmd, cw, &pc, sizeof pc);
+    pc.launchOverTiles = 1;
+    s.core.traceIndirectAndEnd(s.ctx, cmd, w, pc, s.classifier.traceArguments());
+  }
 
   ShadowOutputs& o = s.outputs;
   o.visibility = images[0].image;

@@ -34,6 +34,11 @@ struct PassStats {
   // Any-hit shader invocations (alpha tests on non-opaque geometry, MeshDesc::nonOpaque); 0 when every mesh the
   // rays reached is opaque.
   uint64_t anyHitInvocations = 0;
+  // A pass with a tile classifier (ShadowPass): of the image's 8x8-pixel tiles, those traced and those whose
+  // pixels all needed no ray (written without tracing). Both 0 when the pass ran without one.
+  uint64_t tilesTraced = 0;
+  uint64_t tilesSkipped = 0;
+  uint64_t tilesTotal() const { return tilesTraced + tilesSkipped; }
   double raysPerSecond() const { return gpuMs > 0.0 ? double(rays) / (gpuMs * 1e-3) : 0.0; }
 };
 
