@@ -26,10 +26,32 @@ const float kKernel[3] = float[3](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
 // of unknown noise at 0.0325 RMSE, 6 at 0.0311).
 const float kValueSigmas = 6.0;
 
-void store(ivec2 ip, float value, float variance) {
+// The final step's estimate of the filter's squared bias around the pixel: the previous steps' change of each
+// pixel of the 3x3 neighbourhood on the same surface (`same`), squared and averaged, less the noise that change
+// removed (for pure noise, the change is the noise itself). A pattern the filter flattens changes every pixel
+// by more than its noise, with either sign; noise averages out to ~0.
+float biasSquared(ivec2 ip, bool same[9]) {
+#ifdef RB_DN_ATROUS_FINAL
+  float changes = 0.0, noise = 0.0, count = 0.0;
+  for (int k = 0; k < 9; ++k) {
+    if (!same[k]) continue;
+    ivec2 q = ip + ivec2(k % 3 - 1, k / 3 - 1);
+    vec2 t = texelFetch(temporalIn, q, 0).rg;
+    float d = texelFetch(signalIn, q, 0).r - t.r;
+    changes += d * d;
+    noise += t.g;
+    count += 1.0;
+  }
+  return count > 0.0 ? max(changes - noise, 0.0) / count : 0.0;
+#else
+  return 0.0;
+#endif
+}
+
+void store(ivec2 ip, float value, float variance, float bias2) {
 #ifdef RB_DN_ATROUS_FINAL
   vec2 temporal = texelFetch(temporalIn, ip, 0).rg;
-  imageStore(signalOut, ip, vec4(rbDnLimitedShift(temporal.r, temporal.g, value)));
+  imageStore(signalOut, ip, vec4(rbDnLimitedShift(temporal.r, temporal.g, value, bias2)));
 #else
   imageStore(signalOut, ip, vec4(value, variance, 0.0, 0.0));
 #endif
@@ -42,7 +64,7 @@ void main() {
   vec2 centre = texelFetch(signalIn, ip, 0).rg;
   float depth = texelFetch(gDepth, ip, 0).r;
   if (rbDnSky(depth)) {
-    store(ip, centre.r, centre.g);
+    store(ip, centre.r, centre.g, 0.0);
     return;
   }
   vec3 p = rbDnCameraRelative(pixel, depth);
@@ -50,6 +72,8 @@ void main() {
   int step = int(pc.atrousStep);
   float tolerance = length(p) * pc.depthSigma * float(step) + 1e-6;
   float sum = 0.0, weights = 0.0, variances = 0.0;
+  bool same[9];  // the 3x3 neighbourhood (step 1) on the centre's surface: the final step's bias estimate
+  for (int k = 0; k < 9; ++k) same[k] = false;
   for (int dy = -2; dy <= 2; ++dy) {
     for (int dx = -2; dx <= 2; ++dx) {
       ivec2 q = ip + ivec2(dx, dy) * step;
@@ -62,6 +86,7 @@ void main() {
       // Distance of the neighbour from the centre's tangent plane, relative to the view distance: flat
       // surfaces seen at a grazing angle keep their weight, steps in depth lose it.
       float planeDistance = abs(dot(qp - p, n)) / tolerance;
+      if (step == 1 && abs(dx) <= 1 && abs(dy) <= 1) same[(dy + 1) * 3 + dx + 1] = planeDistance < 1.0;
       float sigma = kValueSigmas * sqrt(max(centre.g, 0.0)) + 1e-4;
       float w = kKernel[abs(dx)] * kKernel[abs(dy)] * exp(-planeDistance - abs(qv.r - centre.r) / sigma) *
                 pow(max(dot(n, qn), 0.0), pc.normalPower);
@@ -71,5 +96,15 @@ void main() {
     }
   }
   // The centre is always a tap of its own (weight 9/64 > 0).
-  store(ip, centre.r + sum / weights, variances / (weights * weights));
+#ifdef RB_DN_ATROUS_FINAL
+  if (step != 1) {
+    // The 3x3 neighbourhood's surface test at this step's tolerance scaled back to one pixel.
+    for (int k = 0; k < 9; ++k) {
+      ivec2 q = clamp(ip + ivec2(k % 3 - 1, k / 3 - 1), ivec2(0), ivec2(pc.size) - 1);
+      float qd = texelFetch(gDepth, q, 0).r;
+      same[k] = !rbDnSky(qd) && abs(dot(rbDnCameraRelative(uvec2(q), qd) - p, n)) * float(step) < tolerance;
+    }
+  }
+#endif
+  store(ip, centre.r + sum / weights, variances / (weights * weights), biasSquared(ip, same));
 }

@@ -7,14 +7,15 @@
 //
 // Scalar signals: the filtering follows the noise measured in the data. The temporal pass estimates the variance
 // left in each pixel's mean: binomial for a fraction of DenoiseSettings::raysPerPixel binary rays, at a
-// probability taken from the pixel's rays and its 3x3 neighbourhood (so a one-ray 0 or 1 still counts as noisy),
-// else the neighbourhood's variance; divided by the frames accumulated. The a-trous steps (5x5 taps, 2 by
-// default) mix only values that differ by less than the smaller of the two pixels' noise, and carry the variance
-// through. The last step moves the temporal mean towards the filtered value by at most as much as its noise
-// explains (three standard deviations, falling off beyond), and not at all where the noise is under
-// DenoiseSettings::convergedNoise: converged or many-ray signals pass bit for bit. One temporal and
-// spatialIterations a-trous dispatches (3 dispatches by default); 26 bytes of images per pixel (30 with three or
-// more steps; 91 MiB at 2560x1440).
+// probability taken from the pixel's rays and a 3x3 window of its neighbourhood (so a one-ray 0 or 1 still counts
+// as noisy), else the window's variance; the least of the four windows with the pixel in a corner (an edge is not
+// noise); divided by the frames accumulated. The a-trous steps (5x5 taps, 2 by default) weight value differences
+// by the centre's noise, and carry the variance through. The last step moves the temporal mean towards the filtered
+// value by at most as much as its noise explains (one standard deviation, falling off beyond, and less where the
+// previous steps changed the neighbourhood by more than its noise: a pattern finer than the filter), and not at all
+// where the noise is under DenoiseSettings::convergedNoise: converged or many-ray signals pass bit for bit. One
+// temporal and spatialIterations a-trous dispatches (3 dispatches by default); 26 bytes of images per pixel (30 with
+// three or more steps; 91 MiB at 2560x1440).
 //
 // RGB and reflection signals (SVGF-style, Schied et al. 2017): the temporal pass reprojects bilinearly and keeps,
 // beside the mean colour, the running variance of one frame's colour (from the 3x3 windows around the pixel while the
@@ -54,9 +55,10 @@ struct DenoiserDesc {
   DenoiseSignal signal = DenoiseSignal::Scalar;
 };
 
-// Default of DenoiseSettings::convergedNoise: a scalar pixel whose noise has a standard deviation under 2% passes
-// unfiltered (1024 binary rays give at most 1.6%); up to twice that the filter's shift is ramped in.
-inline constexpr float kDefaultDenoiseConvergedNoise = 0.02f;
+// Default of DenoiseSettings::convergedNoise: a scalar pixel whose noise has a standard deviation under 0.1 passes
+// unfiltered (32 binary rays give at most 0.088: the filter's bias in narrow penumbrae costs more than such noise);
+// up to twice that the filter's shift is ramped in.
+inline constexpr float kDefaultDenoiseConvergedNoise = 0.1f;
 
 struct DenoiseSettings {
   // false = accumulate over frames. Rgb: true still runs the temporal dispatch (it measures the noise), without
