@@ -31,8 +31,9 @@ void main() {
   vec4 centre = texelFetch(signalIn, ip, 0);
   uvec2 g = texelFetch(guide, ip, 0).xy;
   float dist = rbDnGuideDistance(g);
-  if (dist <= 0.0) {  // sky
-    imageStore(signalOut, ip, vec4(centre.rgb, final ? 1.0 : centre.a));
+  if (dist <= 0.0) {  // sky, or no reflection there (coverage 0 in the output)
+    float coverage = (pc.flags & RB_DN_RGB_REFLECTION) != 0u ? 0.0 : 1.0;
+    imageStore(signalOut, ip, vec4(centre.rgb, final ? coverage : centre.a));
     return;
   }
   vec3 n = rbDnGuideNormal(g);
@@ -88,11 +89,14 @@ void main() {
         others > 1e-6 ? max((tapVariances - geometric[k] * qv.a * qv.a) / others, 0.0) : centre.a * centre.a;
     float sigma = kColourSigma * sqrt(min(centreVariance, qv.a * qv.a)) + floorSigma;
     float w = geometric[k] * exp(-length(qv.rgb - centre.rgb) / sigma);
-    sum += w * qv.rgb;
+    sum += w * (qv.rgb - centre.rgb);
     varianceSum += w * w * qv.a * qv.a;
     weights += w;
   }
-  vec3 filtered = sum / weights;
+  // Summed as differences from the centre: where every tap that counts has the centre's colour the result is the
+  // centre exactly (a weighted mean of the values rounds, and the rounding of half floats, lavapipe's at least,
+  // then drifts a converged colour down by an ulp every step).
+  vec3 filtered = centre.rgb + sum / weights;
   float deviation = sqrt(varianceSum) / weights;
   imageStore(signalOut, ip, vec4(filtered, final ? 1.0 : deviation));
 }

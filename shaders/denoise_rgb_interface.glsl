@@ -15,6 +15,7 @@
 #define RB_RGB_TEMPORAL_BINDING_VALUE_OUT 7  // rgb: accumulated colour, a: its standard deviation
 #define RB_RGB_TEMPORAL_BINDING_GUIDE_OUT 8  // the a-trous steps' geometry (denoise_rgb_common.glsl)
 #define RB_RGB_TEMPORAL_BINDING_NORMAL 9
+#define RB_RGB_TEMPORAL_BINDING_ROUGHNESS 10  // with RB_DN_RGB_REFLECTION: .x, or the normal's .w
 // A-trous pass (denoise_rgb_atrous.comp).
 #define RB_RGB_ATROUS_BINDING_GUIDE 0
 #define RB_RGB_ATROUS_BINDING_SIGNAL_IN 1
@@ -22,5 +23,10 @@
 
 // This dispatch writes the denoiser's output: a = 1 instead of the standard deviation.
 #define RB_DN_RGB_FINAL 0x100u
+// DenoiseSignal::Reflection: .a of the signal is coverage (0 = no reflection: passed through, not a tap, a = 0 in
+// the output), and the roughness guides the filter; RB_DN_RGB_ROUGHNESS_IMAGE: roughness is the roughness image's
+// .x, else the normal's .w.
+#define RB_DN_RGB_REFLECTION 0x200u
+#define RB_DN_RGB_ROUGHNESS_IMAGE 0x400u
 
 #endif

@@ -6,7 +6,9 @@
 // pixel reads ~0; SVGF, Schied et al. 2017, keeps raw moments instead). Writes the accumulated colour with its
 // standard deviation in .a: the variance of one frame (from the history, or from the neighbourhood while the
 // history is short) divided by the frames averaged, so the spatial filter knows how noisy the mean still is.
-// It also writes the guide image of the a-trous steps.
+// It also writes the guide image of the a-trous steps. Reflections (RB_DN_RGB_REFLECTION): a pixel without
+// coverage is handled like the sky, and the deviation shrinks with the roughness below kRbDnGlossyRoughness, so
+// the a-trous steps leave a mirror's sharp reflection as it is.
 #include "denoise_rgb_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -20,6 +22,11 @@ layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SURFACE_OUT, rg32f) uniform wr
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_VALUE_OUT, rgba16f) uniform writeonly image2D valueOut;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_GUIDE_OUT, rg32ui) uniform writeonly uimage2D guideOut;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_NORMAL) uniform sampler2D gNormal;
+layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_ROUGHNESS) uniform sampler2D gRoughness;
+
+// Reflections: the roughness from which the filter treats a reflection as glossy (noisy) in full; a mirror's
+// (ReflectionPass traces one deterministic ray under 0.02) spread over its neighbours is detail, not noise.
+const float kRbDnGlossyRoughness = 0.1;
 
 float squared(vec3 v) { return dot(v, v); }
 
@@ -34,8 +41,10 @@ float spatialVariance(ivec2 ip, float dist) {
       int k = (y + 2) * 5 + (x + 2);
       ivec2 q = clamp(ip + ivec2(x, y), ivec2(0), ivec2(pc.size) - 1);
       float qd = texelFetch(gDepth, q, 0).r;
-      same[k] = !rbDnSky(qd) && abs(length(rbDnCameraRelative(uvec2(q), qd)) - dist) <= 0.05 * dist;
-      colours[k] = texelFetch(signalIn, q, 0).rgb;
+      vec4 qv = texelFetch(signalIn, q, 0);
+      same[k] = !rbDnSky(qd) && abs(length(rbDnCameraRelative(uvec2(q), qd)) - dist) <= 0.05 * dist &&
+                ((pc.flags & RB_DN_RGB_REFLECTION) == 0u || qv.a >= 0.5);
+      colours[k] = qv.rgb;
     }
   }
   float v4[4];
@@ -72,12 +81,14 @@ void main() {
   if (any(greaterThanEqual(pixel, pc.size))) return;
   ivec2 ip = ivec2(pixel);
   const bool final = (pc.flags & RB_DN_RGB_FINAL) != 0u;
-  vec3 value = texelFetch(signalIn, ip, 0).rgb;
+  const bool reflection = (pc.flags & RB_DN_RGB_REFLECTION) != 0u;
+  vec4 texel = texelFetch(signalIn, ip, 0);
+  vec3 value = texel.rgb;
   float depth = texelFetch(gDepth, ip, 0).r;
-  if (rbDnSky(depth)) {
+  if (rbDnSky(depth) || (reflection && texel.a < 0.5)) {
     imageStore(historyOut, ip, vec4(value, 0.0));
     imageStore(surfaceOut, ip, vec4(0.0));
-    imageStore(valueOut, ip, vec4(value, final ? 1.0 : 0.0));
+    imageStore(valueOut, ip, vec4(value, final ? (reflection ? 0.0 : 1.0) : 0.0));
     imageStore(guideOut, ip, uvec4(0u));
     return;
   }
@@ -129,5 +140,11 @@ void main() {
   imageStore(surfaceOut, ip, vec4(dist, variance, 0.0, 0.0));
   // Too few frames for the recurrence to know the noise: the neighbourhood's.
   float frameVariance = frames < kRbDnMinTemporalVarianceFrames ? spatialVariance(ip, dist) : variance;
-  imageStore(valueOut, ip, vec4(accumulated, final ? 1.0 : sqrt(frameVariance / frames)));
+  float deviation = sqrt(frameVariance / frames);
+  if (reflection) {
+    float roughness = (pc.flags & RB_DN_RGB_ROUGHNESS_IMAGE) != 0u ? texelFetch(gRoughness, ip, 0).x
+                                                                   : texelFetch(gRoughness, ip, 0).w;
+    deviation *= clamp(roughness / kRbDnGlossyRoughness, 0.0, 1.0);
+  }
+  imageStore(valueOut, ip, vec4(accumulated, final ? 1.0 : deviation));
 }

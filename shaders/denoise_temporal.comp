@@ -3,7 +3,9 @@
 // Temporal accumulation with reprojection: each pixel finds where its surface was last frame (camera motion,
 // or the engine's motion vectors), checks that the same surface is there (view distance within a tolerance),
 // and blends its new noisy value into the history as a running mean over up to `max history` frames.
-#include "denoise_common.glsl"
+// It also measures the noise left in that mean (denoise_noise.glsl), which the a-trous steps filter by: .g of
+// the value written is its variance.
+#include "denoise_noise.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = RB_TEMPORAL_BINDING_DEPTH) uniform sampler2D gDepth;
@@ -13,18 +15,21 @@ layout(set = 0, binding = RB_TEMPORAL_BINDING_HISTORY_IN) uniform sampler2D hist
 layout(set = 0, binding = RB_TEMPORAL_BINDING_DISTANCE_IN) uniform sampler2D distanceIn; // last frame's distance
 layout(set = 0, binding = RB_TEMPORAL_BINDING_HISTORY_OUT, rg16f) uniform writeonly image2D historyOut;
 layout(set = 0, binding = RB_TEMPORAL_BINDING_DISTANCE_OUT, r32f) uniform writeonly image2D distanceOut;
-layout(set = 0, binding = RB_TEMPORAL_BINDING_VALUE_OUT, r16f) uniform writeonly image2D valueOut;  // the value alone
+layout(set = 0, binding = RB_TEMPORAL_BINDING_VALUE_OUT, rg16f) uniform writeonly image2D valueOut;
+layout(set = 0, binding = RB_TEMPORAL_BINDING_FINAL_OUT, r16f) uniform writeonly image2D finalOut;
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (any(greaterThanEqual(pixel, pc.size))) return;
   ivec2 ip = ivec2(pixel);
+  const bool final = (pc.flags & RB_DN_TEMPORAL_FINAL) != 0u;
   float value = texelFetch(signalIn, ip, 0).r;
   float depth = texelFetch(gDepth, ip, 0).r;
   if (rbDnSky(depth)) {
     imageStore(historyOut, ip, vec4(value, 0.0, 0.0, 0.0));
     imageStore(distanceOut, ip, vec4(0.0));
-    imageStore(valueOut, ip, vec4(value));
+    imageStore(valueOut, ip, vec4(value, 0.0, 0.0, 0.0));
+    if (final) imageStore(finalOut, ip, vec4(value));
     return;
   }
   vec3 rel = rbDnCameraRelative(pixel, depth);
@@ -51,5 +56,6 @@ void main() {
     }
   }
   imageStore(historyOut, ip, vec4(accumulated, frames, 0.0, 0.0));
-  imageStore(valueOut, ip, vec4(accumulated));
+  imageStore(valueOut, ip, vec4(accumulated, rbDnNoiseVariance(signalIn, ip, accumulated, frames), 0.0, 0.0));
+  if (final) imageStore(finalOut, ip, vec4(accumulated));
 }

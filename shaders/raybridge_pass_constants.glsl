@@ -91,7 +91,7 @@ struct PrimaryConstants {
   uint pad1;        //  76
 };
 
-// The denoiser's temporal and a-trous passes. 224 bytes.
+// The denoiser's temporal and a-trous passes. 228 bytes.
 struct DenoiseConstants {
   mat4 inverseProjection;       //   0
   mat3 viewToWorld;             //  64: as GBufferConstants::viewToWorld
@@ -105,6 +105,7 @@ struct DenoiseConstants {
   float wAtDepthOne;            // 212: as GBufferConstants::wAtDepthOne
   float normalPower;            // 216
   float signalRaysPerPixel;     // 220: rays per pixel of the noisy signal; 0 = unknown
+  float convergedNoise;         // 224: scalar: noise standard deviation under which the value passes unfiltered
 };
 
 // The refit-quality measure of dynamic BLASes (blas_cluster_bounds.comp). 48 bytes.

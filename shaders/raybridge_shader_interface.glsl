@@ -48,12 +48,14 @@
 #define RB_TEMPORAL_BINDING_DISTANCE_IN 4
 #define RB_TEMPORAL_BINDING_HISTORY_OUT 5
 #define RB_TEMPORAL_BINDING_DISTANCE_OUT 6
-#define RB_TEMPORAL_BINDING_VALUE_OUT 7
+#define RB_TEMPORAL_BINDING_VALUE_OUT 7  // rg: the value and the variance of its noise
+#define RB_TEMPORAL_BINDING_FINAL_OUT 8  // r: the denoiser's output, written with RB_DN_TEMPORAL_FINAL
 // The denoiser's a-trous pass.
 #define RB_ATROUS_BINDING_DEPTH 0
 #define RB_ATROUS_BINDING_NORMAL 1
 #define RB_ATROUS_BINDING_SIGNAL_IN 2
-#define RB_ATROUS_BINDING_SIGNAL_OUT 3
+#define RB_ATROUS_BINDING_SIGNAL_OUT 3  // rg: value, variance (denoise_atrous.comp); r: the output (_final.comp)
+#define RB_ATROUS_BINDING_TEMPORAL 4    // denoise_atrous_final.comp: the temporal result the shift starts from
 
 // GBufferConstants::flags: what the G-buffer description says.
 #define RB_GB_REVERSED_Z 1u
@@ -92,6 +94,7 @@
 #define RB_DN_OCTAHEDRAL 2u
 #define RB_DN_HISTORY 4u  // last frame's history is valid (temporal pass)
 #define RB_DN_MOTION 8u   // the G-buffer has motion vectors (temporal pass)
+#define RB_DN_TEMPORAL_FINAL 16u  // scalar temporal pass: no a-trous step follows, write the output too
 
 // ClusterBoundsConstants::positionFormat.
 #define RB_POSITION_RGB32F 0u

@@ -27,9 +27,9 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
   EffectResult result;
   result.effect = "reflections";
   result.compared = "final HDR image (linear RGB), surface pixels";
-  result.effectMsNote =
-      "traced: ReflectionPass GPU ms; raster: the probe capture (a one-time cost, recaptured only when the scene, "
-      "sun or sky change; 0 per frame otherwise), constant sky: no pass (0 ms)";
+  result.effectMsNote = "traced: ReflectionPass (+ Denoiser) GPU ms; raster: the probe capture (a one-time cost, "
+                        "recaptured only when the scene, "
+                        "sun or sky change; 0 per frame otherwise), constant sky: no pass (0 ms)";
   rbAdapter::Adapter& adapter = driver.adapter();
   rbAdapter::FrameSettings& s = adapter.settings();
   const se::FrameParams base = driver.baseParams();
@@ -45,8 +45,9 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
   // Every surface traces (threshold 1 by default): the engine treats untraced pixels as reflecting nothing, so a
   // lower threshold would make the reference itself wrong on rough surfaces.
   desc.reflections.roughnessThreshold = plan.reflectionRoughness;
-  auto apply = [&](uint32_t rays) {
+  auto apply = [&](uint32_t rays, bool denoise = false) {
     desc.reflections.raysPerPixel = rays;
+    desc.reflections.disableDenoiser = !denoise;
     rb::Status st = adapter.effects().setDesc(desc);
     return st ? se::Status::success() : se::Status::failure("HybridEffects::setDesc: " + st.error().message);
   };
@@ -87,24 +88,34 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
     return se::Status::success();
   };
 
-  // Traced rows (the reflection is not denoised: raw only).
+  // Traced rows: raw and denoised, each its own run (the engine composites whichever image the adapter hands it).
   for (uint32_t n : plan.reflectionRays) {
-    if (se::Status st = apply(n); !st) return R::failure(st.error);
-    auto samples = driver.run(base, plan.warmupFrames, plan.timedFrames);
-    if (!samples) return R::failure(samples.error);
-    if (auto cap = driver.capture(base); !cap) return R::failure(cap.error);
-    auto rgb = hdrRgb(driver.engine());
-    if (!rgb) return R::failure(rgb.error);
-    Row row;
-    row.method = "traced_raw";
-    row.setting = std::to_string(n) + (n == 1 ? " ray" : " rays");
-    row.id = "traced_raw_r" + std::to_string(n);
-    row.params = {{"rays_per_pixel", n}, {"roughness_threshold", plan.reflectionRoughness}};
-    const PassResult pass = passMedian(samples.value, "reflection", &rb::HybridStats::reflection);
-    row.passes = {pass};
-    row.effectMs = pass.gpuMs;
-    row.effectMsOf = "reflection";
-    if (se::Status st = finish(std::move(row), samples.value, rgb.value); !st) return R::failure(st.error);
+    for (bool denoised : {false, true}) {
+      if (se::Status st = apply(n, denoised); !st) return R::failure(st.error);
+      auto samples = driver.run(base, plan.warmupFrames, plan.timedFrames);
+      if (!samples) return R::failure(samples.error);
+      // Single-frame denoising, as the shadow and AO rows: the captured frame uses its own rays only.
+      adapter.effects().resetHistory();
+      if (auto cap = driver.capture(base); !cap) return R::failure(cap.error);
+      auto rgb = hdrRgb(driver.engine());
+      if (!rgb) return R::failure(rgb.error);
+      Row row;
+      row.method = denoised ? "traced_denoised" : "traced_raw";
+      row.setting = std::to_string(n) + (n == 1 ? " ray" : " rays");
+      row.id = row.method + "_r" + std::to_string(n);
+      row.params = {{"rays_per_pixel", n}, {"roughness_threshold", plan.reflectionRoughness}, {"denoised", denoised}};
+      const PassResult pass = passMedian(samples.value, "reflection", &rb::HybridStats::reflection);
+      row.passes = {pass};
+      row.effectMs = pass.gpuMs;
+      row.effectMsOf = "reflection";
+      if (denoised) {
+        const PassResult dn = passMedian(samples.value, "reflection_denoise", &rb::HybridStats::reflectionDenoise);
+        row.passes.push_back(dn);
+        row.effectMs += dn.gpuMs;
+        row.effectMsOf = "reflection + reflection_denoise";
+      }
+      if (se::Status st = finish(std::move(row), samples.value, rgb.value); !st) return R::failure(st.error);
+    }
   }
 
   // Raster rows: constant sky (probe off) and the probe at each resolution.

@@ -11,7 +11,7 @@ namespace rbEffects {
 
 // One SDK pass of a traced row (medians over the timed frames).
 struct PassResult {
-  std::string name;  // "shadow", "shadow_denoise", "ao", "ao_denoise", "reflection"
+  std::string name;  // "shadow", "shadow_denoise", "ao", "ao_denoise", "reflection", "reflection_denoise"
   double gpuMs = 0.0;
   uint64_t rays = 0;  // counted by the shaders (PassStats::rays), not derived from the settings
   double raysPerSecond() const { return gpuMs > 0.0 ? double(rays) / (gpuMs * 1e-3) : 0.0; }

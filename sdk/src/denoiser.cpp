@@ -33,6 +33,9 @@ void multiply(const double a[16], const double b[16], double out[16]) {
 // (a 63x63 footprint), SVGF's reach for a few rays per pixel; the noise-aware weights keep it from
 // over-blurring.
 constexpr uint32_t kDefaultRgbIterations = 5;
+// A-trous iterations of a scalar signal when DenoiseSettings::spatialIterations is 0: steps 1 and 2, a 13x13
+// footprint.
+constexpr uint32_t kDefaultScalarIterations = 2;
 
 // The image barriers of one step of either record path, gathered and recorded as one vkCmdPipelineBarrier.
 struct BarrierBatch {
@@ -55,9 +58,11 @@ struct Denoiser::Impl {
   Context& ctx;
   DenoiseSignal signal = DenoiseSignal::Scalar;
   ComputePipeline temporal, atrous;
+  ComputePipeline atrousFinal;  // Scalar: the last a-trous step (writes the output)
   VkSampler sampler = VK_NULL_HANDLE;
-  // Scalar: 0,1: history ping-pong (RG16F); 2,3: view distance ping-pong (R32F); 4,5: spatial ping-pong
-  // (R16F); 6: this frame's temporal result (R16F). Rgb: see recordRgb.
+  // Scalar: 0,1: history ping-pong (RG16F: mean, frames); 2,3: view distance ping-pong (R32F); 4: this frame's
+  // temporal result (RG16F: value, noise variance); 5 and 7: the a-trous ping-pong (RG16F, 7 only for three steps
+  // or more); 6: the output (R16F). Rgb: see recordRgb.
   PassImages images;
   PassMetrics metrics;
   DenoiseOutputs outputs;
@@ -69,6 +74,7 @@ struct Denoiser::Impl {
   ~Impl() {  // frames in flight may still run its dispatches
     temporal.retire(ctx);
     atrous.retire(ctx);
+    atrousFinal.retire(ctx);
     internal::contextImpl(ctx).retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
     images.retire(ctx);
     metrics.retire(ctx);
@@ -81,10 +87,11 @@ Denoiser::~Denoiser() = default;
 Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context) { return create(context, DenoiserDesc{}); }
 
 Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const DenoiserDesc& desc) {
-  if (desc.signal != DenoiseSignal::Scalar && desc.signal != DenoiseSignal::Rgb) {
+  if (desc.signal != DenoiseSignal::Scalar && desc.signal != DenoiseSignal::Rgb &&
+      desc.signal != DenoiseSignal::Reflection) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
                  "Denoiser: DenoiserDesc::signal has an unknown value " + std::to_string(uint32_t(desc.signal)) +
-                     "; use DenoiseSignal::Scalar or DenoiseSignal::Rgb"};
+                     "; use DenoiseSignal::Scalar, Rgb or Reflection"};
   }
   auto impl = std::make_unique<Impl>(context);
   impl->signal = desc.signal;
@@ -95,14 +102,15 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
   auto storage = [&](uint32_t b) {
     return VkDescriptorSetLayoutBinding{b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, nullptr};
   };
-  if (desc.signal == DenoiseSignal::Rgb) {
+  if (desc.signal != DenoiseSignal::Scalar) {
     Result<ComputePipeline> t = ComputePipeline::create(
         context, SpirvModule::of(spirv::denoise_rgb_temporal_comp),
         {sampled(RB_RGB_TEMPORAL_BINDING_DEPTH), sampled(RB_RGB_TEMPORAL_BINDING_MOTION),
          sampled(RB_RGB_TEMPORAL_BINDING_SIGNAL), sampled(RB_RGB_TEMPORAL_BINDING_HISTORY_IN),
          sampled(RB_RGB_TEMPORAL_BINDING_SURFACE_IN), storage(RB_RGB_TEMPORAL_BINDING_HISTORY_OUT),
          storage(RB_RGB_TEMPORAL_BINDING_SURFACE_OUT), storage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT),
-         storage(RB_RGB_TEMPORAL_BINDING_GUIDE_OUT), sampled(RB_RGB_TEMPORAL_BINDING_NORMAL)},
+         storage(RB_RGB_TEMPORAL_BINDING_GUIDE_OUT), sampled(RB_RGB_TEMPORAL_BINDING_NORMAL),
+         sampled(RB_RGB_TEMPORAL_BINDING_ROUGHNESS)},
         sizeof(DenoiseConstants), "denoiser RGB temporal");
     if (!t) return t.error();
     impl->temporal = t.value();
@@ -114,13 +122,13 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
     if (!a) return a.error();
     impl->atrous = a.value();
   } else {
-    Result<ComputePipeline> t =
-        ComputePipeline::create(context, SpirvModule::of(spirv::denoise_temporal_comp),
-                                {sampled(RB_TEMPORAL_BINDING_DEPTH), sampled(RB_TEMPORAL_BINDING_MOTION),
-                                 sampled(RB_TEMPORAL_BINDING_SIGNAL), sampled(RB_TEMPORAL_BINDING_HISTORY_IN),
-                                 sampled(RB_TEMPORAL_BINDING_DISTANCE_IN), storage(RB_TEMPORAL_BINDING_HISTORY_OUT),
-                                 storage(RB_TEMPORAL_BINDING_DISTANCE_OUT), storage(RB_TEMPORAL_BINDING_VALUE_OUT)},
-                                sizeof(DenoiseConstants), "denoiser temporal");
+    Result<ComputePipeline> t = ComputePipeline::create(
+        context, SpirvModule::of(spirv::denoise_temporal_comp),
+        {sampled(RB_TEMPORAL_BINDING_DEPTH), sampled(RB_TEMPORAL_BINDING_MOTION), sampled(RB_TEMPORAL_BINDING_SIGNAL),
+         sampled(RB_TEMPORAL_BINDING_HISTORY_IN), sampled(RB_TEMPORAL_BINDING_DISTANCE_IN),
+         storage(RB_TEMPORAL_BINDING_HISTORY_OUT), storage(RB_TEMPORAL_BINDING_DISTANCE_OUT),
+         storage(RB_TEMPORAL_BINDING_VALUE_OUT), storage(RB_TEMPORAL_BINDING_FINAL_OUT)},
+        sizeof(DenoiseConstants), "denoiser temporal");
     if (!t) return t.error();
     impl->temporal = t.value();
     Result<ComputePipeline> a =
@@ -130,6 +138,13 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
                                 sizeof(DenoiseConstants), "denoiser a-trous");
     if (!a) return a.error();
     impl->atrous = a.value();
+    Result<ComputePipeline> f = ComputePipeline::create(
+        context, SpirvModule::of(spirv::denoise_atrous_final_comp),
+        {sampled(RB_ATROUS_BINDING_DEPTH), sampled(RB_ATROUS_BINDING_NORMAL), sampled(RB_ATROUS_BINDING_SIGNAL_IN),
+         storage(RB_ATROUS_BINDING_SIGNAL_OUT), sampled(RB_ATROUS_BINDING_TEMPORAL)},
+        sizeof(DenoiseConstants), "denoiser a-trous (final)");
+    if (!f) return f.error();
+    impl->atrousFinal = f.value();
   }
   Result<VkSampler> s = createNearestSampler(context);
   if (!s) return s.error();
@@ -213,6 +228,9 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
     w.storageImage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT, im[4].view);
     w.storageImage(RB_RGB_TEMPORAL_BINDING_GUIDE_OUT, im[6].view);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_NORMAL, g.normal.view, s.sampler, readLayout(g.normal));
+    // Read only for reflections (RB_DN_RGB_REFLECTION): the roughness image, else the normal (roughness in .w).
+    const GBufferImage& roughness = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
+    w.sampledImage(RB_RGB_TEMPORAL_BINDING_ROUGHNESS, roughness.view, s.sampler, readLayout(roughness));
     s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
   }
   for (uint32_t base : {0u, 2u}) barrier(im[base + cur], gen, ro, write, read);
@@ -256,6 +274,110 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   return {};
 }
 
+// The scalar path (DenoiseSignal::Scalar). The temporal pass always runs: it measures the noise the a-trous
+// weights and the final shift need (with disableTemporal it ignores the history). Its result (value, variance)
+// stays in image 4 for the final step; the steps before it ping-pong between images 5 and 7 (7 exists only for
+// three steps or more); the final step writes the R16 output, image 6.
+Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
+                    const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags, const double camera[3]) {
+  Context& ctx = s.ctx;
+  const uint32_t iterations = settings.disableSpatial ? 0u
+                                                      : (settings.spatialIterations ? settings.spatialIterations
+                                                                                    : kDefaultScalarIterations);
+  std::vector<PassImages::Spec> specs = {
+      {VK_FORMAT_R16G16_SFLOAT, "denoiser history A"}, {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},
+      {VK_FORMAT_R32_SFLOAT, "denoiser distance A"},   {VK_FORMAT_R32_SFLOAT, "denoiser distance B"},
+      {VK_FORMAT_R16G16_SFLOAT, "denoiser temporal"},  {VK_FORMAT_R16G16_SFLOAT, "denoiser spatial A"},
+      {VK_FORMAT_R16_SFLOAT, "denoiser output"}};
+  if (iterations >= 3) specs.push_back({VK_FORMAT_R16G16_SFLOAT, "denoiser spatial B"});
+  // New images (a new size, or a step count that needs the second spatial image or no longer does) hold no history.
+  const bool recreated = s.images.size() != specs.size() || s.images[0].width != g.width ||
+                         s.images[0].height != g.height;
+  if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
+  if (recreated) s.historyValid = false;
+  const PassImages& im = s.images;
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
+  const uint32_t cur = s.parity, prev = 1 - s.parity;
+
+  s.metrics.beginRecording(ctx, cmd);
+  s.metrics.writeStart(ctx, cmd);
+  BarrierBatch batch{vk, cmd};
+  const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | cs |
+                                       VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
+  const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  const VkImageLayout gen = VK_IMAGE_LAYOUT_GENERAL;
+  const VkAccessFlags read = VK_ACCESS_SHADER_READ_BIT, write = VK_ACCESS_SHADER_WRITE_BIT;
+  const bool historyUsable = !settings.disableTemporal && s.historyValid;
+  if (!historyUsable) {
+    // Nothing valid to read: give last frame's images a defined layout for the descriptor reads.
+    for (uint32_t base : {0u, 2u}) batch.add(im[base + prev], VK_IMAGE_LAYOUT_UNDEFINED, ro, 0, read);
+  }
+  // Every image written this frame starts undefined, in GENERAL; `writable` tracks the spatial ones.
+  for (uint32_t base : {0u, 2u}) batch.add(im[base + cur], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
+  for (size_t i = 4; i < im.size(); ++i) batch.add(im[i], VK_IMAGE_LAYOUT_UNDEFINED, gen, read, write);
+  batch.flush(readers, cs);
+  bool writable[8] = {};
+  for (size_t i = 5; i < im.size(); ++i) writable[i] = true;
+
+  pc.flags = flags | (historyUsable ? RB_DN_HISTORY : 0u) | (iterations == 0 ? RB_DN_TEMPORAL_FINAL : 0u);
+  pc.maxHistoryFrames = settings.disableTemporal ? 1u : (settings.maxHistoryFrames ? settings.maxHistoryFrames : 32u);
+  for (int i = 0; i < 16; ++i) pc.previousViewProjection[i] = static_cast<float>(s.previousViewProjection[i]);
+  for (int i = 0; i < 3; ++i) pc.cameraDelta[i] = static_cast<float>(camera[i] - s.previousCamera[i]);
+  {
+    DescriptorWrites w;
+    w.sampledImage(RB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
+    const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
+    w.sampledImage(RB_TEMPORAL_BINDING_MOTION, motion.view, s.sampler, readLayout(motion));
+    w.sampledImage(RB_TEMPORAL_BINDING_SIGNAL, signal, s.sampler, ro);
+    w.sampledImage(RB_TEMPORAL_BINDING_HISTORY_IN, im[prev].view, s.sampler, ro);
+    w.sampledImage(RB_TEMPORAL_BINDING_DISTANCE_IN, im[2 + prev].view, s.sampler, ro);
+    w.storageImage(RB_TEMPORAL_BINDING_HISTORY_OUT, im[cur].view);
+    w.storageImage(RB_TEMPORAL_BINDING_DISTANCE_OUT, im[2 + cur].view);
+    w.storageImage(RB_TEMPORAL_BINDING_VALUE_OUT, im[4].view);
+    w.storageImage(RB_TEMPORAL_BINDING_FINAL_OUT, im[6].view);
+    s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
+  }
+  for (uint32_t i : {cur, 2 + cur, 4u}) batch.add(im[i], gen, ro, write, read);
+  // A history written without temporal filtering holds one frame only: the next frame starts afresh anyway.
+  s.historyValid = !settings.disableTemporal;
+  s.parity = prev;
+
+  pc.flags = flags;
+  uint32_t input = 4;
+  for (uint32_t i = 0; i < iterations; ++i) {
+    const bool final = i + 1 == iterations;
+    const uint32_t out = final ? 6u : (i % 2 == 0 ? 5u : 7u);
+    if (!writable[out]) {
+      // Reusing the spatial image read one step earlier.
+      batch.add(im[out], ro, gen, read, write);
+      writable[out] = true;
+    }
+    batch.flush(cs, i == 0 ? readers : cs);
+    pc.atrousStep = 1u << i;
+    DescriptorWrites w;
+    w.sampledImage(RB_ATROUS_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
+    w.sampledImage(RB_ATROUS_BINDING_NORMAL, g.normal.view, s.sampler, readLayout(g.normal));
+    w.sampledImage(RB_ATROUS_BINDING_SIGNAL_IN, im[input].view, s.sampler, ro);
+    w.storageImage(RB_ATROUS_BINDING_SIGNAL_OUT, im[out].view);
+    if (final) w.sampledImage(RB_ATROUS_BINDING_TEMPORAL, im[4].view, s.sampler, ro);
+    (final ? s.atrousFinal : s.atrous).dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
+    batch.add(im[out], gen, ro, write, read);
+    writable[out] = false;
+    input = out;
+  }
+  // Every image ends in SHADER_READ_ONLY_OPTIMAL, written or not.
+  for (size_t i = 5; i < im.size(); ++i)
+    if (writable[i]) batch.add(im[i], gen, ro, write, read);
+  batch.flush(cs, readers);
+  s.metrics.writeEnd(ctx, cmd);
+  s.outputs.denoised = im[6].image;
+  s.outputs.denoisedView = im[6].view;
+  s.outputs.width = g.width;
+  s.outputs.height = g.height;
+  return {};
+}
+
 }  // namespace
 
 Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
@@ -287,6 +409,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   pc.depthSigma = settings.depthSigma > 0.0f ? settings.depthSigma : 0.005f;
   pc.normalPower = settings.normalPower > 0.0f ? settings.normalPower : 32.0f;
   pc.signalRaysPerPixel = float(settings.raysPerPixel);
+  pc.convergedNoise = settings.convergedNoise > 0.0f ? settings.convergedNoise : kDefaultDenoiseConvergedNoise;
 
   // This frame's camera: projection * rotation-only view, kept for next frame's reprojection.
   double camera[3];
@@ -299,7 +422,14 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   viewRot[15] = 1.0;
   double viewProjection[16];
   multiply(proj, viewRot, viewProjection);
-  if (s.signal == DenoiseSignal::Rgb) {
+  if (s.signal == DenoiseSignal::Reflection) {
+    if (!g.roughnessInNormalW && !g.roughnessMetalness.view) {
+      return invalid("a Reflection signal needs the G-buffer's roughness: set GBufferDesc::roughnessInNormalW or "
+                     "roughnessMetalness");
+    }
+    flags |= RB_DN_RGB_REFLECTION | (g.roughnessMetalness.view ? RB_DN_RGB_ROUGHNESS_IMAGE : 0u);
+  }
+  if (s.signal != DenoiseSignal::Scalar) {
     Status st = recordRgb(s, cmd, g, signal, settings, pc, flags, camera);
     if (st) {
       std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
@@ -308,121 +438,12 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
     return st;
   }
 
-  std::vector<PassImages::Spec> specs = {
-      {VK_FORMAT_R16G16_SFLOAT, "denoiser history A"},   {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},
-      {VK_FORMAT_R32_SFLOAT, "denoiser distance A"},     {VK_FORMAT_R32_SFLOAT, "denoiser distance B"},
-      {VK_FORMAT_R16_SFLOAT, "denoiser spatial A"},      {VK_FORMAT_R16_SFLOAT, "denoiser spatial B"},
-      {VK_FORMAT_R16_SFLOAT, "denoiser temporal result"}};
-  bool resized = s.images.size() == 0 || s.images[0].width != g.width || s.images[0].height != g.height;
-  if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
-  if (resized) s.historyValid = false;
-  const PassImages& im = s.images;
-  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
-  const uint32_t cur = s.parity, prev = 1 - s.parity;
-
-  s.metrics.beginRecording(ctx, cmd);
-  s.metrics.writeStart(ctx, cmd);
-  // The images written this frame start undefined; last frame's history and distance are read as they are.
-  BarrierBatch batch{vk, cmd};
-  auto barrier = [&](const GpuImage& img, VkImageLayout from, VkImageLayout to, VkAccessFlags src, VkAccessFlags dst) {
-    batch.add(img, from, to, src, dst);
-  };
-  auto flush = [&](VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) { batch.flush(srcStage, dstStage); };
-  const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
-  const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | cs |
-                                       VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
-  const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-  const bool temporal = !settings.disableTemporal;
-  const bool historyUsable = temporal && s.historyValid;
-  if (!historyUsable) {
-    // Nothing valid to read: give last frame's images a defined layout for the descriptor reads.
-    barrier(im[prev], VK_IMAGE_LAYOUT_UNDEFINED, ro, 0, VK_ACCESS_SHADER_READ_BIT);
-    barrier(im[2 + prev], VK_IMAGE_LAYOUT_UNDEFINED, ro, 0, VK_ACCESS_SHADER_READ_BIT);
+  Status st = recordScalar(s, cmd, g, signal, settings, pc, flags, camera);
+  if (st) {
+    std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
+    std::memcpy(s.previousCamera, camera, sizeof camera);
   }
-  barrier(im[cur], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
-          VK_ACCESS_SHADER_WRITE_BIT);
-  barrier(im[2 + cur], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
-          VK_ACCESS_SHADER_WRITE_BIT);
-  barrier(im[4], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
-          VK_ACCESS_SHADER_WRITE_BIT);
-  barrier(im[5], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
-          VK_ACCESS_SHADER_WRITE_BIT);
-  barrier(im[6], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
-          VK_ACCESS_SHADER_WRITE_BIT);
-  flush(readers, cs);
-
-  VkImageView current = signal;  // what the next stage reads
-  const GpuImage* last = nullptr;
-  if (temporal) {
-    uint32_t maxHistory = settings.maxHistoryFrames ? settings.maxHistoryFrames : 32u;
-    pc.flags = flags | (historyUsable ? RB_DN_HISTORY : 0u);
-    pc.maxHistoryFrames = maxHistory;
-    for (int i = 0; i < 16; ++i) pc.previousViewProjection[i] = static_cast<float>(s.previousViewProjection[i]);
-    for (int i = 0; i < 3; ++i) pc.cameraDelta[i] = static_cast<float>(camera[i] - s.previousCamera[i]);
-    DescriptorWrites w;
-    w.sampledImage(RB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
-    const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
-    w.sampledImage(RB_TEMPORAL_BINDING_MOTION, motion.view, s.sampler, readLayout(motion));
-    w.sampledImage(RB_TEMPORAL_BINDING_SIGNAL, signal, s.sampler, ro);
-    w.sampledImage(RB_TEMPORAL_BINDING_HISTORY_IN, im[prev].view, s.sampler, ro);
-    w.sampledImage(RB_TEMPORAL_BINDING_DISTANCE_IN, im[2 + prev].view, s.sampler, ro);
-    w.storageImage(RB_TEMPORAL_BINDING_HISTORY_OUT, im[cur].view);
-    w.storageImage(RB_TEMPORAL_BINDING_DISTANCE_OUT, im[2 + cur].view);
-    w.storageImage(RB_TEMPORAL_BINDING_VALUE_OUT, im[6].view);
-    s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
-    barrier(im[cur], VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
-    barrier(im[2 + cur], VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
-    barrier(im[6], VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
-    flush(cs, readers);
-    current = im[6].view;
-    last = &im[6];
-    s.historyValid = true;
-    s.parity = prev;
-  }
-  if (!settings.disableSpatial) {
-    uint32_t iterations = settings.spatialIterations ? settings.spatialIterations : 2u;
-    pc.flags = flags;
-    for (uint32_t i = 0; i < iterations; ++i) {
-      const GpuImage& out = im[4 + (i % 2)];
-      if (i >= 2) {
-        // Reusing a ping-pong image read two steps ago: back to GENERAL for writing.
-        barrier(out, ro, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_SHADER_WRITE_BIT);
-        flush(cs, cs);
-      }
-      pc.atrousStep = 1u << i;
-      DescriptorWrites w;
-      w.sampledImage(RB_ATROUS_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
-      w.sampledImage(RB_ATROUS_BINDING_NORMAL, g.normal.view, s.sampler, readLayout(g.normal));
-      w.sampledImage(RB_ATROUS_BINDING_SIGNAL_IN, current, s.sampler, ro);
-      w.storageImage(RB_ATROUS_BINDING_SIGNAL_OUT, out.view);
-      s.atrous.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
-      barrier(out, VK_IMAGE_LAYOUT_GENERAL, ro, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
-      flush(cs, readers);
-      current = out.view;
-      last = &out;
-    }
-    // A spatial image this frame did not write is still in GENERAL: keep every image's layout known.
-    if (iterations == 1) {
-      barrier(im[5], VK_IMAGE_LAYOUT_GENERAL, ro, 0, VK_ACCESS_SHADER_READ_BIT);
-      flush(cs, readers);
-    }
-  } else {
-    barrier(im[4], VK_IMAGE_LAYOUT_GENERAL, ro, 0, VK_ACCESS_SHADER_READ_BIT);
-    barrier(im[5], VK_IMAGE_LAYOUT_GENERAL, ro, 0, VK_ACCESS_SHADER_READ_BIT);
-    flush(cs, readers);
-  }
-  if (!temporal) {
-    barrier(im[6], VK_IMAGE_LAYOUT_GENERAL, ro, 0, VK_ACCESS_SHADER_READ_BIT);
-    flush(cs, readers);
-  }
-  s.metrics.writeEnd(ctx, cmd);
-  std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
-  std::memcpy(s.previousCamera, camera, sizeof camera);
-  s.outputs.denoised = last->image;
-  s.outputs.denoisedView = last->view;
-  s.outputs.width = g.width;
-  s.outputs.height = g.height;
-  return {};
+  return st;
 }
 
 }  // namespace rb

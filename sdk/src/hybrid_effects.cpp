@@ -115,6 +115,7 @@ struct HybridEffects::Impl {
   std::unique_ptr<ReflectionPass> reflection;
   std::unique_ptr<ManyLightPass> localLights;
   std::unique_ptr<Denoiser> localLightDenoiser;
+  std::unique_ptr<Denoiser> reflectionDenoiser;
   // The engine's materials, shared by every pass: reflection hits shade with them, and shadow, AO and
   // reflection rays alpha-test non-opaque geometry with them. The table (GPU memory) exists only while a pass
   // does; the engine's last setMaterials is kept here to fill it when one is created.
@@ -161,6 +162,7 @@ struct HybridEffects::Impl {
     if (!shadow || desc.shadows.disableDenoiser) shadowDenoiser.reset();
     if (!ao || desc.ao.disableDenoiser) aoDenoiser.reset();
     if (!localLightsDenoised()) localLightDenoiser.reset();
+    if (!reflection || desc.reflections.disableDenoiser) reflectionDenoiser.reset();
     return syncMaterialTable();
   }
 
@@ -182,7 +184,7 @@ struct HybridEffects::Impl {
     d.raysPerPixel = kind == DenoiseSignal::Scalar ? rays : 0u;
     if (Status st = slot->record(cmd, gbuffer, signal, d); !st) return wrap(what, st.error());
     const DenoiseOutputs& dn = slot->outputs();
-    const VkFormat format = kind == DenoiseSignal::Rgb ? VK_FORMAT_R16G16B16A16_SFLOAT : VK_FORMAT_R16_SFLOAT;
+    const VkFormat format = kind == DenoiseSignal::Scalar ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
     out = image(dn.denoised, dn.denoisedView, format, dn.layout, dn.width, dn.height);
     return {};
   }
@@ -257,8 +259,11 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   const GBufferDesc& g = f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer;
   if (Status st = reflection->record(cmd, g, tlas, s); !st) return wrap("ReflectionPass::record", st.error());
   const ReflectionOutputs& o = reflection->outputs();
-  outputs.reflection = image(o.radiance, o.radianceView, VK_FORMAT_R16G16B16A16_SFLOAT, o.layout, o.width, o.height);
-  return {};
+  outputs.reflection = outputs.reflectionRaw = image(o.radiance, o.radianceView, VK_FORMAT_R16G16B16A16_SFLOAT,
+                                                     o.layout, o.width, o.height);
+  // Guided by the roughness of the G-buffer the rays were traced from.
+  return denoise(reflectionDenoiser, !desc.reflections.disableDenoiser, "Denoiser (reflections)", cmd, g,
+                 o.radianceView, 0, outputs.reflection, DenoiseSignal::Reflection);
 }
 
 Result<std::unique_ptr<HybridEffects>> HybridEffects::create(Context& context, AccelerationStructureService* service,
@@ -335,13 +340,19 @@ void HybridEffects::resetHistory() {
   if (impl_->shadowDenoiser) impl_->shadowDenoiser->resetHistory();
   if (impl_->aoDenoiser) impl_->aoDenoiser->resetHistory();
   if (impl_->localLightDenoiser) impl_->localLightDenoiser->resetHistory();
+  if (impl_->reflectionDenoiser) impl_->reflectionDenoiser->resetHistory();
 }
 
 HybridStats HybridEffects::stats() const {
   const Impl& a = *impl_;
-  return {
-      statsOf(a.shadow),      statsOf(a.shadowDenoiser),    statsOf(a.ao), statsOf(a.aoDenoiser), statsOf(a.reflection),
-      statsOf(a.localLights), statsOf(a.localLightDenoiser)};
+  return {statsOf(a.shadow),
+          statsOf(a.shadowDenoiser),
+          statsOf(a.ao),
+          statsOf(a.aoDenoiser),
+          statsOf(a.reflection),
+          statsOf(a.localLights),
+          statsOf(a.localLightDenoiser),
+          statsOf(a.reflectionDenoiser)};
 }
 
 MemoryStats HybridEffects::memoryStats() const {
@@ -360,5 +371,6 @@ const ManyLightPass* HybridEffects::localLightPass() const { return impl_->local
 const Denoiser* HybridEffects::shadowDenoiser() const { return impl_->shadowDenoiser.get(); }
 const Denoiser* HybridEffects::aoDenoiser() const { return impl_->aoDenoiser.get(); }
 const Denoiser* HybridEffects::localLightDenoiser() const { return impl_->localLightDenoiser.get(); }
+const Denoiser* HybridEffects::reflectionDenoiser() const { return impl_->reflectionDenoiser.get(); }
 
 }  // namespace rb

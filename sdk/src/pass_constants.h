@@ -159,8 +159,9 @@ struct DenoiseConstants {
   float wAtDepthOne;
   float normalPower;
   float signalRaysPerPixel;  // 0 = unknown
+  float convergedNoise;      // scalar: DenoiseSettings::convergedNoise
 };
-static_assert(sizeof(DenoiseConstants) == 224);
+static_assert(sizeof(DenoiseConstants) == 228);
 RB_ASSERT_OFFSET(DenoiseConstants, inverseProjection, 0);
 RB_ASSERT_OFFSET(DenoiseConstants, viewToWorld, 64);
 RB_ASSERT_OFFSET(DenoiseConstants, previousViewProjection, 112);
@@ -173,6 +174,7 @@ RB_ASSERT_OFFSET(DenoiseConstants, maxHistoryFrames, 208);
 RB_ASSERT_OFFSET(DenoiseConstants, wAtDepthOne, 212);
 RB_ASSERT_OFFSET(DenoiseConstants, normalPower, 216);
 RB_ASSERT_OFFSET(DenoiseConstants, signalRaysPerPixel, 220);
+RB_ASSERT_OFFSET(DenoiseConstants, convergedNoise, 224);
 
 struct ClusterBoundsConstants {
   uint64_t positions;  // device addresses

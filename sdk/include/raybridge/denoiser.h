@@ -1,12 +1,24 @@
-// Denoising for ray-traced signals: single-channel ones (shadow visibility, AO) and RGB HDR ones (the
-// many-light irradiance of ManyLightPass), chosen by DenoiserDesc::signal. Temporal accumulation with
-// reprojection (camera motion, or the engine's motion vectors when GBufferDesc::motionVectors is given),
-// followed by an edge-aware a-trous spatial filter guided by depth and normals. Each signal needs its own
+// Denoising for ray-traced signals: single-channel ones (shadow visibility, AO), RGB HDR ones (the many-light
+// irradiance of ManyLightPass) and reflections (ReflectionPass), chosen by DenoiserDesc::signal. Temporal
+// accumulation with reprojection (camera motion, or the engine's motion vectors when GBufferDesc::motionVectors is
+// given), followed by an edge-aware a-trous spatial filter guided by depth and normals. Each signal needs its own
 // Denoiser (it keeps that signal's history). The raw input is left untouched, so raw and denoised are both
 // available.
 //
-// RGB signals (SVGF-style, Schied et al. 2017): the temporal pass reprojects bilinearly and keeps, beside the
-// mean colour, the running variance of one frame's colour (from the 3x3 windows around the pixel while the
+// Scalar signals: the filtering follows the noise measured in the data. The temporal pass estimates the variance
+// left in each pixel's mean: binomial for a fraction of DenoiseSettings::raysPerPixel binary rays, at a
+// probability taken from the pixel's rays and a 3x3 window of its neighbourhood (so a one-ray 0 or 1 still counts
+// as noisy), else the window's variance; the least of the four windows with the pixel in a corner (an edge is not
+// noise); divided by the frames accumulated. The a-trous steps (5x5 taps, 2 by default) weight value differences
+// by the centre's noise, and carry the variance through. The last step moves the temporal mean towards the filtered
+// value by at most as much as its noise explains (one standard deviation, falling off beyond, and less where the
+// previous steps changed the neighbourhood by more than its noise: a pattern finer than the filter), and not at all
+// where the noise is under DenoiseSettings::convergedNoise: converged or many-ray signals pass bit for bit. One
+// temporal and spatialIterations a-trous dispatches (3 dispatches by default); 26 bytes of images per pixel (30 with
+// three or more steps; 91 MiB at 2560x1440).
+//
+// RGB and reflection signals (SVGF-style, Schied et al. 2017): the temporal pass reprojects bilinearly and keeps,
+// beside the mean colour, the running variance of one frame's colour (from the 3x3 windows around the pixel while the
 // history is shorter than 4 frames); the a-trous steps (3x3 taps, 5 by default) stop at colour differences larger
 // than the remaining noise of the mean, so a converged or noise-free signal passes nearly unchanged, and filter
 // in the signal's own domain (no albedo demodulation: ManyLightPass's irradiance has none). One temporal and
@@ -31,6 +43,11 @@ namespace rb {
 enum class DenoiseSignal : uint32_t {
   Scalar = 0,  // default: R16/R32 .r (shadow visibility, AO); output R16_SFLOAT
   Rgb,         // RGBA16F/RGBA32F .rgb, HDR (e.g. ManyLightOutputs::irradiance); output R16G16B16A16_SFLOAT, a = 1
+  // RGBA16F/RGBA32F reflected radiance, .a = coverage (ReflectionOutputs::radiance): filtered as Rgb, guided by
+  // the G-buffer's roughness (required): the filter's colour tolerance shrinks with it below roughness 0.1, so
+  // a mirror (roughness 0, one deterministic ray) is not blurred. Pixels without coverage are neither filtered
+  // nor taps. Output R16G16B16A16_SFLOAT, a = the coverage (0 or 1).
+  Reflection,
 };
 
 // Fixed for the denoiser's life (its history and images follow it). Zero-initialised = a scalar denoiser.
@@ -38,28 +55,36 @@ struct DenoiserDesc {
   DenoiseSignal signal = DenoiseSignal::Scalar;
 };
 
+// Default of DenoiseSettings::convergedNoise: a scalar pixel whose noise has a standard deviation under 0.1 passes
+// unfiltered (32 binary rays give at most 0.088: the filter's bias in narrow penumbrae costs more than such noise);
+// up to twice that the filter's shift is ramped in.
+inline constexpr float kDefaultDenoiseConvergedNoise = 0.1f;
+
 struct DenoiseSettings {
   // false = accumulate over frames. Rgb: true still runs the temporal dispatch (it measures the noise), without
   // history.
   bool disableTemporal = false;
   bool disableSpatial = false;  // false = run the a-trous filter
-  // 0 = 2 for Scalar (steps 1 and 2: a 13x13 footprint; 3 over-blurs 4-ray AO), 5 for Rgb (3x3 taps at steps 1 to
-  // 16: its weights follow the measured noise, so the wide reach only blurs where the signal is still noisy).
+  // 0 = 2 for Scalar (steps 1 and 2: a 13x13 footprint), 5 for Rgb and Reflection (3x3 taps at steps 1 to 16:
+  // their weights follow the measured noise, so the wide reach only blurs where the signal is still noisy).
   // At most 6.
   uint32_t spatialIterations = 0;
   uint32_t maxHistoryFrames = 0;  // 0 = 32: the running mean forgets more slowly than this
   float depthSigma = 0.0f;        // 0 = 0.005: plane-distance tolerance relative to view distance, per step
   float normalPower = 0.0f;       // 0 = 32: exponent of the normal similarity weight
   // Scalar signals: rays per pixel behind the signal, when it is a fraction of binary rays (shadow visibility,
-  // binary AO): the spatial filter then knows the noise exactly and keeps every edge that is not noise.
+  // binary AO): the noise is then binomial, and an edge that all rays agree on is kept.
   // 0 = unknown: the noise is estimated from the 3x3 neighbourhood, which also blurs thin noise-free features.
   // Rgb signals ignore it: their noise is the colour variance measured over the accumulated frames.
   uint32_t raysPerPixel = 0;
+  // Scalar signals: standard deviation of the noise under which a pixel passes unfiltered (its temporal mean, or
+  // the raw value without history). 0 = kDefaultDenoiseConvergedNoise.
+  float convergedNoise = 0.0f;
 };
 
 // Owned by the denoiser, left in SHADER_READ_ONLY_OPTIMAL after record().
 struct DenoiseOutputs {
-  // DenoiseSignal::Scalar: R16_SFLOAT (.r). DenoiseSignal::Rgb: R16G16B16A16_SFLOAT (.rgb, a = 1).
+  // DenoiseSignal::Scalar: R16_SFLOAT (.r). Rgb: R16G16B16A16_SFLOAT (.rgb, a = 1). Reflection: as Rgb, a = coverage.
   VkImage denoised = VK_NULL_HANDLE;
   VkImageView denoisedView = VK_NULL_HANDLE;
   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
@@ -78,6 +103,8 @@ class Denoiser {
   //   Scalar: an R16/R32 float image view with the noisy value in .r.
   //   Rgb: an RGBA16F/RGBA32F image view with the noisy HDR value in .rgb (.a is ignored). A VkImageView does
   //        not tell its format, so this cannot be checked: a one-channel view would read as red only.
+  //   Reflection: as Rgb, .a = coverage (0 = no reflection there); the G-buffer must carry roughness
+  //        (GBufferDesc::roughnessInNormalW or roughnessMetalness), that of the reflection rays.
   // The G-buffer is the one the signal was traced from.
   Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, VkImageView signal,
                 const DenoiseSettings& settings = {});

@@ -16,8 +16,8 @@
 //                                                       // compute shaders
 //
 // Order inside record(): pending BLAS work and the TLAS (when it builds one) -> shadows [-> denoiser] -> AO
-// [-> denoiser] -> local lights [-> denoiser] -> reflections. Only what the description enables exists: a disabled
-// effect has no pass, no denoiser, no image and traces no ray; hard shadows (one ray) are never denoised.
+// [-> denoiser] -> local lights [-> denoiser] -> reflections [-> denoiser]. Only what the description enables exists: a
+// disabled effect has no pass, no denoiser, no image and traces no ray; hard shadows (one ray) are never denoised.
 //
 // Lifetime: setDesc()/applyPreset() and the destructor retire passes to the Context's deferred release (see
 // context.h), so switching effects mid-run needs no wait-idle. Destroy it before its Context and before the
@@ -70,6 +70,9 @@ struct AoEffectSettings {
 struct ReflectionEffectSettings {
   float roughnessThreshold = 0.0f;  // 0 = kDefaultReflectionRoughnessThreshold: rougher pixels trace nothing
   uint32_t raysPerPixel = 0;        // glossy pixels; 0 = kDefaultReflectionRays (mirrors trace one)
+  // false = denoised (a DenoiseSignal::Reflection Denoiser, HybridEffectsDesc::denoiser's settings): glossy
+  // pixels are filtered as far as their noise asks, mirrors (roughness 0) are not blurred.
+  bool disableDenoiser = false;
 };
 
 struct LocalLightEffectSettings {
@@ -88,7 +91,7 @@ struct HybridEffectsDesc {
   AoEffectSettings ao;
   ReflectionEffectSettings reflections;
   LocalLightEffectSettings localLights;
-  // Shared by the shadow, AO and local light denoisers (raysPerPixel is filled in per scalar signal).
+  // Shared by the shadow, AO, local light and reflection denoisers (raysPerPixel is filled in per scalar signal).
   DenoiseSettings denoiser;
   // Build the TLAS with camera-relative origin (TlasBuildOptions::originOffset = the G-buffer's camera
   // position), so precision holds far from the world origin. Only used when record() builds the TLAS.
@@ -142,7 +145,9 @@ struct EffectImage {
 struct HybridOutputs {
   EffectImage shadow, shadowRaw;  // R16_SFLOAT visibility, 1 = lit
   EffectImage ao, aoRaw;          // R16_SFLOAT open fraction, 1 = open
-  EffectImage reflection;         // R16G16B16A16_SFLOAT radiance, a = 1 where rays were traced
+  // R16G16B16A16_SFLOAT radiance, a = 1 where rays were traced: reflection is denoised unless
+  // ReflectionEffectSettings::disableDenoiser, else it is reflectionRaw.
+  EffectImage reflection, reflectionRaw;
   // R16G16B16A16_SFLOAT shadowed diffuse irradiance of the local lights (ManyLightOutputs): localLights is
   // denoised in Stochastic mode unless LocalLightEffectSettings::disableDenoiser; else it is localLightsRaw.
   EffectImage localLights, localLightsRaw;
@@ -150,10 +155,10 @@ struct HybridOutputs {
 
 // Per-pass measurements of the latest recordings whose frames have finished (zero for what does not exist).
 struct HybridStats {
-  PassStats shadow, shadowDenoise, ao, aoDenoise, reflection, localLights, localLightsDenoise;
+  PassStats shadow, shadowDenoise, ao, aoDenoise, reflection, localLights, localLightsDenoise, reflectionDenoise;
   double totalGpuMs() const {
     return shadow.gpuMs + shadowDenoise.gpuMs + ao.gpuMs + aoDenoise.gpuMs + reflection.gpuMs + localLights.gpuMs +
-           localLightsDenoise.gpuMs;
+           localLightsDenoise.gpuMs + reflectionDenoise.gpuMs;
   }
   uint64_t totalRays() const { return shadow.rays + ao.rays + reflection.rays + localLights.rays; }
 };
@@ -186,7 +191,7 @@ class HybridEffects {
   Status record(VkCommandBuffer cmd, const HybridFrame& frame);
   const HybridOutputs& outputs() const;
   const TlasInfo& lastTlas() const;  // the TLAS the latest record() traced
-  // Forget the denoisers' history (camera cut, scene change): shadows, AO and local lights.
+  // Forget the denoisers' history (camera cut, scene change): shadows, AO, local lights and reflections.
   void resetHistory();
 
   HybridStats stats() const;
@@ -203,6 +208,7 @@ class HybridEffects {
   const Denoiser* shadowDenoiser() const;
   const Denoiser* aoDenoiser() const;
   const Denoiser* localLightDenoiser() const;  // nullptr unless Stochastic local lights are denoised
+  const Denoiser* reflectionDenoiser() const;  // nullptr unless reflections are denoised
 
   struct Impl;
 

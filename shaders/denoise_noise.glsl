@@ -1,0 +1,73 @@
+// The scalar denoiser's noise model: how noisy a pixel's (accumulated) value still is, measured from the data,
+// and how far the filter may move it. Shared by its temporal and a-trous passes.
+#ifndef RAYBRIDGE_DENOISE_NOISE_GLSL
+#define RAYBRIDGE_DENOISE_NOISE_GLSL
+
+#include "denoise_common.glsl"
+
+// Binary rays: the neighbourhood's mean enters the pixel's estimate of the ray's probability as this many
+// rays' worth. One ray's own 0 or 1 would read as noise-free (p (1 - p) = 0); many rays outweigh it, so an edge
+// that every ray agrees on keeps (almost) no noise.
+const float kRbDnPriorRays = 1.0;
+
+// Variance of the noise of `mean`, the average of `frames` frames of the signal at `ip`. Each of the four 3x3
+// windows that hold the pixel in a corner gives an estimate, and the least is taken (Kuwahara's trick, as the RGB
+// path): noise spreads every window, while a noise-free edge, even a one-ray one, leaves a window on its own side.
+// With the rays per pixel known (a fraction of binary rays) an estimate is binomial, p (1 - p) / (rays * frames),
+// at a probability p from the pixel's own rays plus the window's mean; else the window's variance divided by the
+// frames averaged.
+float rbDnNoiseVariance(sampler2D signal, ivec2 ip, float mean, float frames) {
+  float v[25];
+  for (int y = -2; y <= 2; ++y)
+    for (int x = -2; x <= 2; ++x) v[(y + 2) * 5 + x + 2] = texelFetch(signal, clamp(ip + ivec2(x, y), ivec2(0), ivec2(pc.size) - 1), 0).r;
+  const float rays = pc.signalRaysPerPixel * frames;
+  const float c = clamp(mean, 0.0, 1.0);
+  float least = 1e30;
+  for (int wy = 0; wy <= 2; wy += 2) {
+    for (int wx = 0; wx <= 2; wx += 2) {
+      float m1 = 0.0, m2 = 0.0;
+      for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 3; ++x) {
+          float q = v[(wy + y) * 5 + wx + x];
+          m1 += q;
+          m2 += q * q;
+        }
+      }
+      m1 /= 9.0;
+      float variance;
+      if (rays > 0.0) {
+        float p = clamp((c * rays + kRbDnPriorRays * m1) / (rays + kRbDnPriorRays), 0.0, 1.0);
+        variance = p * (1.0 - p) / rays;
+      } else {
+        variance = max(m2 / 9.0 - m1 * m1, 0.0) * (9.0 / 8.0) / frames;
+      }
+      least = min(least, variance);
+    }
+  }
+  return least;
+}
+
+// The largest shift the filter may give a pixel, in standard deviations of its noise: a larger difference
+// between the filtered and the unfiltered value is more than noise explains (an edge, the curve of a penumbra),
+// and the shift then falls off as (limit / difference)^4. One: on the effects bench's demo scene (lavapipe, 160x90)
+// three let the filter's bias in narrow penumbrae and AO creases through (denoised shadows at 32 rays 0.016 RMSE
+// against 0.0066 raw); one halves that, and kDefaultDenoiseConvergedNoise leaves many-ray pixels alone.
+const float kRbDnShiftSigmas = 1.0;
+
+// `anchor` (unfiltered, noise variance `variance`) moved towards `filtered` as far as its noise explains; left
+// exactly as it is where the noise's standard deviation is under pc.convergedNoise, with a ramp up to twice that.
+// `bias2`: the filter's squared bias around the pixel, estimated by the caller; the shift is scaled by the Wiener
+// gain variance / (variance + bias2), so where filtering changes the signal itself (a shadow pattern finer than
+// the filter) more than the noise it removes, the pixel stays near its own value.
+float rbDnLimitedShift(float anchor, float variance, float filtered, float bias2) {
+  float sigma = sqrt(max(variance, 0.0));
+  float gain = clamp(sigma / pc.convergedNoise - 1.0, 0.0, 1.0);
+  if (gain <= 0.0) return anchor;
+  float d = filtered - anchor;
+  float limit = kRbDnShiftSigmas * sigma;
+  float r = abs(d) <= limit ? 1.0 : limit / abs(d);
+  float wiener = variance / (variance + max(bias2, 0.0));
+  return anchor + gain * wiener * d * (r * r) * (r * r);
+}
+
+#endif
