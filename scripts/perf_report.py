@@ -82,7 +82,7 @@ def render_row(folder, name, probes):
         passes[pname] = entry
     row["passes"] = passes
     if "raybridge" in st:
-        row["memory_bytes"] = st["raybridge"].get("memory", {}).get("total")
+        row["memory_bytes"] = st["raybridge"].get("memory_bytes", {}).get("total")
         row["tlas_instances"] = st["raybridge"]["acceleration_structures"].get("tlas_instances")
     if len(parts) > 3 and fs.get("frames"):
         row["flythrough"] = {"camera_path": st.get("camera_path", {}).get("file"), **fs}

@@ -72,7 +72,7 @@ TEST_CASE("raybridge-render along a camera path reports per-frame percentiles", 
     DYNAMIC_SECTION(mode) {
       int status = 0;
       const std::string out = renderOutput("--camera-path \"" + pathFile.string() + "\" --mode " + mode +
-                                               " --preset low --width 64 --height 40 --frames 9 --out \"" +
+                                               " --preset low --width 64 --height 40 --frames 9 --dump --out \"" +
                                                (dir / mode).string() + "\"",
                                            status);
       INFO(out);
@@ -81,9 +81,10 @@ TEST_CASE("raybridge-render along a camera path reports per-frame percentiles", 
       REQUIRE(stats.is_object());
       const nlohmann::json& fs = stats["frame_series"];
       INFO(fs.dump(2));
-      // Nine frames less the warm-up. The engine resolves a frame when its slot is reused and, at the final wait,
-      // reports the newest only: the one frame before the last is never seen (two frames in flight).
-      const int expected = 9 - int(rbRender::kFrameSeriesWarmupFrames) - 1;
+      // Nine frames: the last captures the images (--dump) and is not timed, the first three are the warm-up. The
+      // engine resolves a frame when its slot is reused and, at the final wait, reports the newest only: the one
+      // frame before the last timed one is never seen (two frames in flight).
+      const int expected = 9 - 1 - int(rbRender::kFrameSeriesWarmupFrames) - 1;
       CHECK(fs["frames"] == expected);
       for (const char* metric : {"frame_gpu_ms", "hook_gpu_ms"}) {
         REQUIRE(fs.contains(metric));
@@ -115,7 +116,8 @@ TEST_CASE("raybridge-render --perf-scene composes the shared models on a fine gr
   fs::remove_all(dir);
   int status = 0;
   const std::string out = renderOutput(
-      "--perf-scene --preset hard-shadows --width 64 --height 36 --frames 2 --out \"" + dir.string() + "\"", status);
+      "--perf-scene --preset hard-shadows --width 64 --height 36 --frames 4 --dump --out \"" + dir.string() + "\"",
+      status);
   INFO(out);
   REQUIRE(status == 0);
   const nlohmann::json stats = readJson(dir / "stats.json");

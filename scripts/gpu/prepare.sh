@@ -12,7 +12,7 @@
 #   SCENES_DIR=...       glTF models to carry (default ../shared/scenes beside the checkout); geometry only
 #   EXTRA_BINS="F ..."   more executables to carry into bin/ (e.g. raybridge-render-base for run_remote.sh perf)
 #
-# .devcarry/ layout (files over 2 MiB are stored gzipped as NAME.gz; run_remote.sh unpacks them):
+# .devcarry/ layout (files over 256 KiB are stored gzipped as NAME.gz; run_remote.sh unpacks them):
 #   bin/      raybridge-bench, the test executables, raybridge-render and other sample executables
 #   lib/      shared libraries the binaries and the layer need, outside glibc and the C++ runtime (per ldd)
 #   lib-fallback/  libstdc++ and libgcc_s, used there only if the machine's own are too old
@@ -182,7 +182,7 @@ else
 fi
 
 # ---- 7. compress what is large, check the size -------------------------------------------------------------
-find "$CARRY" -type f -size +2M ! -name '*.deb' ! -name '*.gz' -exec gzip -9 {} +
+find "$CARRY" -type f -size +256k ! -name '*.deb' ! -name '*.gz' -exec gzip -9 {} +
 bytes=$(du -sb "$CARRY" | cut -f1)
 mib=$(( (bytes + 1048575) / 1048576 ))
 {

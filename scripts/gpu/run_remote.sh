@@ -18,8 +18,9 @@
 #   RB_BENCH_ARGS=...   benchmark arguments (default: --scenario all --full)
 #   RB_TIME_BUDGET=500  seconds for the whole run
 #   RB_PERF_SIZE="2560 1440", RB_PERF_FRAMES=40, RB_PERF_PATH_FRAMES=240, RB_PERF_PRESETS="hard-shadows low medium
-#   high ultra", RB_PERF_BENCH_ARGS=--full: the perf mode's size, frames per row and along the path, presets and
-#   benchmark arguments (smaller ones for a rehearsal on lavapipe)
+#   high ultra", RB_PERF_VARIANT_PRESETS="hard-shadows low ultra", RB_PERF_BENCH_ARGS=--full: the perf mode's
+#   size, frames per row and along the path, presets (of the current build and of the earlier ones) and benchmark
+#   arguments (smaller ones for a rehearsal on lavapipe)
 #   RB_RUNTIME_DIR=DIR  where .devcarry is unpacked (default /tmp/raybridge-devcarry)
 set -u
 
@@ -249,8 +250,9 @@ fi
 # ---- perf: docs/performance.md. The probe on ~100k and ~1M triangles, then the performance scene (--perf-scene,
 # ~3M triangles) and the demo scene at 2560x1440 per preset (hybrid; raster for low and ultra), the fly-through
 # along scripts/gpu/perf_flythrough.json (raster and hybrid), the TLAS and trace benchmarks; perf_report.py writes
-# perf_gpu.json. With bin/raybridge-render-base (an earlier build carried by prepare.sh's EXTRA_BINS), every hybrid
-# row is rendered by it too, right after the current one, as the "before" of docs/performance.md. Validation off.
+# perf_gpu.json. With bin/raybridge-render-VARIANT (earlier builds carried by prepare.sh's EXTRA_BINS), the hybrid
+# rows of RB_PERF_VARIANT_PRESETS are rendered by each of them too, right after the current one, as the "before"
+# rows of docs/performance.md (scene name SCENE-VARIANT). Validation off.
 if want perf; then
   : >"$OUT/perf_gpu.log"
   PDIR="$(mktemp -d)"
@@ -265,7 +267,7 @@ if want perf; then
   perf_render() {  # NAME BINARY ARGS...
     local name="$1" bin="$2"
     shift 2
-    RAYBRIDGE_VALIDATION=0 step "perf $name" 90 "$OUT/perf_gpu.log" "$bin" --width "$PW" --height "$PH" "$@" \
+    RAYBRIDGE_VALIDATION=0 step "perf $name" 90 "$OUT/perf_gpu.log" "$bin" --width "$PW" --height "$PH" --dump "$@" \
       --out "$PDIR/$name"
   }
   for scene in perf demo; do
@@ -274,10 +276,13 @@ if want perf; then
     for preset in ${RB_PERF_PRESETS:-hard-shadows low medium high ultra}; do
       perf_render "${scene}__hybrid__$preset" "$RT/bin/raybridge-render" "${sargs[@]}" --preset "$preset" \
         --frames "$PFRAMES"
-      if [ -x "$RT/bin/raybridge-render-base" ]; then
-        perf_render "${scene}-base__hybrid__$preset" "$RT/bin/raybridge-render-base" "${sargs[@]}" --preset "$preset" \
-          --frames "$PFRAMES"
-      fi
+      # Earlier builds (bin/raybridge-render-VARIANT), each right after the current one: the before/after rows.
+      case " ${RB_PERF_VARIANT_PRESETS:-hard-shadows low ultra} " in *" $preset "*) ;; *) continue ;; esac
+      for vbin in "$RT"/bin/raybridge-render-*; do
+        [ -x "$vbin" ] || continue
+        variant="${vbin##*/raybridge-render-}"
+        perf_render "${scene}-${variant}__hybrid__$preset" "$vbin" "${sargs[@]}" --preset "$preset" --frames "$PFRAMES"
+      done
     done
     for preset in low ultra; do
       perf_render "${scene}__raster__$preset" "$RT/bin/raybridge-render" "${sargs[@]}" --mode raster \
