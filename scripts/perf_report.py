@@ -84,7 +84,9 @@ def render_row(folder, name, probes):
     if "raybridge" in st:
         row["memory_bytes"] = st["raybridge"].get("memory_bytes", {}).get("total")
         row["tlas_instances"] = st["raybridge"]["acceleration_structures"].get("tlas_instances")
-    if len(parts) > 3 and fs.get("frames"):
+    if len(parts) > 3:
+        row["tag"] = parts[3]  # path: the fly-through; res, tri, inst: the cost curves
+    if len(parts) > 3 and parts[3] == "path" and fs.get("frames"):
         row["flythrough"] = {"camera_path": st.get("camera_path", {}).get("file"), **fs}
     if probe:
         row["probe_triangles"] = probe["triangles"]

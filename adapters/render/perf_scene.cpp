@@ -37,7 +37,7 @@ constexpr PerfModel kModels[] = {
 
 }  // namespace
 
-se::Result<se::Scene> makePerfScene(const std::string& scenesDir, PerfSceneInfo& info) {
+se::Result<se::Scene> makePerfScene(const std::string& scenesDir, PerfSceneInfo& info, const PerfSceneShape& shape) {
   using R = se::Result<se::Scene>;
   info = PerfSceneInfo{};
   se::Scene s;
@@ -45,13 +45,16 @@ se::Result<se::Scene> makePerfScene(const std::string& scenesDir, PerfSceneInfo&
   se::Material ground{.name = "polished concrete", .baseColorFactor = {0.62f, 0.6f, 0.57f, 1.0f}};
   ground.roughnessFactor = 0.3f;
   s.materials.push_back(ground);
-  se::MeshData plane = se::makePlane(kPerfGroundSize, kPerfGroundSize, kPerfGroundSegments, kPerfGroundSegments);
+  const uint32_t segments = shape.groundSegments ? shape.groundSegments : kPerfGroundSegments;
+  se::MeshData plane = se::makePlane(kPerfGroundSize, kPerfGroundSize, segments, segments);
   plane.material = 0;
   s.meshes.push_back(std::move(plane));
   s.instances.push_back(se::Instance{.mesh = 0});
 
   std::string looked;
+  const uint32_t copiesScale = shape.copiesScale ? shape.copiesScale : 1u;
   for (const PerfModel& m : kModels) {
+    if (shape.groundOnly) break;
     const std::string path = scenesDir + "/" + m.name + "/" + m.name + ".gltf";
     if (!std::filesystem::is_regular_file(path)) {
       looked += (looked.empty() ? "" : ", ") + path;
@@ -75,10 +78,14 @@ se::Result<se::Scene> makePerfScene(const std::string& scenesDir, PerfSceneInfo&
     meshesOnly.lights.clear();
     const uint32_t meshBase = uint32_t(s.meshes.size());
     se::appendScene(s, meshesOnly, glm::mat4(1.0f));
-    for (uint32_t k = 0; k < m.copies; ++k) {
+    // More copies go on further rings outside the default one, as many per ring, each ring 1.2 model sizes out.
+    for (uint32_t k = 0; k < m.copies * copiesScale; ++k) {
+      const uint32_t ring = k / m.copies, slot = k % m.copies;
       // Evenly round the ring, the ring turned by half a step against the previous one; each copy faces the centre.
-      const float angle = (float(k) + 0.5f * float(info.models % 2)) * glm::two_pi<float>() / float(m.copies);
-      const glm::vec3 at(m.ringRadius * std::sin(angle), 0.0f, m.ringRadius * std::cos(angle));
+      const float angle = (float(slot) + 0.5f * float((info.models + ring) % 2)) * glm::two_pi<float>() /
+                          float(m.copies);
+      const float radius = m.ringRadius + float(ring) * 1.2f * m.size;
+      const glm::vec3 at(radius * std::sin(angle), 0.0f, radius * std::cos(angle));
       const glm::mat4 placement = glm::translate(glm::mat4(1.0f), at) *
                                   glm::rotate(glm::mat4(1.0f), angle + glm::pi<float>(), glm::vec3(0, 1, 0)) *
                                   normalize;
@@ -87,7 +94,7 @@ se::Result<se::Scene> makePerfScene(const std::string& scenesDir, PerfSceneInfo&
     }
     ++info.models;
   }
-  if (info.models == 0)
+  if (info.models == 0 && !shape.groundOnly)
     return R::failure("no model of the performance scene found (looked for " + looked +
                       "); pass --models-from with the folder of the shared glTF models");
   for (const se::Instance& inst : s.instances) info.triangles += s.meshes[inst.mesh].triangleCount();

@@ -16,6 +16,15 @@ namespace rbRender {
 inline constexpr float kPerfGroundSize = 80.0f;
 inline constexpr uint32_t kPerfGroundSegments = 768;
 
+// What the scene holds: the cost curves of docs/performance.md vary these (ground only for the triangle curve, more
+// copies for the instance curve). A zero-initialised PerfSceneShape is the default scene.
+struct PerfSceneShape {
+  uint32_t groundSegments = 0;  // 0 = kPerfGroundSegments; quads per side of the ground
+  // Copies of every model relative to the default scene; 0 = 1. With groundOnly, no model at all.
+  uint32_t copiesScale = 0;
+  bool groundOnly = false;
+};
+
 struct PerfSceneInfo {
   uint64_t triangles = 0;  // summed over instances (what the TLAS holds)
   uint64_t instances = 0;  // Scene::instances
@@ -27,6 +36,7 @@ struct PerfSceneInfo {
 // MetalRoughSpheresNoTextures, each on a ring of plinths around the centre. Fails, naming the folder and the files
 // looked for, when none is in `scenesDir`; a missing model is skipped and listed in PerfSceneInfo::missing.
 // Deterministic: the same folder gives the same scene. Has a camera (looking over the rings) and a low sun.
-sample_engine::Result<sample_engine::Scene> makePerfScene(const std::string& scenesDir, PerfSceneInfo& info);
+sample_engine::Result<sample_engine::Scene> makePerfScene(const std::string& scenesDir, PerfSceneInfo& info,
+                                                          const PerfSceneShape& shape = {});
 
 }  // namespace rbRender

@@ -37,9 +37,11 @@ se::Result<se::Scene> loadScene(const RenderOptions& o, std::vector<se::Animatio
                                                      : o.modelsFrom;
   if (o.perfScene) {
     PerfSceneInfo info;
-    auto perf = makePerfScene(modelsDir, info);
+    auto perf = makePerfScene(
+        modelsDir, info,
+        {.groundSegments = o.perfGroundSegments, .copiesScale = o.perfCopies, .groundOnly = o.perfGroundOnly});
     if (!perf) return R::failure("--perf-scene: " + perf.error);
-    if (!info.missing.empty())
+    if (!info.missing.empty() && !o.perfGroundOnly)
       std::fprintf(stderr, "warning: --perf-scene: not found in %s, left out: %s\n", modelsDir.c_str(),
                    info.missing.c_str());
     return perf;
@@ -493,6 +495,7 @@ int main(int argc, char** argv) {
     for (const auto& [name, p] : namedPassStats(es, &fxo)) {
       passes[name] = {
           {"gpu_ms", p->gpuMs}, {"rays", p->rays}, {"rays_per_second", p->raysPerSecond()}, {"frame", p->frame}};
+      if (p->tilesTotal()) passes[name]["tiles"] = {{"traced", p->tilesTraced}, {"skipped", p->tilesSkipped}};
       rays += p->rays;
       std::printf(" %s %.1f ms", name, p->gpuMs);
       if (p->rays) std::printf(" %.2f Mrays (%.1f Mrays/s)", p->rays * 1e-6, p->raysPerSecond() * 1e-6);

@@ -217,10 +217,23 @@ void addOptions(CLI::App& app, RenderOptions& o) {
                  "each playing its first animation at its own offset")
       ->type_name("N")
       ->check(rbCli::wholeNumber(1, 1000));
+  app.add_flag("--tile-classifier", o.tileClassifier,
+               "hybrid shadows: classify 8x8 tiles and trace only those with a pixel that needs\n"
+               "a ray (same image; off by default, see docs/performance.md)");
   app.add_flag("--perf-scene", o.perfScene,
                "the performance scene instead of the demo: the shared static glTF models, each\n"
                "instanced on a ring around the centre, on a finely tessellated ground (about\n"
                "3M triangles in 400 instances; docs/performance.md)");
+  app.add_option("--perf-ground", o.perfGroundSegments,
+                 "--perf-scene's ground in N x N quads (default 768: 1.18M triangles)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(1, 4096));
+  app.add_option("--perf-copies", o.perfCopies,
+                 "--perf-scene with K times as many copies of every model, on further rings\n"
+                 "(default 1)")
+      ->type_name("K")
+      ->check(rbCli::wholeNumber(1, 256));
+  app.add_flag("--perf-ground-only", o.perfGroundOnly, "--perf-scene's ground alone, no model");
   app.add_option("--models-from,--characters-from", o.modelsFrom,
                  "where the glTF folders of --characters and --perf-scene are\n"
                  "(default ../shared/scenes)")
@@ -288,6 +301,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
   }
   h.shadows.raysPerPixel = shadowRays;
   h.shadows.disableDenoiser = !o.denoise;
+  h.shadows.tileClassifier = o.tileClassifier;
   if ((h.effects & rb::kEffectShadows) && shadowRays > 1)
     r.sunRadiusDegrees = h.shadows.softAngularRadiusDegrees > 0.0f ? h.shadows.softAngularRadiusDegrees
                                                                    : rb::kDefaultSoftLightAngularRadiusDegrees;
@@ -320,6 +334,9 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
     return "--characters: adds characters to the demo scene; it cannot be combined with --scene";
   if (o.perfScene && (o.characters || !o.scene.empty()))
     return "--perf-scene is a scene of its own; it cannot be combined with --scene or --characters";
+  if (!o.perfScene && (o.perfGroundSegments || o.perfCopies || o.perfGroundOnly))
+    return "--perf-ground, --perf-copies and --perf-ground-only shape the performance scene: add --perf-scene";
+  if (o.perfGroundOnly && o.perfCopies) return "--perf-copies: --perf-ground-only places no model to copy";
   if (!o.modelsFrom.empty() && !o.characters && !o.perfScene)
     return "--models-from needs --characters N or --perf-scene";
   if (uint64_t(o.width) * o.height > uint64_t(8192) * 8192)

@@ -41,7 +41,8 @@ struct RenderOptions {
   // --light-rays: shadow rays per pixel shared by the scene's KHR_lights_punctual lights; 0 = exact (one ray per
   // light that reaches the pixel). Else kDefaultLightRays below.
   std::optional<uint32_t> lightRays;
-  bool denoise = true;  // --no-denoise
+  bool denoise = true;          // --no-denoise
+  bool tileClassifier = false;  // --tile-classifier: HybridEffectsDesc::shadows.tileClassifier
   // Raster mode's shadow map: --shadow-map-size (0 = none, else 1024..8192) and --pcf (taps per axis, 1..9);
   // else the preset's raster counterpart.
   std::optional<uint32_t> shadowMapSize;
@@ -61,6 +62,9 @@ struct RenderOptions {
   // --perf-scene: the performance scene of perf_scene.h (shared models from `modelsFrom`, instanced on a finely
   // tessellated ground) instead of the demo scene.
   bool perfScene = false;
+  uint32_t perfGroundSegments = 0;  // --perf-ground N; 0 = kPerfGroundSegments (perf_scene.h)
+  uint32_t perfCopies = 0;          // --perf-copies K: K times the models' copies; 0 = 1; with --perf-ground-only none
+  bool perfGroundOnly = false;      // --perf-ground-only
   std::string modelsFrom;  // --models-from DIR (or --characters-from); empty = ../shared/scenes beside the source tree
   rb::DynamicBuildMode dynamicMode = rb::DynamicBuildMode::InFrame;  // --dynamic-builds
   std::string device;

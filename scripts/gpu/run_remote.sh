@@ -296,6 +296,24 @@ if want perf; then
         --frames "${RB_PERF_PATH_FRAMES:-240}"
     done
   done
+  # Cost curves (ultra, 20 frames each): resolution, triangles (the ground alone, 10k to 10M) and instances (more
+  # copies of the models). Row tags: res, tri, inst.
+  if [ "${RB_PERF_CURVES:-1}" = 1 ]; then
+    for size in "1280 720" "1920 1080" "3840 2160"; do
+      read -r cw ch <<<"$size"
+      RAYBRIDGE_VALIDATION=0 step "perf res $cw" 90 "$OUT/perf_gpu.log" "$RT/bin/raybridge-render" --width "$cw" \
+        --height "$ch" --dump --perf-scene --models-from "$SCENES" --preset ultra --frames 20 \
+        --out "$PDIR/perf-${cw}x${ch}__hybrid__ultra__res"
+    done
+    for n in 70 224 708 2236; do
+      perf_render "ground-n${n}__hybrid__ultra__tri" "$RT/bin/raybridge-render" --perf-scene --perf-ground-only \
+        --perf-ground "$n" --preset ultra --frames 20
+    done
+    for k in 4 16; do
+      perf_render "perf-x${k}__hybrid__ultra__inst" "$RT/bin/raybridge-render" --perf-scene --models-from "$SCENES" \
+        --perf-copies "$k" --preset ultra --frames 20
+    done
+  fi
   read -r -a PBENCH <<<"${RB_PERF_BENCH_ARGS:---full}"
   RAYBRIDGE_VALIDATION=0 step "perf tlas bench" 150 "$OUT/perf_gpu.log" "$RT/bin/raybridge-bench" --scenario tlas \
     "${PBENCH[@]}" --out "$OUT/perf_tlas_gpu.json"

@@ -215,6 +215,7 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   ShadowSettings s;
   s.raysPerPixel = plan.rays;
   s.materials = materials.get();  // alpha tests non-opaque geometry
+  s.tileClassifier = desc.shadows.tileClassifier;
   if (Status st = shadow->record(cmd, f.gbuffer, tlas, plan.light, s); !st)
     return wrap("ShadowPass::record", st.error());
   const ShadowOutputs& o = shadow->outputs();

@@ -134,7 +134,7 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   };
   s.core.writeCommon(s.ctx, w, g, tlas);
   writeOutputs(w);
-  if (settings.disableTileClassifier) {
+  if (!settings.tileClassifier) {
     s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
   } else {
     DescriptorWrites cw;

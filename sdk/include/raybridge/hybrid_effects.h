@@ -58,6 +58,7 @@ struct ShadowEffectSettings {
   // Directional lights: the angular radius to use instead of the light's own. 0 = the light's own.
   float softAngularRadiusDegrees = 0.0f;
   bool disableDenoiser = false;  // false = soft shadows are denoised (hard shadows never are)
+  bool tileClassifier = false;   // ShadowSettings::tileClassifier (off by default: see shadow_pass.h)
 };
 
 struct AoEffectSettings {
