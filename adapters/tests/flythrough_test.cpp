@@ -68,11 +68,11 @@ TEST_CASE("raybridge-render along a camera path reports per-frame percentiles", 
   std::ofstream(pathFile) << R"({"version": 1, "keyframes": [
     {"position": [0, 3, 12], "orientation": [-0.1305, 0, 0, 0.9914], "duration": 1},
     {"position": [4, 2, 9], "orientation": [-0.1, 0.2, 0.02, 0.97]}]})";
-  for (const char* mode : {"hybrid", "raster"}) {
+  for (const char* mode : {"hybrid", "raster", "raytraced"}) {
     DYNAMIC_SECTION(mode) {
       int status = 0;
       const std::string out = renderOutput("--camera-path \"" + pathFile.string() + "\" --mode " + mode +
-                                               " --preset low --width 64 --height 40 --frames 9 --out \"" +
+                                               " --preset low --width 64 --height 40 --frames 9 --dump --out \"" +
                                                (dir / mode).string() + "\"",
                                            status);
       INFO(out);
@@ -81,9 +81,10 @@ TEST_CASE("raybridge-render along a camera path reports per-frame percentiles", 
       REQUIRE(stats.is_object());
       const nlohmann::json& fs = stats["frame_series"];
       INFO(fs.dump(2));
-      // Nine frames less the warm-up. The engine resolves a frame when its slot is reused and, at the final wait,
-      // reports the newest only: the one frame before the last is never seen (two frames in flight).
-      const int expected = 9 - int(rbRender::kFrameSeriesWarmupFrames) - 1;
+      // Nine frames: the last captures the images (--dump) and is not timed, the first three are the warm-up. The
+      // engine resolves a frame when its slot is reused and, at the final wait, reports the newest only: the one
+      // frame before the last timed one is never seen (two frames in flight).
+      const int expected = 9 - 1 - int(rbRender::kFrameSeriesWarmupFrames) - 1;
       CHECK(fs["frames"] == expected);
       for (const char* metric : {"frame_gpu_ms", "hook_gpu_ms"}) {
         REQUIRE(fs.contains(metric));
@@ -98,6 +99,12 @@ TEST_CASE("raybridge-render along a camera path reports per-frame percentiles", 
         REQUIRE(fs.contains("ao_gpu_ms"));
         // The SDK resolves a pass's frame once a later frame begins: the last frames of the run stay unresolved.
         CHECK(fs["shadow_gpu_ms"]["samples"].get<int>() >= expected - 2);
+        CHECK(fs["hook_gpu_ms"]["p50"].get<double>() > 0.0);
+      } else if (std::string(mode) == "raytraced") {
+        // The primary shading pass is the hook's work; the engine draws no raster shading around it.
+        REQUIRE(fs.contains("primary_shading_gpu_ms"));
+        CHECK(fs["primary_shading_gpu_ms"]["samples"].get<int>() >= expected - 2);
+        CHECK_FALSE(fs.contains("shadow_gpu_ms"));
         CHECK(fs["hook_gpu_ms"]["p50"].get<double>() > 0.0);
       } else {
         CHECK_FALSE(fs.contains("shadow_gpu_ms"));
@@ -115,7 +122,8 @@ TEST_CASE("raybridge-render --perf-scene composes the shared models on a fine gr
   fs::remove_all(dir);
   int status = 0;
   const std::string out = renderOutput(
-      "--perf-scene --preset hard-shadows --width 64 --height 36 --frames 2 --out \"" + dir.string() + "\"", status);
+      "--perf-scene --preset hard-shadows --width 64 --height 36 --frames 4 --dump --out \"" + dir.string() + "\"",
+      status);
   INFO(out);
   REQUIRE(status == 0);
   const nlohmann::json stats = readJson(dir / "stats.json");
