@@ -199,7 +199,8 @@ void addOptions(CLI::App& app, RenderOptions& o) {
                "when denoised), ao.exr (AO the lighting used; plus ao_raw.exr in hybrid mode),\n"
                "reflection.exr (hybrid), lights.exr (shadowed irradiance E of the scene's punctual\n"
                "lights, no BRDF or albedo, no sun; plus lights_raw.exr when denoised; lights.png and\n"
-               "lights_raw.png show them as E/(1+E)), stats.json");
+               "lights_raw.png show them as E/(1+E)), stats.json; --mode raytraced: depth.exr\n"
+               "(the primary rays' own distances) and stats.json");
   app.add_option("--frames", o.frames, "frames to render, the last is reported (default 3)")
       ->type_name("N")
       ->check(rbCli::wholeNumber(1, 100000));

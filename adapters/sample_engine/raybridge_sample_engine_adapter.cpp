@@ -157,11 +157,6 @@ se::Result<std::unique_ptr<Adapter>> Adapter::create(se::Engine& engine, const A
     auto pass = rb::PrimaryShadingPass::create(*impl->ctx);
     if (!pass) return R::failure(message("rb::PrimaryShadingPass::create", pass.error()));
     impl->shading = std::move(pass.value());
-    if (!engine.scene().lights.empty()) {
-      auto lights = rb::ManyLightPass::create(*impl->ctx);
-      if (!lights) return R::failure(message("rb::ManyLightPass::create", lights.error()));
-      impl->lightList = std::move(lights.value());
-    }
   }
   std::unique_ptr<Adapter> adapter(new Adapter(std::move(impl)));
   if (se::Status s = adapter->syncScene(); !s) return R::failure(s.error);
@@ -282,6 +277,11 @@ void Adapter::recordRayTraced(const se::PrepassHookInfo& info) {
   if (!tlas) return keepFirst(a.error, message("recordTlasBuild", tlas.error()));
   a.tlas = tlas.value();
   rb::PrimaryShadingSettings s;
+  if (!info.lights.empty() && !a.lightList) {  // made by the first frame with lights; it only uploads the list
+    auto lights = rb::ManyLightPass::create(*a.ctx);
+    if (!lights) return keepFirst(a.error, message("rb::ManyLightPass::create", lights.error()));
+    a.lightList = std::move(lights.value());
+  }
   if (a.lightList) {
     convertLights(info.lights, a.lights);
     if (rb::Status st = a.lightList->recordLightList(info.commandBuffer, a.tlas, a.lights); !st)

@@ -43,8 +43,8 @@ struct AdapterConfig {
   bool rayTraced = false;
 };
 
-struct FrameSettings {               // change them between frames through Adapter::settings()
-  bool enabled = true;               // false = record nothing: the engine uses its own lighting terms
+struct FrameSettings {  // change them between frames through Adapter::settings()
+  bool enabled = true;  // false = record nothing: the engine uses its own lighting terms (ray-traced mode: the sky)
   bool updateDeformedMeshes = true;  // false = deforming BLASes keep their pose (a paused animation costs nothing)
 };
 
