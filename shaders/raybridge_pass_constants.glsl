@@ -91,6 +91,17 @@ struct PrimaryConstants {
   uint pad1;        //  76
 };
 
+// PrimaryShadingPass. 128 bytes: the camera of the PrimaryRayPass, then the hits' lighting (hit_shading.glsl).
+struct PrimaryShadingConstants {
+  PrimaryConstants camera;  //   0: flags = RB_GB_ALPHA_TEST or 0, frameIndex = the noise seed
+  vec3 sunDirection;        //  80: towards the sun, unit length
+  float ambientIntensity;   //  92: scales skyRadiance as the ambient light of hit points
+  vec3 sunRadiance;         //  96
+  uint lightCount;          // 108: local lights lighting hits (RB_PRIMARY_SHADING_BINDING_LIGHTS); 0 = none
+  vec3 skyRadiance;         // 112: what rays that miss see
+  uint lightCandidates;     // 124: lights weighed per hit to pick the one it traces a shadow ray to
+};
+
 // The denoiser's temporal and a-trous passes. 228 bytes.
 struct DenoiseConstants {
   mat4 inverseProjection;       //   0

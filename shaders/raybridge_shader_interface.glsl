@@ -40,6 +40,11 @@
 #define RB_PRIMARY_BINDING_TLAS 0
 #define RB_PRIMARY_BINDING_HIT_DISTANCE 1
 #define RB_PRIMARY_BINDING_HIT_IDS 2
+// The PrimaryShadingPass: RB_BINDING_TLAS, RB_BINDING_RAY_COUNTERS, RB_BINDING_SHADING_RECORDS, RB_BINDING_MATERIALS,
+// the texture set, and these.
+#define RB_PRIMARY_SHADING_BINDING_RADIANCE 1
+#define RB_PRIMARY_SHADING_BINDING_DISTANCE 2
+#define RB_PRIMARY_SHADING_BINDING_LIGHTS 10  // the ManyLightPass's light list (GpuLight[]), read by the hits
 // The denoiser's temporal pass.
 #define RB_TEMPORAL_BINDING_DEPTH 0
 #define RB_TEMPORAL_BINDING_MOTION 1  // the depth image again without motion vectors

@@ -242,3 +242,49 @@ TEST_CASE("effects front ends created and destroyed every frame, cycling all pre
   }
   destroyScene(fx, built);
 }
+
+// The primary shading pass the same way, over fewer frames: its pipeline takes seconds to compile on lavapipe.
+TEST_CASE("primary shading passes destroyed while their frame is in flight are released by the context",
+          "[lifetime][primary-shading]") {
+  GpuFixture fx;
+  const uint32_t framesInFlight = fx.ctx().framesInFlight();
+  TestScene scene = makeConformanceScene();
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  rb::TlasBuildOptions options;
+  options.writeShadingRecords = true;  // its hits read them
+  BuiltScene built = buildScene(fx, *service.value(), scene, options);
+  const rb::PrimaryRayCamera camera = conformanceCamera();
+  REQUIRE(fx.device().waitIdle().ok());
+  fx.ctx().releaseAfterIdle();
+  const rb::MemoryStats start = fx.ctx().memoryStats();
+
+  FrameRing ring(fx, framesInFlight);
+  VkDeviceSize perFrame = 0;
+  for (uint32_t frame = 0; frame < framesInFlight + 1; ++frame) {
+    const uint32_t slot = frame % framesInFlight;
+    VkCommandBuffer cmd = ring.acquire(slot);
+    fx.ctx().beginFrame();
+    {
+      auto pass = rb::PrimaryShadingPass::create(fx.ctx());
+      RB_REQUIRE_OK(pass);
+      RB_REQUIRE_OK(pass.value()->record(cmd, built.tlas, camera, {48, 32, VK_NULL_HANDLE}));
+      ring.submit(slot);
+      if (frame == 0) perFrame = passBytes(fx.ctx().memoryStats()) - passBytes(start);
+    }  // destroyed before the GPU has finished the frame, with no wait
+    const VkDeviceSize held = passBytes(fx.ctx().memoryStats()) - passBytes(start);
+    INFO("frame " << frame << ": " << held << " bytes held, " << perFrame << " per frame");
+    REQUIRE(held >= perFrame);  // retired, not freed, while the frame may run
+    REQUIRE(held <= (framesInFlight + 1) * perFrame);
+  }
+  REQUIRE(perFrame > 0);
+  REQUIRE(fx.device().waitIdle().ok());
+  fx.ctx().releaseAfterIdle();
+  const rb::MemoryStats end = fx.ctx().memoryStats();
+  for (size_t c = 0; c < size_t(rb::MemoryCategory::Count); ++c) {
+    INFO(rb::toString(rb::MemoryCategory(c)));
+    CHECK(end.bytes[c] == start.bytes[c]);
+  }
+  CHECK(end.allocations == start.allocations);
+  destroyScene(fx, built);
+}

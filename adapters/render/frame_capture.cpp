@@ -50,6 +50,7 @@ struct FrameCapture::Impl {
     std::string name;
     size_t buffer;
     uint32_t channels;
+    bool float32;
   };
   std::vector<Named> names;
   uint32_t width = 0, height = 0;
@@ -134,11 +135,11 @@ se::Status FrameCapture::record(const se::PrepassHookInfo& info, const se::PassI
     size_t k = 0;
     while (k < distinct.size() && distinct[k]->image != img.image) ++k;
     if (k == distinct.size()) distinct.push_back(&img);
-    c.names.push_back({img.name, k, img.channels});
+    c.names.push_back({img.name, k, img.channels, img.float32});
   }
   if (c.extra.size() < distinct.size()) c.extra.resize(distinct.size());
   for (size_t k = 0; k < distinct.size() && e.empty(); ++k)
-    e = c.ensure(c.extra[k], pixels * 2 * distinct[k]->channels);
+    e = c.ensure(c.extra[k], pixels * (distinct[k]->float32 ? 4 : 2) * distinct[k]->channels);
   if (!e.empty()) return se::Status::failure("frame capture: " + e);
 
   struct Target {
@@ -203,6 +204,10 @@ CapturedFrame FrameCapture::read() const {
   for (const Impl::Named& n : c.names) {
     std::vector<float>& out = f.images[n.name];
     out.resize(pixels * n.channels);
+    if (n.float32) {
+      std::memcpy(out.data(), c.extra[n.buffer].mapped, out.size() * sizeof(float));
+      continue;
+    }
     const auto* v = static_cast<const uint16_t*>(c.extra[n.buffer].mapped);
     for (size_t i = 0; i < out.size(); ++i) out[i] = halfToFloat(v[i]);
   }

@@ -21,12 +21,13 @@ struct CapturedFrame {
   std::map<std::string, std::vector<float>> images;  // by name: `channels` floats per pixel
 };
 
-// An effect image to copy: R16_SFLOAT (channels 1) or R16G16B16A16_SFLOAT (channels 4), in
-// SHADER_READ_ONLY_OPTIMAL, the size of the pre-pass.
+// An effect image to copy: R16_SFLOAT (channels 1) or R16G16B16A16_SFLOAT (channels 4), or R32_SFLOAT with
+// float32, in SHADER_READ_ONLY_OPTIMAL, the size of the pre-pass.
 struct CaptureImage {
   std::string name;
   VkImage image = VK_NULL_HANDLE;
   uint32_t channels = 1;
+  bool float32 = false;  // 32-bit floats (e.g. the ray-traced mode's distances) instead of 16-bit ones
 };
 
 class FrameCapture {

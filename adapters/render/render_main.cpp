@@ -1,6 +1,7 @@
 // raybridge-render: one headless image of a scene with the sample engine, in raster mode (the engine's shadow
-// maps, SSAO and reflection probe) or hybrid mode (Raybridge's ray-traced shadows, AO, reflections and shadowed
-// local lights through the adapter), plus optional dumps and stats.
+// maps, SSAO and reflection probe), hybrid mode (Raybridge's ray-traced shadows, AO, reflections and shadowed
+// local lights through the adapter) or ray-traced mode (no raster shading: Raybridge shades primary rays into the
+// engine's HDR target), plus optional dumps and stats.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -192,7 +193,8 @@ int main(int argc, char** argv) {
   }
   if (o.help) return std::printf("%s", renderUsage()), 0;
   if (const char* v = std::getenv("RAYBRIDGE_VALIDATION"); v && std::string(v) == "1") o.validation = true;
-  const bool hybrid = o.mode == Mode::Hybrid;
+  const bool hybrid = o.mode == Mode::Hybrid, rayTraced = o.mode == Mode::RayTraced;
+  const char* modeName = hybrid ? "hybrid" : rayTraced ? "raytraced" : "raster";
 
   std::vector<se::AnimationPlayback> characterPlaybacks;  // --characters: one animation per character
   auto scene = loadScene(o, characterPlaybacks);          // before any Vulkan work, so bad input fails fast
@@ -202,7 +204,7 @@ int main(int argc, char** argv) {
     if (std::string e = rbCameraPath::loadCameraPath(o.cameraPath, cameraPath); !e.empty())
       return fail("--camera-path: " + e);
 
-  // The same device in both modes (Raybridge's extensions enabled), so raster and hybrid compare like for like.
+  // The same device in every mode (Raybridge's extensions enabled), so the modes compare like for like.
   rb::RequiredFeatures features;
   se::EngineConfig config;
   config.enableValidation = o.validation;
@@ -247,13 +249,16 @@ int main(int argc, char** argv) {
   // (no light, no pass).
   const size_t lightCount = engine.scene().lights.size();
   if (!o.effects && lightCount && o.preset != rb::Preset::None) fx.hybrid.effects |= rb::kEffectLocalLights;
+  if (rayTraced) fx.hybrid.effects = 0;  // no G-buffer effect: the primary rays' hits are lit by sun, sky and lights
   const rb::EffectSet effects = fx.hybrid.effects;
   const bool wantShadows = effects & rb::kEffectShadows, wantAo = effects & rb::kEffectAo,
              wantReflections = effects & rb::kEffectReflections, wantLights = effects & rb::kEffectLocalLights;
   std::unique_ptr<rbAdapter::Adapter> adapter;
-  if (hybrid) {
+  if (hybrid || rayTraced) {
     rbAdapter::AdapterConfig ac;
     ac.effects = fx.hybrid;
+    ac.rayTraced = rayTraced;
+    params.externalColor = rayTraced;  // the hook shades the frame; the engine draws no G-buffer or lighting
     ac.geometricNormals = o.geometricNormals;
     ac.accelerationStructures.dynamicMode = o.dynamicMode;
     auto a = rbAdapter::Adapter::create(engine, ac);
@@ -274,7 +279,7 @@ int main(int argc, char** argv) {
   }
   // The engine's own shadowed irradiance of the punctual lights (shadow maps for the strongest few), for lights.exr
   // wherever Raybridge does not compute it.
-  params.outputLocalLightIrradiance = o.dump && lightCount && !(hybrid && wantLights);
+  params.outputLocalLightIrradiance = o.dump && lightCount && !(hybrid && wantLights) && !rayTraced;
   std::unique_ptr<FrameCapture> capture;
   if (o.dump) {
     auto c = FrameCapture::create(engine);
@@ -291,7 +296,9 @@ int main(int argc, char** argv) {
     capturedViewProj = info.viewProj;
     const bool geometric = o.geometricNormals;
     std::vector<CaptureImage> images;
-    if (adapter) {
+    if (const rb::PrimaryShadingPass* shading = adapter ? adapter->primaryShading() : nullptr) {
+      images = {{"distance", shading->outputs().distance, 1, true}};  // the pre-pass images are only cleared
+    } else if (adapter) {
       const rb::HybridOutputs& fo = adapter->effects().outputs();
       images = {{"shadow", fo.shadow.image, 1},
                 {"ao", fo.ao.image, 1},
@@ -335,6 +342,8 @@ int main(int argc, char** argv) {
       series.add("hook_gpu_ms", t.frameNumber, t.hookMs);
     }
     if (!adapter) return;
+    if (const rb::PrimaryShadingPass* shading = adapter->primaryShading(); shading && shading->stats().frame)
+      series.add("primary_shading_gpu_ms", shading->stats().frame, shading->stats().gpuMs);
     const rb::HybridStats es = adapter->effects().stats();
     for (const auto& [name, p] : namedPassStats(es))
       if (p->frame) series.add(std::string(name) + "_gpu_ms", p->frame, p->gpuMs);
@@ -371,7 +380,7 @@ int main(int argc, char** argv) {
   if (se::Status s = se::writePng((out / "final.png").string(), ldr.value); !s) return fail(s.error);
   if (se::Status s = se::writeExr((out / "final.exr").string(), hdr.value); !s) return fail(s.error);
   std::printf("wrote %s and %s (%ux%u, %s)\n", (out / "final.png").c_str(), (out / "final.exr").c_str(), o.width,
-              o.height, hybrid ? "hybrid" : "raster");
+              o.height, modeName);
   if (const nlohmann::json fs = series.summary(); fs.contains("frame_gpu_ms"))
     std::printf("over %d frames after %u warm-up frames: frame GPU ms p50 %.2f p99 %.2f; hook p50 %.2f p99 %.2f\n",
                 fs["frames"].get<int>(), kFrameSeriesWarmupFrames, fs["frame_gpu_ms"]["p50"].get<double>(),
@@ -384,7 +393,7 @@ int main(int argc, char** argv) {
   // Statistics. The SDK resolves a pass's GPU time kFramesInFlight frames after recording it.
   nlohmann::json stats;
   const double engineTotal = frameTotalMs(timings);
-  stats["mode"] = hybrid ? "hybrid" : "raster";
+  stats["mode"] = modeName;
   stats["width"] = o.width;
   stats["height"] = o.height;
   stats["frames"] = o.frames;
@@ -415,7 +424,9 @@ int main(int argc, char** argv) {
   const uint32_t shadowRays = hd.shadows.raysPerPixel ? hd.shadows.raysPerPixel : 1u;  // the engine's sun has no size
   stats["sun"] = {{"direction", vec(params.sun.direction)},
                   {"angular_radius_degrees", hybrid && wantShadows ? fx.sunRadiusDegrees : 0.0f},
-                  {"rays_per_pixel", hybrid && wantShadows ? shadowRays : 0u}};
+                  {"rays_per_pixel", rayTraced               ? 1u
+                                     : hybrid && wantShadows ? shadowRays
+                                                             : 0u}};  // raytraced: hard
   stats["preset"] = rb::toString(o.preset);
   stats["effects"] = {
       {"enabled", effectSetToString(effects)},
@@ -432,7 +443,7 @@ int main(int argc, char** argv) {
     const se::LocalShadowStats ls = engine.lastLocalShadowStats();
     uint32_t byType[3] = {0, 0, 0};
     for (const se::PunctualLight& l : engine.scene().lights) ++byType[uint32_t(l.type)];
-    const bool traced = hybrid && wantLights;
+    const bool traced = (hybrid && wantLights) || rayTraced;
     const rb::LocalLightEffectSettings& ll = fx.hybrid.localLights;
     stats["lights"] = {{"count", lightCount},
                        {"directional", byType[0]},
@@ -441,15 +452,17 @@ int main(int argc, char** argv) {
                        {"shadowed_by", !lightCount ? "none"
                                        : traced    ? "raybridge"
                                                    : "engine shadow maps for the strongest lights"},
-                       {"mode", !traced                               ? "raster"
+                       {"mode", rayTraced                             ? "one resampled light per hit"
+                                : !traced                             ? "raster"
                                 : ll.mode == rb::ManyLightMode::Exact ? "exact"
                                                                       : "stochastic"},
-                       {"rays_per_pixel", traced && ll.mode == rb::ManyLightMode::Stochastic ? ll.raysPerPixel : 0u},
+                       {"rays_per_pixel",
+                        hybrid && traced && ll.mode == rb::ManyLightMode::Stochastic ? ll.raysPerPixel : 0u},
                        {"denoised", traced && adapter && adapter->effects().localLightDenoiser() != nullptr},
                        {"shadow_mapped_lights", traced ? 0u : ls.shadowedLights},
                        {"shadow_map_views", traced ? 0u : ls.shadowViews}};
   }
-  if (!hybrid) {
+  if (o.mode == Mode::Raster) {
     const se::ShadowMapStats sm = engine.lastShadowMapStats();
     stats["effects"]["raster_counterparts"] = {{"shadows", sm.enabled ? "shadow map" : "none (unshadowed sun)"},
                                                {"shadow_map_size", sm.enabled ? sm.mapSize : 0u},
@@ -491,8 +504,11 @@ int main(int argc, char** argv) {
     memory["total"] = mem.total();
     nlohmann::json passes = nlohmann::json::object();
     uint64_t rays = 0;
-    std::printf("Raybridge (%s):", effectSetToString(effects).c_str());
-    for (const auto& [name, p] : namedPassStats(es, &fxo)) {
+    std::printf("Raybridge (%s):", rayTraced ? "raytraced" : effectSetToString(effects).c_str());
+    std::vector<std::pair<const char*, const rb::PassStats*>> named = namedPassStats(es, &fxo);
+    const rb::PassStats shadingStats = adapter->primaryShading() ? adapter->primaryShading()->stats() : rb::PassStats{};
+    if (rayTraced) named.push_back({"primary_shading", &shadingStats});
+    for (const auto& [name, p] : named) {
       passes[name] = {
           {"gpu_ms", p->gpuMs}, {"rays", p->rays}, {"rays_per_second", p->raysPerSecond()}, {"frame", p->frame}};
       if (p->tilesTotal()) passes[name]["tiles"] = {{"traced", p->tilesTraced}, {"skipped", p->tilesSkipped}};
@@ -515,8 +531,8 @@ int main(int argc, char** argv) {
           {"scratch_bytes", as.scratchBytes},
           {"storage_block_bytes", as.storageBlockBytes},
           {"dedup_hits", as.dedupHits},
-          {"tlas_instances", fxo.lastTlas().instanceCount},
-          {"tlas_skipped_instances", fxo.lastTlas().skippedInstances},
+          {"tlas_instances", adapter->lastTlas().instanceCount},
+          {"tlas_skipped_instances", adapter->lastTlas().skippedInstances},
           {"dynamic_builds", o.dynamicMode == rb::DynamicBuildMode::InFrame          ? "in-frame"
                              : o.dynamicMode == rb::DynamicBuildMode::AsyncSameFrame ? "async"
                                                                                      : "async-late"},
@@ -543,9 +559,11 @@ int main(int argc, char** argv) {
       return s ? std::string() : s.error;
     };
     // The hook's viewProj is camera-relative: the eye is at the origin of the positions it reconstructs.
-    std::string e = write("depth.exr", toExr(f, distances(f, capturedViewProj), 1));
-    if (e.empty()) e = write("normal.exr", toExr(f, f.normal, 4));
-    std::vector<std::string> written = {"depth.exr", "normal.exr"};
+    // Ray-traced: the primary rays' own distances (the same convention); the engine drew no G-buffer normals.
+    std::string e = write("depth.exr",
+                          toExr(f, rayTraced ? f.images.at("distance") : distances(f, capturedViewProj), 1));
+    std::vector<std::string> written = {"depth.exr"};
+    if (e.empty() && !rayTraced) e = write("normal.exr", toExr(f, f.normal, 4)), written.push_back("normal.exr");
     // Hybrid: Raybridge's images as captured in the hook (raw only where a denoiser ran).
     auto writeCaptured = [&](const std::string& name, int channels) {
       auto it = f.images.find(name);
@@ -579,7 +597,7 @@ int main(int argc, char** argv) {
       if (e.empty()) writeLights("lights", toExr(f, values, 4));
     }
     // Raster: the engine's shadow-map visibility and SSAO.
-    if (e.empty() && !hybrid) {
+    if (e.empty() && o.mode == Mode::Raster) {
       auto visibility = engine.readbackShadowVisibility();
       if (!visibility) e = visibility.error;
       else

@@ -182,9 +182,12 @@ void addOptions(CLI::App& app, RenderOptions& o) {
       ->type_name("N")
       ->check(rbCli::wholeNumber(1, 9));
 
-  rbCli::addEnum(app, "--mode", o.mode, {{"raster", Mode::Raster}, {"hybrid", Mode::Hybrid}},
+  rbCli::addEnum(app, "--mode", o.mode,
+                 {{"raster", Mode::Raster}, {"hybrid", Mode::Hybrid}, {"raytraced", Mode::RayTraced}},
                  "hybrid: Raybridge's effects; raster: the engine's counterparts of the same\n"
-                 "effects (shadow map, SSAO, reflection probe) (default hybrid)");
+                 "effects (shadow map, SSAO, reflection probe); raytraced: no raster shading,\n"
+                 "one primary ray per pixel shaded by Raybridge (sun with a shadow ray, sky\n"
+                 "ambient, emission, the punctual lights; no AO or reflections) (default hybrid)");
   rbCli::addEnum(app, "--gbuffer-normals", o.geometricNormals, {{"shading", false}, {"geometric", true}},
                  "normal the passes use (default shading)");
   app.add_option("--out", o.out, "output folder (default out): final.png, final.exr")
@@ -196,7 +199,8 @@ void addOptions(CLI::App& app, RenderOptions& o) {
                "when denoised), ao.exr (AO the lighting used; plus ao_raw.exr in hybrid mode),\n"
                "reflection.exr (hybrid), lights.exr (shadowed irradiance E of the scene's punctual\n"
                "lights, no BRDF or albedo, no sun; plus lights_raw.exr when denoised; lights.png and\n"
-               "lights_raw.png show them as E/(1+E)), stats.json");
+               "lights_raw.png show them as E/(1+E)), stats.json; --mode raytraced: depth.exr\n"
+               "(the primary rays' own distances) and stats.json");
   app.add_option("--frames", o.frames, "frames to render, the last is reported (default 3)")
       ->type_name("N")
       ->check(rbCli::wholeNumber(1, 100000));
@@ -339,6 +343,11 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
   if (o.perfGroundOnly && o.perfCopies) return "--perf-copies: --perf-ground-only places no model to copy";
   if (!o.modelsFrom.empty() && !o.characters && !o.perfScene)
     return "--models-from needs --characters N or --perf-scene";
+  if (o.mode == Mode::RayTraced && o.effects)
+    return "--effects: --mode raytraced shades every primary ray with the sun (a shadow ray), the sky and the "
+           "punctual lights; AO and reflections need the G-buffer it does not draw, so it takes no effect list";
+  if (o.mode == Mode::RayTraced && o.geometricNormals)
+    return "--gbuffer-normals: --mode raytraced draws no G-buffer; its hits shade with the mesh normals";
   if (uint64_t(o.width) * o.height > uint64_t(8192) * 8192)
     return "--width/--height: " + std::to_string(o.width) + "x" + std::to_string(o.height) + " exceeds 67 megapixels";
   return {};

@@ -15,7 +15,9 @@
 
 namespace rbRender {
 
-enum class Mode { Raster, Hybrid };
+// Raster: the engine's own shadow maps, SSAO and probe. Hybrid: Raybridge's effects on the raster frame. RayTraced:
+// no raster shading at all; Raybridge shades one primary ray per pixel (the thesis's pure ray-traced mode).
+enum class Mode { Raster, Hybrid, RayTraced };
 
 struct RenderOptions {
   std::string scene;  // empty = the engine's procedural demo scene

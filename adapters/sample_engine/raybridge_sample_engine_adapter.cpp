@@ -2,6 +2,7 @@
 #include "raybridge_sample_engine_adapter.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 namespace rbAdapter {
@@ -109,6 +110,11 @@ struct Adapter::Impl {
   std::unique_ptr<rb::Context> ctx;
   std::unique_ptr<rb::AccelerationStructureService> as;
   std::unique_ptr<rb::HybridEffects> fx;
+  // Ray-traced mode: the materials hits shade with, the pass, and the local lights' list (no G-buffer to cull).
+  std::unique_ptr<rb::MaterialTable> materials;
+  std::unique_ptr<rb::PrimaryShadingPass> shading;
+  std::unique_ptr<rb::ManyLightPass> lightList;
+  rb::TlasInfo tlas;                     // ray-traced mode's latest
   std::vector<rb::MeshHandle> meshes;    // parallel to engine.meshes(); null for empty meshes
   std::vector<rb::MeshHandle> deformed;  // parallel to engine.deformedInstances(): dynamic BLASes
   std::vector<rb::Instance> instances;
@@ -141,6 +147,17 @@ se::Result<std::unique_ptr<Adapter>> Adapter::create(se::Engine& engine, const A
   auto fx = rb::HybridEffects::create(*impl->ctx, impl->as.get(), fxDesc);
   if (!fx) return R::failure(message("rb::HybridEffects::create", fx.error()));
   impl->fx = std::move(fx.value());
+  if (config.rayTraced) {
+    if (impl->fx->desc().effects != 0)
+      return R::failure("AdapterConfig::rayTraced: the effects " + std::to_string(impl->fx->desc().effects) +
+                        " (rb::EffectSet) need the G-buffer ray-traced mode does not draw; leave them empty");
+    auto table = rb::MaterialTable::create(*impl->ctx);
+    if (!table) return R::failure(message("rb::MaterialTable::create", table.error()));
+    impl->materials = std::move(table.value());
+    auto pass = rb::PrimaryShadingPass::create(*impl->ctx);
+    if (!pass) return R::failure(message("rb::PrimaryShadingPass::create", pass.error()));
+    impl->shading = std::move(pass.value());
+  }
   std::unique_ptr<Adapter> adapter(new Adapter(std::move(impl)));
   if (se::Status s = adapter->syncScene(); !s) return R::failure(s.error);
   return R::success(std::move(adapter));
@@ -195,13 +212,16 @@ se::Status Adapter::syncScene() {
     a.instanceSource.push_back(uint32_t(i));
   }
   if (rb::Status s = a.fx->setMaterials(materials, views); !s) return failure("HybridEffects::setMaterials", s.error());
+  if (a.materials)
+    if (rb::Status s = a.materials->setMaterials(materials, views); !s)
+      return failure("MaterialTable::setMaterials", s.error());
   return se::Status::success();
 }
 
 void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& inputs) {
   Impl& a = *impl_;
   a.ctx->beginFrame();  // every frame, so deferred releases and statistics keep pace with the engine
-  if (!a.settings.enabled || a.fx->desc().effects == 0) return;
+  if (!a.settings.enabled || (a.fx->desc().effects == 0 && !a.shading)) return;
   // This frame's node animation moves instances; deformation rewrote the deformed buffers.
   if (info.instanceTransforms.size() == a.engine.scene().instances.size())
     for (size_t k = 0; k < a.instances.size(); ++k)
@@ -210,6 +230,7 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   if (!a.deformed.empty() && a.settings.updateDeformedMeshes)
     if (rb::Status s = a.as->updateDynamicMeshes(a.deformed, ready, info.submitWaits, info.deformWaits); !s)
       return keepFirst(a.error, message("updateDynamicMeshes", s.error()));
+  if (a.shading) return recordRayTraced(info);
   rb::HybridFrame f;
   rb::GBufferDesc& g = f.gbuffer;
   g.width = info.extent.width, g.height = info.extent.height;
@@ -241,6 +262,58 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   inputs.localLightIrradiance = out.localLights.view;  // replaces the engine's local lights and their shadow maps
 }
 
+void Adapter::recordRayTraced(const se::PrepassHookInfo& info) {
+  Impl& a = *impl_;
+  if (!info.hdrColor.view)
+    return keepFirst(a.error, "ray-traced mode: the frame has no HDR target to shade into; render it with "
+                              "FrameParams::externalColor");
+  if (auto pending = a.as->recordPendingWork(info.commandBuffer); !pending)
+    return keepFirst(a.error, message("recordPendingWork", pending.error()));
+  // Camera-relative TLAS around the float eye the camera below starts from, so the eye is exactly its origin.
+  rb::TlasBuildOptions options;
+  for (int i = 0; i < 3; ++i) options.originOffset[i] = double(info.cameraPosition[i]);
+  options.writeShadingRecords = true;  // hits shade with the materials
+  auto tlas = a.as->recordTlasBuild(info.commandBuffer, a.instances, options);
+  if (!tlas) return keepFirst(a.error, message("recordTlasBuild", tlas.error()));
+  a.tlas = tlas.value();
+  rb::PrimaryShadingSettings s;
+  if (!info.lights.empty() && !a.lightList) {  // made by the first frame with lights; it only uploads the list
+    auto lights = rb::ManyLightPass::create(*a.ctx);
+    if (!lights) return keepFirst(a.error, message("rb::ManyLightPass::create", lights.error()));
+    a.lightList = std::move(lights.value());
+  }
+  if (a.lightList) {
+    convertLights(info.lights, a.lights);
+    if (rb::Status st = a.lightList->recordLightList(info.commandBuffer, a.tlas, a.lights); !st)
+      return keepFirst(a.error, message("ManyLightPass::recordLightList", st.error()));
+    s.lights = a.lightList.get();
+  }
+  // The engine's camera: eye, its view direction and up (rotation-only view), and the field of view of its
+  // projection (proj[1][1] = -1 / tan(fovY / 2), Y flipped). The target is as far as the eye is from the origin
+  // (at least 1), so its direction keeps float precision far from the origin.
+  const glm::mat3 toWorld(info.invView);
+  const glm::vec3 forward = -toWorld[2], up = toWorld[1];
+  const float reach = std::max(1.0f, glm::length(info.cameraPosition));
+  rb::PrimaryRayCamera camera;
+  for (int i = 0; i < 3; ++i) {
+    camera.eye[i] = info.cameraPosition[i];
+    camera.target[i] = info.cameraPosition[i] + forward[i] * reach;
+    camera.upHint[i] = up[i];
+  }
+  camera.verticalFovDegrees = glm::degrees(2.0f * std::atan(1.0f / std::abs(info.proj[1][1])));
+  std::copy_n(&info.sunDirection[0], 3, s.sunDirection);
+  std::copy_n(&info.sunRadiance[0], 3, s.sunRadiance);
+  std::copy_n(&info.skyColor[0], 3, s.skyRadiance);
+  s.ambientIntensity = info.ambientIntensity;
+  s.flags = rb::kPrimaryShadingExplicitLighting;  // the engine's own values, zeros included
+  s.materials = a.materials.get();
+  rb::PrimaryShadingTargets targets;
+  targets.width = info.extent.width, targets.height = info.extent.height;
+  targets.radiance = info.hdrColor.view;  // GENERAL, as the engine hands it over and wants it back
+  if (rb::Status st = a.shading->record(info.commandBuffer, a.tlas, camera, targets, s); !st)
+    return keepFirst(a.error, message("PrimaryShadingPass::record", st.error()));
+}
+
 se::PrepassHook Adapter::prepassHook() {
   return [this](const se::PrepassHookInfo& info, se::LightingInputs& inputs) { recordFrame(info, inputs); };
 }
@@ -249,6 +322,8 @@ FrameSettings& Adapter::settings() { return impl_->settings; }
 const std::string& Adapter::lastError() const { return impl_->error; }
 rb::HybridEffects& Adapter::effects() { return *impl_->fx; }
 const rb::HybridEffects& Adapter::effects() const { return *impl_->fx; }
+const rb::PrimaryShadingPass* Adapter::primaryShading() const { return impl_->shading.get(); }
+const rb::TlasInfo& Adapter::lastTlas() const { return impl_->shading ? impl_->tlas : impl_->fx->lastTlas(); }
 rb::Context& Adapter::context() { return *impl_->ctx; }
 rb::AccelerationStructureService& Adapter::accelerationStructures() { return *impl_->as; }
 

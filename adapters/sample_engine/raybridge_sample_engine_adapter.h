@@ -4,6 +4,9 @@
 // rb::GBufferDesc, hands its KHR_lights_punctual lights to the local lights effect and lets an rb::HybridEffects
 // front end record the effects, whose outputs become the engine's LightingInputs. Frame: shadow map -> pre-pass ->
 // [hook: beginFrame, BLAS work, TLAS, effects] -> lighting.
+// Ray-traced mode (AdapterConfig::rayTraced, with FrameParams::externalColor): no G-buffer and no raster
+// lighting; the hook builds the TLAS and an rb::PrimaryShadingPass shades one primary ray per pixel (sun with a
+// shadow ray, sky ambient, emission, the punctual lights) straight into the engine's HDR target.
 //
 //   rb::RequiredFeatures features;                       // must outlive Engine::create()
 //   rbAdapter::configureEngine(config, features);        // config: the engine's EngineConfig
@@ -35,10 +38,13 @@ struct AdapterConfig {
   // Zero = the SDK's defaults. With an async dynamicMode and no asyncQueue, the engine's async compute queue
   // is handed over (VK_NULL_HANDLE on one-queue devices: the SDK falls back to in-frame work).
   rb::AsServiceDesc accelerationStructures;
+  // Pure ray tracing instead of effects on the raster frame: frames must set FrameParams::externalColor, and
+  // `effects` must be empty (they need the G-buffer that mode does not draw; create() fails naming them).
+  bool rayTraced = false;
 };
 
-struct FrameSettings {               // change them between frames through Adapter::settings()
-  bool enabled = true;               // false = record nothing: the engine uses its own lighting terms
+struct FrameSettings {  // change them between frames through Adapter::settings()
+  bool enabled = true;  // false = record nothing: the engine uses its own lighting terms (ray-traced mode: the sky)
   bool updateDeformedMeshes = true;  // false = deforming BLASes keep their pose (a paused animation costs nothing)
 };
 
@@ -68,6 +74,10 @@ class Adapter {
   // The SDK objects: the front end (effects, presets, outputs, statistics), the AS service, the context.
   rb::HybridEffects& effects();
   const rb::HybridEffects& effects() const;
+  // The ray-traced mode's pass (outputs: its distance image; stats), nullptr otherwise.
+  const rb::PrimaryShadingPass* primaryShading() const;
+  // The TLAS the latest frame traced (either mode).
+  const rb::TlasInfo& lastTlas() const;
   rb::Context& context();
   rb::AccelerationStructureService& accelerationStructures();
 
@@ -75,6 +85,7 @@ class Adapter {
 
  private:
   explicit Adapter(std::unique_ptr<Impl> impl);
+  void recordRayTraced(const sample_engine::PrepassHookInfo& info);  // recordFrame() in ray-traced mode
   std::unique_ptr<Impl> impl_;
 };
 

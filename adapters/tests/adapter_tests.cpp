@@ -105,7 +105,9 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--sun-radius 45", "--sun-radius: 45 is outside [0, 45) degrees"},
       {"--shadow-map-size 5", "--shadow-map-size: 5 is outside 1024..8192 (or 0 = no shadow map)"},
       {"--pcf 0", "--pcf: 0 is outside 1..9"},
-      {"--mode fast", "--mode: 'fast' is not raster or hybrid"},
+      {"--mode fast", "--mode: 'fast' is not raster, hybrid or raytraced"},
+      {"--mode raytraced --effects ao", "--effects: --mode raytraced shades every primary ray"},
+      {"--mode raytraced --gbuffer-normals geometric", "--gbuffer-normals: --mode raytraced draws no G-buffer"},
   };
   for (const Case& c : cases) {
     const RunResult r = runRender(c.args + " --out " + (dir / "out").string());

@@ -68,7 +68,7 @@ TEST_CASE("raybridge-render along a camera path reports per-frame percentiles", 
   std::ofstream(pathFile) << R"({"version": 1, "keyframes": [
     {"position": [0, 3, 12], "orientation": [-0.1305, 0, 0, 0.9914], "duration": 1},
     {"position": [4, 2, 9], "orientation": [-0.1, 0.2, 0.02, 0.97]}]})";
-  for (const char* mode : {"hybrid", "raster"}) {
+  for (const char* mode : {"hybrid", "raster", "raytraced"}) {
     DYNAMIC_SECTION(mode) {
       int status = 0;
       const std::string out = renderOutput("--camera-path \"" + pathFile.string() + "\" --mode " + mode +
@@ -99,6 +99,12 @@ TEST_CASE("raybridge-render along a camera path reports per-frame percentiles", 
         REQUIRE(fs.contains("ao_gpu_ms"));
         // The SDK resolves a pass's frame once a later frame begins: the last frames of the run stay unresolved.
         CHECK(fs["shadow_gpu_ms"]["samples"].get<int>() >= expected - 2);
+        CHECK(fs["hook_gpu_ms"]["p50"].get<double>() > 0.0);
+      } else if (std::string(mode) == "raytraced") {
+        // The primary shading pass is the hook's work; the engine draws no raster shading around it.
+        REQUIRE(fs.contains("primary_shading_gpu_ms"));
+        CHECK(fs["primary_shading_gpu_ms"]["samples"].get<int>() >= expected - 2);
+        CHECK_FALSE(fs.contains("shadow_gpu_ms"));
         CHECK(fs["hook_gpu_ms"]["p50"].get<double>() > 0.0);
       } else {
         CHECK_FALSE(fs.contains("shadow_gpu_ms"));

@@ -107,10 +107,17 @@ struct ManyLightPass::Impl {
     retireBuffer(ctx, lights);
     retireBuffer(ctx, tiles);
   }
-  Status ensureBuffers(uint32_t lightCount, VkDeviceSize tileBytes);
+  Status ensureLightBuffers(uint32_t lightCount);
+  Status ensureTiles(VkDeviceSize tileBytes);
+  // Checks and converts the lights, then records their upload into `lights` (the list the rays read).
+  Status uploadLights(VkCommandBuffer cmd, const TlasInfo& tlas, std::span<const LightSource> lightList);
+  // Copies `staging` into this frame's ring slot and records its copy into `lights`.
+  void recordUpload(VkCommandBuffer cmd, uint32_t count);
+  // What other passes read (internal::lightList) after an upload of `count` lights this frame.
+  void remember(const TlasInfo& tlas, uint32_t count);
 };
 
-Status ManyLightPass::Impl::ensureBuffers(uint32_t lightCount, VkDeviceSize tileBytes) {
+Status ManyLightPass::Impl::ensureLightBuffers(uint32_t lightCount) {
   if (lightCount > capacity) {
     uint32_t grown = std::max(64u, capacity);
     while (grown < lightCount) grown *= 2;
@@ -129,6 +136,10 @@ Status ManyLightPass::Impl::ensureBuffers(uint32_t lightCount, VkDeviceSize tile
     lights = d.value();
     capacity = grown;
   }
+  return {};
+}
+
+Status ManyLightPass::Impl::ensureTiles(VkDeviceSize tileBytes) {
   if (tiles.size != tileBytes) {
     retireBuffer(ctx, tiles);
     Result<GpuBuffer> t = createBuffer(ctx, tileBytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryLocation::DeviceLocal,
@@ -136,6 +147,42 @@ Status ManyLightPass::Impl::ensureBuffers(uint32_t lightCount, VkDeviceSize tile
     if (!t) return t.error();
     tiles = t.value();
   }
+  return {};
+}
+
+void ManyLightPass::Impl::recordUpload(VkCommandBuffer cmd, uint32_t count) {
+  if (count == 0) return;
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
+  // This frame's ring slot, copied to the device list once last frame's readers are done with it.
+  const uint32_t slot = uint32_t(ctx.frameIndex() % ctx.framesInFlight());
+  const VkDeviceSize slotBytes = VkDeviceSize(capacity) * sizeof(GpuLight);
+  const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
+                                       VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
+  std::memcpy(static_cast<uint8_t*>(ring.mapped) + slot * slotBytes, staging.data(), count * sizeof(GpuLight));
+  VkBufferMemoryBarrier before = bufferBarrier(lights.buffer, VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
+  vk.vkCmdPipelineBarrier(cmd, readers, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 1, &before, 0, nullptr);
+  VkBufferCopy region{slot * slotBytes, 0, count * sizeof(GpuLight)};
+  vk.vkCmdCopyBuffer(cmd, ring.buffer, lights.buffer, 1, &region);
+  VkBufferMemoryBarrier after = bufferBarrier(lights.buffer, VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
+  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, readers, 0, 0, nullptr, 1, &after, 0, nullptr);
+}
+
+void ManyLightPass::Impl::remember(const TlasInfo& tlas, uint32_t count) {
+  recorded.buffer = lights.buffer;
+  recorded.count = count;
+  recorded.frame = ctx.frameIndex();
+  for (int i = 0; i < 3; ++i) recorded.originOffset[i] = tlas.originOffset[i];
+}
+
+Status ManyLightPass::Impl::uploadLights(VkCommandBuffer cmd, const TlasInfo& tlas,
+                                         std::span<const LightSource> lightList) {
+  const uint32_t count = uint32_t(lightList.size());
+  staging.resize(count);
+  for (uint32_t i = 0; i < count; ++i)
+    if (Status st = convertLight(lightList[i], i, tlas.originOffset, staging[i]); !st) return st;
+  if (Status st = ensureLightBuffers(std::max(count, 1u)); !st) return st;
+  recordUpload(cmd, count);
+  remember(tlas, count);
   return {};
 }
 
@@ -197,29 +244,15 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   pc.tiles[0] = (g.width + kManyLightTileSize - 1) / kManyLightTileSize;
   pc.tiles[1] = (g.height + kManyLightTileSize - 1) / kManyLightTileSize;
   const VkDeviceSize tileBytes = VkDeviceSize(pc.tiles[0]) * pc.tiles[1] * RB_ML_TILE_UINTS * sizeof(uint32_t);
-  if (Status st = s.ensureBuffers(std::max(count, 1u), tileBytes); !st) return st;
+  if (Status st = s.ensureLightBuffers(std::max(count, 1u)); !st) return st;
+  if (Status st = s.ensureTiles(tileBytes); !st) return st;
 
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ManyLightPass", pc.gbuffer.flags); !st) return st;
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16G16B16A16_SFLOAT, "many-light irradiance"}}); !st)
     return st;
   const DeviceFunctions& vk = internal::deviceFunctions(s.ctx);
-  // Upload: this frame's ring slot, copied to the device list once last frame's readers are done with it.
-  const uint32_t slot = uint32_t(s.ctx.frameIndex() % s.ctx.framesInFlight());
-  const VkDeviceSize slotBytes = VkDeviceSize(s.capacity) * sizeof(GpuLight);
-  const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
-                                       VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
-  if (count > 0) {
-    std::memcpy(static_cast<uint8_t*>(s.ring.mapped) + slot * slotBytes, s.staging.data(), count * sizeof(GpuLight));
-    VkBufferMemoryBarrier before = bufferBarrier(s.lights.buffer, VK_ACCESS_SHADER_READ_BIT,
-                                                 VK_ACCESS_TRANSFER_WRITE_BIT);
-    vk.vkCmdPipelineBarrier(cmd, readers, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 1, &before, 0, nullptr);
-    VkBufferCopy region{slot * slotBytes, 0, count * sizeof(GpuLight)};
-    vk.vkCmdCopyBuffer(cmd, s.ring.buffer, s.lights.buffer, 1, &region);
-    VkBufferMemoryBarrier after = bufferBarrier(s.lights.buffer, VK_ACCESS_TRANSFER_WRITE_BIT,
-                                                VK_ACCESS_SHADER_READ_BIT);
-    vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, readers, 0, 0, nullptr, 1, &after, 0, nullptr);
-  }
+  s.recordUpload(cmd, count);
   // Tile culling: last frame's rays read the lists this overwrites.
   VkBufferMemoryBarrier tilesFree = bufferBarrier(s.tiles.buffer, VK_ACCESS_SHADER_READ_BIT,
                                                   VK_ACCESS_SHADER_WRITE_BIT);
@@ -242,16 +275,23 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   w.storageImage(RB_ML_BINDING_IRRADIANCE, images[0].view);
   s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
 
-  s.recorded.buffer = s.lights.buffer;
-  s.recorded.count = count;
-  s.recorded.frame = s.ctx.frameIndex();
-  for (int i = 0; i < 3; ++i) s.recorded.originOffset[i] = tlas.originOffset[i];
+  s.remember(tlas, count);
   ManyLightOutputs& o = s.outputs;
   o.irradiance = images[0].image;
   o.irradianceView = images[0].view;
   o.width = g.width;
   o.height = g.height;
   return {};
+}
+
+Status ManyLightPass::recordLightList(VkCommandBuffer cmd, const TlasInfo& tlas, std::span<const LightSource> lights) {
+  if (!cmd)
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass::recordLightList: cmd is VK_NULL_HANDLE"};
+  if (lights.size() > kMaxLights)
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "ManyLightPass::recordLightList: " + std::to_string(lights.size()) + " lights exceed kMaxLights (" +
+                     std::to_string(kMaxLights) + "); pass the strongest or nearest ones"};
+  return impl_->uploadLights(cmd, tlas, lights);
 }
 
 internal::LightListView internal::ManyLightPassAccess::lightList(const ManyLightPass& pass) {

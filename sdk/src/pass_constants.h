@@ -130,6 +130,24 @@ RB_ASSERT_OFFSET(PrimaryConstants, height, 60);
 RB_ASSERT_OFFSET(PrimaryConstants, flags, 64);
 RB_ASSERT_OFFSET(PrimaryConstants, frameIndex, 68);
 
+struct PrimaryShadingConstants {
+  PrimaryConstants camera;
+  float sunDirection[3];  // towards the sun, unit length
+  float ambientIntensity;
+  float sunRadiance[3];
+  uint32_t lightCount;
+  float skyRadiance[3];
+  uint32_t lightCandidates;
+};
+static_assert(sizeof(PrimaryShadingConstants) == 128);
+RB_ASSERT_OFFSET(PrimaryShadingConstants, camera, 0);
+RB_ASSERT_OFFSET(PrimaryShadingConstants, sunDirection, 80);
+RB_ASSERT_OFFSET(PrimaryShadingConstants, ambientIntensity, 92);
+RB_ASSERT_OFFSET(PrimaryShadingConstants, sunRadiance, 96);
+RB_ASSERT_OFFSET(PrimaryShadingConstants, lightCount, 108);
+RB_ASSERT_OFFSET(PrimaryShadingConstants, skyRadiance, 112);
+RB_ASSERT_OFFSET(PrimaryShadingConstants, lightCandidates, 124);
+
 struct ManyLightConstants {
   GBufferConstants gbuffer;
   uint32_t lightCount;

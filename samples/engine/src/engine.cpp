@@ -206,7 +206,12 @@ std::string Engine::Impl::createTargets(VkExtent2D extent) {
   if (e.empty())
     e = gpu.createImage({kNormalFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | readable},
                         targets.geometricNormal);
-  if (e.empty()) e = gpu.createImage({kHdrFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | readable}, targets.hdr);
+  // Storage and transfer destination too: a hook supplying the frame's colour (FrameParams::externalColor) writes it.
+  if (e.empty())
+    e = gpu.createImage({kHdrFormat, extent,
+                         VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
+                             VK_IMAGE_USAGE_TRANSFER_DST_BIT | readable},
+                        targets.hdr);
   if (e.empty())
     e = gpu.createImage({kLdrFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT},
                         targets.ldr);

@@ -51,6 +51,10 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   const uint32_t probeResolution = ReflectionProbe::clampResolution(params.reflectionProbe.resolution);
   if (params.reflectionProbe.enabled)
     if (std::string e = probe.prepare(probeResolution); !e.empty()) return "reflection probe: " + e;
+  if (params.externalColor && (params.outputLocalLightIrradiance || params.outputShadowVisibility))
+    return std::string(
+               "renderFrame: FrameParams::externalColor leaves the shading to the hook, so the engine has no ") +
+           (params.outputShadowVisibility ? "outputShadowVisibility" : "outputLocalLightIrradiance") + " to write";
   if (std::string e = ensureEffectImages(params); !e.empty()) return "effect images: " + e;
   if (std::string e = prepareLocalShadowMaps(params.localLights); !e.empty()) return "local shadow maps: " + e;
   if (params.outputLocalLightIrradiance && !targets.localIrradiance.image)
@@ -121,7 +125,7 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   // The probe is static: captured again only when something it depends on changed.
   ProbeKey probeKey;
   bool captureProbe = false;
-  if (params.reflectionProbe.enabled) {
+  if (params.reflectionProbe.enabled && !params.externalColor) {
     // Its light matrix is relative to the probe, not the camera: moving the camera does not recapture.
     const glm::vec3 probePosition = ReflectionProbe::positionFor(params.reflectionProbe, bounds);
     float probeLightRadius = 1.0f;
@@ -184,10 +188,12 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   lastSubmittedSlot = slot;
   currentFrame = (currentFrame + 1) % kFramesInFlight;
   frameRendered = true;
-  ssaoRendered = params.ssao.enabled;
+  ssaoRendered = params.ssao.enabled && !params.externalColor;
   shadowVisibilityRendered = params.outputShadowVisibility;
   localIrradianceRendered = params.outputLocalLightIrradiance;
-  shadowStats = ShadowMapStats{shadowsOn, shadowsOn ? shadowSize : 0u, taps, frame.frameNumber};
+  const bool shadowMapDrawn = shadowsOn && !params.externalColor;
+  shadowStats = ShadowMapStats{shadowMapDrawn, shadowMapDrawn ? shadowSize : 0u, shadowMapDrawn ? taps : 0u,
+                               frame.frameNumber};
 
   if (imageIndex) {
     VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
@@ -220,7 +226,9 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
 
   // (1) Shadow map. Previous contents are discarded (UNDEFINED); the barrier also orders this write after
   // the previous frame's sampling. Without a shadow map only the placeholder's layout is set for binding.
-  if (!params.shadow.enabled) {
+  // With an external colour nothing samples the map: it is only put in its read layout, as without one.
+  const bool external = params.externalColor;
+  if (!params.shadow.enabled || external) {
     imageBarrier(cmd, targets.shadowMap.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED, kReadLayout,
                  VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
@@ -279,7 +287,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
         cmd, extent,
         {colorAttachment(targets.normalRoughness.view, {}), colorAttachment(targets.geometricNormal.view, {})}, &depth);
     // BLEND surfaces stay out: depth and normals (and what the hook computes from them) are the opaque scene's.
-    if (haveScene)
+    if (haveScene && !external)
       drawScene(cmd, scene, pipelines, DrawPass::Prepass, {pipelines.prepass, pipelines.prepassMasked}, eye);
     vkCmdEndRendering(cmd);
   }
@@ -297,12 +305,24 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
 
   // (2b) The engine's own screen-space effects. SSAO runs whenever enabled (also next to an external AO
   // input, so both can be read back from one frame); the shadow-visibility image only on request.
-  if (params.ssao.enabled) recordSsao(frame, params.ssao);
+  if (params.ssao.enabled && !external) recordSsao(frame, params.ssao);
   timestamp(kTsSsaoEnd);
   if (params.outputShadowVisibility) recordShadowVisibility(frame);
   timestamp(kTsShadowVisibilityEnd);
 
-  // (3) Extension point.
+  // (3) Extension point. With an external colour the hook gets the HDR target, cleared to the sky (the previous
+  // frame's tonemap may still read it).
+  if (external) {
+    imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
+                 VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                 VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    const VkClearColorValue sky{{params.skyColor.r, params.skyColor.g, params.skyColor.b, 1.0f}};
+    const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdClearColorImage(cmd, targets.hdr.image, VK_IMAGE_LAYOUT_GENERAL, &sky, 1, &all);
+    imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
+                 VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                 VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+  }
   LightingInputs inputs = params.lightingInputs;
   if (hook) {
     PrepassHookInfo info;
@@ -331,6 +351,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     info.deformedInstances = deformer.instances();
     info.deformSemaphore = deformer.semaphore();
     info.deformValue = deformer.active() ? frame.frameNumber : 0;
+    if (external) info.hdrColor = {targets.hdr.image, targets.hdr.view, kHdrFormat, VK_IMAGE_LAYOUT_GENERAL};
     info.submitWaits = &submitWaits;
     info.deformWaits = deformer.active() ? &deformer.pendingWaits() : nullptr;
     hook(info, inputs);
@@ -376,36 +397,42 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
   writeImageDescriptors(ctx.device, frame.tonemapSet, {{pipelines.nearestSampler, targets.hdr.view, kReadLayout}});
 
   // (4) Forward lighting: EQUAL test against the pre-pass depth, background keeps the sky clear color; then the
-  // blended surfaces in the same rendering scope.
-  imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-               VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
-               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-  {
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = targets.depth.view;
-    depth.imageLayout = kDepthReadLayout;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_NONE;  // read-only: no write access at the end of the pass
-    VkClearColorValue sky{{params.skyColor.r, params.skyColor.g, params.skyColor.b, 1.0f}};
-    beginRendering(cmd, extent, {colorAttachment(targets.hdr.view, sky)}, &depth);
-    // Set 0 again: the effect passes' pipeline layout (other push constants) disturbed the binding.
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 0, 1, &frame.frameSet, 0,
-                            nullptr);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 2, 1, &frame.lightingSet, 0,
-                            nullptr);
-    if (haveScene) {
-      drawScene(cmd, scene, pipelines, DrawPass::Lighting, {pipelines.forward, pipelines.forwardMasked}, eye);
-      // (4b) BLEND surfaces over the lit opaque scene, back to front, tested against the pre-pass depth.
-      drawBlended(cmd, scene, pipelines, eye);
+  // blended surfaces in the same rendering scope. With an external colour the hook's becomes the tonemap's input.
+  if (external) {
+    imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kReadLayout,
+                 VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+  } else {
+    imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
+                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    {
+      VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+      depth.imageView = targets.depth.view;
+      depth.imageLayout = kDepthReadLayout;
+      depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+      depth.storeOp = VK_ATTACHMENT_STORE_OP_NONE;  // read-only: no write access at the end of the pass
+      VkClearColorValue sky{{params.skyColor.r, params.skyColor.g, params.skyColor.b, 1.0f}};
+      beginRendering(cmd, extent, {colorAttachment(targets.hdr.view, sky)}, &depth);
+      // Set 0 again: the effect passes' pipeline layout (other push constants) disturbed the binding.
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 0, 1, &frame.frameSet, 0,
+                              nullptr);
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines.sceneLayout, 2, 1, &frame.lightingSet, 0,
+                              nullptr);
+      if (haveScene) {
+        drawScene(cmd, scene, pipelines, DrawPass::Lighting, {pipelines.forward, pipelines.forwardMasked}, eye);
+        // (4b) BLEND surfaces over the lit opaque scene, back to front, tested against the pre-pass depth.
+        drawBlended(cmd, scene, pipelines, eye);
+      }
+      vkCmdEndRendering(cmd);
     }
-    vkCmdEndRendering(cmd);
+    imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                 kReadLayout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
   }
   timestamp(kTsLightingEnd);
 
   // (5) Tonemap into the 8-bit sRGB target, left in TRANSFER_SRC_OPTIMAL for readback / swapchain blit.
-  imageBarrier(cmd, targets.hdr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, kReadLayout,
-               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-               VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
   imageBarrier(cmd, targets.ldr.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
                VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);

@@ -250,7 +250,9 @@ void Engine::Impl::recordLocalLights(FrameResources& frame, const FrameParams& p
   const uint32_t count = settings.enabled ? uint32_t(frameLights.size()) : 0u;
   const bool external = inputs.localLightIrradiance != VK_NULL_HANDLE;
   // An external E replaces the shadowed diffuse, so the maps are only needed for the engine's own output.
-  const bool drawMaps = count > 0 && targets.localShadowLayers >= 6 && (!external || params.outputLocalLightIrradiance);
+  // FrameParams::externalColor: nothing samples them.
+  const bool drawMaps = count > 0 && targets.localShadowLayers >= 6 && !params.externalColor &&
+                        (!external || params.outputLocalLightIrradiance);
   const uint32_t taps = std::clamp(settings.pcfKernelSize, 1u, kMaxShadowPcfKernel);
   const uint32_t mapSize = targets.localShadowMapSize;
   const std::vector<uint32_t> shadowed = drawMaps ? strongestLights(frameLights, eye, targets.localShadowLayers / 6)

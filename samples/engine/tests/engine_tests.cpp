@@ -550,3 +550,56 @@ TEST_CASE("an external reflection replaces the environment term by its alpha (co
   REQUIRE(f.engine->waitIdle().ok());
   CHECK(f.engine->validationErrorCount() == 0);
 }
+
+TEST_CASE("an external colour replaces the raster frame: the tonemap and the readbacks show the hook's image",
+          "[render][external-color]") {
+  auto engine = makeEngine();
+  REQUIRE(engine->loadScene(makeDefaultDemoScene()).ok());
+  REQUIRE(engine->setRenderSize(kWidth, kHeight).ok());
+  FrameParams params = paramsFor(*engine);
+  params.externalColor = true;
+  params.ssao.enabled = true;  // skipped with the rest of the raster shading
+
+  SECTION("without a hook every pixel is the sky, and no shadow map is drawn") {
+    ImageRGBA32F hdr = renderHdr(*engine, params);
+    for (uint32_t y : {1u, kHeight / 2, kHeight - 2})
+      for (uint32_t x : {1u, kWidth / 2, kWidth - 2})
+        for (int c = 0; c < 3; ++c) CHECK(std::abs(hdr.at(x, y)[c] - params.skyColor[c]) < 2e-3f);
+    CHECK_FALSE(engine->lastShadowMapStats().enabled);
+    CHECK_FALSE(engine->readbackSsao().ok());
+  }
+  SECTION("the hook's colour, written into the HDR target it is handed") {
+    const glm::vec4 colour(2.0f, 0.5f, 0.25f, 1.0f);
+    bool handed = false;
+    engine->setPrepassHook([&](const PrepassHookInfo& info, LightingInputs&) {
+      handed = info.hdrColor.view && info.hdrColor.layout == VK_IMAGE_LAYOUT_GENERAL &&
+               info.hdrColor.format == VK_FORMAT_R16G16B16A16_SFLOAT;
+      const VkClearColorValue value{{colour.r, colour.g, colour.b, colour.a}};
+      const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+      vkCmdClearColorImage(info.commandBuffer, info.hdrColor.image, VK_IMAGE_LAYOUT_GENERAL, &value, 1, &all);
+    });
+    ImageRGBA32F hdr = renderHdr(*engine, params);
+    auto ldr = engine->readbackLdr();
+    REQUIRE(ldr.ok());
+    engine->setPrepassHook({});
+    CHECK(handed);
+    const glm::u8vec3 expected = tonemapToSrgb8(glm::vec3(colour), params.exposure);
+    for (uint32_t y : {1u, kHeight / 2, kHeight - 2}) {
+      for (uint32_t x : {1u, kWidth / 2, kWidth - 2}) {
+        for (int c = 0; c < 3; ++c) {
+          CHECK(std::abs(hdr.at(x, y)[c] - colour[c]) < 2e-3f);
+          CHECK(std::abs(int(ldr.value.at(x, y)[c]) - int(expected[c])) <= 1);
+        }
+      }
+    }
+  }
+  SECTION("outputs of the raster shading cannot be asked for") {
+    params.outputShadowVisibility = true;
+    Status s = engine->renderFrame(params);
+    REQUIRE_FALSE(s.ok());
+    CHECK(s.error.find("externalColor") != std::string::npos);
+    CHECK(s.error.find("outputShadowVisibility") != std::string::npos);
+  }
+  (void)engine->waitIdle();
+  CHECK(engine->validationErrorCount() == 0);
+}

@@ -101,6 +101,9 @@ class ManyLightPass {
   // names the light's index and field.
   Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas,
                 std::span<const LightSource> lights, const ManyLightSettings& settings = {});
+  // Records the light upload alone (no culling, no rays, no output image), for passes lit by the list without a
+  // G-buffer (PrimaryShadingSettings::lights); checked as record() checks it. stats() does not measure it.
+  Status recordLightList(VkCommandBuffer cmd, const TlasInfo& tlas, std::span<const LightSource> lights);
   const ManyLightOutputs& outputs() const;
   // GPU time (upload, culling and tracing) and rays of the latest recording whose frame has finished.
   PassStats stats() const;

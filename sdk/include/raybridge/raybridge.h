@@ -14,6 +14,7 @@
 #include <raybridge/material_table.h>
 #include <raybridge/presets.h>
 #include <raybridge/primary_ray_pass.h>
+#include <raybridge/primary_shading_pass.h>
 #include <raybridge/reflection_pass.h>
 #include <raybridge/result.h>
 #include <raybridge/shadow_pass.h>

@@ -35,6 +35,9 @@
 // morphed) instances, a compute submission writes each one's deformed vertex buffers and signals a timeline
 // semaphore to the frame number; the main submission waits on it. Static scenes skip both.
 //
+// With FrameParams::externalColor the hook supplies the whole frame's colour instead (pure ray tracing): the
+// engine then only clears the pre-pass images, calls the hook with its HDR target and tonemaps what it wrote.
+//
 // Add-ons (e.g. a ray-tracing adapter) plug in through four small things:
 //   * EngineConfig: extra device extensions / feature chain, so they can share the engine's device;
 //   * setPrepassHook(): called with the frame's command buffer between the pre-pass and the lighting pass;
@@ -274,6 +277,13 @@ struct FrameParams {
   // Also writes the shadow-map sun visibility the lighting uses (PCF, and 0 where the shading normal faces
   // away from the sun; 1 on background) into an R16F image for readbackShadowVisibility().
   bool outputShadowVisibility = false;
+  // The pre-pass hook supplies the frame's colour (e.g. a ray tracer shading primary rays): the engine records no
+  // shadow map, probe capture, pre-pass draws (depth and normals are only cleared: far plane, 0), SSAO, shadow
+  // visibility, local shadow maps or lighting (blended surfaces included), so their timings are about 0. Before
+  // the hook the HDR target is cleared to skyColor and handed over as PrepassHookInfo::hdrColor; the tonemap,
+  // readbackHdr() and readbackLdr() show what the hook wrote there. renderFrame fails when an output above is also
+  // requested (outputLocalLightIrradiance, outputShadowVisibility): the engine shades nothing to output.
+  bool externalColor = false;
   // Animation time in seconds; must be finite and >= 0 (renderFrame fails naming the value otherwise).
   double time = 0.0;
   // The animations that play this frame, each at time + timeOffset, looping over its own duration, applied in
@@ -350,6 +360,10 @@ struct PrepassHookInfo {
   // main submission already waits for it (ALL_COMMANDS), so commands recorded in commandBuffer see them.
   VkSemaphore deformSemaphore = VK_NULL_HANDLE;
   uint64_t deformValue = 0;
+  // FrameParams::externalColor only (else all null): the frame's HDR target, R16G16B16A16_SFLOAT, `extent` pixels,
+  // cleared to skyColor, in VK_IMAGE_LAYOUT_GENERAL, usable as a storage image and a transfer destination. The hook
+  // writes the frame's linear colour into it and leaves it in GENERAL; the tonemap then reads it.
+  PassImage hdrColor;
   // Waits to add to this frame's main submission (e.g. an async BLAS build on another queue). Never null.
   std::vector<VkSemaphoreSubmitInfo>* submitWaits = nullptr;
   // Waits the engine's NEXT deformation submission performs before it overwrites the deformed buffers (e.g.

@@ -1,0 +1,109 @@
+// Pure ray tracing: one primary ray per pixel from a pinhole camera (PrimaryRayCamera), shaded where it hits
+// with the engine's materials exactly as reflection hits are (reflection_pass.h): base colour, metallic and
+// emissive factors and textures, the sun with a shadow ray, the sky's ambient light, and the local lights of a
+// ManyLightPass when given (one resampled light per hit, with its shadow ray). A ray that misses returns the sky.
+// No G-buffer is read: the pass replaces an engine's rasterized shading (the thesis's "ray-traced" mode).
+//
+// Alpha: primary and shadow rays alpha-test non-opaque geometry with the material table (material_table.h):
+// they pass through Mask cut-outs, and Blend surfaces stop them with probability alpha (per pixel and frame:
+// stochastic transparency, since no forward pass draws blended surfaces afterwards).
+//
+// Needs: a TLAS built with TlasBuildOptions::writeShadingRecords, Instance::material set, a device whose ray
+// recursion depth is at least 2 (a shadow ray from each hit). Outputs: radiance (RGBA16F, linear) and the
+// distance from the eye to the hit along the unit ray direction (R32F, 0 = miss), in the pass's own images or
+// the radiance in the caller's image (PrimaryShadingTargets::radiance).
+//
+// Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output images and
+// measurement objects are handed to the Context's deferred release (see context.h) and freed once those frames
+// are done. Destroy it before its Context.
+//
+// Thread safety: externally synchronised, like the Context it was created from.
+#pragma once
+
+#include <raybridge/acceleration_structures.h>
+#include <raybridge/context.h>
+#include <raybridge/effects.h>
+#include <raybridge/many_light_pass.h>
+#include <raybridge/material_table.h>
+#include <raybridge/primary_ray_pass.h>
+#include <raybridge/reflection_pass.h>
+
+#include <memory>
+
+namespace rb {
+
+// Defaults of PrimaryShadingSettings: the lighting defaults of reflection hits (reflection_pass.h).
+inline constexpr uint32_t kDefaultPrimaryShadingLightCandidates = kDefaultReflectionLightCandidates;
+inline constexpr uint32_t kMaxPrimaryShadingLightCandidates = 64;
+
+enum PrimaryShadingFlags : uint32_t {
+  // Take sunRadiance, skyRadiance and ambientIntensity as given, zeros included (a black sky, no sky light).
+  // Without it an all-zero colour or a zero intensity means its default constant.
+  kPrimaryShadingExplicitLighting = 1u << 0,
+  // No directional light: hits are lit by the sky alone (no sun shadow rays).
+  kPrimaryShadingNoSun = 1u << 1,
+};
+
+// A zero-initialised PrimaryShadingSettings is valid: every zero field means the default named on its line.
+struct PrimaryShadingSettings {
+  float sunDirection[3] = {0.0f, 0.0f, 0.0f};  // towards the sun; all zero = straight up (0, 1, 0)
+  float sunRadiance[3] = {0.0f, 0.0f, 0.0f};   // linear, the sun's colour times intensity; 0 = kDefaultSunRadiance
+  float skyRadiance[3] = {0.0f, 0.0f, 0.0f};   // linear, what missing rays see; 0 = kDefaultSkyRadiance
+  float ambientIntensity = 0.0f;  // sky light on hit surfaces, times skyRadiance; 0 = kDefaultAmbientIntensity
+  uint32_t flags = 0;             // PrimaryShadingFlags
+  // The table hits shade with and alpha-test with; nullptr = every surface white and opaque.
+  const MaterialTable* materials = nullptr;
+  // Local lights: the light list this ManyLightPass uploaded earlier this frame (record() or recordLightList(),
+  // same TLAS). nullptr = sun and sky only.
+  const ManyLightPass* lights = nullptr;
+  uint32_t lightCandidates = 0;  // 0 = kDefaultPrimaryShadingLightCandidates; at most 64
+};
+
+struct PrimaryShadingTargets {
+  uint32_t width = 0;   // required
+  uint32_t height = 0;  // required
+  // Optional: the caller's R16G16B16A16_SFLOAT storage image view, width x height, in VK_IMAGE_LAYOUT_GENERAL, to
+  // write the radiance into instead of the pass's own image (e.g. the engine's HDR target). It stays in GENERAL;
+  // the caller orders earlier accesses before VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR and later reads after
+  // it. VK_NULL_HANDLE = the pass's own image (PrimaryShadingOutputs::radiance).
+  VkImageView radiance = VK_NULL_HANDLE;
+};
+
+// Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
+struct PrimaryShadingOutputs {
+  // R16G16B16A16_SFLOAT: rgb linear radiance towards the eye, a = 1. VK_NULL_HANDLE when the latest record()
+  // wrote the caller's PrimaryShadingTargets::radiance instead.
+  VkImage radiance = VK_NULL_HANDLE;
+  VkImageView radianceView = VK_NULL_HANDLE;
+  // R32_SFLOAT: distance from the eye to the hit along the pixel-centre ray (unit direction); 0 = nothing hit.
+  VkImage distance = VK_NULL_HANDLE;
+  VkImageView distanceView = VK_NULL_HANDLE;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  uint32_t width = 0, height = 0;
+};
+
+class PrimaryShadingPass {
+ public:
+  // Fails with ErrorCode::MissingFeature on a device whose ray recursion depth is below 2.
+  static Result<std::unique_ptr<PrimaryShadingPass>> create(Context& context);
+  // Retires its Vulkan objects to the context, without waiting: the images of outputs() stay valid for the
+  // frames already recorded.
+  ~PrimaryShadingPass();
+
+  // Records the trace. The camera is in world space; the pass subtracts TlasInfo::originOffset from eye and target
+  // (in double) to trace a camera-relative TLAS. The TLAS must have been built by recordTlasBuild() earlier in
+  // submission order. On an error (named field) nothing is recorded.
+  Status record(VkCommandBuffer cmd, const TlasInfo& tlas, const PrimaryRayCamera& camera,
+                const PrimaryShadingTargets& targets, const PrimaryShadingSettings& settings = {});
+  const PrimaryShadingOutputs& outputs() const;
+  // The latest measurement whose frame has finished: GPU time, and rays (primary plus shadow rays).
+  PassStats stats() const;
+
+  struct Impl;
+
+ private:
+  explicit PrimaryShadingPass(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rb
