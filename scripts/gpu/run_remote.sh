@@ -288,9 +288,18 @@ if want perf; then
       perf_render "${scene}__raster__$preset" "$RT/bin/raybridge-render" "${sargs[@]}" --mode raster \
         --preset "$preset" --frames "$PFRAMES"
     done
+    # Pure ray tracing (primary rays shaded, no G-buffer; the preset does not apply), and the shadow pass's tile
+    # classifier against the same binary's default.
+    perf_render "${scene}__raytraced__none" "$RT/bin/raybridge-render" "${sargs[@]}" --mode raytraced \
+      --preset none --frames "$PFRAMES"
+    for preset in hard-shadows ultra; do
+      perf_render "${scene}__hybrid__${preset}__classifier" "$RT/bin/raybridge-render" "${sargs[@]}" \
+        --preset "$preset" --tile-classifier --frames "$PFRAMES"
+    done
   done
-  for mode in hybrid raster; do
+  for mode in hybrid raster raytraced; do
     for preset in low ultra; do
+      [ "$mode" = raytraced ] && [ "$preset" = ultra ] && continue  # the preset does not apply
       perf_render "perf__${mode}__${preset}__path" "$RT/bin/raybridge-render" --perf-scene --models-from "$SCENES" \
         --mode "$mode" --preset "$preset" --camera-path "$ROOT/scripts/gpu/perf_flythrough.json" \
         --frames "${RB_PERF_PATH_FRAMES:-240}"

@@ -102,8 +102,10 @@ void PassMetrics::beginRecording(Context& ctx, VkCommandBuffer cmd) {
   if (!counters_.valid()) return;
   // After any earlier use of the counters in this command buffer (the pass recorded twice in a frame): clear, then
   // let the shaders add.
+  // TRANSFER_WRITE in the first scope: the earlier recording's fill and readback copy (write after write).
   memoryBarrier(c.vk, cmd, kCounterShaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT,
+                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                    VK_ACCESS_TRANSFER_WRITE_BIT,
                 VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
   c.vk.vkCmdFillBuffer(cmd, counters_.buffer, slot * counterBytes(), counterBytes(), 0u);
   memoryBarrier(c.vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kCounterShaderStages,

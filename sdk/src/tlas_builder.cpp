@@ -283,14 +283,17 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   const VkAccelerationStructureBuildRangeInfoKHR* rangePtr = &range;
 
   if (copyInstances && written) {
-    // The build and the shaders that read this slot's device copies before (a service recorded twice into one
-    // command buffer across beginFrame()) are done before the copies overwrite them.
+    // The build and the shaders that read this slot's device copies before, and the copies that wrote them (a
+    // service recorded twice into one command buffer across beginFrame()), are done before the copies overwrite
+    // them (found by synchronization validation on the H200, where Auto copies).
     constexpr VkPipelineStageFlags readers = VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR |
                                              VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
     VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    before.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT;
+    before.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT |
+                           VK_ACCESS_TRANSFER_WRITE_BIT;
     before.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    c.vk.vkCmdPipelineBarrier(cmd, readers, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0, nullptr, 0, nullptr);
+    c.vk.vkCmdPipelineBarrier(cmd, readers | VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1,
+                              &before, 0, nullptr, 0, nullptr);
     const VkBufferCopy instanceRegion{0, 0, VkDeviceSize(written) * sizeof(VkAccelerationStructureInstanceKHR)};
     c.vk.vkCmdCopyBuffer(cmd, slot.instances.buffer, slot.deviceInstances.buffer, 1, &instanceRegion);
     if (records) {
