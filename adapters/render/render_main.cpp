@@ -128,6 +128,7 @@ std::vector<std::pair<const char*, const rb::PassStats*>> namedPassStats(const r
       {"ao", !effects || effects->aoPass() ? &es.ao : nullptr},
       {"ao_denoise", !effects || effects->aoDenoiser() ? &es.aoDenoise : nullptr},
       {"reflection", !effects || effects->reflectionPass() ? &es.reflection : nullptr},
+      {"reflection_denoise", !effects || effects->reflectionDenoiser() ? &es.reflectionDenoise : nullptr},
       {"local_lights", !effects || effects->localLightPass() ? &es.localLights : nullptr},
       {"local_lights_denoise", !effects || effects->localLightDenoiser() ? &es.localLightsDenoise : nullptr}};
   std::vector<std::pair<const char*, const rb::PassStats*>> out;
