@@ -4,6 +4,7 @@
 #include <string>
 
 #include "context_impl.h"
+#include "memory_barrier.h"
 
 namespace rb {
 
@@ -12,14 +13,6 @@ namespace {
 // The stages whose shaders add to the counters: ray tracing passes and compute passes.
 constexpr VkPipelineStageFlags kCounterShaderStages = VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR |
                                                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
-
-void memoryBarrier(const DeviceFunctions& vk, VkCommandBuffer cmd, VkPipelineStageFlags srcStages,
-                   VkAccessFlags srcAccess, VkPipelineStageFlags dstStages, VkAccessFlags dstAccess) {
-  VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  b.srcAccessMask = srcAccess;
-  b.dstAccessMask = dstAccess;
-  vk.vkCmdPipelineBarrier(cmd, srcStages, dstStages, 0, 1, &b, 0, nullptr, 0, nullptr);
-}
 
 }  // namespace
 
@@ -103,13 +96,13 @@ void PassMetrics::beginRecording(Context& ctx, VkCommandBuffer cmd) {
   // After any earlier use of the counters in this command buffer (the pass recorded twice in a frame): clear, then
   // let the shaders add.
   // TRANSFER_WRITE in the first scope: the earlier recording's fill and readback copy (write after write).
-  memoryBarrier(c.vk, cmd, kCounterShaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
-                    VK_ACCESS_TRANSFER_WRITE_BIT,
-                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
+  recordMemoryBarrier(c.vk, cmd, kCounterShaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                          VK_ACCESS_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
   c.vk.vkCmdFillBuffer(cmd, counters_.buffer, slot * counterBytes(), counterBytes(), 0u);
-  memoryBarrier(c.vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kCounterShaderStages,
-                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  recordMemoryBarrier(c.vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kCounterShaderStages,
+                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 void PassMetrics::writeStart(Context& ctx, VkCommandBuffer cmd) {
@@ -123,13 +116,13 @@ void PassMetrics::writeEnd(Context& ctx, VkCommandBuffer cmd) {
   const uint32_t slot = static_cast<uint32_t>(ctx.frameIndex() % ctx.framesInFlight());
   if (timing_) vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps_, 2 * slot + 1);
   if (!counters_.valid()) return;
-  memoryBarrier(vk, cmd, kCounterShaderStages, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                VK_ACCESS_TRANSFER_READ_BIT);
+  recordMemoryBarrier(vk, cmd, kCounterShaderStages, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                      VK_ACCESS_TRANSFER_READ_BIT);
   const VkBufferCopy region{slot * counterBytes(), slot * counterBytes(), counterBytes()};
   vk.vkCmdCopyBuffer(cmd, counters_.buffer, readback_.buffer, 1, &region);
   // The host reads the copy after the frame's fence (collect()).
-  memoryBarrier(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-                VK_ACCESS_HOST_READ_BIT);
+  recordMemoryBarrier(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                      VK_ACCESS_HOST_READ_BIT);
 }
 
 }  // namespace rb

@@ -1,6 +1,7 @@
 #include "tile_classifier.h"
 
 #include "context_impl.h"
+#include "memory_barrier.h"
 #include "raybridge_shader_interface.glsl"
 
 namespace rb {
@@ -73,12 +74,9 @@ void TileClassifier::classify(Context& ctx, VkCommandBuffer cmd, const Descripto
   pipeline_.dispatch(ctx, cmd, w.writes, constants, constantBytes, width_, height_);
   // Everything the classifier wrote: the arguments (read by the launch), the list, the skipped tiles' outputs and
   // the counters (which the ray generation shaders write after it).
-  VkMemoryBarrier done{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  done.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  done.dstAccessMask = VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                          VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, 0, 1,
-                          &done, 0, nullptr, 0, nullptr);
+  recordMemoryBarrier(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR,
+                      VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 }  // namespace rb

@@ -6,6 +6,7 @@
 
 #include "as_service_impl.h"
 #include "content_hash.h"
+#include "memory_barrier.h"
 
 namespace rb {
 
@@ -288,22 +289,18 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     // them (found by synchronization validation on the H200, where Auto copies).
     constexpr VkPipelineStageFlags readers = VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR |
                                              VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
-    VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    before.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT |
-                           VK_ACCESS_TRANSFER_WRITE_BIT;
-    before.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    c.vk.vkCmdPipelineBarrier(cmd, readers | VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1,
-                              &before, 0, nullptr, 0, nullptr);
+    recordMemoryBarrier(c.vk, cmd, readers | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                        VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT |
+                            VK_ACCESS_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
     const VkBufferCopy instanceRegion{0, 0, VkDeviceSize(written) * sizeof(VkAccelerationStructureInstanceKHR)};
     c.vk.vkCmdCopyBuffer(cmd, slot.instances.buffer, slot.deviceInstances.buffer, 1, &instanceRegion);
     if (records) {
       const VkBufferCopy recordRegion{0, 0, VkDeviceSize(written) * sizeof(ShadingRecord)};
       c.vk.vkCmdCopyBuffer(cmd, slot.shading.buffer, slot.deviceShading.buffer, 1, &recordRegion);
     }
-    VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    after.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT;
-    c.vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, readers, 0, 1, &after, 0, nullptr, 0, nullptr);
+    recordMemoryBarrier(c.vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, readers,
+                        VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT);
   }
   // Earlier BLAS builds and this slot's previous use of its scratch must be complete.
   recordAsBarrier(c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
