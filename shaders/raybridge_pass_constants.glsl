@@ -119,6 +119,17 @@ struct DenoiseConstants {
   float convergedNoise;         // 224: scalar: noise standard deviation under which the value passes unfiltered
 };
 
+// The allocation step of adaptive rays (adaptive_allocate.comp). 32 bytes.
+struct AdaptivePlanConstants {
+  uvec2 size;         //  0: width, height in pixels
+  uint budget;        //  8: most rays this frame (0xFFFFFFFF = no cap)
+  float uniformRays;  // 12: > 0: the budget is this many rays per surface pixel (under the cap)
+  uint minRays;       // 16: every surface pixel's rays while the budget allows
+  uint maxRays;       // 20: no pixel gets more
+  uint frameIndex;    // 24: the rounding noise's seed
+  uint pad0;          // 28
+};
+
 // The refit-quality measure of dynamic BLASes (blas_cluster_bounds.comp). 48 bytes.
 struct ClusterBoundsConstants {
   uvec2 positions;      //  0: device address of vertex 0's position

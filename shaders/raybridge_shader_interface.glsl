@@ -18,6 +18,8 @@
 #define RB_REFLECTION_BINDING_ROUGHNESS_METALNESS 5  // the normal image again when roughness is in normal.w
 #define RB_REFLECTION_BINDING_RADIANCE 6
 #define RB_REFLECTION_BINDING_LIGHTS 10  // the ManyLightPass's light list (GpuLight[]), read by the hits
+// Adaptive rays (the AO and shadow passes' adaptive ray generation modules): the plan of adaptive_rays.glsl.
+#define RB_BINDING_RAY_PLAN 11
 // Every pass whose rays can hit non-opaque geometry (shadow, AO, reflection) also has the TLAS's shading
 // records, the material table and the texture set (alpha testing in the any-hit shaders, shading in reflections).
 #define RB_BINDING_SHADING_RECORDS 7
@@ -61,6 +63,17 @@
 #define RB_ATROUS_BINDING_SIGNAL_IN 2
 #define RB_ATROUS_BINDING_SIGNAL_OUT 3  // rg: value, variance (denoise_atrous.comp); r: the output (_final.comp)
 #define RB_ATROUS_BINDING_TEMPORAL 4    // denoise_atrous_final.comp: the temporal result the shift starts from
+
+// The adaptive ray planning dispatches (adaptive_estimate.comp, adaptive_allocate.comp).
+#define RB_ADAPTIVE_BINDING_DEPTH 0
+#define RB_ADAPTIVE_BINDING_MOTION 1    // the depth image again without motion vectors
+#define RB_ADAPTIVE_BINDING_HISTORY 2   // the denoiser's history of last frame (mean, frames)
+#define RB_ADAPTIVE_BINDING_DISTANCE 3  // the denoiser's view distances of last frame
+#define RB_ADAPTIVE_BINDING_WEIGHTS 4   // rg16f: reprojected mean, weight
+#define RB_ADAPTIVE_BINDING_COUNTERS 5  // RbPlanCounters
+#define RB_ADAPTIVE_BINDING_PLAN 6      // rg16f: rays, reprojected mean
+// Fixed point of RbPlanCounters::weightSum: a pixel weighs at most 0.52, so 2^32 holds 8K x 4K pixels.
+#define RB_ADAPTIVE_WEIGHT_SCALE 256.0
 
 // GBufferConstants::flags: what the G-buffer description says.
 #define RB_GB_REVERSED_Z 1u

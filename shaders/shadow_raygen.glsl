@@ -2,9 +2,11 @@
 // centre. Soft: n rays over the light's disk (stratified Fibonacci spiral, rotated per pixel and frame).
 // No ray for sky pixels, surfaces facing away from the light, or pixels outside a spot cone or light range
 // (rbShadowPixel, shared with the tile classifier). With the classifier the launch covers its tile list
-// (pc.launchOverTiles); the tiles it left out already hold their outputs.
+// (pc.launchOverTiles); the tiles it left out already hold their outputs. With RB_ADAPTIVE_RAYS (shadow_adaptive.rgen)
+// each traced pixel's ray count comes from the adaptive plan (adaptive_rays.glsl).
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ShadowPushConstants { ShadowConstants pc; };
+#include "adaptive_rays.glsl"
 #include "ray_counters.glsl"
 #include "shadow_pixel.glsl"
 #include "shadow_tiles.glsl"
@@ -40,7 +42,14 @@ void main() {
     bool directional = pc.lightType == RB_LIGHT_DIRECTIONAL;
     // The light's extent: a directional light's disk (as a slope) or a point or spot light's sphere.
     float spread = directional ? pc.tanAngularRadius : pc.lightRadius;
-    uint count = max(pc.raysPerPixel, 1u);
+#ifdef RB_ADAPTIVE_RAYS
+    const vec2 plan = texelFetch(rayPlan, ip, 0).xy;
+    const uint count = uint(plan.x);
+    const float historyMean = plan.y;
+#else
+    const uint count = max(pc.raysPerPixel, 1u);
+    const float historyMean = 0.0;  // never read: every traced pixel gets a ray
+#endif
     uint seed = rbPcg(pixel.x + pc.gbuffer.size.x * pixel.y + rbPcg(pc.gbuffer.frameIndex));
     float jitter = rbToUnit(seed);
     float rotation = rbToUnit(rbPcg(seed)) * 2.0 * RB_PI;
@@ -80,7 +89,8 @@ void main() {
       }
     }
     rays = count;
-    visibility = float(visible) / float(count);
+    // A pixel the adaptive plan gave no ray keeps its reprojected history mean.
+    visibility = count == 0u ? historyMean : float(visible) / float(count);
     if (nearest == 1e30) nearest = 0.0;
   }
   imageStore(outVisibility, ip, vec4(visibility));

@@ -3,18 +3,43 @@
 #include <cmath>
 #include <string>
 
+#include "adaptive_rays.h"
 #include "context_impl.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
 
 namespace rb {
 
+namespace {
+// The pipeline of the pass: ao.rgen, or ao_adaptive.rgen (which adds the plan's binding).
+RayTracingPipelineDesc aoPipelineDesc(bool adaptive) {
+  RayTracingPipelineDesc p;
+  p.name = adaptive ? "AO pass (adaptive rays)" : "AO pass";
+  p.raygen = adaptive ? SpirvModule::of(spirv::ao_adaptive_rgen) : SpirvModule::of(spirv::ao_rgen);
+  p.misses = {SpirvModule::of(spirv::occlusion_rmiss)};
+  p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::occlusion_rchit), {}}};
+  const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
+  p.bindings = PassCore::commonBindings();
+  p.bindings.push_back({RB_AO_BINDING_OUTPUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
+  if (adaptive) p.bindings.push_back({RB_BINDING_RAY_PLAN, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
+  p.pushConstantBytes = sizeof(AoConstants);
+  return p;
+}
+}  // namespace
+
 struct AoPass::Impl {
   Context& ctx;
   PassCore core;
+  // Adaptive rays, created on first use.
+  RayTracingPipeline adaptivePipeline;
+  AdaptiveRayPlanner planner;
   AoOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() { core.retire(ctx); }  // frames in flight may still trace with it
+  ~Impl() {  // frames in flight may still trace with it
+    core.retire(ctx);
+    adaptivePipeline.retire(ctx);
+    planner.retire(ctx);
+  }
 };
 
 AoPass::AoPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -22,16 +47,9 @@ AoPass::~AoPass() = default;
 
 Result<std::unique_ptr<AoPass>> AoPass::create(Context& context) {
   auto impl = std::make_unique<Impl>(context);
-  RayTracingPipelineDesc p;
-  p.name = "AO pass";
-  p.raygen = SpirvModule::of(spirv::ao_rgen);
-  p.misses = {SpirvModule::of(spirv::occlusion_rmiss)};
-  p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::occlusion_rchit), {}}};
-  p.bindings = PassCore::commonBindings();
-  p.bindings.push_back(
-      {RB_AO_BINDING_OUTPUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr});
-  p.pushConstantBytes = sizeof(AoConstants);
-  if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::ao_rahit)); !s) return s.error();
+  if (Status s = impl->core.init(context, aoPipelineDesc(false), SpirvModule::of(spirv::ao_rahit)); !s) {
+    return s.error();
+  }
   return std::unique_ptr<AoPass>(new AoPass(std::move(impl)));
 }
 
@@ -49,6 +67,7 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   if (settings.estimator != AoEstimator::Binary && settings.estimator != AoEstimator::DistanceWeighted) {
     return invalid("AoSettings::estimator has an unknown value");
   }
+  if (Status st = AdaptiveRayPlanner::validate(settings.adaptive, "AoPass: AoSettings::adaptive"); !st) return st;
   AoConstants pc{};
   if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "AoPass", pc.gbuffer); !st) return st;
   pc.range = range;
@@ -57,14 +76,34 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
 
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "AoPass", pc.gbuffer.flags); !st) return st;
+  if (settings.adaptive.enabled && !s.adaptivePipeline.pipeline) {
+    Result<RayTracingPipeline> p = s.core.createVariant(s.ctx, aoPipelineDesc(true), SpirvModule::of(spirv::ao_rahit));
+    if (!p) return p.error();
+    s.adaptivePipeline = p.value();
+  }
+  const PassStats latest = s.core.metrics.latest(s.ctx);
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}}); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
   w.storageImage(RB_AO_BINDING_OUTPUT, s.core.images[0].view);
-  s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  bool planned = false;
+  if (settings.adaptive.enabled) {
+    Result<bool> r = s.planner.record(s.ctx, cmd, g, settings.adaptive, pc.raysPerPixel, latest, "AoPass");
+    if (!r) {
+      s.core.end(s.ctx, cmd);  // the outputs stay in a known layout; nothing was traced
+      return r.error();
+    }
+    planned = r.value();
+  }
+  if (planned) {
+    w.sampledImage(RB_BINDING_RAY_PLAN, s.planner.planView(), s.core.sampler, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  }
+  s.core.traceAndEnd(s.ctx, cmd, w, pc, g, planned ? &s.adaptivePipeline : nullptr);
   s.outputs.ao = s.core.images[0].image;
   s.outputs.aoView = s.core.images[0].view;
   s.outputs.width = g.width;
   s.outputs.height = g.height;
+  s.outputs.rayPlan = planned ? s.planner.planImage() : VK_NULL_HANDLE;
+  s.outputs.rayPlanView = planned ? s.planner.planView() : VK_NULL_HANDLE;
   return {};
 }
 

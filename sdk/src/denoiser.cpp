@@ -6,6 +6,7 @@
 
 #include "compute_pipeline.h"
 #include "context_impl.h"
+#include "denoiser_history.h"
 #include "denoise_rgb_interface.glsl"
 #include "gbuffer_sampler.h"
 #include "image_barriers.h"
@@ -164,7 +165,7 @@ namespace {
 // a-trous weights need (with disableTemporal it ignores the history). The a-trous steps then ping-pong between
 // the two spatial images, the temporal result being the first of them; the last dispatch writes a = 1.
 Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
-                 const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags, const double camera[3]) {
+                 const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags) {
   Context& ctx = s.ctx;
   // 0,1: colour history ping-pong (rgb mean, a frames); 2,3: surface ping-pong (view distance, variance of one
   // frame's colour: RG32F, a variance of HDR values overflows half floats); 4,5: the temporal result and the
@@ -213,8 +214,6 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
                                   : (settings.spatialIterations ? settings.spatialIterations : kDefaultRgbIterations);
   pc.flags = flags | (historyUsable ? RB_DN_HISTORY : 0u) | (iterations == 0 ? RB_DN_RGB_FINAL : 0u);
   pc.maxHistoryFrames = settings.disableTemporal ? 1u : (settings.maxHistoryFrames ? settings.maxHistoryFrames : 32u);
-  for (int i = 0; i < 16; ++i) pc.previousViewProjection[i] = static_cast<float>(s.previousViewProjection[i]);
-  for (int i = 0; i < 3; ++i) pc.cameraDelta[i] = static_cast<float>(camera[i] - s.previousCamera[i]);
   {
     DescriptorWrites w;
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
@@ -279,7 +278,7 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
 // stays in image 4 for the final step; the steps before it ping-pong between images 5 and 7 (7 exists only for
 // three steps or more); the final step writes the R16 output, image 6.
 Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
-                    const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags, const double camera[3]) {
+                    const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags) {
   Context& ctx = s.ctx;
   const uint32_t iterations = settings.disableSpatial ? 0u
                                                       : (settings.spatialIterations ? settings.spatialIterations
@@ -322,8 +321,6 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
 
   pc.flags = flags | (historyUsable ? RB_DN_HISTORY : 0u) | (iterations == 0 ? RB_DN_TEMPORAL_FINAL : 0u);
   pc.maxHistoryFrames = settings.disableTemporal ? 1u : (settings.maxHistoryFrames ? settings.maxHistoryFrames : 32u);
-  for (int i = 0; i < 16; ++i) pc.previousViewProjection[i] = static_cast<float>(s.previousViewProjection[i]);
-  for (int i = 0; i < 3; ++i) pc.cameraDelta[i] = static_cast<float>(camera[i] - s.previousCamera[i]);
   {
     DescriptorWrites w;
     w.sampledImage(RB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
@@ -378,41 +375,25 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
   return {};
 }
 
-}  // namespace
-
-Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
-                        const DenoiseSettings& settings) {
-  Impl& s = *impl_;
-  Context& ctx = s.ctx;
-  auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "Denoiser: " + m}; };
-  if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
-  if (!signal) return invalid("signal is VK_NULL_HANDLE; pass the noisy image's view");
-  if (settings.spatialIterations > 6) return invalid("DenoiseSettings::spatialIterations exceeds 6");
-  if (settings.disableTemporal && settings.disableSpatial) {
-    return invalid("both temporal and spatial filtering are disabled; use the raw signal instead");
-  }
-  // The G-buffer checks and camera terms are those of the ray tracing passes (no TLAS involved here).
+// The constants every dispatch of a frame shares: the G-buffer's camera and layout (checked as the ray tracing
+// passes check them), and the reprojection from last frame's camera (previousViewProjection, cameraDelta). Also
+// returns this frame's camera position and rotation-only view-projection, which record() keeps for next frame.
+Status prepareConstants(const Denoiser::Impl& s, const GBufferDesc& g, const char* who, DenoiseConstants& pc,
+                        uint32_t& flags, double camera[3], double viewProjection[16]) {
   GBufferConstants pass{};
   TlasInfo noTlas;
   noTlas.tlas = reinterpret_cast<VkAccelerationStructureKHR>(uintptr_t(1));  // fillGBufferConstants wants one
-  if (Status st = fillGBufferConstants(g, noTlas, ctx.frameIndex(), "Denoiser", pass); !st) return st;
-  DenoiseConstants pc{};
+  if (Status st = fillGBufferConstants(g, noTlas, s.ctx.frameIndex(), who, pass); !st) return st;
   std::memcpy(pc.inverseProjection, pass.inverseProjection, sizeof pc.inverseProjection);
   std::memcpy(pc.viewToWorld, pass.viewToWorld, sizeof pc.viewToWorld);
   pc.wAtDepthOne = pass.wAtDepthOne;
-  uint32_t flags = 0;
+  flags = 0;
   if (g.depthConvention == DepthConvention::ReversedZ) flags |= RB_DN_REVERSED_Z;
   if (g.normalEncoding == NormalEncoding::Octahedral) flags |= RB_DN_OCTAHEDRAL;
   if (g.motionVectors.view) flags |= RB_DN_MOTION;
   pc.size[0] = g.width;
   pc.size[1] = g.height;
-  pc.depthSigma = settings.depthSigma > 0.0f ? settings.depthSigma : 0.005f;
-  pc.normalPower = settings.normalPower > 0.0f ? settings.normalPower : 32.0f;
-  pc.signalRaysPerPixel = float(settings.raysPerPixel);
-  pc.convergedNoise = settings.convergedNoise > 0.0f ? settings.convergedNoise : kDefaultDenoiseConvergedNoise;
-
   // This frame's camera: projection * rotation-only view, kept for next frame's reprojection.
-  double camera[3];
   cameraPosition(g, camera);
   double proj[16], viewRot[16] = {};
   for (int i = 0; i < 16; ++i) proj[i] = g.projection[i];
@@ -420,8 +401,32 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
     for (int r = 0; r < 3; ++r) viewRot[c * 4 + r] = g.view[c * 4 + r];
   }
   viewRot[15] = 1.0;
-  double viewProjection[16];
   multiply(proj, viewRot, viewProjection);
+  for (int i = 0; i < 16; ++i) pc.previousViewProjection[i] = static_cast<float>(s.previousViewProjection[i]);
+  for (int i = 0; i < 3; ++i) pc.cameraDelta[i] = static_cast<float>(camera[i] - s.previousCamera[i]);
+  return {};
+}
+
+}  // namespace
+
+Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
+                        const DenoiseSettings& settings) {
+  Impl& s = *impl_;
+  auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "Denoiser: " + m}; };
+  if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
+  if (!signal) return invalid("signal is VK_NULL_HANDLE; pass the noisy image's view");
+  if (settings.spatialIterations > 6) return invalid("DenoiseSettings::spatialIterations exceeds 6");
+  if (settings.disableTemporal && settings.disableSpatial) {
+    return invalid("both temporal and spatial filtering are disabled; use the raw signal instead");
+  }
+  DenoiseConstants pc{};
+  uint32_t flags = 0;
+  double camera[3], viewProjection[16];
+  if (Status st = prepareConstants(s, g, "Denoiser", pc, flags, camera, viewProjection); !st) return st;
+  pc.depthSigma = settings.depthSigma > 0.0f ? settings.depthSigma : 0.005f;
+  pc.normalPower = settings.normalPower > 0.0f ? settings.normalPower : 32.0f;
+  pc.signalRaysPerPixel = float(settings.raysPerPixel);
+  pc.convergedNoise = settings.convergedNoise > 0.0f ? settings.convergedNoise : kDefaultDenoiseConvergedNoise;
   if (s.signal == DenoiseSignal::Reflection) {
     if (!g.roughnessInNormalW && !g.roughnessMetalness.view) {
       return invalid("a Reflection signal needs the G-buffer's roughness: set GBufferDesc::roughnessInNormalW or "
@@ -430,7 +435,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
     flags |= RB_DN_RGB_REFLECTION | (g.roughnessMetalness.view ? RB_DN_RGB_ROUGHNESS_IMAGE : 0u);
   }
   if (s.signal != DenoiseSignal::Scalar) {
-    Status st = recordRgb(s, cmd, g, signal, settings, pc, flags, camera);
+    Status st = recordRgb(s, cmd, g, signal, settings, pc, flags);
     if (st) {
       std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
       std::memcpy(s.previousCamera, camera, sizeof camera);
@@ -438,12 +443,41 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
     return st;
   }
 
-  Status st = recordScalar(s, cmd, g, signal, settings, pc, flags, camera);
+  Status st = recordScalar(s, cmd, g, signal, settings, pc, flags);
   if (st) {
     std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
     std::memcpy(s.previousCamera, camera, sizeof camera);
   }
   return st;
 }
+
+namespace internal {
+
+DenoiserHistory latestHistory(const Denoiser& denoiser, const GBufferDesc& g) {
+  const Denoiser::Impl& s = DenoiserAccess::impl(denoiser);
+  DenoiserHistory h;
+  // Scalar images: 0,1 the history ping-pong, 2,3 the distances; the latest record() wrote 1 - parity.
+  if (s.signal != DenoiseSignal::Scalar || s.images.size() < 4 || s.images[0].width != g.width ||
+      s.images[0].height != g.height) {
+    return h;
+  }
+  const uint32_t last = 1 - s.parity;
+  h.mean = s.images[last].view;
+  h.distance = s.images[2 + last].view;
+  h.sampler = s.sampler;
+  h.valid = s.historyValid;
+  return h;
+}
+
+Status historyReprojection(const Denoiser& denoiser, const GBufferDesc& g, const char* who, DenoiseConstants& pc) {
+  const Denoiser::Impl& s = DenoiserAccess::impl(denoiser);
+  uint32_t flags = 0;
+  double camera[3], viewProjection[16];
+  if (Status st = prepareConstants(s, g, who, pc, flags, camera, viewProjection); !st) return st;
+  pc.flags = flags | (s.historyValid ? RB_DN_HISTORY : 0u);
+  return {};
+}
+
+}  // namespace internal
 
 }  // namespace rb

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "adaptive_rays.h"
+
 namespace rb {
 
 namespace {
@@ -40,6 +42,15 @@ Status validate(const HybridEffectsDesc& d) {
                    std::to_string(d.localLights.candidates) + " must be at most 64");
   if (d.reflections.raysPerPixel > 64)
     return invalid("reflections.raysPerPixel " + std::to_string(d.reflections.raysPerPixel) + " exceeds 64");
+  if (Status st = AdaptiveRayPlanner::validate(d.ao.adaptive, "HybridEffects: ao.adaptive", false); !st) return st;
+  if (Status st = AdaptiveRayPlanner::validate(d.shadows.adaptive, "HybridEffects: shadows.adaptive", false); !st)
+    return st;
+  if (d.ao.adaptive.enabled && d.ao.disableDenoiser)
+    return invalid("ao.adaptive plans from the AO denoiser's history: enable the denoiser (ao.disableDenoiser = "
+                   "false) or disable adaptive rays");
+  if (d.shadows.adaptive.enabled && d.shadows.disableDenoiser)
+    return invalid("shadows.adaptive plans from the shadow denoiser's history: enable the denoiser "
+                   "(shadows.disableDenoiser = false) or disable adaptive rays");
   return {};
 }
 
@@ -216,14 +227,19 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   s.raysPerPixel = plan.rays;
   s.materials = materials.get();  // alpha tests non-opaque geometry
   s.tileClassifier = desc.shadows.tileClassifier;
+  // Adaptive rays plan from the denoiser's history: none before its first frame (the pass then traces uniformly).
+  s.adaptive = desc.shadows.adaptive;
+  s.adaptive.history = shadowDenoiser.get();
+  s.adaptive.enabled = s.adaptive.enabled && s.adaptive.history && plan.soft;
   if (Status st = shadow->record(cmd, f.gbuffer, tlas, plan.light, s); !st)
     return wrap("ShadowPass::record", st.error());
   const ShadowOutputs& o = shadow->outputs();
   outputs.shadowRaw = outputs.shadow = image(o.visibility, o.visibilityView, VK_FORMAT_R16_SFLOAT, o.layout, o.width,
                                              o.height);
-  // The visibility is a fraction of plan.rays binary rays.
+  // The visibility is a fraction of plan.rays binary rays; with adaptive rays the count varies per pixel, so the
+  // denoiser measures the noise instead.
   return denoise(shadowDenoiser, plan.soft && !desc.shadows.disableDenoiser, "Denoiser (shadows)", cmd, f.gbuffer,
-                 o.visibilityView, plan.rays, outputs.shadow);
+                 o.visibilityView, desc.shadows.adaptive.enabled ? 0u : plan.rays, outputs.shadow);
 }
 
 Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -232,11 +248,17 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   s.raysPerPixel = desc.ao.raysPerPixel;
   s.range = desc.ao.range;
   s.estimator = desc.ao.estimator;
+  s.adaptive = desc.ao.adaptive;
+  s.adaptive.history = aoDenoiser.get();  // none before the denoiser's first frame: uniform rays then
+  s.adaptive.enabled = s.adaptive.enabled && s.adaptive.history;
   if (Status st = ao->record(cmd, f.gbuffer, tlas, s); !st) return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
   outputs.aoRaw = outputs.ao = image(o.ao, o.aoView, VK_FORMAT_R16_SFLOAT, o.layout, o.width, o.height);
-  // Binary AO is a fraction of binary rays; distance-weighted AO is not, so its noise is estimated.
-  const uint32_t rays = s.estimator == AoEstimator::Binary ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays) : 0u;
+  // Binary AO is a fraction of binary rays; distance-weighted AO is not, nor is adaptive AO (the count varies per
+  // pixel), so their noise is estimated.
+  const uint32_t rays = s.estimator == AoEstimator::Binary && !desc.ao.adaptive.enabled
+                            ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays)
+                            : 0u;
   return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, f.gbuffer, o.aoView, rays, outputs.ao);
 }
 

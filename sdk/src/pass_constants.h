@@ -164,6 +164,22 @@ RB_ASSERT_OFFSET(ManyLightConstants, raysPerPixel, 168);
 RB_ASSERT_OFFSET(ManyLightConstants, candidates, 172);
 RB_ASSERT_OFFSET(ManyLightConstants, tiles, 176);
 
+struct AdaptivePlanConstants {
+  uint32_t size[2];
+  uint32_t budget;    // most rays this frame (UINT32_MAX = no cap)
+  float uniformRays;  // > 0: the budget is this many rays per surface pixel (under the cap)
+  uint32_t minRays;
+  uint32_t maxRays;
+  uint32_t frameIndex;
+  uint32_t pad0;
+};
+static_assert(sizeof(AdaptivePlanConstants) == 32);
+RB_ASSERT_OFFSET(AdaptivePlanConstants, budget, 8);
+RB_ASSERT_OFFSET(AdaptivePlanConstants, uniformRays, 12);
+RB_ASSERT_OFFSET(AdaptivePlanConstants, minRays, 16);
+RB_ASSERT_OFFSET(AdaptivePlanConstants, maxRays, 20);
+RB_ASSERT_OFFSET(AdaptivePlanConstants, frameIndex, 24);
+
 struct DenoiseConstants {
   float inverseProjection[16];
   float viewToWorld[3][4];  // as GBufferConstants::viewToWorld

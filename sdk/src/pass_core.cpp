@@ -8,21 +8,27 @@
 
 namespace rb {
 
+// The material bindings and texture set of alpha testing, added to `desc` (the layout is created once, by init()).
+void PassCore::addAlphaTest(RayTracingPipelineDesc& desc, SpirvModule alphaAnyHit,
+                            VkShaderStageFlags recordStages) const {
+  for (HitGroupDesc& g : desc.hitGroups) g.anyHit = alphaAnyHit;
+  const VkShaderStageFlags stages = recordStages | VK_SHADER_STAGE_ANY_HIT_BIT_KHR;
+  for (VkDescriptorSetLayoutBinding& b : desc.bindings) {
+    if (b.binding == RB_BINDING_RAY_COUNTERS) b.stageFlags |= VK_SHADER_STAGE_ANY_HIT_BIT_KHR;
+  }
+  desc.bindings.push_back({RB_BINDING_SHADING_RECORDS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr});
+  desc.bindings.push_back({RB_BINDING_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr});
+  static_assert(RB_SET_TEXTURES == 1, "the texture set is the first extra set");
+  desc.extraSetLayouts = {textureLayout};
+}
+
 Status PassCore::init(Context& ctx, RayTracingPipelineDesc desc, SpirvModule alphaAnyHit,
                       VkShaderStageFlags recordStages) {
   if (alphaAnyHit.code) {
-    for (HitGroupDesc& g : desc.hitGroups) g.anyHit = alphaAnyHit;
-    const VkShaderStageFlags stages = recordStages | VK_SHADER_STAGE_ANY_HIT_BIT_KHR;
-    for (VkDescriptorSetLayoutBinding& b : desc.bindings) {
-      if (b.binding == RB_BINDING_RAY_COUNTERS) b.stageFlags |= VK_SHADER_STAGE_ANY_HIT_BIT_KHR;
-    }
-    desc.bindings.push_back({RB_BINDING_SHADING_RECORDS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr});
-    desc.bindings.push_back({RB_BINDING_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr});
     Result<VkDescriptorSetLayout> layout = createTextureSetLayout(ctx);
     if (!layout) return layout.error();
     textureLayout = layout.value();
-    static_assert(RB_SET_TEXTURES == 1, "the texture set is the first extra set");
-    desc.extraSetLayouts = {textureLayout};
+    addAlphaTest(desc, alphaAnyHit, recordStages);
     Result<std::unique_ptr<MaterialTable>> fallback = MaterialTable::create(ctx);
     if (!fallback) return fallback.error();
     fallbackMaterials = std::move(fallback.value());
@@ -34,6 +40,12 @@ Status PassCore::init(Context& ctx, RayTracingPipelineDesc desc, SpirvModule alp
   if (!s) return s.error();
   sampler = s.value();
   return metrics.init(ctx, desc.name);
+}
+
+Result<RayTracingPipeline> PassCore::createVariant(Context& ctx, RayTracingPipelineDesc desc, SpirvModule alphaAnyHit,
+                                                   VkShaderStageFlags recordStages) const {
+  if (alphaAnyHit.code) addAlphaTest(desc, alphaAnyHit, recordStages);
+  return RayTracingPipeline::create(ctx, desc);
 }
 
 void PassCore::retire(Context& ctx) {
@@ -92,10 +104,11 @@ Status PassCore::writeMaterials(DescriptorWrites& w, const TlasInfo& tlas, const
 }
 
 void PassCore::bind(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
-                    uint32_t constantBytes) const {
-  pipeline.bind(ctx, cmd, w.writes, constants, constantBytes);
+                    uint32_t constantBytes, const RayTracingPipeline* variant) const {
+  const RayTracingPipeline& p = variant ? *variant : pipeline;
+  p.bind(ctx, cmd, w.writes, constants, constantBytes);
   if (textureLayout) {
-    internal::deviceFunctions(ctx).vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipeline.layout,
+    internal::deviceFunctions(ctx).vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, p.layout,
                                                            RB_SET_TEXTURES, 1, &boundTextures, 0, nullptr);
   }
 }
@@ -110,9 +123,9 @@ Status PassCore::begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
 }
 
 void PassCore::traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
-                           uint32_t constantBytes, const GBufferDesc& g) {
-  bind(ctx, cmd, w, constants, constantBytes);
-  pipeline.trace(ctx, cmd, g.width, g.height);
+                           uint32_t constantBytes, const GBufferDesc& g, const RayTracingPipeline* variant) {
+  bind(ctx, cmd, w, constants, constantBytes, variant);
+  (variant ? *variant : pipeline).trace(ctx, cmd, g.width, g.height);
   end(ctx, cmd);
 }
 

@@ -16,6 +16,7 @@
 namespace rb {
 
 struct PassCore {
+
   RayTracingPipeline pipeline;
   VkSampler sampler = VK_NULL_HANDLE;
   PassImages images;
@@ -30,6 +31,13 @@ struct PassCore {
   // (shading records, materials, texture set); `recordStages` are the stages besides any-hit that read them.
   Status init(Context& ctx, RayTracingPipelineDesc desc, SpirvModule alphaAnyHit = {},
               VkShaderStageFlags recordStages = 0);
+  // Another pipeline of the pass with the same alpha testing (a variant of its ray generation module, e.g. with
+  // adaptive rays), sharing this core's texture set layout, images and measurements. The caller retires it.
+  Result<RayTracingPipeline> createVariant(Context& ctx, RayTracingPipelineDesc desc, SpirvModule alphaAnyHit = {},
+                                           VkShaderStageFlags recordStages = 0) const;
+  // What init() and createVariant() add to a pipeline for alpha testing: the any-hit shader, the material
+  // bindings and the texture set layout.
+  void addAlphaTest(RayTracingPipelineDesc& desc, SpirvModule alphaAnyHit, VkShaderStageFlags recordStages) const;
   // Hands the pipeline, sampler, images and measurement objects to the context's deferred release: the pass
   // may be destroyed while frames that recorded it are still in flight.
   void retire(Context& ctx);
@@ -48,24 +56,25 @@ struct PassCore {
 
   // Ensures the outputs, starts the measurements and makes the outputs writable.
   Status begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const std::vector<PassImages::Spec>& outputs);
-  // Binds the pipeline, set 0 (`w`), the texture set (when the pass has one) and the push constants.
-  void bind(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
-            uint32_t constantBytes) const;
+  // Binds the pipeline (or `variant`, from createVariant()), set 0 (`w`), the texture set (when the pass has one)
+  // and the push constants.
+  void bind(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants, uint32_t constantBytes,
+            const RayTracingPipeline* variant = nullptr) const;
   // Traces one ray generation invocation per G-buffer pixel with the pass's push constants (ShadowConstants,
   // AoConstants, ...), then makes the outputs readable.
   template <typename Constants>
   void traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const Constants& pc,
-                   const GBufferDesc& g) {
-    traceAndEnd(ctx, cmd, w, &pc, sizeof pc, g);
+                   const GBufferDesc& g, const RayTracingPipeline* variant = nullptr) {
+    traceAndEnd(ctx, cmd, w, &pc, sizeof pc, g, variant);
   }
   void traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
-                   uint32_t constantBytes, const GBufferDesc& g);
+                   uint32_t constantBytes, const GBufferDesc& g, const RayTracingPipeline* variant = nullptr);
   // The same with the launch size read from a VkTraceRaysIndirectCommandKHR on the GPU (a tile classifier's).
   template <typename Constants>
   void traceIndirectAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const Constants& pc,
-                           VkDeviceAddress arguments) {
-    bind(ctx, cmd, w, &pc, sizeof pc);
-    pipeline.traceIndirect(ctx, cmd, arguments);
+                           VkDeviceAddress arguments, const RayTracingPipeline* variant = nullptr) {
+    bind(ctx, cmd, w, &pc, sizeof pc, variant);
+    (variant ? *variant : pipeline).traceIndirect(ctx, cmd, arguments);
     end(ctx, cmd);
   }
   // Makes the outputs readable and ends the measurements.

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "adaptive_rays.h"
 #include "context_impl.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
@@ -19,11 +20,17 @@ struct ShadowPass::Impl {
   ShadowPassDesc desc;
   PassCore core;
   TileClassifier classifier;
+  // Adaptive rays (soft lights), created on first use: shadow_adaptive.rgen and its planner.
+  RayTracingPipelineDesc adaptiveDesc;
+  RayTracingPipeline adaptivePipeline;
+  AdaptiveRayPlanner planner;
   ShadowOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still trace with it
     core.retire(ctx);
     classifier.retire(ctx);
+    adaptivePipeline.retire(ctx);
+    planner.retire(ctx);
   }
 };
 
@@ -49,6 +56,12 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
   }
   p.bindings.push_back({RB_SHADOW_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr});
   p.pushConstantBytes = sizeof(ShadowConstants);
+  if (!desc.outputHitDistance) {
+    impl->adaptiveDesc = p;
+    impl->adaptiveDesc.name = "shadow pass (adaptive rays)";
+    impl->adaptiveDesc.raygen = SpirvModule::of(spirv::shadow_adaptive_rgen);
+    impl->adaptiveDesc.bindings.push_back({RB_BINDING_RAY_PLAN, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
+  }
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::shadow_rahit)); !s) return s.error();
 
   // The classifier: the ray generation shader's bindings but the TLAS and the material bindings, in a compute
@@ -117,6 +130,21 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
     return invalid("ShadowSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " exceeds 4096");
   }
   pc.raysPerPixel = soft ? (settings.raysPerPixel ? settings.raysPerPixel : kDefaultSoftShadowRays) : 1u;
+  if (Status st = AdaptiveRayPlanner::validate(settings.adaptive, "ShadowPass: ShadowSettings::adaptive"); !st) {
+    return st;
+  }
+  if (settings.adaptive.enabled && s.desc.outputHitDistance) {
+    return invalid("adaptive rays do not write the occluder distance: create the pass without "
+                   "ShadowPassDesc::outputHitDistance, or disable ShadowSettings::adaptive");
+  }
+  // A hard light's one ray per pixel is exact: nothing to adapt.
+  const bool adaptive = settings.adaptive.enabled && soft;
+  if (adaptive && !s.adaptivePipeline.pipeline) {
+    Result<RayTracingPipeline> p = s.core.createVariant(s.ctx, s.adaptiveDesc, SpirvModule::of(spirv::shadow_rahit));
+    if (!p) return p.error();
+    s.adaptivePipeline = p.value();
+  }
+  const PassStats latest = s.core.metrics.latest(s.ctx);
 
   std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16_SFLOAT, "shadow visibility"}};
   if (s.desc.outputHitDistance) specs.push_back({VK_FORMAT_R32_SFLOAT, "shadow hit distance"});
@@ -134,15 +162,28 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   };
   s.core.writeCommon(s.ctx, w, g, tlas);
   writeOutputs(w);
+  bool planned = false;
+  if (adaptive) {
+    Result<bool> r = s.planner.record(s.ctx, cmd, g, settings.adaptive, pc.raysPerPixel, latest, "ShadowPass");
+    if (!r) {
+      s.core.end(s.ctx, cmd);  // the outputs stay in a known layout; nothing was traced
+      return r.error();
+    }
+    planned = r.value();
+  }
+  if (planned) {
+    w.sampledImage(RB_BINDING_RAY_PLAN, s.planner.planView(), s.core.sampler, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  }
+  const RayTracingPipeline* variant = planned ? &s.adaptivePipeline : nullptr;
   if (!settings.tileClassifier) {
-    s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+    s.core.traceAndEnd(s.ctx, cmd, w, pc, g, variant);
   } else {
     DescriptorWrites cw;
     s.core.writeGBuffer(s.ctx, cw, g);
     writeOutputs(cw);
     s.classifier.classify(s.ctx, cmd, cw, &pc, sizeof pc);
     pc.launchOverTiles = 1;
-    s.core.traceIndirectAndEnd(s.ctx, cmd, w, pc, s.classifier.traceArguments());
+    s.core.traceIndirectAndEnd(s.ctx, cmd, w, pc, s.classifier.traceArguments(), variant);
   }
 
   ShadowOutputs& o = s.outputs;
@@ -152,6 +193,8 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   o.hitDistanceView = s.desc.outputHitDistance ? images[1].view : VK_NULL_HANDLE;
   o.width = g.width;
   o.height = g.height;
+  o.rayPlan = planned ? s.planner.planImage() : VK_NULL_HANDLE;
+  o.rayPlanView = planned ? s.planner.planView() : VK_NULL_HANDLE;
   return {};
 }
 

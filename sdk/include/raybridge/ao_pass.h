@@ -12,6 +12,7 @@
 #pragma once
 
 #include <raybridge/acceleration_structures.h>
+#include <raybridge/adaptive_rays.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/material_table.h>
@@ -35,6 +36,9 @@ struct AoSettings {
   // The materials that alpha-test non-opaque geometry (MaterialTable: Mask cut-outs, stochastic Blend), read
   // through the TLAS's shading records (needed then). nullptr = none: every surface occludes.
   const MaterialTable* materials = nullptr;
+  // Rays per pixel where the denoiser's history says the estimate is uncertain, within a budget
+  // (adaptive_rays.h): raysPerPixel is then the average the budget is made of. Disabled by default.
+  AdaptiveRaySettings adaptive;
 };
 
 // Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record().
@@ -43,6 +47,11 @@ struct AoOutputs {
   VkImageView aoView = VK_NULL_HANDLE;
   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   uint32_t width = 0, height = 0;
+  // Adaptive rays (AoSettings::adaptive): the latest record()'s plan, R16G16_SFLOAT, .x = the rays the pixel
+  // traced, .y = its reprojected history mean (a debug view of where rays went), in `layout`. VK_NULL_HANDLE when
+  // that record() did not plan (adaptive rays off, or no history yet).
+  VkImage rayPlan = VK_NULL_HANDLE;
+  VkImageView rayPlanView = VK_NULL_HANDLE;
 };
 
 class AoPass {

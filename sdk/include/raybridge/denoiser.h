@@ -39,6 +39,10 @@
 
 namespace rb {
 
+namespace internal {
+struct DenoiserAccess;
+}
+
 // What a Denoiser filters.
 enum class DenoiseSignal : uint32_t {
   Scalar = 0,  // default: R16/R32 .r (shadow visibility, AO); output R16_SFLOAT
@@ -117,6 +121,7 @@ class Denoiser {
   struct Impl;
 
  private:
+  friend struct internal::DenoiserAccess;  // adaptive rays read the history (sdk/src/denoiser_history.h)
   explicit Denoiser(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

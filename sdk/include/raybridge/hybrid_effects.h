@@ -59,6 +59,9 @@ struct ShadowEffectSettings {
   float softAngularRadiusDegrees = 0.0f;
   bool disableDenoiser = false;  // false = soft shadows are denoised (hard shadows never are)
   bool tileClassifier = false;   // ShadowSettings::tileClassifier (off by default: see shadow_pass.h)
+  // Soft shadows: rays per pixel planned from the shadow denoiser's history (adaptive_rays.h); raysPerPixel is the
+  // average the budget is made of. `history` is ignored (the effect's denoiser, which must be enabled).
+  AdaptiveRaySettings adaptive;
 };
 
 struct AoEffectSettings {
@@ -66,6 +69,9 @@ struct AoEffectSettings {
   float range = 0.0f;         // 0 = kDefaultAoRange
   AoEstimator estimator = AoEstimator::Binary;
   bool disableDenoiser = false;  // false = denoised
+  // Rays per pixel planned from the AO denoiser's history (adaptive_rays.h); raysPerPixel is the average the budget
+  // is made of. `history` is ignored (the effect's denoiser, which must be enabled).
+  AdaptiveRaySettings adaptive;
 };
 
 struct ReflectionEffectSettings {

@@ -22,6 +22,7 @@
 #pragma once
 
 #include <raybridge/acceleration_structures.h>
+#include <raybridge/adaptive_rays.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/material_table.h>
@@ -48,6 +49,10 @@ struct ShadowSettings {
   // true = classify 8x8 tiles first and trace only those with a pixel that needs a ray; false = trace every
   // pixel's launch (default: faster where skipped pixels are cheap, see the top of this file).
   bool tileClassifier = false;
+  // Soft lights: rays per pixel where the denoiser's history says the visibility is uncertain, within a budget
+  // (adaptive_rays.h); raysPerPixel is then the average the budget is made of. A hard light traces one ray per
+  // pixel regardless. Not with ShadowPassDesc::outputHitDistance. Disabled by default.
+  AdaptiveRaySettings adaptive;
 };
 
 // Images owned by the pass, sized to the G-buffer, left in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL after
@@ -59,6 +64,10 @@ struct ShadowOutputs {
   VkImageView hitDistanceView = VK_NULL_HANDLE;
   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   uint32_t width = 0, height = 0;
+  // Adaptive rays (ShadowSettings::adaptive): the latest record()'s plan, as AoOutputs::rayPlan (.x rays per pixel,
+  // .y reprojected history mean). VK_NULL_HANDLE when that record() did not plan.
+  VkImage rayPlan = VK_NULL_HANDLE;
+  VkImageView rayPlanView = VK_NULL_HANDLE;
 };
 
 class ShadowPass {

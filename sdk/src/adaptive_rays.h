@@ -1,0 +1,49 @@
+// The planning half of adaptive rays (raybridge/adaptive_rays.h): two compute dispatches that give every pixel its
+// rays for this frame from the history of the pass's denoiser, within a ray budget (adaptive_estimate.comp,
+// adaptive_allocate.comp), and the controller that moves the budget towards a GPU time target (adaptive_budget.h).
+// A pass that supports adaptive rays owns one, and traces with its adaptive ray generation module, which reads
+// the plan at RB_BINDING_RAY_PLAN. Owns two RG16F images at the G-buffer's size (MemoryCategory::PassImages) and a
+// 16-byte counter buffer (PassBuffers), created on first use.
+#pragma once
+
+#include <raybridge/adaptive_rays.h>
+#include <raybridge/gbuffer.h>
+
+#include "adaptive_budget.h"
+#include "compute_pipeline.h"
+#include "pass_images.h"
+
+namespace rb {
+
+class AdaptiveRayPlanner {
+ public:
+  // Checks the settings (`needHistory` = false: all but AdaptiveRaySettings::history, which the caller fills
+  // in); `who` names the pass and field in the error ("AoPass: AoSettings::adaptive").
+  static Status validate(const AdaptiveRaySettings& settings, const char* who, bool needHistory = true);
+  // Hands the pipelines, images and counters to the context's deferred release.
+  void retire(Context& ctx);
+
+  // Records the planning for `g` and returns true, or returns false and records nothing when there is no history
+  // to plan from yet (the denoiser has not recorded at this size): the pass then traces uniformly. `latest`: the
+  // pass's latest finished measurement (the time target's feedback). After it, plan() holds each pixel's rays and
+  // history mean in SHADER_READ_ONLY_OPTIMAL, visible to ray tracing, compute and fragment shaders.
+  Result<bool> record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const AdaptiveRaySettings& settings,
+                      uint32_t raysPerPixel, const PassStats& latest, const char* who);
+  VkImageView planView() const { return images_.size() ? images_[1].view : VK_NULL_HANDLE; }
+  VkImage planImage() const { return images_.size() ? images_[1].image : VK_NULL_HANDLE; }
+  // The ray budget of the latest record() (UINT32_MAX when it was the uniform rays, resolved on the GPU).
+  uint64_t budget() const { return budget_; }
+
+ private:
+  Status init(Context& ctx);
+  ComputePipeline estimate_, allocate_;
+  PassImages images_;  // 0: weights (mean, weight), 1: the plan (rays, mean)
+  GpuBuffer counters_;
+  RayBudgetController controller_;
+  uint64_t budget_ = 0;
+};
+
+// The rays per pixel an adaptive pass may give one pixel (AdaptiveRaySettings::maxRaysPerPixel resolved).
+uint32_t adaptiveMaxRays(const AdaptiveRaySettings& settings, uint32_t raysPerPixel);
+
+}  // namespace rb

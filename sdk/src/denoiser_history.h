@@ -1,0 +1,30 @@
+// What adaptive rays (adaptive_rays.h) read of a scalar Denoiser: the history its latest record() wrote, and the
+// reprojection from that frame's camera to the G-buffer about to be traced (the temporal pass's own).
+#pragma once
+
+#include <raybridge/denoiser.h>
+
+#include "pass_constants.h"
+
+namespace rb::internal {
+
+struct DenoiserAccess {
+  static const Denoiser::Impl& impl(const Denoiser& d) { return *d.impl_; }
+};
+
+struct DenoiserHistory {
+  // In SHADER_READ_ONLY_OPTIMAL: RG16F (mean, frames accumulated) and R32F (view distance of each pixel's surface).
+  // VK_NULL_HANDLE when the denoiser has no scalar images of the G-buffer's size (before its first record(), after
+  // a resize, or for an RGB signal).
+  VkImageView mean = VK_NULL_HANDLE;
+  VkImageView distance = VK_NULL_HANDLE;
+  VkSampler sampler = VK_NULL_HANDLE;  // nearest, clamped: the denoiser's own
+  bool valid = false;                  // false = the images hold no usable history (reset, temporal off)
+};
+
+DenoiserHistory latestHistory(const Denoiser& denoiser, const GBufferDesc& g);
+// The temporal pass's constants for `g` (camera, layout, reprojection; RB_DN_HISTORY when the history is valid);
+// the settings-dependent fields are left 0. `who` names the caller in G-buffer errors.
+Status historyReprojection(const Denoiser& denoiser, const GBufferDesc& g, const char* who, DenoiseConstants& pc);
+
+}  // namespace rb::internal

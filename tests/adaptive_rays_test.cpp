@@ -1,0 +1,271 @@
+// Adaptive rays per pixel (raybridge/adaptive_rays.h): the budget controller on a simulated cost, and on lavapipe
+// the ray budget as counted by the shaders, the plan's agreement with the counters, and where the rays go.
+#include <raybridge/raybridge.h>
+
+#include <catch2/catch_test_macros.hpp>
+#include <glm/gtc/packing.hpp>
+
+#include <cmath>
+#include <cstring>
+
+#include "adaptive_budget.h"
+#include "embree_reference.h"
+#include "synthetic_gbuffer.h"
+#include "test_scene.h"
+#include "test_support.h"
+
+using namespace rbtest;
+
+namespace {
+
+// The plan image (R16G16F) as (rays, mean) pairs.
+std::vector<float> readPlan(GpuFixture& fx, VkImage image, uint32_t w, uint32_t h) {
+  std::vector<uint8_t> raw = readPassImage(fx, image, w, h, 4);
+  std::vector<float> out(size_t(w) * h * 2);
+  for (size_t i = 0; i < out.size(); ++i) {
+    uint16_t half;
+    std::memcpy(&half, raw.data() + 2 * i, 2);
+    out[i] = glm::unpackHalf1x16(half);
+  }
+  return out;
+}
+
+struct AdaptiveScene {
+  GpuFixture& fx;
+  TestScene scene = makeConformanceScene();
+  EmbreeScene embree;
+  CpuGBuffer cpu;
+  std::unique_ptr<rb::AccelerationStructureService> service;
+  BuiltScene built;
+  std::unique_ptr<GpuGBuffer> gbuffer;
+  uint32_t surfacePixels = 0;
+  AdaptiveScene(GpuFixture& f, uint32_t w, uint32_t h) : fx(f) {
+    addToEmbree(embree, scene);
+    cpu = traceGBuffer(embree, conformanceView(w, h));
+    for (uint8_t hit : cpu.hit) surfacePixels += hit;
+    auto s = rb::AccelerationStructureService::create(fx.ctx());
+    RB_REQUIRE_OK(s);
+    service = std::move(s.value());
+    built = buildScene(fx, *service, scene);
+    gbuffer = std::make_unique<GpuGBuffer>(fx, cpu);
+  }
+  ~AdaptiveScene() {
+    gbuffer.reset();
+    destroyScene(fx, built);
+  }
+  rb::HybridFrame frame() const {
+    rb::HybridFrame f;
+    f.gbuffer = gbuffer->desc();
+    f.tlas = &built.tlas;
+    f.light.direction[0] = 0.4f;
+    f.light.direction[1] = 1.0f;
+    f.light.direction[2] = 0.3f;
+    f.light.angularRadiusDegrees = 4.0f;  // soft: the shadows are a mean of rays
+    return f;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("the ray budget controller settles on its time target despite a fixed cost and frames in flight",
+          "[adaptive]") {
+  // Simulated pass: 0.3 ms of fixed cost plus 2e-7 ms per ray; measurements come back two frames late.
+  auto cost = [](double rays) { return 0.3 + 2e-7 * rays; };
+  const double target = 1.5;  // ms: the fixed point is (1.5 - 0.3) / 2e-7 = 6e6 rays
+  rb::RayBudgetController c;
+  std::vector<uint64_t> planned;
+  rb::PassStats latest;
+  for (uint64_t frame = 1; frame <= 40; ++frame) {
+    if (frame > 2) {
+      latest.frame = frame - 2;
+      latest.rays = planned[frame - 3];
+      latest.gpuMs = cost(double(latest.rays));
+    }
+    planned.push_back(c.next(latest, target, 2e7, 1e3, 1e9));
+  }
+  INFO("final budget " << planned.back());
+  CHECK(std::abs(double(planned.back()) - 6e6) < 0.03 * 6e6);
+  CHECK(std::abs(cost(double(planned.back())) - target) < 0.03 * target);
+  // One measurement is taken in once: asking again without a new frame keeps the budget.
+  const uint64_t again = c.next(latest, target, 2e7, 1e3, 1e9);
+  CHECK(again == planned.back());
+  // The bounds hold whatever the measurement says.
+  rb::RayBudgetController fast;
+  rb::PassStats cheap;
+  cheap.frame = 1;
+  cheap.rays = 1000;
+  cheap.gpuMs = 1e-6;
+  CHECK(fast.next(cheap, target, 5e5, 1e3, 1e6) <= uint64_t(1e6));
+  rb::RayBudgetController slow;
+  rb::PassStats dear = cheap;
+  dear.gpuMs = 1e6;
+  uint64_t low = 0;
+  for (int i = 0; i < 40; ++i) {
+    dear.frame = uint64_t(i + 1);
+    low = slow.next(dear, target, 5e5, 1e3, 1e6);
+  }
+  CHECK(low == 1000);
+}
+
+TEST_CASE("adaptive AO traces no more rays than its budget, the plan matches the counters, and rays go where the "
+          "history is uncertain",
+          "[adaptive][ao]") {
+  GpuFixture fx;
+  const uint32_t w = 64, h = 48;
+  AdaptiveScene s(fx, w, h);
+  REQUIRE(s.surfacePixels > 1000);
+  rb::HybridEffectsDesc desc;
+  desc.effects = rb::kEffectAo;
+  desc.ao.raysPerPixel = 4;
+  desc.ao.range = 2.0f;
+  desc.ao.adaptive.enabled = true;
+  desc.ao.adaptive.maxRaysPerFrame = 3 * uint64_t(s.surfacePixels);  // under the uniform 4 per pixel
+  auto fxr = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
+  RB_REQUIRE_OK(fxr);
+  rb::HybridEffects& effects = *fxr.value();
+  const rb::HybridFrame frame = s.frame();
+
+  // Frame 1 has no history: uniform rays, no plan.
+  fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });
+  CHECK(effects.aoPass()->outputs().rayPlan == VK_NULL_HANDLE);
+  CHECK(effects.stats().ao.rays == 4ull * s.surfacePixels);
+
+  for (int i = 0; i < 6; ++i) {
+    fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });
+    const rb::AoOutputs& o = effects.aoPass()->outputs();
+    REQUIRE(o.rayPlan != VK_NULL_HANDLE);
+    const uint64_t rays = effects.stats().ao.rays;
+    const std::vector<float> plan = readPlan(fx, o.rayPlan, w, h);
+    uint64_t planned = 0;
+    uint32_t maxRays = 0;
+    for (size_t p = 0; p < size_t(w) * h; ++p) {
+      planned += uint64_t(plan[2 * p]);
+      maxRays = std::max(maxRays, uint32_t(plan[2 * p]));
+      if (!s.cpu.hit[p]) CHECK(plan[2 * p] == 0.0f);  // sky: no ray
+    }
+    INFO("frame " << i << ": " << rays << " rays counted, " << planned << " planned, budget "
+                  << desc.ao.adaptive.maxRaysPerFrame);
+    CHECK(rays == planned);  // the shader traced exactly what the plan says
+    CHECK(rays <= desc.ao.adaptive.maxRaysPerFrame);
+    CHECK(rays >= desc.ao.adaptive.maxRaysPerFrame * 9 / 10);  // and the budget is spent
+    CHECK(maxRays <= rb::kDefaultAdaptiveMaxRaysFactor * 4);
+    if (i == 5) {
+      // Where the history is settled at fully open (1) or closed (0) the estimate is certain; where it is in
+      // between (corners, contact) it is not: those pixels get more rays.
+      double certainRays = 0, uncertainRays = 0;
+      uint32_t certain = 0, uncertain = 0;
+      for (size_t p = 0; p < size_t(w) * h; ++p) {
+        if (!s.cpu.hit[p]) continue;
+        const float mean = plan[2 * p + 1];
+        if (mean > 0.99f || mean < 0.01f) {
+          certainRays += plan[2 * p];
+          ++certain;
+        } else if (mean > 0.25f && mean < 0.75f) {
+          uncertainRays += plan[2 * p];
+          ++uncertain;
+        }
+      }
+      REQUIRE(certain > 50);
+      REQUIRE(uncertain > 20);
+      INFO("mean rays: certain pixels " << certainRays / certain << ", uncertain " << uncertainRays / uncertain);
+      CHECK(uncertainRays / uncertain > 2.0 * (certainRays / certain));
+    }
+  }
+}
+
+TEST_CASE("adaptive soft shadows stay within the uniform rays by default and follow a time target down",
+          "[adaptive][shadows]") {
+  GpuFixture fx;
+  const uint32_t w = 48, h = 36;
+  AdaptiveScene s(fx, w, h);
+  rb::HybridEffectsDesc desc;
+  desc.effects = rb::kEffectShadows;
+  desc.shadows.raysPerPixel = 4;
+  desc.shadows.adaptive.enabled = true;  // no cap, no time target: the uniform rays, redistributed
+  auto fxr = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
+  RB_REQUIRE_OK(fxr);
+  rb::HybridEffects& effects = *fxr.value();
+  const rb::HybridFrame frame = s.frame();
+  for (int i = 0; i < 4; ++i) {
+    fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });
+    const rb::ShadowOutputs& o = effects.shadowPass()->outputs();
+    const uint64_t rays = effects.stats().shadow.rays;
+    INFO("frame " << i << ": " << rays << " rays, " << s.surfacePixels << " surface pixels");
+    CHECK(rays <= 4ull * s.surfacePixels);
+    if (i > 0) {
+      REQUIRE(o.rayPlan != VK_NULL_HANDLE);
+      const std::vector<float> plan = readPlan(fx, o.rayPlan, w, h);
+      uint64_t planned = 0;
+      for (size_t p = 0; p < size_t(w) * h; ++p) planned += uint64_t(plan[2 * p]);
+      // Pixels facing away from the light are planned rays but trace none.
+      CHECK(rays <= planned);
+    }
+  }
+  // A time target no pass can meet: the budget falls to its floor (one ray per 64 pixels) within a few frames.
+  desc.shadows.adaptive.timeBudgetMs = 1e-6f;
+  RB_REQUIRE_OK(effects.setDesc(desc));
+  uint64_t first = 0, last = 0;
+  for (int i = 0; i < 12; ++i) {
+    fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });
+    last = effects.stats().shadow.rays;
+    if (i == 0) first = last;
+  }
+  INFO("rays: first " << first << ", last " << last);
+  CHECK(last <= uint64_t(w) * h / 64 + 1);
+  CHECK(last < first);
+}
+
+TEST_CASE("bad adaptive ray settings are named", "[adaptive][bad_input]") {
+  GpuFixture fx;
+  AdaptiveScene s(fx, 16, 12);
+  auto ao = rb::AoPass::create(fx.ctx());
+  RB_REQUIRE_OK(ao);
+  auto expectError = [&](const rb::AoSettings& settings, const char* needle) {
+    fx.runFrame([&](VkCommandBuffer cmd) {
+      rb::Status st = ao.value()->record(cmd, s.gbuffer->desc(), s.built.tlas, settings);
+      REQUIRE_FALSE(st.ok());
+      INFO(st.error().message);
+      CHECK(st.error().code == rb::ErrorCode::InvalidArgument);
+      CHECK(st.error().message.find(needle) != std::string::npos);
+    });
+  };
+  rb::AoSettings a;
+  a.adaptive.enabled = true;
+  expectError(a, "history is nullptr");
+  auto rgb = rb::Denoiser::create(fx.ctx(), rb::DenoiserDesc{rb::DenoiseSignal::Rgb});
+  RB_REQUIRE_OK(rgb);
+  a.adaptive.history = rgb.value().get();
+  expectError(a, "DenoiseSignal::Scalar");
+  auto scalar = rb::Denoiser::create(fx.ctx());
+  RB_REQUIRE_OK(scalar);
+  a.adaptive.history = scalar.value().get();
+  a.adaptive.timeBudgetMs = std::nanf("");
+  expectError(a, "timeBudgetMs");
+  a.adaptive.timeBudgetMs = 0.0f;
+  a.adaptive.maxRaysPerPixel = 1000;
+  expectError(a, "maxRaysPerPixel 1000 exceeds 256");
+  a.adaptive.maxRaysPerPixel = 2;
+  a.adaptive.minRaysPerPixel = 3;
+  expectError(a, "minRaysPerPixel 3 exceeds maxRaysPerPixel 2");
+
+  rb::HybridEffectsDesc desc;
+  desc.effects = rb::kEffectAo;
+  desc.ao.adaptive.enabled = true;
+  desc.ao.disableDenoiser = true;
+  auto bad = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
+  REQUIRE_FALSE(bad.ok());
+  CHECK(bad.error().message.find("ao.adaptive") != std::string::npos);
+
+  auto shadow = rb::ShadowPass::create(fx.ctx(), rb::ShadowPassDesc{true});
+  RB_REQUIRE_OK(shadow);
+  fx.runFrame([&](VkCommandBuffer cmd) {
+    rb::ShadowSettings ss;
+    ss.adaptive.enabled = true;
+    ss.adaptive.history = scalar.value().get();
+    rb::Light soft;
+    soft.angularRadiusDegrees = 2.0f;
+    rb::Status st = shadow.value()->record(cmd, s.gbuffer->desc(), s.built.tlas, soft, ss);
+    REQUIRE_FALSE(st.ok());
+    CHECK(st.error().message.find("outputHitDistance") != std::string::npos);
+  });
+}
