@@ -16,5 +16,7 @@ namespace rbEffects {
 sample_engine::Result<EffectResult> runShadowSweep(FrameDriver& driver, const SweepPlan& plan);
 sample_engine::Result<EffectResult> runAoSweep(FrameDriver& driver, const SweepPlan& plan);
 sample_engine::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan& plan);
+// --scenario adaptive (adaptive_sweep.cpp): uniform against adaptive rays for `effect` (kEffectShadows or kEffectAo).
+sample_engine::Result<EffectResult> runAdaptiveSweep(FrameDriver& driver, const SweepPlan& plan, rb::EffectBits effect);
 
 }  // namespace rbEffects

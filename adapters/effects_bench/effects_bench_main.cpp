@@ -45,6 +45,7 @@ SweepPlan makePlan(const Options& o, bool cpu, uint32_t width, uint32_t height) 
     p.shadowRays = {1, 16};
     p.aoRays = {1, 16};
     p.reflectionRays = {1, 8};
+    p.adaptiveRays = {4};
     p.shadowMaps = {{1024, 1}, {2048, 5}};
     p.ssaoKernels = {8, 32};
     p.probeSizes = {0, 64};
@@ -52,6 +53,7 @@ SweepPlan makePlan(const Options& o, bool cpu, uint32_t width, uint32_t height) 
     p.shadowRays = {1, 2, 4, 8, 16, 32};
     p.aoRays = {1, 2, 4, 8, 16, 32};
     p.reflectionRays = {1, 2, 4, 8};
+    p.adaptiveRays = {2, 4, 8};
     for (uint32_t size : {1024u, 2048u, 4096u, 8192u})
       for (uint32_t pcf : {1u, 3u, 5u, 7u}) p.shadowMaps.push_back({size, pcf});
     p.ssaoKernels = {8, 16, 32, 64};
@@ -115,7 +117,8 @@ int main(int argc, char** argv) {
                                                      {rb::kEffectReflections, runReflectionSweep}};
   for (auto [flag, sweep] : sweeps) {
     if (!(o.effects & flag)) continue;
-    auto r = sweep(driver, plan);
+    if (o.scenario == "adaptive" && flag == rb::kEffectReflections) continue;  // adaptive rays: shadows and AO
+    auto r = o.scenario == "adaptive" ? runAdaptiveSweep(driver, plan, flag) : sweep(driver, plan);
     if (!r) return fail(r.error);
     results.push_back(std::move(r.value));
   }

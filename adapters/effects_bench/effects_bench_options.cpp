@@ -53,9 +53,11 @@ void addOptions(CLI::App& app, Options& o) {
       "resolution or kernel, times each setting with GPU timestamps (median of --frames frames) and measures\n"
       "its error (RMSE over surface pixels) against a converged reference traced by Raybridge.");
   app.footer("Defaults: 1920x1080 on a GPU, 320x180 on a CPU device; --quick: tiny size, few settings, and checks.");
-  app.add_option("--scenario", o.scenario, "what to measure (default and only: speed-vs-error)")
+  app.add_option("--scenario", o.scenario,
+                 "what to measure: speed-vs-error (default), or adaptive (uniform against adaptive rays per pixel for "
+                 "shadows and ao, accumulated over frames)")
       ->type_name("NAME")
-      ->check(rbCli::oneOf({"speed-vs-error"}));
+      ->check(rbCli::oneOf({"speed-vs-error", "adaptive"}));
   app.add_option_function<std::string>(
          "--effects",
          [&o](const std::string& value) { rbCli::parseNameSet(value, kEffectNames, "an effect", o.effects); },

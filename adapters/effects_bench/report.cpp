@@ -51,7 +51,7 @@ nlohmann::json toJson(const EffectResult& r, const std::optional<RawRate>& raw) 
                     {"image", row.image}});
   }
   const Reference& ref = r.reference;
-  return {{"compared", r.compared},
+  nlohmann::json out = {{"compared", r.compared},
           {"effect_ms_note", r.effectMsNote},
           {"surface_pixels", r.surfacePixels},
           {"reference",
@@ -66,6 +66,8 @@ nlohmann::json toJson(const EffectResult& r, const std::optional<RawRate>& raw) 
           {"rows", rows},
           {"checks", {{"passed", r.checkFailures.empty()}, {"failures", r.checkFailures}}},
           {"seconds", r.seconds}};
+  if (!r.summary.is_null()) out["summary"] = r.summary;
+  return out;
 }
 
 void printTables(const std::vector<EffectResult>& results, const std::optional<RawRate>& raw) {

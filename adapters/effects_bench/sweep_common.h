@@ -18,6 +18,7 @@ struct SweepPlan {
   uint32_t warmupFrames = 2, timedFrames = 3;
   // Traced: rays per pixel. Raster: shadow map size x PCF kernel, SSAO kernel, probe resolution (0 = sky).
   std::vector<uint32_t> shadowRays, aoRays, reflectionRays;
+  std::vector<uint32_t> adaptiveRays;  // --scenario adaptive: the uniform ray counts compared
   std::vector<std::pair<uint32_t, uint32_t>> shadowMaps;
   std::vector<uint32_t> ssaoKernels, probeSizes;
   // Reference: total rays per pixel; traced in frames of at most kReferenceRaysPerFrame rays.

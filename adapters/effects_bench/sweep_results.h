@@ -50,6 +50,7 @@ struct EffectResult {
   Reference reference;
   std::vector<Row> rows;
   std::vector<std::string> checkFailures;  // self-checks that failed (empty = all passed)
+  nlohmann::json summary;                  // scenario-specific conclusions (null = none)
   double seconds = 0.0;
 };
 

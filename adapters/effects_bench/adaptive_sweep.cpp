@@ -1,0 +1,234 @@
+// The adaptive-rays scenario (--scenario adaptive): soft shadows and AO accumulated over frames with the denoiser
+// on a still camera, uniform rays per pixel against adaptive rays (raybridge/adaptive_rays.h), each scored by the
+// RMSE of the denoised image after kAccumulatedFrames frames against the converged reference. Per uniform ray
+// count n it reports:
+//   uniform            n rays in every pixel;
+//   adaptive_equal_rays the same rays, spent where the denoiser's history is uncertain;
+//   adaptive_equal_time a GPU time target equal to the uniform row's pass time (planning included);
+//   adaptive_budget    fractions of the uniform rays (AdaptiveRaySettings::maxRaysPerFrame), from which the
+//                      summary interpolates the rays saved at the uniform row's error.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "effect_sweeps.h"
+#include "image_error.h"
+
+namespace rbEffects {
+
+namespace se = sample_engine;
+using Stats = rb::HybridStats;
+
+namespace {
+
+// Frames accumulated before the error is measured: the denoiser's history then holds that many frames, which the
+// adaptive plan had to work with (the first frame of every run is uniform: no history yet).
+constexpr uint32_t kAccumulatedFrames = 8;
+const double kBudgetFractions[] = {0.25, 0.375, 0.5, 0.625, 0.75, 1.0};
+
+struct Effect {
+  std::string name;
+  rb::EffectBits flag{};
+  const char* passName = "";
+  const char* denoiseName = "";
+  rb::PassStats Stats::*pass = nullptr;
+  rb::PassStats Stats::*denoise = nullptr;
+  const char* rawImage = "";
+  const char* denoisedImage = "";
+  rb::AdaptiveRaySettings rb::HybridEffectsDesc::*adaptive = nullptr;
+  std::function<void(rb::HybridEffectsDesc&, uint32_t)> setRays;
+  std::vector<uint32_t> rays;
+  uint32_t referenceRays = 0;
+  se::FrameParams params;
+};
+
+rb::AdaptiveRaySettings& adaptiveOf(rb::HybridEffectsDesc& d, const Effect& fx) {
+  return fx.flag == rb::kEffectAo ? d.ao.adaptive : d.shadows.adaptive;
+}
+
+}  // namespace
+
+se::Result<EffectResult> runAdaptiveSweep(FrameDriver& driver, const SweepPlan& plan, rb::EffectBits which) {
+  using R = se::Result<EffectResult>;
+  const auto start = std::chrono::steady_clock::now();
+  Effect fx;
+  fx.flag = which;
+  fx.params = driver.baseParams();
+  if (which == rb::kEffectAo) {
+    fx.name = "ao_adaptive";
+    fx.passName = "ao";
+    fx.denoiseName = "ao_denoise";
+    fx.pass = &Stats::ao;
+    fx.denoise = &Stats::aoDenoise;
+    fx.rawImage = "ao_raw";
+    fx.denoisedImage = "ao";
+    const float range = plan.aoRange;
+    fx.setRays = [range](rb::HybridEffectsDesc& d, uint32_t n) {
+      d.ao.raysPerPixel = n;
+      d.ao.range = range;
+      d.ao.estimator = rb::AoEstimator::Binary;
+    };
+    fx.rays = plan.adaptiveRays;
+    fx.referenceRays = plan.referenceAo;
+  } else {
+    fx.name = "shadows_adaptive";
+    fx.passName = "shadow";
+    fx.denoiseName = "shadow_denoise";
+    fx.pass = &Stats::shadow;
+    fx.denoise = &Stats::shadowDenoise;
+    fx.rawImage = "shadow_raw";
+    fx.denoisedImage = "shadow";
+    const float radius = plan.sunRadiusDegrees;
+    fx.setRays = [radius](rb::HybridEffectsDesc& d, uint32_t n) {
+      d.shadows.softAngularRadiusDegrees = radius;
+      d.shadows.raysPerPixel = n;
+    };
+    fx.rays = plan.adaptiveRays;
+    fx.referenceRays = plan.referenceShadows;
+    fx.params.shadow.enabled = false;  // the traced rows read no shadow map
+  }
+  EffectResult result;
+  result.effect = fx.name;
+  result.compared = std::string(fx.flag == rb::kEffectAo ? "ambient-occlusion open fraction" : "sun visibility") +
+                    " after " + std::to_string(kAccumulatedFrames) +
+                    " frames of temporal accumulation (denoised, still camera), surface pixels";
+  result.effectMsNote = std::string(fx.passName) + " + " + fx.denoiseName +
+                        " GPU ms, median over the accumulated frames (adaptive: planning included)";
+  rbAdapter::Adapter& adapter = driver.adapter();
+  adapter.settings().enabled = true;
+
+  auto apply = [&](const rb::HybridEffectsDesc& d) {
+    rb::Status st = adapter.effects().setDesc(d);
+    return st ? se::Status::success() : se::Status::failure("HybridEffects::setDesc: " + st.error().message);
+  };
+  rb::HybridEffectsDesc desc;
+  desc.effects = fx.flag;
+  desc.shadows.disableDenoiser = desc.ao.disableDenoiser = true;
+  fx.setRays(desc, std::min(fx.referenceRays, kReferenceRaysPerFrame));
+  if (se::Status st = apply(desc); !st) return R::failure(st.error);
+  const uint32_t perFrame = std::min(fx.referenceRays, kReferenceRaysPerFrame);
+  result.reference.raysPerFrame = perFrame;
+  progress("%s: reference, %u rays per pixel", fx.name.c_str(), fx.referenceRays);
+  auto ref = traceReference(
+      driver, fx.params, (fx.referenceRays + perFrame - 1) / perFrame, 1,
+      [&](const rbRender::CapturedFrame& f) -> se::Result<std::vector<float>> {
+        auto it = f.images.find(fx.rawImage);
+        if (it == f.images.end()) return se::Result<std::vector<float>>::failure("no raw image captured");
+        return se::Result<std::vector<float>>::success(it->second);
+      },
+      fx.pass, result.reference);
+  if (!ref) return R::failure(fx.name + " reference: " + ref.error);
+  result.surfacePixels = countSet(ref.value.mask);
+
+  // One run: history reset, kAccumulatedFrames timed frames, then the capture frame's denoised image.
+  auto runOnce = [&](const rb::HybridEffectsDesc& d, Row& row) -> std::string {
+    if (se::Status st = apply(d); !st) return st.error;
+    adapter.effects().resetHistory();
+    auto samples = driver.run(fx.params, 0, kAccumulatedFrames);
+    if (!samples) return samples.error;
+    auto cap = driver.capture(fx.params);
+    if (!cap) return cap.error;
+    auto it = cap.value.images.find(fx.denoisedImage);
+    if (it == cap.value.images.end()) return std::string("no denoised image captured");
+    // Skip the first frames, where the budget controller (with a time target) has not settled yet.
+    std::vector<FrameSample> settled(samples.value.begin() + kAccumulatedFrames / 2, samples.value.end());
+    const PassResult pass = passMedian(settled, fx.passName, fx.pass);
+    const PassResult denoise = passMedian(settled, fx.denoiseName, fx.denoise);
+    row.passes = {pass, denoise};
+    row.effectMs = pass.gpuMs + denoise.gpuMs;
+    row.effectMsOf = std::string(fx.passName) + " + " + fx.denoiseName;
+    row.engineMs = engineMedians(settled);
+    row.frameMs = row.engineMs["frame"];
+    const ErrorStats e = compare(it->second, ref.value.values, ref.value.mask, 1);
+    row.rmse = e.rmse;
+    row.bias = e.bias;
+    row.params["rays_per_frame"] = pass.rays;
+    row.params["rays_per_surface_pixel"] = result.surfacePixels ? double(pass.rays) / double(result.surfacePixels) : 0.0;
+    row.params["frames"] = kAccumulatedFrames;
+    progress("%s: %-20s %-28s effect %7.3f ms  rays/frame %10llu  RMSE %.5f", fx.name.c_str(), row.method.c_str(),
+             row.setting.c_str(), row.effectMs, static_cast<unsigned long long>(pass.rays), row.rmse);
+    result.rows.push_back(row);
+    return {};
+  };
+
+  nlohmann::json summary = nlohmann::json::array();
+  for (uint32_t n : fx.rays) {
+    rb::HybridEffectsDesc d;
+    d.effects = fx.flag;
+    fx.setRays(d, n);
+    Row uniform;
+    uniform.method = "uniform";
+    uniform.setting = std::to_string(n) + " rays";
+    uniform.id = "uniform_r" + std::to_string(n);
+    uniform.params = {{"rays_per_pixel", n}, {"adaptive", false}};
+    if (std::string err = runOnce(d, uniform); !err.empty()) return R::failure(err);
+    const Row u = result.rows.back();
+
+    rb::AdaptiveRaySettings& a = adaptiveOf(d, fx);
+    a.enabled = true;
+    Row equalRays;
+    equalRays.method = "adaptive_equal_rays";
+    equalRays.setting = std::to_string(n) + " rays on average";
+    equalRays.id = "adaptive_rays_r" + std::to_string(n);
+    equalRays.params = {{"rays_per_pixel", n}, {"adaptive", true}};
+    if (std::string err = runOnce(d, equalRays); !err.empty()) return R::failure(err);
+    const double rmseEqualRays = result.rows.back().rmse;
+
+    a.timeBudgetMs = float(u.passes[0].gpuMs);
+    Row equalTime;
+    equalTime.method = "adaptive_equal_time";
+    equalTime.setting = "target " + std::to_string(a.timeBudgetMs).substr(0, 6) + " ms";
+    equalTime.id = "adaptive_time_r" + std::to_string(n);
+    equalTime.params = {{"rays_per_pixel", n}, {"adaptive", true}, {"time_budget_ms", a.timeBudgetMs}};
+    if (std::string err = runOnce(d, equalTime); !err.empty()) return R::failure(err);
+    const Row t = result.rows.back();
+    a.timeBudgetMs = 0.0f;
+
+    // Rays saved at equal error: the least budget whose error is no worse than uniform's, interpolated.
+    std::vector<std::pair<double, double>> curve;  // (fraction of the uniform rays, RMSE)
+    for (double f : kBudgetFractions) {
+      a.maxRaysPerFrame = uint64_t(std::llround(f * n * double(result.surfacePixels)));
+      Row b;
+      b.method = "adaptive_budget";
+      b.setting = std::to_string(int(std::lround(f * 100))) + "% of " + std::to_string(n) + " rays";
+      b.id = "adaptive_budget_r" + std::to_string(n) + "_" + std::to_string(int(std::lround(f * 1000)));
+      b.params = {{"rays_per_pixel", n}, {"adaptive", true}, {"budget_fraction", f}};
+      if (std::string err = runOnce(d, b); !err.empty()) return R::failure(err);
+      curve.push_back({f, result.rows.back().rmse});
+    }
+    a.maxRaysPerFrame = 0;
+    double fractionAtEqualError = -1.0;  // < 0: even the full budget's error is above uniform's
+    for (size_t i = 0; i < curve.size(); ++i) {
+      if (curve[i].second <= u.rmse) {
+        if (i == 0) {
+          fractionAtEqualError = curve[0].first;
+        } else {
+          const auto [f0, e0] = curve[i - 1];
+          const auto [f1, e1] = curve[i];
+          fractionAtEqualError = e0 == e1 ? f1 : f0 + (f1 - f0) * (e0 - u.rmse) / (e0 - e1);
+        }
+        break;
+      }
+    }
+    nlohmann::json s = {{"rays_per_pixel", n},
+                        {"uniform_rmse", u.rmse},
+                        {"uniform_effect_ms", u.effectMs},
+                        {"adaptive_equal_rays_rmse", rmseEqualRays},
+                        {"adaptive_equal_time_rmse", t.rmse},
+                        {"adaptive_equal_time_effect_ms", t.effectMs},
+                        {"budget_fraction_at_equal_error", fractionAtEqualError}};
+    s["rays_saved_at_equal_error"] = fractionAtEqualError >= 0.0 ? nlohmann::json(1.0 - fractionAtEqualError)
+                                                                 : nlohmann::json(nullptr);
+    summary.push_back(s);
+    progress("%s: %u rays: uniform RMSE %.5f; adaptive %.5f at equal rays, %.5f at equal time; rays saved at equal "
+             "error %s",
+             fx.name.c_str(), n, u.rmse, rmseEqualRays, t.rmse,
+             fractionAtEqualError >= 0.0 ? (std::to_string(int(std::lround((1.0 - fractionAtEqualError) * 100))) + "%").c_str()
+                                         : "none (adaptive never reaches uniform's error)");
+  }
+  result.summary = summary;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return R::success(std::move(result));
+}
+
+}  // namespace rbEffects
