@@ -143,7 +143,8 @@ se::Result<EffectResult> runAdaptiveSweep(FrameDriver& driver, const SweepPlan& 
     row.rmse = e.rmse;
     row.bias = e.bias;
     row.params["rays_per_frame"] = pass.rays;
-    row.params["rays_per_surface_pixel"] = result.surfacePixels ? double(pass.rays) / double(result.surfacePixels) : 0.0;
+    row.params["rays_per_surface_pixel"] = result.surfacePixels ? double(pass.rays) / double(result.surfacePixels)
+                                                                : 0.0;
     row.params["frames"] = kAccumulatedFrames;
     progress("%s: %-20s %-28s effect %7.3f ms  rays/frame %10llu  RMSE %.5f", fx.name.c_str(), row.method.c_str(),
              row.setting.c_str(), row.effectMs, static_cast<unsigned long long>(pass.rays), row.rmse);
@@ -223,8 +224,9 @@ se::Result<EffectResult> runAdaptiveSweep(FrameDriver& driver, const SweepPlan& 
     progress("%s: %u rays: uniform RMSE %.5f; adaptive %.5f at equal rays, %.5f at equal time; rays saved at equal "
              "error %s",
              fx.name.c_str(), n, u.rmse, rmseEqualRays, t.rmse,
-             fractionAtEqualError >= 0.0 ? (std::to_string(int(std::lround((1.0 - fractionAtEqualError) * 100))) + "%").c_str()
-                                         : "none (adaptive never reaches uniform's error)");
+             fractionAtEqualError >= 0.0
+                 ? (std::to_string(int(std::lround((1.0 - fractionAtEqualError) * 100))) + "%").c_str()
+                 : "none (adaptive never reaches uniform's error)");
   }
   result.summary = summary;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

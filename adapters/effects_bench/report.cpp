@@ -52,20 +52,20 @@ nlohmann::json toJson(const EffectResult& r, const std::optional<RawRate>& raw) 
   }
   const Reference& ref = r.reference;
   nlohmann::json out = {{"compared", r.compared},
-          {"effect_ms_note", r.effectMsNote},
-          {"surface_pixels", r.surfacePixels},
-          {"reference",
-           {{"rays_per_pixel", ref.raysPerFrame * ref.frames},
-            {"rays_per_frame", ref.raysPerFrame},
-            {"frames", ref.frames},
-            {"rays_counted", ref.raysCounted},
-            {"halves_rmse", ref.halvesRmse},
-            {"noise_rmse_estimate", ref.noiseRmse()},
-            {"seconds", ref.seconds},
-            {"image", ref.image}}},
-          {"rows", rows},
-          {"checks", {{"passed", r.checkFailures.empty()}, {"failures", r.checkFailures}}},
-          {"seconds", r.seconds}};
+                        {"effect_ms_note", r.effectMsNote},
+                        {"surface_pixels", r.surfacePixels},
+                        {"reference",
+                         {{"rays_per_pixel", ref.raysPerFrame * ref.frames},
+                          {"rays_per_frame", ref.raysPerFrame},
+                          {"frames", ref.frames},
+                          {"rays_counted", ref.raysCounted},
+                          {"halves_rmse", ref.halvesRmse},
+                          {"noise_rmse_estimate", ref.noiseRmse()},
+                          {"seconds", ref.seconds},
+                          {"image", ref.image}}},
+                        {"rows", rows},
+                        {"checks", {{"passed", r.checkFailures.empty()}, {"failures", r.checkFailures}}},
+                        {"seconds", r.seconds}};
   if (!r.summary.is_null()) out["summary"] = r.summary;
   return out;
 }

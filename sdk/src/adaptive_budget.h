@@ -15,8 +15,8 @@
 namespace rb {
 
 struct RayBudgetController {
-  double budget = 0.0;      // rays of the frame being planned; 0 = not started
-  uint64_t lastFrame = 0;   // PassStats::frame of the last measurement taken in
+  double budget = 0.0;     // rays of the frame being planned; 0 = not started
+  uint64_t lastFrame = 0;  // PassStats::frame of the last measurement taken in
   // The rays to plan this frame. `latest`: the pass's latest finished measurement (taken in once per frame it
   // names); `initial`: where to start; the result stays within [minRays, maxRays].
   uint64_t next(const PassStats& latest, double targetMs, double initial, double minRays, double maxRays);

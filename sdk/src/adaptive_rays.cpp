@@ -19,7 +19,8 @@ constexpr VkDeviceSize kCounterBytes = 4 * sizeof(uint32_t);
 }  // namespace
 
 uint32_t adaptiveMaxRays(const AdaptiveRaySettings& s, uint32_t raysPerPixel) {
-  const uint32_t rays = s.maxRaysPerPixel ? s.maxRaysPerPixel : kDefaultAdaptiveMaxRaysFactor * std::max(raysPerPixel, 1u);
+  const uint32_t rays = s.maxRaysPerPixel ? s.maxRaysPerPixel
+                                          : kDefaultAdaptiveMaxRaysFactor * std::max(raysPerPixel, 1u);
   return std::min(rays, kMaxAdaptiveRays);
 }
 
@@ -152,8 +153,8 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
   reuse.srcQueueFamilyIndex = reuse.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   reuse.buffer = counters_.buffer;
   reuse.size = VK_WHOLE_SIZE;
-  vk.vkCmdPipelineBarrier(cmd, cs | rt | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, cs | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
-                          nullptr, 1, &reuse, 2, discard);
+  vk.vkCmdPipelineBarrier(cmd, cs | rt | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, cs | VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                          0, nullptr, 1, &reuse, 2, discard);
   vk.vkCmdFillBuffer(cmd, counters_.buffer, 0, kCounterBytes, 0);
   recordMemoryBarrier(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, cs, rw);
 

@@ -6,8 +6,8 @@
 
 #include "compute_pipeline.h"
 #include "context_impl.h"
-#include "denoiser_history.h"
 #include "denoise_rgb_interface.glsl"
+#include "denoiser_history.h"
 #include "gbuffer_sampler.h"
 #include "image_barriers.h"
 #include "pass_constants.h"

@@ -16,7 +16,6 @@
 namespace rb {
 
 struct PassCore {
-
   RayTracingPipeline pipeline;
   VkSampler sampler = VK_NULL_HANDLE;
   PassImages images;

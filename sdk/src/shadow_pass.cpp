@@ -60,7 +60,8 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
     impl->adaptiveDesc = p;
     impl->adaptiveDesc.name = "shadow pass (adaptive rays)";
     impl->adaptiveDesc.raygen = SpirvModule::of(spirv::shadow_adaptive_rgen);
-    impl->adaptiveDesc.bindings.push_back({RB_BINDING_RAY_PLAN, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
+    impl->adaptiveDesc.bindings.push_back(
+        {RB_BINDING_RAY_PLAN, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
   }
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::shadow_rahit)); !s) return s.error();
 
