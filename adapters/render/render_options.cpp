@@ -1,6 +1,10 @@
 // Command-line parsing of raybridge-render, through CLI11 (samples/common/cli_support.h).
 #include "render_options.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <optional>
 #include <vector>
 
 #include "cli_support.h"
@@ -57,6 +61,40 @@ CLI::Validator presetValidator() {
 }
 
 // Every option of the command, stored into `o` when the parse runs its callbacks.
+// --adaptive: "ao", "shadows=0.8", "ao=1.0,shadows". Fills `o` when given; returns an error message or "".
+std::string parseAdaptive(const std::string& value, RenderOptions* o) {
+  std::optional<float> shadows, ao;
+  size_t start = 0;
+  while (start <= value.size()) {
+    const size_t end = std::min(value.find(',', start), value.size());
+    const std::string item = value.substr(start, end - start);
+    const size_t eq = item.find('=');
+    const std::string name = item.substr(0, eq);
+    float ms = 0.0f;
+    if (eq != std::string::npos) {
+      const std::string number = item.substr(eq + 1);
+      char* stop = nullptr;
+      ms = std::strtof(number.c_str(), &stop);
+      if (number.empty() || *stop != '\0' || !std::isfinite(ms) || ms <= 0.0f) {
+        return "'" + number + "' in '" + item + "' is not a time in ms greater than 0";
+      }
+    }
+    if (name == "shadows") {
+      shadows = ms;
+    } else if (name == "ao") {
+      ao = ms;
+    } else {
+      return "'" + name + "' in '" + value + "' is not an effect with adaptive rays (shadows, ao)";
+    }
+    start = end + 1;
+  }
+  if (o) {
+    o->adaptiveShadowsMs = shadows;
+    o->adaptiveAoMs = ao;
+  }
+  return {};
+}
+
 void addOptions(CLI::App& app, RenderOptions& o) {
   rbCli::prepare(app);
   app.description(
@@ -224,6 +262,13 @@ void addOptions(CLI::App& app, RenderOptions& o) {
   app.add_flag("--tile-classifier", o.tileClassifier,
                "hybrid shadows: classify 8x8 tiles and trace only those with a pixel that needs\n"
                "a ray (same image; off by default, see docs/performance.md)");
+  app.add_option_function<std::string>(
+         "--adaptive", [&o](const std::string& v) { parseAdaptive(v, &o); },
+         "adaptive rays per pixel for soft shadows and AO, planned from the denoiser's history:\n"
+         "EFFECT[=MS],... with EFFECT shadows or ao and MS a GPU time target for its pass\n"
+         "(default: the preset's rays, redistributed); e.g. ao=1.0,shadows")
+      ->type_name("LIST")
+      ->check(CLI::Validator([](std::string& v) { return parseAdaptive(v, nullptr); }, ""));
   app.add_flag("--perf-scene", o.perfScene,
                "the performance scene instead of the demo: the shared static glTF models, each\n"
                "instanced on a ring around the centre, on a finely tessellated ground (about\n"
@@ -306,6 +351,8 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.shadows.raysPerPixel = shadowRays;
   h.shadows.disableDenoiser = !o.denoise;
   h.shadows.tileClassifier = o.tileClassifier;
+  h.shadows.adaptive.enabled = o.adaptiveShadowsMs.has_value();
+  h.shadows.adaptive.timeBudgetMs = o.adaptiveShadowsMs.value_or(0.0f);
   if ((h.effects & rb::kEffectShadows) && shadowRays > 1)
     r.sunRadiusDegrees = h.shadows.softAngularRadiusDegrees > 0.0f ? h.shadows.softAngularRadiusDegrees
                                                                    : rb::kDefaultSoftLightAngularRadiusDegrees;
@@ -314,6 +361,8 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.range = o.aoRange ? *o.aoRange : rb::kDefaultAoRange;
   h.ao.estimator = o.aoEstimator;
   h.ao.disableDenoiser = !o.denoise;
+  h.ao.adaptive.enabled = o.adaptiveAoMs.has_value();
+  h.ao.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
 
   const uint32_t lightRays = o.lightRays ? *o.lightRays : kDefaultLightRays;
   h.localLights.mode = lightRays ? rb::ManyLightMode::Stochastic : rb::ManyLightMode::Exact;
@@ -348,6 +397,10 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
            "punctual lights; AO and reflections need the G-buffer it does not draw, so it takes no effect list";
   if (o.mode == Mode::RayTraced && o.geometricNormals)
     return "--gbuffer-normals: --mode raytraced draws no G-buffer; its hits shade with the mesh normals";
+  if ((o.adaptiveShadowsMs || o.adaptiveAoMs) && !o.denoise)
+    return "--adaptive: adaptive rays plan from the denoiser's history; drop --no-denoise";
+  if ((o.adaptiveShadowsMs || o.adaptiveAoMs) && o.mode != Mode::Hybrid)
+    return "--adaptive: only --mode hybrid traces the shadow and AO passes it adapts";
   if (uint64_t(o.width) * o.height > uint64_t(8192) * 8192)
     return "--width/--height: " + std::to_string(o.width) + "x" + std::to_string(o.height) + " exceeds 67 megapixels";
   return {};

@@ -45,6 +45,9 @@ struct RenderOptions {
   std::optional<uint32_t> lightRays;
   bool denoise = true;          // --no-denoise
   bool tileClassifier = false;  // --tile-classifier: HybridEffectsDesc::shadows.tileClassifier
+  // --adaptive EFFECT[=MS],...: adaptive rays per pixel for shadows and ao (AdaptiveRaySettings), with a GPU time
+  // target in ms (0 = the uniform rays, redistributed). Unset = uniform rays.
+  std::optional<float> adaptiveShadowsMs, adaptiveAoMs;
   // Raster mode's shadow map: --shadow-map-size (0 = none, else 1024..8192) and --pcf (taps per axis, 1..9);
   // else the preset's raster counterpart.
   std::optional<uint32_t> shadowMapSize;

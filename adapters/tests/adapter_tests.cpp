@@ -108,6 +108,10 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--mode fast", "--mode: 'fast' is not raster, hybrid or raytraced"},
       {"--mode raytraced --effects ao", "--effects: --mode raytraced shades every primary ray"},
       {"--mode raytraced --gbuffer-normals geometric", "--gbuffer-normals: --mode raytraced draws no G-buffer"},
+      {"--adaptive reflections", "--adaptive: 'reflections' in 'reflections' is not an effect with adaptive rays"},
+      {"--adaptive ao=-1", "--adaptive: '-1' in 'ao=-1' is not a time in ms greater than 0"},
+      {"--adaptive ao=fast", "--adaptive: 'fast' in 'ao=fast' is not a time in ms"},
+      {"--adaptive ao --no-denoise", "--adaptive: adaptive rays plan from the denoiser's history"},
   };
   for (const Case& c : cases) {
     const RunResult r = runRender(c.args + " --out " + (dir / "out").string());
