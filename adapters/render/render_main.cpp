@@ -440,6 +440,10 @@ int main(int argc, char** argv) {
       {"reflection_rays_per_pixel",
        wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays)
                        : 0u}};
+  // Adaptive rays (--adaptive): per effect, the time target (0 = the uniform rays, redistributed).
+  for (auto [name, a] : {std::pair{"shadows", &hd.shadows.adaptive}, std::pair{"ao", &hd.ao.adaptive}}) {
+    if (a->enabled) stats["effects"]["adaptive"][name] = {{"time_budget_ms", a->timeBudgetMs}};
+  }
   {
     const se::LocalShadowStats ls = engine.lastLocalShadowStats();
     uint32_t byType[3] = {0, 0, 0};

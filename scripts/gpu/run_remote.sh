@@ -3,7 +3,7 @@
 # .devcarry/ that scripts/gpu/prepare.sh assembled and the device tool carried. Run from the repository root:
 #
 #   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, render, effects, animated, lights,
-#                                                          perf (default all)
+#                                                          perf, adaptive, soak (default all)
 #
 # Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
 # tests_gpu.log, effects_gpu.json, effects_gpu.log, render_gpu.tar.gz (render logs, stats.json and final.png
@@ -26,7 +26,7 @@ set -u
 
 MODE="${1:-all}"
 for m in ${MODE//,/ }; do
-  case "$m" in all|bench|tests|render|effects|animated|lights|perf) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, render, effects, animated, lights or perf" >&2; exit 2 ;; esac
+  case "$m" in all|bench|tests|render|effects|animated|lights|perf|adaptive|soak) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, render, effects, animated, lights, perf, adaptive or soak" >&2; exit 2 ;; esac
 done
 want() { [ "$MODE" = all ] || [[ ",$MODE," == *",$1,"* ]]; }
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -332,6 +332,52 @@ if want perf; then
     --renders "$PDIR" --command "bash scripts/gpu/run_remote.sh perf" --out "$OUT/perf_gpu.json"
   grep -E '^(perf|demo)|trace (primary|stress)|GPU ms|^in place|^device copy|^copy' "$OUT/perf_gpu.log" | head -n 80
   tar -C "$PDIR" -czf "$OUT/perf_render_gpu.tar.gz" --exclude='*.exr' --exclude='*.png' . 2>/dev/null
+fi
+# ---- adaptive: docs/performance.md's "trace only where needed" and half resolution. The probe, then
+# raybridge-effects-bench --scenario adaptive (uniform against adaptive rays after 8 accumulated frames) and the
+# speed-vs-error sweep of AO and reflections (full and half resolution rows) at RB_ADAPTIVE_SIZE, then the Ultra
+# preset on the performance and demo scenes with per-effect time targets and half resolution (RB_ADAPTIVE_ULTRA).
+# perf_report.py writes adaptive_perf_gpu.json from the renders. Validation off.
+if want adaptive; then
+  : >"$OUT/adaptive_gpu.log"
+  ADIR="$(mktemp -d)"
+  read -r AW AH <<<"${RB_ADAPTIVE_SIZE:-2560 1440}"
+  if [ -x "$RT/probe/probe" ]; then
+    RAYBRIDGE_VALIDATION=0 step "probe k10" 60 "$OUT/probe_gpu.log" "$RT/probe/probe" --width 2560 --height 1440 \
+      --rays 64 --k 10 --ground-tiles 64 --reps 7
+  fi
+  RAYBRIDGE_VALIDATION=0 step "effects adaptive" 200 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-effects-bench" \
+    --scenario adaptive --effects shadows,ao --width "$AW" --height "$AH" --out "$OUT/effects_adaptive_gpu.json"
+  RAYBRIDGE_VALIDATION=0 step "effects half" 200 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-effects-bench" \
+    --effects ao,reflections --width "$AW" --height "$AH" --out "$OUT/effects_half_gpu.json"
+  AFRAMES="${RB_PERF_FRAMES:-40}"
+  for scene in perf demo; do
+    sargs=()
+    [ "$scene" = perf ] && sargs=(--perf-scene --models-from "$SCENES")
+    while IFS='|' read -r tag vargs; do
+      [ -n "$tag" ] || continue
+      read -r -a va <<<"$vargs"
+      RAYBRIDGE_VALIDATION=0 step "adaptive ${scene} ${tag}" 90 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-render" \
+        --width "$AW" --height "$AH" --dump "${sargs[@]}" --preset ultra --frames "$AFRAMES" "${va[@]}" \
+        --out "$ADIR/${scene}__hybrid__ultra__${tag}"
+    done <<<"${RB_ADAPTIVE_ULTRA:-uniform|
+adaptive|--adaptive ao,shadows
+half|--half-res ao,reflections
+budget|--adaptive ao=0.6,shadows=0.5 --half-res ao,reflections}"
+  done
+  step "adaptive report" 30 "$OUT/adaptive_gpu.log" python3 "$ROOT/scripts/perf_report.py" \
+    --probe-log "$OUT/probe_gpu.log" --renders "$ADIR" --command "bash scripts/gpu/run_remote.sh adaptive" \
+    --out "$OUT/adaptive_perf_gpu.json"
+  grep -E '^(shadows|ao)_adaptive:|^(ao|reflections):|GPU ms|Raybridge' "$OUT/adaptive_gpu.log" | head -n 80
+fi
+# ---- soak: raybridge-bench --scenario soak, 10,000 frames with validation off, then 2,000 with validation on.
+if want soak; then
+  : >"$OUT/soak_gpu.log"
+  RAYBRIDGE_VALIDATION=0 step "soak" 300 "$OUT/soak_gpu.log" "$RT/bin/raybridge-bench" --scenario soak \
+    --frames "${RB_SOAK_FRAMES:-10000}" --out "$OUT/soak_gpu.json"
+  RAYBRIDGE_VALIDATION=1 step "soak validation" 200 "$OUT/soak_gpu.log" "$RT/bin/raybridge-bench" --scenario soak \
+    --frames 2000 --out "$OUT/soak_validation_gpu.json"
+  grep -E 'soak|growth|handles|validation' "$OUT/soak_gpu.log" | tail -n 30
 fi
 # ---- tests (validation on) ---------------------------------------------------------------------------------
 if want tests; then
