@@ -12,9 +12,14 @@ namespace rb {
 struct AoPass::Impl {
   Context& ctx;
   PassCore core;
+  // AoSettings::halfResolution: the sample image and the upsample, made on first use.
+  HalfResolution half{HalfResolution::Signal::Ao};
   AoOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() { core.retire(ctx); }  // frames in flight may still trace with it
+  ~Impl() {  // frames in flight may still trace with it
+    core.retire(ctx);
+    half.retire(ctx);
+  }
 };
 
 AoPass::AoPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -54,13 +59,24 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   pc.range = range;
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultAoRays;
   pc.estimator = static_cast<uint32_t>(settings.estimator);  // RB_AO_*
+  pc.halfResolution = settings.halfResolution ? 1u : 0u;
 
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "AoPass", pc.gbuffer.flags); !st) return st;
+  if (settings.halfResolution) {
+    if (Status st = s.half.ensure(s.ctx, g.width, g.height); !st) return st;
+  } else {
+    s.half.releaseImage(s.ctx);  // full resolution holds no sample image
+  }
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}}); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
-  w.storageImage(RB_AO_BINDING_OUTPUT, s.core.images[0].view);
-  s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  if (settings.halfResolution) {
+    w.storageImage(RB_AO_BINDING_OUTPUT, s.half.samplesView());
+    s.core.traceHalfAndEnd(s.ctx, cmd, w, pc, g, s.half);
+  } else {
+    w.storageImage(RB_AO_BINDING_OUTPUT, s.core.images[0].view);
+    s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  }
   s.outputs.ao = s.core.images[0].image;
   s.outputs.aoView = s.core.images[0].view;
   s.outputs.width = g.width;

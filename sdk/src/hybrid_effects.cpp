@@ -232,6 +232,7 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   s.raysPerPixel = desc.ao.raysPerPixel;
   s.range = desc.ao.range;
   s.estimator = desc.ao.estimator;
+  s.halfResolution = desc.ao.halfResolution;
   if (Status st = ao->record(cmd, f.gbuffer, tlas, s); !st) return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
   outputs.aoRaw = outputs.ao = image(o.ao, o.aoView, VK_FORMAT_R16_SFLOAT, o.layout, o.width, o.height);
@@ -245,6 +246,7 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.materials = materials.get();
   s.roughnessThreshold = desc.reflections.roughnessThreshold;
   s.raysPerPixel = desc.reflections.raysPerPixel;
+  s.halfResolution = desc.reflections.halfResolution;
   s.flags = (f.flags & kFrameExplicitLighting) ? kReflectionExplicitLighting : 0u;
   for (int i = 0; i < 3; ++i) {
     s.sunRadiance[i] = f.lightRadiance[i];

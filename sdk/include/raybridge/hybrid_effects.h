@@ -66,6 +66,8 @@ struct AoEffectSettings {
   float range = 0.0f;         // 0 = kDefaultAoRange
   AoEstimator estimator = AoEstimator::Binary;
   bool disableDenoiser = false;  // false = denoised
+  // false = every pixel traces; true = AoSettings::halfResolution (a quarter of the rays, depth-aware upsample).
+  bool halfResolution = false;
 };
 
 struct ReflectionEffectSettings {
@@ -74,6 +76,9 @@ struct ReflectionEffectSettings {
   // false = denoised (a DenoiseSignal::Reflection Denoiser, HybridEffectsDesc::denoiser's settings): glossy
   // pixels are filtered as far as their noise asks, mirrors (roughness 0) are not blurred.
   bool disableDenoiser = false;
+  // false = every pixel traces; true = ReflectionSettings::halfResolution (a quarter of the rays, depth-aware
+  // upsample).
+  bool halfResolution = false;
 };
 
 struct LocalLightEffectSettings {
