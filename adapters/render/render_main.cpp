@@ -438,8 +438,9 @@ int main(int argc, char** argv) {
       {"reflection_roughness_threshold", hd.reflections.roughnessThreshold ? hd.reflections.roughnessThreshold
                                                                            : rb::kDefaultReflectionRoughnessThreshold},
       {"reflection_rays_per_pixel",
-       wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays)
-                       : 0u}};
+       wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays) : 0u},
+      {"ao_half_resolution", hybrid && wantAo && hd.ao.halfResolution},
+      {"reflection_half_resolution", hybrid && wantReflections && hd.reflections.halfResolution}};
   {
     const se::LocalShadowStats ls = engine.lastLocalShadowStats();
     uint32_t byType[3] = {0, 0, 0};
