@@ -5,8 +5,9 @@
 
 Each figure has two rows (x = GPU ms of the effect's own passes, then of the whole frame) and one or two
 columns (y = RMSE against the converged reference; y = mean FLIP over the surface pixels when --images is given
-and the flip-evaluator package is installed). One curve per method: traced raw, traced denoised, raster (raster
-points that no other raster setting beats in both time and error are joined, the rest are plain markers).
+and the flip-evaluator package is installed). One curve per method: traced raw, traced denoised (and both at half
+resolution, AO and reflections), raster (raster points that no other raster setting beats in both time and error
+are joined, the rest are plain markers).
 Writes <out-dir>/<tag>_<effect>.png and prints a markdown table (with FLIP and the rays/s of traced passes).
 
 Needs matplotlib and numpy; FLIP needs `pip install flip-evaluator` (skipped with a message otherwise).
@@ -22,6 +23,8 @@ import sys
 METHODS = [  # key, legend, colour, marker
     ("traced_raw", "traced, raw", "tab:blue", "o"),
     ("traced_denoised", "traced, denoised (1 frame)", "tab:green", "s"),
+    ("traced_half_raw", "traced half res, raw", "tab:cyan", "o"),
+    ("traced_half_denoised", "traced half res, denoised (1 frame)", "tab:olive", "s"),
     ("raster", "raster", "tab:red", "^"),
 ]
 

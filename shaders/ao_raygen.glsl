@@ -3,10 +3,13 @@
 // as the mean over cosine-weighted directions (1 = fully open).
 //   binary:            a ray that hits within R contributes 0, else 1
 //   distance-weighted: a hit at distance t contributes t / R (occluders fade out towards the range)
+// At half resolution (pc.halfResolution) the launch is one invocation per 2x2 block, each tracing for the pixel of
+// its block that half_resolution.glsl picks this frame and writing the half-resolution image at its own index.
 // Included by ao.rgen (pc.raysPerPixel rays everywhere) and ao_adaptive.rgen (RB_ADAPTIVE_RAYS: each pixel's rays
 // come from the plan of adaptive_rays.glsl; a pixel given none keeps its reprojected history mean).
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform AoPushConstants { AoConstants pc; };
+#include "half_resolution.glsl"
 #include "pass_inputs.glsl"
 #include "adaptive_rays.glsl"
 #include "ray_counters.glsl"
@@ -21,12 +24,15 @@ layout(set = 0, binding = RB_AO_BINDING_OUTPUT, r16f) uniform writeonly image2D 
 layout(location = 0) rayPayloadEXT float hitT;
 
 void main() {
-  uvec2 pixel = gl_LaunchIDEXT.xy;
-  if (any(greaterThanEqual(pixel, pc.gbuffer.size))) return;
+  const bool halfRes = pc.halfResolution != 0u;
+  uvec2 launch = gl_LaunchIDEXT.xy;
+  if (any(greaterThanEqual(launch, halfRes ? rbHalfResSize(pc.gbuffer.size) : pc.gbuffer.size))) return;
+  uvec2 pixel = halfRes ? rbHalfResTracedPixel(launch, pc.gbuffer.frameIndex, pc.gbuffer.size) : launch;
   ivec2 ip = ivec2(pixel);
+  ivec2 target = ivec2(launch);  // the output texel: the pixel, or at half resolution its sample
   float depth = texelFetch(gDepth, ip, 0).r;
   if (rbIsSky(depth)) {
-    imageStore(outAo, ip, vec4(1.0));
+    imageStore(outAo, target, vec4(1.0));
     return;
   }
   vec3 n = rbDecodeNormal(texelFetch(gNormal, ip, 0), rbNormalEncoding());
@@ -40,7 +46,7 @@ void main() {
   const vec2 plan = texelFetch(rayPlan, ip, 0).xy;
   const uint count = uint(plan.x);
   if (count == 0u) {
-    imageStore(outAo, ip, vec4(plan.y));
+    imageStore(outAo, target, vec4(plan.y));
     return;
   }
 #else
@@ -67,6 +73,6 @@ void main() {
       open += clamp(hitT / range, 0.0, 1.0);
     }
   }
-  imageStore(outAo, ip, vec4(open / float(count)));
+  imageStore(outAo, target, vec4(open / float(count)));
   rbCountRays(pixel, count);
 }

@@ -14,6 +14,14 @@ bool rbIsSky(float depth) {
 
 uint rbNormalEncoding() { return (pc.gbuffer.flags & RB_GB_OCTAHEDRAL) != 0u ? 1u : 0u; }
 
+// The roughness the G-buffer holds for `pixel`: normal.w (RB_GB_ROUGHNESS_IN_NORMAL_W) or the r of the roughness
+// image (RB_GB_ROUGHNESS_IMAGE); 1 without either. `normalTexel`: the pixel's normal texel.
+float rbRoughness(vec4 normalTexel, sampler2D roughnessMetalness, ivec2 pixel) {
+  return (pc.gbuffer.flags & RB_GB_ROUGHNESS_IN_NORMAL_W) != 0u ? normalTexel.w
+         : (pc.gbuffer.flags & RB_GB_ROUGHNESS_IMAGE) != 0u    ? texelFetch(roughnessMetalness, pixel, 0).x
+                                                                 : 1.0;
+}
+
 vec3 rbCameraRelative(uvec2 pixel, float depth) {
   return rbReconstructCameraRelative(pixel, vec2(pc.gbuffer.size), depth, pc.gbuffer.inverseProjection,
                                      pc.gbuffer.viewToWorld, pc.gbuffer.wAtDepthOne,

@@ -44,7 +44,7 @@ struct AoConstants {
   float range;               // 160: occluders further than this do not count
   uint raysPerPixel;         // 164
   uint estimator;            // 168: RB_AO_*
-  uint pad0;                 // 172
+  uint halfResolution;       // 172: 1 = one sample per 2x2 block into the half-resolution image (half_resolution.glsl)
 };
 
 // ReflectionPass. 224 bytes.
@@ -58,8 +58,17 @@ struct ReflectionConstants {
   uint raysPerPixel;         // 204
   uint lightCount;           // 208: local lights lighting hits (RB_REFLECTION_BINDING_LIGHTS); 0 = none
   uint lightCandidates;      // 212: lights weighed per hit to pick the one it traces a shadow ray to
-  uint pad0;                 // 216
-  uint pad1;                 // 220
+  uint halfResolution;       // 216: 1 = one sample per 2x2 block into the half-resolution image (half_resolution.glsl)
+  uint pad0;                 // 220
+};
+
+// The depth-aware upsample of half-resolution AO and reflections (upsample_depth_aware.glsl). 176 bytes.
+struct UpsampleConstants {
+  GBufferConstants gbuffer;  //   0: the traced pass's: full-resolution size, and the frame that chose the samples
+  float roughnessThreshold;  // 160: reflections: rougher pixels have no reflection (a = 0), as in reflect.rgen
+  uint pad0;                 // 164
+  uint pad1;                 // 168
+  uint pad2;                 // 172
 };
 
 // ManyLightPass (its tile culling and its rays). 192 bytes.

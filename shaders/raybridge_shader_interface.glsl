@@ -63,6 +63,12 @@
 #define RB_ATROUS_BINDING_SIGNAL_IN 2
 #define RB_ATROUS_BINDING_SIGNAL_OUT 3  // rg: value, variance (denoise_atrous.comp); r: the output (_final.comp)
 #define RB_ATROUS_BINDING_TEMPORAL 4    // denoise_atrous_final.comp: the temporal result the shift starts from
+// The depth-aware upsample of half-resolution AO and reflections (upsample_depth_aware.glsl).
+#define RB_UPSAMPLE_BINDING_DEPTH 0
+#define RB_UPSAMPLE_BINDING_NORMAL 1
+#define RB_UPSAMPLE_BINDING_ROUGHNESS_METALNESS 2  // reflections; the normal image again when roughness is in normal.w
+#define RB_UPSAMPLE_BINDING_SAMPLES 3              // the half-resolution image the pass traced into
+#define RB_UPSAMPLE_BINDING_OUTPUT 4               // the pass's full-resolution output
 
 // The adaptive ray planning dispatches (adaptive_estimate.comp, adaptive_allocate.comp).
 #define RB_ADAPTIVE_BINDING_DEPTH 0
@@ -113,6 +119,12 @@
 #define RB_DN_HISTORY 4u  // last frame's history is valid (temporal pass)
 #define RB_DN_MOTION 8u   // the G-buffer has motion vectors (temporal pass)
 #define RB_DN_TEMPORAL_FINAL 16u  // scalar temporal pass: no a-trous step follows, write the output too
+
+// Half-resolution tracing (AoConstants/ReflectionConstants::halfResolution): sample (i, j) of frame f traces for
+// G-buffer pixel (2i + x, 2j + y), clamped to the image, with (x, y) = (0,0), (1,1), (1,0), (0,1) for f mod 4 = 0..3:
+// every pixel of a 2x2 block once in 4 frames, diagonal neighbours first (shaders/half_resolution.glsl).
+#define RB_HALF_RES_OFFSET_X(frame) ((6u >> ((frame)&3u)) & 1u)
+#define RB_HALF_RES_OFFSET_Y(frame) ((10u >> ((frame)&3u)) & 1u)
 
 // ClusterBoundsConstants::positionFormat.
 #define RB_POSITION_RGB32F 0u

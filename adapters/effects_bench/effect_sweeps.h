@@ -7,6 +7,8 @@
 //                (radius = plan.aoRange, readbackSsao).
 //   reflections  error on the final HDR image: ReflectionPass (glossy rays) vs the constant sky or the
 //                reflection probe (their only output is the lit image).
+// AO and reflections also run their traced settings at half resolution (AoEffectSettings / ReflectionEffectSettings
+// ::halfResolution): rows "traced_half_raw" and "traced_half_denoised", against the same full-resolution reference.
 #pragma once
 
 #include "sweep_common.h"

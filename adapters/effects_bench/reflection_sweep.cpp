@@ -45,9 +45,10 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
   // Every surface traces (threshold 1 by default): the engine treats untraced pixels as reflecting nothing, so a
   // lower threshold would make the reference itself wrong on rough surfaces.
   desc.reflections.roughnessThreshold = plan.reflectionRoughness;
-  auto apply = [&](uint32_t rays, bool denoise = false) {
+  auto apply = [&](uint32_t rays, bool denoise = false, bool halfResolution = false) {
     desc.reflections.raysPerPixel = rays;
     desc.reflections.disableDenoiser = !denoise;
+    desc.reflections.halfResolution = halfResolution;
     rb::Status st = adapter.effects().setDesc(desc);
     return st ? se::Status::success() : se::Status::failure("HybridEffects::setDesc: " + st.error().message);
   };
@@ -88,33 +89,38 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
     return se::Status::success();
   };
 
-  // Traced rows: raw and denoised, each its own run (the engine composites whichever image the adapter hands it).
-  for (uint32_t n : plan.reflectionRays) {
-    for (bool denoised : {false, true}) {
-      if (se::Status st = apply(n, denoised); !st) return R::failure(st.error);
-      auto samples = driver.run(base, plan.warmupFrames, plan.timedFrames);
-      if (!samples) return R::failure(samples.error);
-      // Single-frame denoising, as the shadow and AO rows: the captured frame uses its own rays only.
-      adapter.effects().resetHistory();
-      if (auto cap = driver.capture(base); !cap) return R::failure(cap.error);
-      auto rgb = hdrRgb(driver.engine());
-      if (!rgb) return R::failure(rgb.error);
-      Row row;
-      row.method = denoised ? "traced_denoised" : "traced_raw";
-      row.setting = std::to_string(n) + (n == 1 ? " ray" : " rays");
-      row.id = row.method + "_r" + std::to_string(n);
-      row.params = {{"rays_per_pixel", n}, {"roughness_threshold", plan.reflectionRoughness}, {"denoised", denoised}};
-      const PassResult pass = passMedian(samples.value, "reflection", &rb::HybridStats::reflection);
-      row.passes = {pass};
-      row.effectMs = pass.gpuMs;
-      row.effectMsOf = "reflection";
-      if (denoised) {
-        const PassResult dn = passMedian(samples.value, "reflection_denoise", &rb::HybridStats::reflectionDenoise);
-        row.passes.push_back(dn);
-        row.effectMs += dn.gpuMs;
-        row.effectMsOf = "reflection + reflection_denoise";
+  // Traced rows: raw and denoised, each its own run (the engine composites whichever image the adapter hands it),
+  // at full then at half resolution.
+  for (bool half : {false, true}) {
+    for (uint32_t n : plan.reflectionRays) {
+      for (bool denoised : {false, true}) {
+        if (se::Status st = apply(n, denoised, half); !st) return R::failure(st.error);
+        auto samples = driver.run(base, plan.warmupFrames, plan.timedFrames);
+        if (!samples) return R::failure(samples.error);
+        // Single-frame denoising, as the shadow and AO rows: the captured frame uses its own rays only.
+        adapter.effects().resetHistory();
+        if (auto cap = driver.capture(base); !cap) return R::failure(cap.error);
+        auto rgb = hdrRgb(driver.engine());
+        if (!rgb) return R::failure(rgb.error);
+        Row row;
+        row.method = half ? (denoised ? "traced_half_denoised" : "traced_half_raw")
+                          : (denoised ? "traced_denoised" : "traced_raw");
+        row.setting = std::to_string(n) + (n == 1 ? " ray" : " rays") + (half ? ", half res" : "");
+        row.id = row.method + "_r" + std::to_string(n);
+        row.params = {{"rays_per_pixel", n}, {"roughness_threshold", plan.reflectionRoughness}, {"denoised", denoised}};
+        if (half) row.params["half_resolution"] = true;
+        const PassResult pass = passMedian(samples.value, "reflection", &rb::HybridStats::reflection);
+        row.passes = {pass};
+        row.effectMs = pass.gpuMs;
+        row.effectMsOf = "reflection";
+        if (denoised) {
+          const PassResult dn = passMedian(samples.value, "reflection_denoise", &rb::HybridStats::reflectionDenoise);
+          row.passes.push_back(dn);
+          row.effectMs += dn.gpuMs;
+          row.effectMsOf = "reflection + reflection_denoise";
+        }
+        if (se::Status st = finish(std::move(row), samples.value, rgb.value); !st) return R::failure(st.error);
       }
-      if (se::Status st = finish(std::move(row), samples.value, rgb.value); !st) return R::failure(st.error);
     }
   }
 

@@ -87,7 +87,8 @@ void printTables(const std::vector<EffectResult>& results, const std::optional<R
               raw ? "of raw" : "");
   for (const EffectResult& r : results) {
     for (const Row& row : r.rows) {
-      if (row.method != "traced_raw") continue;  // the denoised row repeats the same trace pass
+      // The denoised rows repeat the same trace pass.
+      if (row.method != "traced_raw" && row.method != "traced_half_raw") continue;
       for (const PassResult& p : row.passes) {
         std::printf("%-12s %-14s %-10s %12llu %10.3f %12.2f", r.effect.c_str(), p.name.c_str(), row.setting.c_str(),
                     static_cast<unsigned long long>(p.rays), p.gpuMs, p.raysPerSecond() * 1e-6);

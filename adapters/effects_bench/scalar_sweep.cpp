@@ -30,6 +30,8 @@ struct ScalarEffect {
   const char* rawImage = "";  // capture names (FrameDriver::capture)
   const char* denoisedImage = "";
   std::function<void(rb::HybridEffectsDesc&, uint32_t)> setRays;
+  // Sets the effect's half-resolution tracing; null = the effect has none (no half-resolution rows).
+  std::function<void(rb::HybridEffectsDesc&, bool)> setHalfResolution;
   std::vector<uint32_t> rays;
   uint32_t referenceRays = 0;
   se::FrameParams tracedParams;  // engine parameters of traced rows and of the reference
@@ -57,10 +59,11 @@ se::Result<EffectResult> runScalarSweep(FrameDriver& driver, const SweepPlan& pl
   rbAdapter::Adapter& adapter = driver.adapter();
   rbAdapter::FrameSettings& s = adapter.settings();
   rb::HybridEffectsDesc desc;  // what the traced rows run, applied before each run
-  auto apply = [&](bool denoise, uint32_t rays) {
+  auto apply = [&](bool denoise, uint32_t rays, bool halfResolution = false) {
     desc.effects = fx.flag;
     desc.shadows.disableDenoiser = desc.ao.disableDenoiser = !denoise;
     fx.setRays(desc, rays);
+    if (fx.setHalfResolution) fx.setHalfResolution(desc, halfResolution);
     rb::Status st = adapter.effects().setDesc(desc);
     return st ? se::Status::success() : se::Status::failure("HybridEffects::setDesc: " + st.error().message);
   };
@@ -107,9 +110,14 @@ se::Result<EffectResult> runScalarSweep(FrameDriver& driver, const SweepPlan& pl
     return {};
   };
 
-  // Traced rows: one run per ray count gives both the raw and the denoised row (the raw image stays available).
-  for (uint32_t n : fx.rays) {
-    if (se::Status st = apply(true, n); !st) return R::failure(st.error);
+  // Traced rows: one run per ray count gives both the raw and the denoised row (the raw image stays available);
+  // where the effect has half-resolution tracing, a second run at the same ray count gives its two rows.
+  std::vector<std::pair<uint32_t, bool>> runs;
+  for (uint32_t n : fx.rays) runs.push_back({n, false});
+  if (fx.setHalfResolution)
+    for (uint32_t n : fx.rays) runs.push_back({n, true});
+  for (auto [n, half] : runs) {
+    if (se::Status st = apply(true, n, half); !st) return R::failure(st.error);
     auto samples = driver.run(fx.tracedParams, plan.warmupFrames, plan.timedFrames);
     if (!samples) return R::failure(samples.error);
     // Single-frame denoising: the history is reset so that the capture frame's output uses that frame's rays
@@ -124,10 +132,12 @@ se::Result<EffectResult> runScalarSweep(FrameDriver& driver, const SweepPlan& pl
       auto values = named(cap.value, denoised ? fx.denoisedImage : fx.rawImage);
       if (!values) return R::failure(values.error);
       Row row;
-      row.method = denoised ? "traced_denoised" : "traced_raw";
-      row.setting = std::to_string(n) + (n == 1 ? " ray" : " rays");
+      row.method = half ? (denoised ? "traced_half_denoised" : "traced_half_raw")
+                        : (denoised ? "traced_denoised" : "traced_raw");
+      row.setting = std::to_string(n) + (n == 1 ? " ray" : " rays") + (half ? ", half res" : "");
       row.id = row.method + "_r" + std::to_string(n);
       row.params = {{"rays_per_pixel", n}, {"denoised", denoised}};
+      if (half) row.params["half_resolution"] = true;
       row.passes = {pass};
       if (denoised) row.passes.push_back(denoise);
       row.effectMs = pass.gpuMs + (denoised ? denoise.gpuMs : 0.0);
@@ -227,6 +237,7 @@ se::Result<EffectResult> runAoSweep(FrameDriver& driver, const SweepPlan& plan) 
     d.ao.range = range;
     d.ao.estimator = rb::AoEstimator::Binary;  // the SSAO counterpart is binary too (occluded or not)
   };
+  fx.setHalfResolution = [](rb::HybridEffectsDesc& d, bool half) { d.ao.halfResolution = half; };
   fx.rays = plan.aoRays;
   fx.referenceRays = plan.referenceAo;
   fx.tracedParams = driver.baseParams();

@@ -18,7 +18,9 @@ struct PassResult {
 };
 
 struct Row {
-  std::string method;   // "traced_raw", "traced_denoised", "raster"
+  // "traced_raw", "traced_denoised", "raster"; AO and reflections also "traced_half_raw", "traced_half_denoised"
+  // (half-resolution tracing at the same ray counts, params.half_resolution = true)
+  std::string method;
   std::string setting;  // human-readable, e.g. "8 rays", "map 2048, PCF 3", "probe 128"
   std::string id;       // file-name friendly, unique within the effect (the PNG's stem)
   nlohmann::json params;

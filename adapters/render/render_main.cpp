@@ -439,7 +439,9 @@ int main(int argc, char** argv) {
                                                                            : rb::kDefaultReflectionRoughnessThreshold},
       {"reflection_rays_per_pixel",
        wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays)
-                       : 0u}};
+                       : 0u},
+      {"ao_half_resolution", hybrid && wantAo && hd.ao.halfResolution},
+      {"reflection_half_resolution", hybrid && wantReflections && hd.reflections.halfResolution}};
   // Adaptive rays (--adaptive): per effect, the time target (0 = the uniform rays, redistributed).
   for (auto [name, a] : {std::pair{"shadows", &hd.shadows.adaptive}, std::pair{"ao", &hd.ao.adaptive}}) {
     if (a->enabled) stats["effects"]["adaptive"][name] = {{"time_budget_ms", a->timeBudgetMs}};

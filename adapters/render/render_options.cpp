@@ -51,6 +51,15 @@ CLI::Validator effectSetValidator() {
       "");
 }
 
+CLI::Validator halfResolutionValidator() {
+  return CLI::Validator(
+      [](std::string& value) {
+        bool ao = false, reflections = false;
+        return parseHalfResolution(value, ao, reflections);
+      },
+      "");
+}
+
 CLI::Validator presetValidator() {
   return CLI::Validator(
       [](std::string& value) {
@@ -207,6 +216,14 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "ray per light that reaches the pixel (default 4)")
       ->type_name("N")
       ->check(rbCli::zeroOrWholeNumber(1, 64, "exact"));
+  app.add_option_function<std::string>(
+         "--half-res",
+         [&o](const std::string& value) { parseHalfResolution(value, o.halfResAo, o.halfResReflections); },
+         "effects traced at half resolution (one pixel per 2x2 block, rotating over 4\n"
+         "frames) and upsampled by depth and normals, comma-separated from ao,reflections,\n"
+         "or none (default none)")
+      ->type_name("LIST")
+      ->check(halfResolutionValidator());
   app.add_flag_callback(
       "--no-denoise", [&o] { o.denoise = false; }, "use the raw shadow, AO and local-light images (default: denoised)");
   app.add_option_function<uint32_t>(
@@ -320,6 +337,20 @@ std::string effectSetToString(rb::EffectSet effects) {
   return rbCli::join(names, ",");
 }
 
+std::string parseHalfResolution(std::string_view text, bool& ao, bool& reflections) {
+  if (text == "none") {
+    ao = reflections = false;
+    return {};
+  }
+  uint32_t set = 0;
+  if (std::string e = rbCli::parseNameSet(text, {"ao", "reflections"}, "an effect with half-resolution tracing", set);
+      !e.empty())
+    return e;
+  ao = set & 1u;
+  reflections = set & 2u;
+  return {};
+}
+
 const char* renderUsage() {
   static const std::string help = [] {
     RenderOptions unused;
@@ -363,6 +394,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.disableDenoiser = !o.denoise;
   h.ao.adaptive.enabled = o.adaptiveAoMs.has_value();
   h.ao.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
+  h.ao.halfResolution = o.halfResAo;
 
   const uint32_t lightRays = o.lightRays ? *o.lightRays : kDefaultLightRays;
   h.localLights.mode = lightRays ? rb::ManyLightMode::Stochastic : rb::ManyLightMode::Exact;
@@ -371,6 +403,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
 
   h.reflections.roughnessThreshold = o.reflectionRoughness ? *o.reflectionRoughness : kDefaultReflectionRoughness;
   h.reflections.raysPerPixel = o.reflectionRays ? *o.reflectionRays : kDefaultReflectionRays;
+  h.reflections.halfResolution = o.halfResReflections;
 
   r.raster = p.raster;
   if (o.shadowMapSize) r.raster.mapSize = *o.shadowMapSize;

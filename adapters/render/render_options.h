@@ -43,6 +43,9 @@ struct RenderOptions {
   // --light-rays: shadow rays per pixel shared by the scene's KHR_lights_punctual lights; 0 = exact (one ray per
   // light that reaches the pixel). Else kDefaultLightRays below.
   std::optional<uint32_t> lightRays;
+  // --half-res ao,reflections (any subset, or none): the effects traced at half resolution with the depth-aware
+  // upsample (HybridEffectsDesc::ao/reflections.halfResolution). Default none.
+  bool halfResAo = false, halfResReflections = false;
   bool denoise = true;          // --no-denoise
   bool tileClassifier = false;  // --tile-classifier: HybridEffectsDesc::shadows.tileClassifier
   // --adaptive EFFECT[=MS],...: adaptive rays per pixel for shadows and ao (AdaptiveRaySettings), with a GPU time
@@ -102,6 +105,10 @@ ResolvedEffects resolve(const RenderOptions& options);
 std::string parseEffectSet(std::string_view text, rb::EffectSet& out);
 // "shadows,ao,reflections,lights" in that order; "" for no effect.
 std::string effectSetToString(rb::EffectSet effects);
+// "ao,reflections" (any order and subset; "" or "none" = neither) -> the effects traced at half resolution. Returns
+// "" or an error naming the bad item ("'shadows' in 'ao,shadows' is not an effect with half-resolution tracing (ao,
+// reflections)").
+std::string parseHalfResolution(std::string_view text, bool& ao, bool& reflections);
 
 // Parses argv; returns an error message naming the option and the bad value, or "" on success (options.help is
 // set for -h/--help: print renderUsage() and exit 0).

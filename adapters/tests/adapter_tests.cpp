@@ -112,6 +112,8 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--adaptive ao=-1", "--adaptive: '-1' in 'ao=-1' is not a time in ms greater than 0"},
       {"--adaptive ao=fast", "--adaptive: 'fast' in 'ao=fast' is not a time in ms"},
       {"--adaptive ao --no-denoise", "--adaptive: adaptive rays plan from the denoiser's history"},
+      {"--half-res ao,shadows",
+       "--half-res: 'shadows' in 'ao,shadows' is not an effect with half-resolution tracing (ao, reflections)"},
   };
   for (const Case& c : cases) {
     const RunResult r = runRender(c.args + " --out " + (dir / "out").string());
@@ -141,6 +143,34 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
 
 // Reads the R channel of an EXR written by raybridge-render.
 using rbRenderTest::readExrRed;
+
+TEST_CASE("raybridge-render --half-res traces AO and reflections at half resolution", "[render][halfres]") {
+  // The same frames at full and at half resolution: the option reaches the SDK (the stats say so, and the passes
+  // count about a quarter of the rays), and the images keep their size.
+  auto render = [](const std::string& name, const std::string& halfRes) {
+    const fs::path dir = tempDir(name);
+    const RunResult r = runRender("--effects ao,reflections --width 96 --height 64 --dump --half-res " + halfRes +
+                                  " --out " + dir.string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    int w = 0, h = 0;
+    CHECK(readExrRed(dir / "ao.exr", w, h).size() == 96u * 64u);
+    return nlohmann::json::parse(std::ifstream(dir / "stats.json"));
+  };
+  const nlohmann::json full = render("half_res_none", "none");
+  const nlohmann::json half = render("half_res_both", "ao,reflections");
+  CHECK(full["effects"]["ao_half_resolution"] == false);
+  CHECK(full["effects"]["reflection_half_resolution"] == false);
+  CHECK(half["effects"]["ao_half_resolution"] == true);
+  CHECK(half["effects"]["reflection_half_resolution"] == true);
+  CHECK(half["validation"]["errors"] == 0);
+  for (const char* pass : {"ao", "reflection"}) {
+    const double ratio = half["raybridge"]["passes"][pass]["rays"].get<double>() /
+                         full["raybridge"]["passes"][pass]["rays"].get<double>();
+    INFO(pass << ": half / full rays " << ratio);
+    CHECK((ratio > 0.2 && ratio < 0.3));
+  }
+}
 
 TEST_CASE("raybridge-render: --preset high --dump writes every effect image and counts rays per pass", "[render]") {
   const fs::path dir = tempDir("dump");

@@ -33,12 +33,15 @@ struct AoPass::Impl {
   // Adaptive rays, created on first use.
   RayTracingPipeline adaptivePipeline;
   AdaptiveRayPlanner planner;
+  // AoSettings::halfResolution: the sample image and the upsample, made on first use.
+  HalfResolution half{HalfResolution::Signal::Ao};
   AoOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still trace with it
     core.retire(ctx);
     adaptivePipeline.retire(ctx);
     planner.retire(ctx);
+    half.retire(ctx);
   }
 };
 
@@ -73,6 +76,7 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   pc.range = range;
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultAoRays;
   pc.estimator = static_cast<uint32_t>(settings.estimator);  // RB_AO_*
+  pc.halfResolution = settings.halfResolution ? 1u : 0u;
 
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "AoPass", pc.gbuffer.flags); !st) return st;
@@ -81,12 +85,18 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
     if (!p) return p.error();
     s.adaptivePipeline = p.value();
   }
+  if (settings.halfResolution) {
+    if (Status st = s.half.ensure(s.ctx, g.width, g.height); !st) return st;
+  } else {
+    s.half.releaseImage(s.ctx);  // full resolution holds no sample image
+  }
   const PassStats latest = s.core.metrics.latest(s.ctx);
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}}); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
-  w.storageImage(RB_AO_BINDING_OUTPUT, s.core.images[0].view);
   bool planned = false;
   if (settings.adaptive.enabled) {
+    // With half resolution the plan covers every pixel and the traced quarter uses its entries: a quarter of the
+    // budget is traced (a time target compensates, it measures the rays traced).
     Result<bool> r = s.planner.record(s.ctx, cmd, g, settings.adaptive, pc.raysPerPixel, latest, "AoPass");
     if (!r) {
       s.core.end(s.ctx, cmd);  // the outputs stay in a known layout; nothing was traced
@@ -97,7 +107,14 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   if (planned) {
     w.sampledImage(RB_BINDING_RAY_PLAN, s.planner.planView(), s.core.sampler, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   }
-  s.core.traceAndEnd(s.ctx, cmd, w, pc, g, planned ? &s.adaptivePipeline : nullptr);
+  const RayTracingPipeline* variant = planned ? &s.adaptivePipeline : nullptr;
+  if (settings.halfResolution) {
+    w.storageImage(RB_AO_BINDING_OUTPUT, s.half.samplesView());
+    s.core.traceHalfAndEnd(s.ctx, cmd, w, pc, g, s.half, 0.0f, variant);
+  } else {
+    w.storageImage(RB_AO_BINDING_OUTPUT, s.core.images[0].view);
+    s.core.traceAndEnd(s.ctx, cmd, w, pc, g, variant);
+  }
   s.outputs.ao = s.core.images[0].image;
   s.outputs.aoView = s.core.images[0].view;
   s.outputs.width = g.width;

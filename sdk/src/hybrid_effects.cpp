@@ -251,6 +251,7 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   s.adaptive = desc.ao.adaptive;
   s.adaptive.history = aoDenoiser.get();  // none before the denoiser's first frame: uniform rays then
   s.adaptive.enabled = s.adaptive.enabled && s.adaptive.history;
+  s.halfResolution = desc.ao.halfResolution;
   if (Status st = ao->record(cmd, f.gbuffer, tlas, s); !st) return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
   outputs.aoRaw = outputs.ao = image(o.ao, o.aoView, VK_FORMAT_R16_SFLOAT, o.layout, o.width, o.height);
@@ -267,6 +268,7 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.materials = materials.get();
   s.roughnessThreshold = desc.reflections.roughnessThreshold;
   s.raysPerPixel = desc.reflections.raysPerPixel;
+  s.halfResolution = desc.reflections.halfResolution;
   s.flags = (f.flags & kFrameExplicitLighting) ? kReflectionExplicitLighting : 0u;
   for (int i = 0; i < 3; ++i) {
     s.sunRadiance[i] = f.lightRadiance[i];

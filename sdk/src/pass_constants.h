@@ -73,14 +73,15 @@ struct AoConstants {
   GBufferConstants gbuffer;
   float range;
   uint32_t raysPerPixel;
-  uint32_t estimator;  // RB_AO_* = rb::AoEstimator
-  uint32_t pad0;
+  uint32_t estimator;       // RB_AO_* = rb::AoEstimator
+  uint32_t halfResolution;  // 1 = one sample per 2x2 block into the half-resolution image
 };
 static_assert(sizeof(AoConstants) == 176);
 RB_ASSERT_OFFSET(AoConstants, gbuffer, 0);
 RB_ASSERT_OFFSET(AoConstants, range, 160);
 RB_ASSERT_OFFSET(AoConstants, raysPerPixel, 164);
 RB_ASSERT_OFFSET(AoConstants, estimator, 168);
+RB_ASSERT_OFFSET(AoConstants, halfResolution, 172);
 
 struct ReflectionConstants {
   GBufferConstants gbuffer;
@@ -92,7 +93,8 @@ struct ReflectionConstants {
   uint32_t raysPerPixel;
   uint32_t lightCount;
   uint32_t lightCandidates;
-  uint32_t pad0, pad1;
+  uint32_t halfResolution;  // 1 = one sample per 2x2 block into the half-resolution image
+  uint32_t pad0;
 };
 static_assert(sizeof(ReflectionConstants) == 224);
 RB_ASSERT_OFFSET(ReflectionConstants, gbuffer, 0);
@@ -104,6 +106,16 @@ RB_ASSERT_OFFSET(ReflectionConstants, skyRadiance, 192);
 RB_ASSERT_OFFSET(ReflectionConstants, raysPerPixel, 204);
 RB_ASSERT_OFFSET(ReflectionConstants, lightCount, 208);
 RB_ASSERT_OFFSET(ReflectionConstants, lightCandidates, 212);
+RB_ASSERT_OFFSET(ReflectionConstants, halfResolution, 216);
+
+struct UpsampleConstants {
+  GBufferConstants gbuffer;  // the traced pass's: full-resolution size, the frame that chose the samples
+  float roughnessThreshold;  // reflections: rougher pixels have no reflection (a = 0)
+  uint32_t pad[3];
+};
+static_assert(sizeof(UpsampleConstants) == 176);
+RB_ASSERT_OFFSET(UpsampleConstants, gbuffer, 0);
+RB_ASSERT_OFFSET(UpsampleConstants, roughnessThreshold, 160);
 
 struct PrimaryConstants {
   float eye[3];

@@ -129,6 +129,16 @@ void PassCore::traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWr
   end(ctx, cmd);
 }
 
+void PassCore::traceHalfAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
+                               uint32_t constantBytes, const GBufferConstants& traced, const GBufferDesc& g,
+                               HalfResolution& half, float roughnessThreshold, const RayTracingPipeline* variant) {
+  half.beginTrace(ctx, cmd);
+  bind(ctx, cmd, w, constants, constantBytes, variant);
+  (variant ? *variant : pipeline).trace(ctx, cmd, half.width(), half.height());
+  half.upsample(ctx, cmd, g, sampler, traced, roughnessThreshold, images[0].view);
+  end(ctx, cmd);
+}
+
 void PassCore::end(Context& ctx, VkCommandBuffer cmd) {
   images.endWrite(ctx, cmd);
   metrics.writeEnd(ctx, cmd);

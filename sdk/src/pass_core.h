@@ -8,6 +8,7 @@
 
 #include <memory>
 
+#include "half_resolution.h"
 #include "pass_constants.h"
 #include "pass_images.h"
 #include "pass_metrics.h"
@@ -68,6 +69,18 @@ struct PassCore {
   }
   void traceAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
                    uint32_t constantBytes, const GBufferDesc& g, const RayTracingPipeline* variant = nullptr);
+  // Half resolution: one invocation per 2x2 block (ceil(w/2) x ceil(h/2), `half` ensured), tracing into `half`'s
+  // samples, then the upsample into output 0, then end(): the pass's timestamps hold both. `roughnessThreshold`:
+  // reflections' (the pixels that get no coverage).
+  template <typename Constants>
+  void traceHalfAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const Constants& pc,
+                       const GBufferDesc& g, HalfResolution& half, float roughnessThreshold = 0.0f,
+                       const RayTracingPipeline* variant = nullptr) {
+    traceHalfAndEnd(ctx, cmd, w, &pc, sizeof pc, pc.gbuffer, g, half, roughnessThreshold, variant);
+  }
+  void traceHalfAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,
+                       uint32_t constantBytes, const GBufferConstants& traced, const GBufferDesc& g,
+                       HalfResolution& half, float roughnessThreshold, const RayTracingPipeline* variant = nullptr);
   // The same with the launch size read from a VkTraceRaysIndirectCommandKHR on the GPU (a tile classifier's).
   template <typename Constants>
   void traceIndirectAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const Constants& pc,

@@ -16,9 +16,14 @@ struct ReflectionPass::Impl {
   Context& ctx;
   PassCore core;
   std::unique_ptr<MaterialTable> ownMaterials;  // setMaterials(); retires its buffer and set itself
+  // ReflectionSettings::halfResolution: the sample image and the upsample, made on first use.
+  HalfResolution half{HalfResolution::Signal::Reflection};
   ReflectionOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
-  ~Impl() { core.retire(ctx); }  // frames in flight may still trace with it
+  ~Impl() {  // frames in flight may still trace with it
+    core.retire(ctx);
+    half.retire(ctx);
+  }
 };
 
 ReflectionPass::ReflectionPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -108,6 +113,7 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   pc.ambientIntensity = settings.ambientIntensity == 0.0f && !explicitLighting ? kDefaultAmbientIntensity
                                                                                : settings.ambientIntensity;
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultReflectionRays;
+  pc.halfResolution = settings.halfResolution ? 1u : 0u;
 
   internal::LightListView lights;
   if (settings.lights) {
@@ -126,15 +132,25 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   DescriptorWrites w;
   const MaterialTable* table = settings.materials ? settings.materials : s.ownMaterials.get();
   if (Status st = s.core.writeMaterials(w, tlas, table, "ReflectionPass", pc.gbuffer.flags); !st) return st;
+  if (settings.halfResolution) {
+    if (Status st = s.half.ensure(s.ctx, g.width, g.height); !st) return st;
+  } else {
+    s.half.releaseImage(s.ctx);  // full resolution holds no sample image
+  }
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16G16B16A16_SFLOAT, "reflection radiance"}}); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
   const GBufferImage& rm = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
   w.sampledImage(RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, rm.view, s.core.sampler, readLayout(rm));
-  w.storageImage(RB_REFLECTION_BINDING_RADIANCE, s.core.images[0].view);
+  w.storageImage(RB_REFLECTION_BINDING_RADIANCE,
+                 settings.halfResolution ? s.half.samplesView() : s.core.images[0].view);
   // The local lights' list when given, else any valid buffer (never read: lightCount is 0).
   w.storageBuffer(RB_REFLECTION_BINDING_LIGHTS,
                   pc.lightCount ? lights.buffer : internal::materialTableImpl(*table).materials.buffer);
-  s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  if (settings.halfResolution) {
+    s.core.traceHalfAndEnd(s.ctx, cmd, w, pc, g, s.half, threshold);
+  } else {
+    s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  }
   s.outputs.radiance = s.core.images[0].image;
   s.outputs.radianceView = s.core.images[0].view;
   s.outputs.width = g.width;

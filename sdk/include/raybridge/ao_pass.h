@@ -4,6 +4,15 @@
 // Two estimators, as in the thesis: binary occlusion, and distance-weighted ("distance rays"), where a hit at
 // distance t counts t / R open, so far occluders fade out.
 //
+// Half resolution (AoSettings::halfResolution): one ray generation invocation per 2x2 block of the G-buffer traces
+// for one pixel of its block (the same corner in every block, a different one each frame: every pixel within 4
+// frames, so a temporal denoiser sees them all) into an internal R16_SFLOAT image of ceil(w/2) x ceil(h/2) (half
+// a byte per pixel, MemoryCategory::PassImages, held only while the setting is on). A compute pass then writes the
+// full-resolution output from it: each pixel weights the samples around it bilinearly times their depth (distance
+// from the pixel's tangent plane) and normal similarity, so occlusion does not bleed across silhouettes and
+// creases; a pixel whose sample it is gets that sample exactly. The output keeps its format, size and layout.
+// stats() then counts the rays actually traced (about a quarter) and its gpuMs covers the trace and the upsample.
+//
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output image and
 // measurement objects are handed to the Context's deferred release (see context.h) and freed once those
 // frames are done. Destroy it before its Context.
@@ -39,6 +48,8 @@ struct AoSettings {
   // Rays per pixel where the denoiser's history says the estimate is uncertain, within a budget
   // (adaptive_rays.h): raysPerPixel is then the average the budget is made of. Disabled by default.
   AdaptiveRaySettings adaptive;
+  // Trace a quarter of the pixels and upsample (see Half resolution above). false = every pixel traces its rays.
+  bool halfResolution = false;
 };
 
 // Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record().

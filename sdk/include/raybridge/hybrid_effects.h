@@ -72,6 +72,8 @@ struct AoEffectSettings {
   // Rays per pixel planned from the AO denoiser's history (adaptive_rays.h); raysPerPixel is the average the budget
   // is made of. `history` is ignored (the effect's denoiser, which must be enabled).
   AdaptiveRaySettings adaptive;
+  // false = every pixel traces; true = AoSettings::halfResolution (a quarter of the rays, depth-aware upsample).
+  bool halfResolution = false;
 };
 
 struct ReflectionEffectSettings {
@@ -80,6 +82,9 @@ struct ReflectionEffectSettings {
   // false = denoised (a DenoiseSignal::Reflection Denoiser, HybridEffectsDesc::denoiser's settings): glossy
   // pixels are filtered as far as their noise asks, mirrors (roughness 0) are not blurred.
   bool disableDenoiser = false;
+  // false = every pixel traces; true = ReflectionSettings::halfResolution (a quarter of the rays, depth-aware
+  // upsample).
+  bool halfResolution = false;
 };
 
 struct LocalLightEffectSettings {

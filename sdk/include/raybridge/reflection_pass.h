@@ -11,6 +11,17 @@
 // table given to setMaterials(). Reflection rays and the shadow rays from their hits alpha-test non-opaque
 // geometry with the same table (material_table.h).
 //
+// Half resolution (ReflectionSettings::halfResolution): one ray generation invocation per 2x2 block of the G-buffer
+// traces for one pixel of its block (the same corner in every block, a different one each frame: every pixel within
+// 4 frames, so a temporal denoiser sees them all) into an internal R16G16B16A16_SFLOAT image of ceil(w/2) x
+// ceil(h/2) (2 bytes per pixel, MemoryCategory::PassImages, held only while the setting is on). A compute pass then
+// writes the full-resolution output from it: each pixel weights the covered samples around it bilinearly times
+// their depth (distance from the pixel's tangent plane) and normal similarity, so reflections do not bleed across
+// silhouettes and creases; a pixel whose sample it is gets that sample exactly. Coverage stays the full-resolution
+// pass's: a = 1 on every pixel under the roughness threshold (one with no similar sample takes the most similar
+// covered one nearby), 0 on the sky and rougher pixels. The output keeps its format, size and layout. stats() then
+// counts the rays actually traced (about a quarter) and its gpuMs covers the trace and the upsample.
+//
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output image,
 // material table, texture set and measurement objects are handed to the Context's deferred release (see
 // context.h) and freed once those frames are done. Destroy it before its Context.
@@ -62,6 +73,8 @@ struct ReflectionSettings {
   // contribution there, with a shadow ray (unbiased, noisy like glossy rays). nullptr = sun and sky only.
   const ManyLightPass* lights = nullptr;
   uint32_t lightCandidates = 0;  // 0 = kDefaultReflectionLightCandidates; at most 64
+  // Trace a quarter of the pixels and upsample (see Half resolution above). false = every pixel traces its rays.
+  bool halfResolution = false;
 };
 
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
