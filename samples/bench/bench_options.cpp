@@ -48,7 +48,7 @@ void addOptions(CLI::App& app, BenchOptions& o) {
                  "soak: frames to run (default " + std::to_string(kDefaultSoakFrames) + ", " +
                      std::to_string(kQuickSoakFrames) + " with --quick)")
       ->type_name("N")
-      ->check(rbCli::wholeNumber(20, 100000000));
+      ->check(rbCli::wholeNumber(100, 100000000));
   app.add_option("--seed", o.seed,
                  "soak: seed of the random operations (default " + std::to_string(kDefaultSoakSeed) + ")")
       ->type_name("S")

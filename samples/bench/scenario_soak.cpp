@@ -150,6 +150,17 @@ class SoakRun {
                                      : (env.options().quick ? kQuickSoakFrames : kDefaultSoakFrames)),
         seed_(env.options().seed),
         rng_{env.options().seed} {}
+  // After a failure part-way (BenchFailure), the members go with frames still in flight: the service's and the
+  // Context's contract is a GPU that is done.
+  ~SoakRun() {
+    try {
+      if (ring_) ring_->waitAll();
+    } catch (const BenchFailure&) {
+    }
+    (void)env_.device().waitIdle();
+  }
+  SoakRun(const SoakRun&) = delete;
+  SoakRun& operator=(const SoakRun&) = delete;
 
   nlohmann::json run();
 
@@ -221,7 +232,7 @@ class SoakRun {
   std::string firstAliveHandle_;
   nlohmann::json timeline_ = nlohmann::json::array();
   uint64_t instanceSum_ = 0, liveSum_ = 0, recorded_ = 0;  // sums over the frames recordFrame() recorded
-  VkDeviceSize peakBytes_ = 0;
+  VkDeviceSize peakBytes_ = 0;                             // the most the Context held at the timeline's samples
 };
 
 std::vector<size_t> SoakRun::liveOf(LiveMesh::Kind kind) const {
@@ -943,7 +954,7 @@ nlohmann::json SoakRun::run() {
                         {"staticVariants", variants},
                         {"meanLiveMeshes", double(liveSum_) / double(std::max<uint64_t>(recorded_, 1))},
                         {"meanInstances", double(instanceSum_) / double(std::max<uint64_t>(recorded_, 1))},
-                        {"peakBytes", peakBytes_},
+                        {"peakSampledBytes", peakBytes_},
                         {"warmupMeasurementSeconds", warmupSeconds},
                         {"memory",
                          {{"start", atStart.toJson()},
