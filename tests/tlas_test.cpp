@@ -88,6 +88,36 @@ TEST_CASE("TLAS refits when only transforms change and rebuilds when the meshes 
   destroyScene(fx, built);
 }
 
+TEST_CASE("TLAS refits only over a TLAS built with the same build preference", "[as][tlas]") {
+  // Found by the soak (raybridge-bench --scenario soak): a refit over a TLAS last built with the other preference
+  // repeated different flags (VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03759); the fixture fails the test
+  // on that validation error.
+  GpuFixture fx;
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  auto& s = *service.value();
+  TestScene scene = makeConformanceScene();
+  BuiltScene built = buildScene(fx, s, scene);
+  auto build = [&](rb::TlasBuildPreference preference) {
+    rb::TlasBuildOptions o;
+    o.mode = rb::TlasBuildMode::UpdateIfPossible;
+    o.preference = preference;
+    rb::TlasInfo info;
+    fx.runFrame([&](VkCommandBuffer cmd) {
+      auto t = s.recordTlasBuild(cmd, built.instances, o);
+      RB_REQUIRE_OK(t);
+      info = t.value();
+    });
+    return info;
+  };
+  (void)build(rb::TlasBuildPreference::FastTrace);
+  CHECK(build(rb::TlasBuildPreference::FastTrace).updated);
+  CHECK(!build(rb::TlasBuildPreference::FastBuild).updated);  // new flags: a rebuild
+  CHECK(build(rb::TlasBuildPreference::FastBuild).updated);
+  CHECK(!build(rb::TlasBuildPreference::FastTrace).updated);
+  destroyScene(fx, built);
+}
+
 namespace {
 
 // The bytes of `buffer` (the TLAS's shading records, host-visible or device-local), through a copy into a host

@@ -54,7 +54,10 @@ int run(const BenchOptions& options) {
                              : "");
   std::fflush(stdout);
 
-  auto wanted = [&](const std::string& name) { return options.scenario == "all" || options.scenario == name; };
+  // "all" is every scenario but the soak, which runs only when named.
+  auto wanted = [&](const std::string& name) {
+    return options.scenario == name || (options.scenario == "all" && name != "soak");
+  };
   std::vector<GltfModel> models;
   std::vector<std::string> messages;
   if (wanted("build") || wanted("compaction")) {
@@ -71,7 +74,8 @@ int run(const BenchOptions& options) {
   doc["options"] = {{"scenario", options.scenario},   {"quick", options.quick},
                     {"full", options.full},           {"width", env.sizes().width},
                     {"height", env.sizes().height},   {"scenesDir", options.scenesDir},
-                    {"imagesDir", options.imagesDir}, {"framesInFlight", env.ctx().framesInFlight()}};
+                    {"imagesDir", options.imagesDir}, {"framesInFlight", env.ctx().framesInFlight()},
+                    {"frames", options.frames},       {"seed", options.seed}};
   doc["gltfModels"] = nlohmann::json::array();
   for (const GltfModel& m : models) {
     doc["gltfModels"].push_back({{"name", m.name},
@@ -97,6 +101,7 @@ int run(const BenchOptions& options) {
       {"gigarays", [&] { return runGigaRaysScenario(env); }},
       {"alpha", [&] { return runAlphaScenario(env); }},
       {"lights", [&] { return runLightsScenario(env); }},
+      {"soak", [&] { return runSoakScenario(env); }},
   };
   // A failing scenario is reported and the others still run (a GPU session is too costly to lose whole).
   std::vector<std::string> failures;
@@ -106,6 +111,11 @@ int run(const BenchOptions& options) {
     env.progress(std::string("scenario ") + e.name);
     try {
       doc["scenarios"][e.name] = e.fn();
+      // A scenario that ran to the end but whose checks failed (the soak's leak checks) keeps its numbers.
+      for (const auto& f : doc["scenarios"][e.name].value("failures", nlohmann::json::array())) {
+        std::fprintf(stderr, "raybridge-bench: scenario %s failed: %s\n", e.name, f.get<std::string>().c_str());
+        failures.push_back(std::string(e.name) + ": " + f.get<std::string>());
+      }
     } catch (const BenchFailure& f) {
       std::fprintf(stderr, "raybridge-bench: scenario %s failed: %s\n", e.name, f.what());
       doc["scenarios"][e.name] = {{"error", f.what()}};

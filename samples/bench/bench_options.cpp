@@ -8,7 +8,8 @@ namespace rbbench {
 const std::vector<std::string>& scenarioNames() {
   static const std::vector<std::string> names = {"build",      "duplication", "fastbuild-vs-fasttrace",
                                                  "compaction", "tlas",        "trace",
-                                                 "gigarays",   "alpha",       "lights"};
+                                                 "gigarays",   "alpha",       "lights",
+                                                 "soak"};
   return names;
 }
 
@@ -19,11 +20,14 @@ void addOptions(CLI::App& app, BenchOptions& o) {
   app.description("Measures the acceleration-structure service in the scenarios of the hybrid ray tracing thesis.");
   std::vector<std::string> scenarios = scenarioNames();
   scenarios.push_back("all");
-  app.add_option("--scenario", o.scenario, "scenario to run: " + rbCli::joinNames(scenarios) + " (default all)")
+  app.add_option("--scenario", o.scenario,
+                 "scenario to run: " + rbCli::joinNames(scenarios) + " (default all: every one but soak)")
       ->type_name("NAME")
       ->check(rbCli::oneOf(scenarios));
   app.add_option("--out", o.outPath, "JSON report (default: none)")->type_name("FILE.json");
-  app.add_flag("--quick", o.quick, "smallest sizes, fewest repeats (smoke test)");
+  app.add_flag("--quick", o.quick,
+               "smallest sizes, fewest repeats (smoke test); soak: " + std::to_string(kQuickSoakFrames) +
+                   " small frames");
   app.add_flag("--full", o.full, "GPU sizes (1M triangles) even on a CPU device");
   app.add_option("--width", o.width, "trace width, with --height; default 1920x1080 on a GPU, 640x360 on a\nCPU device")
       ->type_name("W")
@@ -40,6 +44,15 @@ void addOptions(CLI::App& app, BenchOptions& o) {
          "folder (created if missing) for tonemapped PNGs of the lights scenario's 256-light case:\nexact, raw and "
          "denoised (default: none)")
       ->type_name("DIR");
+  app.add_option("--frames", o.frames,
+                 "soak: frames to run (default " + std::to_string(kDefaultSoakFrames) + ", " +
+                     std::to_string(kQuickSoakFrames) + " with --quick)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(100, 100000000));
+  app.add_option("--seed", o.seed,
+                 "soak: seed of the random operations (default " + std::to_string(kDefaultSoakSeed) + ")")
+      ->type_name("S")
+      ->check(rbCli::wholeNumber(0, UINT64_MAX));
 }
 
 }  // namespace

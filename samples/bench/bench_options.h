@@ -7,20 +7,29 @@
 
 namespace rbbench {
 
+// Defaults of the soak scenario's --frames and --seed.
+inline constexpr uint32_t kDefaultSoakFrames = 10000;
+inline constexpr uint32_t kQuickSoakFrames = 2000;
+inline constexpr uint64_t kDefaultSoakSeed = 20261202;
+
 struct BenchOptions {
-  std::string scenario = "all";  // one of scenarioNames() or "all"
+  std::string scenario = "all";  // one of scenarioNames() or "all" (every one but "soak")
   std::string outPath;           // empty = no JSON file
   bool quick = false;            // smallest sizes and fewest repeats (smoke test, under ~2 minutes on lavapipe)
   bool full = false;             // the GPU sizes even on a CPU device (1M triangles, ...)
   uint32_t width = 0;            // 0 = automatic: 1920x1080 on a GPU, smaller on a CPU device
   uint32_t height = 0;
-  std::string device;       // substring of the device name; empty = $RAYBRIDGE_DEVICE or automatic
-  std::string scenesDir;    // glTF models, one folder each; default <source>/../shared/scenes
-  std::string imagesDir;    // lights scenario's pictures (PNG); empty = none
-  std::string commandLine;  // as typed, for the report
+  std::string device;     // substring of the device name; empty = $RAYBRIDGE_DEVICE or automatic
+  std::string scenesDir;  // glTF models, one folder each; default <source>/../shared/scenes
+  std::string imagesDir;  // lights scenario's pictures (PNG); empty = none
+  uint32_t frames = 0;    // soak scenario: frames to run; 0 = kDefaultSoakFrames (kQuickSoakFrames with --quick)
+  uint64_t seed = kDefaultSoakSeed;  // soak scenario: seed of its random operations
+  std::string commandLine;           // as typed, for the report
   bool help = false;
 };
 
+// The scenarios, in the order they run. "all" runs every one but "soak", which runs only when named (it takes
+// minutes and measures no speed).
 const std::vector<std::string>& scenarioNames();
 // The help CLI11 generates for these options.
 std::string usage();

@@ -30,5 +30,9 @@ nlohmann::json runAlphaScenario(BenchEnv& env);
 // The many-light pass on a floor of pillars under 1, 16, 256 and 4,096 lights: stochastic (1 and 4 rays per pixel)
 // against the exact mode, raw and denoised (pass time, rays, relative RMSE).
 nlohmann::json runLightsScenario(BenchEnv& env);
+// Frames recorded and run while meshes, effects, presets, the resolution and the TLAS's instances change at random
+// (seeded); the SDK's memory and handles at the start, after the warm-up and at the end, which must show no growth,
+// no live handle after release and no validation error. Its result lists what failed under "failures".
+nlohmann::json runSoakScenario(BenchEnv& env);
 
 }  // namespace rbbench

@@ -149,6 +149,7 @@ struct TlasSlot {
   uint32_t instanceCapacity = 0;
   VkDeviceSize storageCapacity = 0;
   bool allowsUpdate = false;
+  VkBuildAccelerationStructureFlagsKHR builtFlags = 0;  // of the last build: a refit must repeat them
   uint32_t builtInstanceCount = 0;
   uint64_t blasSignature = 0;          // hash of the BLAS addresses in order, to decide if a refit is valid
   uint64_t writtenFrame = UINT64_MAX;  // frame whose instances the buffer holds

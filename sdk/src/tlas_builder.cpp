@@ -218,22 +218,22 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
                                                                  : slot.instances.address;
 
   const bool wantUpdate = options.mode == TlasBuildMode::UpdateIfPossible;
-  // A refit must start from an intact TLAS built for the same instances: the one recorded last, in whichever
-  // slot, with the same BLASes in the same order.
-  const TlasSlot* source = nullptr;
-  if (wantUpdate && s.lastTlasSlot < s.tlasSlots.size()) {
-    const TlasSlot& prev = s.tlasSlots[s.lastTlasSlot];
-    if (prev.tlas && prev.allowsUpdate && prev.builtInstanceCount == written && prev.blasSignature == signature) {
-      source = &prev;
-    }
-  }
-
   VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
   info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
   info.flags = (options.preference == TlasBuildPreference::FastBuild
                     ? VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR
                     : VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR) |
                (wantUpdate ? VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR : 0);
+  // A refit must start from an intact TLAS built for the same instances with the same flags (a changed build
+  // preference rebuilds): the one recorded last, in whichever slot, with the same BLASes in the same order.
+  const TlasSlot* source = nullptr;
+  if (wantUpdate && s.lastTlasSlot < s.tlasSlots.size()) {
+    const TlasSlot& prev = s.tlasSlots[s.lastTlasSlot];
+    if (prev.tlas && prev.allowsUpdate && prev.builtFlags == info.flags && prev.builtInstanceCount == written &&
+        prev.blasSignature == signature) {
+      source = &prev;
+    }
+  }
   info.geometryCount = 1;
   info.pGeometries = &geometry;
   // Sized for the buffer's capacity so small fluctuations in the instance count reuse the same storage.
@@ -308,6 +308,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   recordAsBarrier(
       c.vk, cmd, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
 
+  slot.builtFlags = info.flags;
   slot.builtInstanceCount = written;
   slot.blasSignature = signature;
   s.lastTlasSlot = slotIndex;

@@ -182,7 +182,7 @@ struct Instance {
 enum class TlasBuildMode : uint8_t {
   Rebuild = 0,       // default: a full build every frame (best trace speed after large motion)
   UpdateIfPossible,  // refit the previous frame's TLAS when the instance list has the same meshes and count
-                     // (and BLAS copies: see DynamicBuildMode)
+                     // (and BLAS copies: see DynamicBuildMode) and it was built with the same preference
 };
 
 // Where the TLAS build reads the instance list from. The SDK writes it on the host into host-visible memory; on a
