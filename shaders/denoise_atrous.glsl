@@ -57,94 +57,32 @@ void store(ivec2 ip, float value, float variance, float bias2) {
 #endif
 }
 
-// Steps 1 and 2 (the scalar default) read their taps from shared memory: the workgroup's 8x8 pixels and an apron of
-// 2 * step pixels, each texel's camera-relative position, normal and signal fetched and reconstructed once instead
-// of by each of the 25 pixels whose kernel covers it. Wider steps read the images directly.
-const int kMaxTiledStep = 2;
-const int kMaxTile = 8 + 4 * kMaxTiledStep;
-shared vec4 tilePosition[kMaxTile * kMaxTile];  // xyz camera-relative, w = 1 on a surface, 0 sky or outside
-shared vec3 tileNormal[kMaxTile * kMaxTile];
-shared vec2 tileSignal[kMaxTile * kMaxTile];
-
-struct Tap {
-  bool valid;  // inside the image and not sky
-  vec3 p, n;
-  vec2 v;
-};
-
-Tap fetchTap(ivec2 q) {
-  Tap t;
-  t.valid = false;
-  t.p = vec3(0.0);
-  t.n = vec3(0.0, 0.0, 1.0);
-  t.v = vec2(0.0);
-  if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(pc.size)))) return t;
-  float qd = texelFetch(gDepth, q, 0).r;
-  t.v = texelFetch(signalIn, q, 0).rg;
-  if (rbDnSky(qd)) return t;
-  t.valid = true;
-  t.p = rbDnCameraRelative(uvec2(q), qd);
-  t.n = rbDnNormal(texelFetch(gNormal, q, 0));
-  return t;
-}
-
 void main() {
-  const int step = int(pc.atrousStep);
-  const bool tiled = step <= kMaxTiledStep;  // uniform across the dispatch
-  const int apron = 2 * step, tileSize = 8 + 2 * apron;
-  const ivec2 origin = ivec2(gl_WorkGroupID.xy) * 8 - apron;
-  if (tiled) {
-    for (int i = int(gl_LocalInvocationIndex); i < tileSize * tileSize; i += 64) {
-      Tap t = fetchTap(origin + ivec2(i % tileSize, i / tileSize));
-      tilePosition[i] = vec4(t.p, t.valid ? 1.0 : 0.0);
-      tileNormal[i] = t.n;
-      tileSignal[i] = t.v;
-    }
-    barrier();
-  }
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (any(greaterThanEqual(pixel, pc.size))) return;
   ivec2 ip = ivec2(pixel);
-  // A tap at `q` (inside the tile when tiled: |offset| <= apron).
-  const ivec2 local = ivec2(gl_LocalInvocationID.xy) + apron;
-  Tap centreTap;
-  if (tiled) {
-    const int i = local.y * tileSize + local.x;
-    centreTap.valid = tilePosition[i].w > 0.0;
-    centreTap.p = tilePosition[i].xyz;
-    centreTap.n = tileNormal[i];
-    centreTap.v = tileSignal[i];
-  } else {
-    centreTap = fetchTap(ip);
-  }
-  vec2 centre = centreTap.v;
-  if (!centreTap.valid) {  // sky (the pixel is inside the image)
+  vec2 centre = texelFetch(signalIn, ip, 0).rg;
+  float depth = texelFetch(gDepth, ip, 0).r;
+  if (rbDnSky(depth)) {
     store(ip, centre.r, centre.g, 0.0);
     return;
   }
-  vec3 p = centreTap.p;
-  vec3 n = centreTap.n;
+  vec3 p = rbDnCameraRelative(pixel, depth);
+  vec3 n = rbDnNormal(texelFetch(gNormal, ip, 0));
+  int step = int(pc.atrousStep);
   float tolerance = length(p) * pc.depthSigma * float(step) + 1e-6;
   float sum = 0.0, weights = 0.0, variances = 0.0;
   bool same[9];  // the 3x3 neighbourhood (step 1) on the centre's surface: the final step's bias estimate
   for (int k = 0; k < 9; ++k) same[k] = false;
   for (int dy = -2; dy <= 2; ++dy) {
     for (int dx = -2; dx <= 2; ++dx) {
-      Tap t;
-      if (tiled) {
-        const ivec2 l = local + ivec2(dx, dy) * step;
-        const int i = l.y * tileSize + l.x;
-        t.valid = tilePosition[i].w > 0.0;
-        t.p = tilePosition[i].xyz;
-        t.n = tileNormal[i];
-        t.v = tileSignal[i];
-      } else {
-        t = fetchTap(ip + ivec2(dx, dy) * step);
-      }
-      if (!t.valid) continue;  // outside the image, or sky
-      vec3 qp = t.p;
-      vec3 qn = t.n;
-      vec2 qv = t.v;
+      ivec2 q = ip + ivec2(dx, dy) * step;
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(pc.size)))) continue;
+      float qd = texelFetch(gDepth, q, 0).r;
+      if (rbDnSky(qd)) continue;
+      vec3 qp = rbDnCameraRelative(uvec2(q), qd);
+      vec3 qn = rbDnNormal(texelFetch(gNormal, q, 0));
+      vec2 qv = texelFetch(signalIn, q, 0).rg;
       // Distance of the neighbour from the centre's tangent plane, relative to the view distance: flat
       // surfaces seen at a grazing angle keep their weight, steps in depth lose it.
       float planeDistance = abs(dot(qp - p, n)) / tolerance;

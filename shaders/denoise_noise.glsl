@@ -16,8 +16,10 @@ const float kRbDnPriorRays = 1.0;
 // With the rays per pixel known (a fraction of binary rays) an estimate is binomial, p (1 - p) / (rays * frames),
 // at a probability p from the pixel's own rays plus the window's mean; else the window's variance divided by the
 // frames averaged.
-// `v`: the signal's 5x5 window around the pixel, row by row (coordinates clamped to the image).
-float rbDnNoiseVariance(float v[25], float mean, float frames) {
+float rbDnNoiseVariance(sampler2D signal, ivec2 ip, float mean, float frames) {
+  float v[25];
+  for (int y = -2; y <= 2; ++y)
+    for (int x = -2; x <= 2; ++x) v[(y + 2) * 5 + x + 2] = texelFetch(signal, clamp(ip + ivec2(x, y), ivec2(0), ivec2(pc.size) - 1), 0).r;
   const float rays = pc.signalRaysPerPixel * frames;
   const float c = clamp(mean, 0.0, 1.0);
   float least = 1e30;

@@ -18,19 +18,7 @@ layout(set = 0, binding = RB_TEMPORAL_BINDING_DISTANCE_OUT, r32f) uniform writeo
 layout(set = 0, binding = RB_TEMPORAL_BINDING_VALUE_OUT, rg16f) uniform writeonly image2D valueOut;
 layout(set = 0, binding = RB_TEMPORAL_BINDING_FINAL_OUT, r16f) uniform writeonly image2D finalOut;
 
-// The workgroup's 8x8 pixels and a 2-pixel apron of this frame's signal, loaded once (each pixel's noise estimate
-// reads a 5x5 window: 25 fetches per pixel became 2.25).
-const int kApron = 2;
-const int kTile = 8 + 2 * kApron;
-shared float tileSignal[kTile * kTile];
-
 void main() {
-  const ivec2 origin = ivec2(gl_WorkGroupID.xy) * 8 - kApron;
-  for (uint i = gl_LocalInvocationIndex; i < uint(kTile * kTile); i += 64u) {
-    ivec2 q = clamp(origin + ivec2(int(i) % kTile, int(i) / kTile), ivec2(0), ivec2(pc.size) - 1);
-    tileSignal[i] = texelFetch(signalIn, q, 0).r;
-  }
-  barrier();
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (any(greaterThanEqual(pixel, pc.size))) return;
   ivec2 ip = ivec2(pixel);
@@ -68,10 +56,6 @@ void main() {
     }
   }
   imageStore(historyOut, ip, vec4(accumulated, frames, 0.0, 0.0));
-  float window[25];
-  const ivec2 local = ivec2(gl_LocalInvocationID.xy) + kApron;
-  for (int y = -2; y <= 2; ++y)
-    for (int x = -2; x <= 2; ++x) window[(y + 2) * 5 + x + 2] = tileSignal[(local.y + y) * kTile + local.x + x];
-  imageStore(valueOut, ip, vec4(accumulated, rbDnNoiseVariance(window, accumulated, frames), 0.0, 0.0));
+  imageStore(valueOut, ip, vec4(accumulated, rbDnNoiseVariance(signalIn, ip, accumulated, frames), 0.0, 0.0));
   if (final) imageStore(finalOut, ip, vec4(accumulated));
 }
