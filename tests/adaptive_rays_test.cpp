@@ -81,28 +81,43 @@ TEST_CASE("the ray budget controller settles on its time target despite a fixed 
       latest.rays = planned[frame - 3];
       latest.gpuMs = cost(double(latest.rays));
     }
-    planned.push_back(c.next(latest, target, 2e7, 1e3, 1e9));
+    planned.push_back(c.next(frame, latest, target, 2e7, 1e3, 1e9));
   }
   INFO("final budget " << planned.back());
   CHECK(std::abs(double(planned.back()) - 6e6) < 0.03 * 6e6);
   CHECK(std::abs(cost(double(planned.back())) - target) < 0.03 * target);
   // One measurement is taken in once: asking again without a new frame keeps the budget.
-  const uint64_t again = c.next(latest, target, 2e7, 1e3, 1e9);
+  const uint64_t again = c.next(41, latest, target, 2e7, 1e3, 1e9);
   CHECK(again == planned.back());
+  // Only a quarter of the plan traced (half resolution): the controller scales the planned budget, not the rays
+  // counted, so it still settles where the pass takes the target time (traced = budget / 4).
+  rb::RayBudgetController quarter;
+  std::vector<uint64_t> budgets;
+  rb::PassStats q;
+  for (uint64_t frame = 1; frame <= 40; ++frame) {
+    if (frame > 2) {
+      q.frame = frame - 2;
+      q.rays = budgets[frame - 3] / 4;
+      q.gpuMs = cost(double(q.rays));
+    }
+    budgets.push_back(quarter.next(frame, q, target, 2e7, 1e3, 1e9));
+  }
+  INFO("quarter-traced budget " << budgets.back());
+  CHECK(std::abs(cost(double(budgets.back()) / 4.0) - target) < 0.03 * target);
   // The bounds hold whatever the measurement says.
   rb::RayBudgetController fast;
   rb::PassStats cheap;
   cheap.frame = 1;
   cheap.rays = 1000;
   cheap.gpuMs = 1e-6;
-  CHECK(fast.next(cheap, target, 5e5, 1e3, 1e6) <= uint64_t(1e6));
+  CHECK(fast.next(1, cheap, target, 5e5, 1e3, 1e6) <= uint64_t(1e6));
   rb::RayBudgetController slow;
   rb::PassStats dear = cheap;
   dear.gpuMs = 1e6;
   uint64_t low = 0;
   for (int i = 0; i < 40; ++i) {
     dear.frame = uint64_t(i + 1);
-    low = slow.next(dear, target, 5e5, 1e3, 1e6);
+    low = slow.next(uint64_t(i + 2), dear, target, 5e5, 1e3, 1e6);
   }
   CHECK(low == 1000);
 }

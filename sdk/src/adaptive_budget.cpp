@@ -5,16 +5,24 @@
 
 namespace rb {
 
-uint64_t RayBudgetController::next(const PassStats& latest, double targetMs, double initial, double minRays,
-                                   double maxRays) {
+uint64_t RayBudgetController::next(uint64_t frame, const PassStats& latest, double targetMs, double initial,
+                                   double minRays, double maxRays) {
   if (budget <= 0.0) budget = initial;
-  if (latest.frame != 0 && latest.frame != lastFrame && latest.gpuMs > 0.0 && latest.rays > 0 && targetMs > 0.0) {
-    lastFrame = latest.frame;
-    const double ideal = double(latest.rays) * targetMs / latest.gpuMs;
-    budget = std::sqrt(std::max(budget, 1.0) * std::max(ideal, 1.0));
+  if (latest.frame != 0 && latest.frame != lastFrame && latest.gpuMs > 0.0 && targetMs > 0.0) {
+    double measured = double(latest.rays);  // the rays counted, when the frame's budget is no longer known
+    for (const Planned& p : planned) {
+      if (p.frame == latest.frame && p.budget > 0.0) measured = p.budget;
+    }
+    if (measured > 0.0) {
+      lastFrame = latest.frame;
+      const double ideal = measured * targetMs / latest.gpuMs;
+      budget = std::sqrt(std::max(budget, 1.0) * std::max(ideal, 1.0));
+    }
   }
   budget = std::clamp(budget, minRays, std::max(minRays, maxRays));
-  return uint64_t(std::llround(budget));
+  const uint64_t rays = uint64_t(std::llround(budget));
+  planned[frame % planned.size()] = {frame, double(rays)};
+  return rays;
 }
 
 }  // namespace rb

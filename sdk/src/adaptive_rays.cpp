@@ -127,7 +127,8 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
     // Start from the uniform rays over the whole image; never below one ray per 64 pixels, so a measurement
     // (which needs rays) always comes back.
     const double initial = double(std::max(raysPerPixel, 1u)) * pixels;
-    const uint64_t r = controller_.next(latest, s.timeBudgetMs, initial, std::max(1.0, std::min(pixels / 64.0, cap)),
+    const uint64_t r = controller_.next(ctx.frameIndex(), latest, s.timeBudgetMs, initial,
+                                        std::max(1.0, std::min(pixels / 64.0, cap)),
                                         std::min(double(maxRays) * pixels, cap));
     pc.budget = uint32_t(std::min<uint64_t>(r, UINT32_MAX));
     pc.uniformRays = 0.0f;
