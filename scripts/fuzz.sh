@@ -46,6 +46,7 @@ trap 'rm -rf "$tmp"' EXIT
 gltf_max_len=262144
 scenes="${RAYBRIDGE_SCENES:-$PWD/../shared/scenes}"
 scene_seeds=()
+scenes_failed=0
 export RAYBRIDGE_FUZZ_GLTF_FILES="$tmp/gltf_files"
 mkdir -p "$RAYBRIDGE_FUZZ_GLTF_FILES" "$tmp/gltf_scenes"
 if [ -d "$scenes" ]; then
@@ -60,14 +61,15 @@ if [ -d "$scenes" ]; then
   # Every scene runs once here (a finding counts like any other); only those that load in under 200 ms seed the
   # fuzzing, where a scene of a million vertices would take most of the time for little new coverage.
   mkdir -p "$work/gltf_loader"
-  if ! build-fuzz/tests/fuzz/gltf_loader_fuzz -runs=1 -timeout=60 "$tmp/gltf_scenes"/*.gltf \
+  rm -f "$work/gltf_loader/scenes_log.txt"
+  if [ "$copied" -gt 0 ] && ! build-fuzz/tests/fuzz/gltf_loader_fuzz -runs=1 -timeout=60 "$tmp/gltf_scenes"/*.gltf \
     >"$work/gltf_loader/scenes_log.txt" 2>&1; then
-    echo "fuzz: FAILED: a shared scene crashed the glTF loader (build-fuzz/fuzz/gltf_loader/scenes_log.txt)" >&2
-    exit 1
+    echo "fuzz: a shared scene fails the glTF loader target (build-fuzz/fuzz/gltf_loader/scenes_log.txt)" >&2
+    scenes_failed=1
   fi
   while read -r file ms; do
     if [ "$ms" -ge 200 ]; then rm -f "$file" && echo "fuzz: $(basename "$file") loads in $ms ms; not a seed"; fi
-  done < <(sed -n 's/^Executed \(.*\) in \([0-9]*\) ms$/\1 \2/p' "$work/gltf_loader/scenes_log.txt")
+  done < <(sed -n 's/^Executed \(.*\) in \([0-9]*\) ms$/\1 \2/p' "$work/gltf_loader/scenes_log.txt" 2>/dev/null)
   scene_seeds=("$tmp/gltf_scenes")
   echo "fuzz: $(ls "$tmp/gltf_scenes" | wc -l) of $copied shared scenes from $scenes as glTF seeds"
 else
@@ -75,7 +77,7 @@ else
 fi
 
 declare -A max_len=([gltf_loader]=$gltf_max_len [mesh_registration]=4096 [render_options]=1024 [camera_path]=8192)
-failed=0
+failed=$scenes_failed
 for t in "${targets[@]}"; do
   dir="$work/$t"
   mkdir -p "$dir/corpus" "$dir/artifacts"
@@ -109,11 +111,15 @@ for t in targets:
     m = re.search(r"stat::number_of_executed_units:\s*(\d+)", log)
     corpus = [os.path.join(d, "corpus", f) for f in os.listdir(os.path.join(d, "corpus"))]
     # slow-unit-* files are a note, not a finding.
-    findings = sorted(f for f in os.listdir(os.path.join(d, "artifacts")) if not f.startswith("slow-unit-"))
+    findings = sorted(os.path.join(d, "artifacts", f) for f in os.listdir(os.path.join(d, "artifacts"))
+                      if not f.startswith("slow-unit-"))
+    scenes_log = os.path.join(d, "scenes_log.txt")  # the shared scenes, each run once before fuzzing
+    if os.path.exists(scenes_log) and "SUMMARY:" in open(scenes_log, errors="replace").read():
+        findings.append(scenes_log)
     summary = re.findall(r"^SUMMARY: .*$", log, re.M)
     report[t] = {"seconds": seconds, "executions": int(m.group(1)) if m else None,
                  "corpus_files": len(corpus), "corpus_bytes": sum(os.path.getsize(f) for f in corpus),
-                 "findings": [os.path.join(d, "artifacts", f) for f in findings], "exit_code": rc,
+                 "findings": findings, "exit_code": rc,
                  "summary": summary[-1] if summary else ""}
     if rc != 0 and not findings and not summary:
         report[t]["summary"] = "failed to run (exit %d); see %s" % (rc, os.path.join(d, "log.txt"))
