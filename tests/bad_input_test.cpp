@@ -2,9 +2,12 @@
 // never a crash or a validation error.
 #include <catch2/catch_test_macros.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "test_scene.h"
 
@@ -80,6 +83,91 @@ TEST_CASE("invalid mesh descriptions are rejected with a message naming the prob
   }
   CHECK(s.stats().blasCount == 0);  // nothing was queued by the rejected calls
   fx.destroy(m);
+}
+
+// Regression tests of what tests/fuzz/mesh_registration_fuzz found. Each names the committed input
+// (tests/fuzz/corpus/mesh_registration/crash-*) that the fuzzer decodes into the MeshDesc written out here.
+
+TEST_CASE("a vertexFormat that is no VkFormat is refused before the driver sees it", "[as][bad-input][fuzz]") {
+  // crash-vertex-format-255 (ff 00 00 71): registerMesh with vertexFormat 255 and every other field zero. The
+  // format went to vkGetPhysicalDeviceFormatProperties first (a validation error: no valid VkFormat value).
+  GpuFixture fx;  // fails the test on any validation error
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  rb::MeshDesc d;
+  d.vertexFormat = VkFormat(255);
+  auto r = service.value()->registerMesh(d);
+  REQUIRE(!r.ok());
+  INFO(r.error().message);
+  CHECK(r.error().code == rb::ErrorCode::InvalidArgument);
+  CHECK(mentions(r.error(), "vertexFormat"));
+  CHECK(mentions(r.error(), "(255)"));
+}
+
+TEST_CASE("a registration's debugName need not outlive registerMesh", "[as][bad-input][fuzz]") {
+  // crash-debug-name-lifetime: a static mesh registered with a debugName whose string then went away, then
+  // updateMesh on it; the service had kept the pointer and read it for the error message (use after scope).
+  GpuFixture fx;
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  auto& s = *service.value();
+  rb::MeshDesc d;  // the fuzzer's fields: only counts and addresses, nothing is built
+  d.vertexStride = 0x80000000u;
+  d.vertexCount = 61;
+  d.triangleCount = 20;
+  d.indexType = rb::IndexType::None;
+  d.vertexAddress = 0xd2ba101;
+  d.vertexBufferBytes = 130996502528ull;
+  d.indexBufferBytes = 240;
+  d.normalStride = 9;
+  d.texcoordStride = 7;
+  std::string name = "fuzzed mesh";
+  d.debugName = name.c_str();
+  auto h = s.registerMesh(d);
+  RB_REQUIRE_OK(h);
+  std::fill(name.begin(), name.end(), '#');  // the engine reuses its string
+  rb::Status u = s.updateMesh(h.value());
+  REQUIRE(!u.ok());
+  INFO(u.error().message);
+  CHECK(mentions(u.error(), "mesh 'fuzzed mesh' was registered with MeshRole::Static"));
+  RB_REQUIRE_OK(s.releaseMesh(h.value()));
+}
+
+TEST_CASE("host indices at an unaligned address are read, not dereferenced as uint32_t", "[as][bad-input][fuzz]") {
+  // crash-unaligned-host-indices: 21845 uint32 indices one byte past an aligned address (UBSan: misaligned
+  // load). MeshDesc::hostIndices asks for no alignment; a stray index must still be caught.
+  GpuFixture fx;
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  rb::MeshDesc d;
+  d.vertexFormat = VK_FORMAT_R32G32_SFLOAT;
+  d.vertexStride = 32;
+  d.vertexCount = 65536;
+  d.triangleCount = 21845;
+  d.vertexAddress = 0x9baee01;
+  d.indexAddress = 0x6f3ea00;
+  d.vertexBufferBytes = 2097152;
+  d.indexBufferBytes = 262140;
+  std::vector<unsigned char> storage(1 + size_t(d.triangleCount) * 3 * 4);
+  for (uint32_t i = 0; i < d.triangleCount * 3; ++i) {
+    const uint32_t index = i == 5 ? d.vertexCount + 7 : i % d.vertexCount;
+    std::memcpy(storage.data() + 1 + size_t(i) * 4, &index, 4);
+  }
+  d.hostIndices = storage.data() + 1;
+  auto r = service.value()->registerMesh(d);
+  REQUIRE(!r.ok());
+  INFO(r.error().message);
+  CHECK(mentions(r.error(), "index 5 is 65543 but vertexCount is 65536"));
+  // Uint16 indices at an odd address, all in range: accepted.
+  d.indexType = rb::IndexType::Uint16;
+  d.indexBufferBytes = size_t(d.triangleCount) * 3 * 2;
+  for (uint32_t i = 0; i < d.triangleCount * 3; ++i) {
+    const uint16_t index = uint16_t(i);
+    std::memcpy(storage.data() + 1 + size_t(i) * 2, &index, 2);
+  }
+  auto ok = service.value()->registerMesh(d);
+  RB_REQUIRE_OK(ok);
+  RB_REQUIRE_OK(service.value()->releaseMesh(ok.value()));
 }
 
 TEST_CASE("stale and null handles are rejected", "[as][bad-input]") {

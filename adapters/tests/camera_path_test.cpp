@@ -234,6 +234,25 @@ TEST_CASE("camera path: every bad file names the problem, the keyframe and the f
   CHECK(error.find("cannot be opened") != std::string::npos);
 }
 
+TEST_CASE("camera path: keys far apart on either side of 0 give finite poses, exact at the keys",
+          "[camera_path][fuzz]") {
+  // tests/fuzz/corpus/camera_path/crash-far-apart-keys.json (camera_path_fuzz): the interpolation computed
+  // b - a = 2e308 = inf, so every pose of the path (even at t = 0: -1e308 + inf * 0) had a NaN position.
+  const std::string input =
+      R"({"version":1,"keyframes":[{"position":[-1e308,0,0],"orientation":[0,0,0,1],"duration":1},)"
+      R"({"position":[1e308,0,0],"orientation":[0,0,0,1]}]})";
+  CameraPath path;
+  REQUIRE(rbCameraPath::parseCameraPath(input, path) == "");
+  CHECK(path.at(0.0).position == Vec3{-1e308, 0, 0});
+  CHECK(path.at(1.0).position == Vec3{1e308, 0, 0});
+  for (double t : {0.25, 0.5, 0.75}) {
+    INFO("t = " << t);
+    const double x = path.at(t).position[0];
+    CHECK(std::isfinite(x));
+    CHECK(std::abs(x - (2.0 * t - 1.0) * 1e308) <= 1e293);
+  }
+}
+
 using rbRenderTest::readJson;
 using rbRenderTest::renderOutput;
 

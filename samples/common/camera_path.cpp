@@ -116,7 +116,10 @@ std::string parseKey(const Json& k, size_t index, bool last, double pathFov, Cam
   return {};
 }
 
-double lerp(double a, double b, double u) { return a + (b - a) * u; }
+// std::lerp, not a + (b - a) * u: b - a overflows for keys far apart on either side of 0 (-1e308 and 1e308), which
+// made the pose between them (and even at the first key, inf * 0) NaN. std::lerp is exact at u = 0 and 1 and finite
+// for finite keys.
+double lerp(double a, double b, double u) { return std::lerp(a, b, u); }
 
 }  // namespace
 

@@ -13,8 +13,8 @@ namespace rb {
 
 namespace {
 
-std::string describe(const MeshDesc& m, uint32_t index) {
-  return m.debugName ? std::string("mesh '") + m.debugName + "'" : "mesh #" + std::to_string(index);
+std::string describe(const ValidatedMesh& m, uint32_t index) {
+  return !m.debugName.empty() ? "mesh '" + m.debugName + "'" : "mesh #" + std::to_string(index);
 }
 
 const char* modeName(DynamicBuildMode m) {
@@ -188,7 +188,7 @@ Status AccelerationStructureService::updateMesh(MeshHandle mesh, const MeshUpdat
   Registration& reg = *r.value();
   const uint32_t index = reg.blas;
   BlasEntry& e = s.entries[index];
-  const std::string name = describe(e.mesh.desc, index);
+  const std::string name = describe(e.mesh, index);
   if (e.mesh.desc.role != MeshRole::Dynamic) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
                  "updateMesh: " + name +

@@ -1,5 +1,6 @@
 #include "mesh_validation.h"
 
+#include <cstring>
 #include <string>
 
 #include "content_hash.h"
@@ -30,10 +31,14 @@ Result<ValidatedMesh> validateMesh(const MeshDesc& in, const DeviceFunctions& vk
   d = in;
   d.hostVertices = nullptr;
   d.hostIndices = nullptr;
+  if (in.debugName) out.debugName = in.debugName;
+  d.debugName = nullptr;
   if (d.vertexFormat == VK_FORMAT_UNDEFINED) d.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
   uint32_t formatSize = vertexFormatSize(d.vertexFormat);
+  // Only a format Raybridge knows reaches the driver: any other value may be no VkFormat at all, which
+  // vkGetPhysicalDeviceFormatProperties must not be given (VUID-vkGetPhysicalDeviceFormatProperties-format-parameter).
   VkFormatProperties fp{};
-  vk.vkGetPhysicalDeviceFormatProperties(physicalDevice, d.vertexFormat, &fp);
+  if (formatSize != 0) vk.vkGetPhysicalDeviceFormatProperties(physicalDevice, d.vertexFormat, &fp);
   if (formatSize == 0 || !(fp.bufferFeatures & VK_FORMAT_FEATURE_ACCELERATION_STRUCTURE_VERTEX_BUFFER_BIT_KHR)) {
     return invalid(std::string("vertexFormat ") + formatName(d.vertexFormat) + " (" +
                    std::to_string(static_cast<int>(d.vertexFormat)) +
@@ -90,9 +95,17 @@ Result<ValidatedMesh> validateMesh(const MeshDesc& in, const DeviceFunctions& vk
   }
   if (in.hostIndices && out.indexSize) {
     // With a CPU copy at hand, an index past the vertex range is caught here instead of reading out of bounds.
+    // Read byte-wise: MeshDesc asks for no alignment of the host copy (a packed file buffer may hold it).
+    const auto* indices = static_cast<const unsigned char*>(in.hostIndices);
     for (uint64_t i = 0; i < indexCount; ++i) {
-      uint32_t v = out.indexSize == 4 ? static_cast<const uint32_t*>(in.hostIndices)[i]
-                                      : static_cast<const uint16_t*>(in.hostIndices)[i];
+      uint32_t v = 0;
+      if (out.indexSize == 4) {
+        std::memcpy(&v, indices + i * 4, 4);
+      } else {
+        uint16_t v16 = 0;
+        std::memcpy(&v16, indices + i * 2, 2);
+        v = v16;
+      }
       if (v >= d.vertexCount) {
         return invalid("index " + std::to_string(i) + " is " + std::to_string(v) + " but vertexCount is " +
                        std::to_string(d.vertexCount));

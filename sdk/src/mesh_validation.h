@@ -3,12 +3,17 @@
 
 #include <raybridge/acceleration_structures.h>
 
+#include <string>
+
 #include "device_functions.h"
 
 namespace rb {
 
 struct ValidatedMesh {
-  MeshDesc desc;  // with defaults resolved (format, stride); host pointers cleared
+  MeshDesc desc;  // with defaults resolved (format, stride); host pointers and debugName cleared
+  // A copy of MeshDesc::debugName ("" = none), for later messages: the engine's string need only live through
+  // the call that passed it.
+  std::string debugName;
   uint64_t key = 0;
   uint32_t indexSize = 0;  // bytes per index, 0 for non-indexed
 };

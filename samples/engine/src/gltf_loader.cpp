@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <set>
 
@@ -531,106 +533,196 @@ struct Loader {
   }
 };
 
+// tinygltf's file callbacks with GltfMemoryDesc::externalFiles applied. tinygltf looks for a URI's file at
+// JoinPath(baseDir, uri), then at "./" + uri; only the first is the URI's place under baseDir.
+struct ExternalFileGate {
+  GltfExternalFiles policy = GltfExternalFiles::Anywhere;
+  std::string prefix;   // what tinygltf's JoinPath puts before the URI: "" or baseDir with a trailing '/'
+  std::string refused;  // the first URI refused, as it reads after the prefix
+};
+
+// Whether `relative` (a URI as a path under the base folder) stays inside it, lexically.
+bool staysInside(const std::string& relative) {
+  if (relative.empty() || relative.front() == '/' || relative.find('\0') != std::string::npos) return false;
+  int depth = 0;
+  for (const std::filesystem::path& part : std::filesystem::path(relative)) {
+    if (part == "..") {
+      if (--depth < 0) return false;
+    } else if (part != "." && !part.empty()) {
+      ++depth;
+    }
+  }
+  return depth > 0;
+}
+
+bool allowedFile(const std::string& path, ExternalFileGate& gate) {
+  if (gate.policy == GltfExternalFiles::Anywhere) return true;
+  const bool underBase = path.compare(0, gate.prefix.size(), gate.prefix) == 0;
+  if (!underBase) return false;  // the working-directory candidate: not the URI's place, not worth a message
+  const std::string relative = path.substr(gate.prefix.size());
+  if (gate.policy == GltfExternalFiles::InsideBaseDir && staysInside(relative)) return true;
+  if (gate.refused.empty()) gate.refused = relative.substr(0, relative.find('\0'));
+  return false;
+}
+
+bool gatedFileExists(const std::string& path, void* user) {
+  std::error_code ec;
+  return allowedFile(path, *static_cast<ExternalFileGate*>(user)) && std::filesystem::is_regular_file(path, ec);
+}
+
+bool gatedReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  if (!allowedFile(path, *static_cast<ExternalFileGate*>(user))) {
+    if (err) *err = "refused";
+    return false;
+  }
+  return tinygltf::ReadWholeFile(out, err, path, nullptr);
+}
+
+// Everything after parsing: the model into result.scene (or result.error, which names `path`).
+void convertModel(const tinygltf::Model& model, const std::string& path, SceneLoadResult& result) {
+  for (const std::string& required : model.extensionsRequired)
+    if (std::find(std::begin(kSupportedExtensions), std::end(kSupportedExtensions), required) ==
+        std::end(kSupportedExtensions)) {
+      result.error = "glTF '" + path + "' requires extension " + required +
+                     ", which the sample engine does not support (it supports KHR_mesh_quantization, "
+                     "KHR_texture_transform, KHR_materials_emissive_strength and KHR_lights_punctual)";
+      return;
+    }
+  Loader loader{model, result, {}, {}, {}, {}, {}, {}};
+  if (std::string e = detail::convertNodes(model, result.scene); !e.empty()) loader.fail(e);
+  if (std::string e = detail::convertSkins(model, result.scene); !e.empty()) loader.fail(e);
+  if (std::string e = detail::convertAnimations(model, result.scene, result.warnings); !e.empty()) loader.fail(e);
+  if (!loader.error.empty()) {
+    result.error = "glTF '" + path + "': " + loader.error;
+    return;
+  }
+  loader.convertLights();
+  if (!loader.error.empty()) {
+    result.error = "glTF '" + path + "': " + loader.error;
+    return;
+  }
+  for (const tinygltf::Image& img : model.images) {
+    result.scene.textures.push_back(convertImage(img));
+    if (result.scene.textures.back().rgba8.empty())
+      result.warnings.push_back("image '" + img.uri + "' could not be decoded; texture ignored");
+  }
+  loader.convertMaterials();
+  // Textures that failed to decode must not be referenced.
+  for (Material& m : result.scene.materials)
+    for (int* t :
+         {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture, &m.emissiveTexture, &m.occlusionTexture})
+      if (*t >= 0 && result.scene.textures[*t].rgba8.empty()) *t = -1;
+
+  // glTF: the file's "scene", else scene 0 (an application choice the spec allows), else every root node.
+  std::vector<int> roots;
+  if (model.defaultScene >= int(model.scenes.size())) {
+    result.error = "glTF '" + path + "': the default scene " + std::to_string(model.defaultScene) +
+                   " is out of range (the file has " + std::to_string(model.scenes.size()) + " scenes)";
+    return;
+  }
+  const int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : (model.scenes.empty() ? -1 : 0);
+  if (sceneIndex >= 0) {
+    roots = model.scenes[sceneIndex].nodes;
+  } else {  // no scene declared: every node that is nobody's child is a root
+    std::vector<bool> isChild(model.nodes.size(), false);
+    for (const auto& n : model.nodes)
+      for (int c : n.children)
+        if (c >= 0 && c < int(isChild.size())) isChild[c] = true;
+    for (size_t i = 0; i < model.nodes.size(); ++i)
+      if (!isChild[i]) roots.push_back(int(i));
+  }
+  for (int r : roots) loader.visit(r, glm::mat4(1.0f), 0);
+  if (!loader.error.empty()) {
+    result.error = "glTF '" + path + "': " + loader.error;
+    return;
+  }
+  // Primitives without a material use a default one appended at the end.
+  bool needsDefault = false;
+  for (const MeshData& m : result.scene.meshes) needsDefault |= m.material >= result.scene.materials.size();
+  if (needsDefault) {
+    uint32_t index = uint32_t(result.scene.materials.size());
+    result.scene.materials.push_back(Material{.name = "gltf default"});
+    for (MeshData& m : result.scene.meshes)
+      if (m.material > index) m.material = index;
+  }
+  if (result.scene.instances.empty()) {
+    result.error = "glTF '" + path + "' contains no renderable triangles";
+    for (size_t w = 0; w < result.warnings.size() && w < 3; ++w) result.error += (w ? "; " : " (") + result.warnings[w];
+    if (!result.warnings.empty()) result.error += result.warnings.size() > 3 ? "; ...)" : ")";
+  }
+  // Whatever the checks above did not name in glTF terms (e.g. a cycle among unvisited nodes).
+  else if (Status s = ScenePose().reset(result.scene); !s)
+    result.error = "glTF '" + path + "': " + s.error;
+}
+
 }  // namespace
 
-SceneLoadResult loadGltf(const std::string& path) {
+SceneLoadResult loadGltfFromMemory(const GltfMemoryDesc& desc) {
   SceneLoadResult result;
+  const std::string name = desc.name.empty() ? std::string("memory") : desc.name;
   try {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) {
-      result.error = "glTF file not found: " + path;
+    if (desc.bytes.empty()) {
+      result.error = "glTF '" + name + "' is empty";
       return result;
     }
+    if (desc.bytes.size() > UINT32_MAX) {
+      result.error = "glTF '" + name + "' has " + std::to_string(desc.bytes.size()) + " bytes; at most 4 GiB load";
+      return result;
+    }
+    ExternalFileGate gate;
+    gate.policy = desc.externalFiles;
+    gate.prefix = desc.baseDir.empty() || desc.baseDir.back() == '/' ? desc.baseDir : desc.baseDir + "/";
     tinygltf::TinyGLTF gltf;
+    gltf.SetFsCallbacks(
+        tinygltf::FsCallbacks{gatedFileExists, tinygltf::ExpandFilePath, gatedReadWholeFile, nullptr, &gate});
     tinygltf::Model model;
     std::string err, warn;
-    const std::string ext = std::filesystem::path(path).extension().string();
-    bool binary = ext == ".glb" || ext == ".GLB";
-    bool ok = binary ? gltf.LoadBinaryFromFile(&model, &err, &warn, path)
-                     : gltf.LoadASCIIFromFile(&model, &err, &warn, path);
+    const auto size = static_cast<unsigned int>(desc.bytes.size());
+    bool ok = desc.binary
+                  ? gltf.LoadBinaryFromMemory(&model, &err, &warn, desc.bytes.data(), size, desc.baseDir)
+                  : gltf.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(desc.bytes.data()),
+                                             size, desc.baseDir);
+    if (!gate.refused.empty()) {
+      result.error =
+          "glTF '" + name + "': the URI '" + gate.refused + "' names " +
+          (desc.externalFiles == GltfExternalFiles::None
+               ? std::string("an external file, which GltfExternalFiles::None refuses (embed it as a data: URI)")
+               : "a file outside the base folder '" + desc.baseDir +
+                     "', which GltfExternalFiles::InsideBaseDir refuses");
+      return result;
+    }
     if (!warn.empty()) result.warnings.push_back(warn);
     if (!ok) {
-      result.error = "failed to parse glTF '" + path + "': " + (err.empty() ? "unknown error" : err);
+      result.error = "failed to parse glTF '" + name + "': " + (err.empty() ? "unknown error" : err);
       return result;
     }
-    for (const std::string& required : model.extensionsRequired)
-      if (std::find(std::begin(kSupportedExtensions), std::end(kSupportedExtensions), required) ==
-          std::end(kSupportedExtensions)) {
-        result.error = "glTF '" + path + "' requires extension " + required +
-                       ", which the sample engine does not support (it supports KHR_mesh_quantization, "
-                       "KHR_texture_transform, KHR_materials_emissive_strength and KHR_lights_punctual)";
-        return result;
-      }
-    Loader loader{model, result, {}, {}, {}, {}, {}, {}};
-    if (std::string e = detail::convertNodes(model, result.scene); !e.empty()) loader.fail(e);
-    if (std::string e = detail::convertSkins(model, result.scene); !e.empty()) loader.fail(e);
-    if (std::string e = detail::convertAnimations(model, result.scene, result.warnings); !e.empty()) loader.fail(e);
-    if (!loader.error.empty()) {
-      result.error = "glTF '" + path + "': " + loader.error;
-      return result;
-    }
-    loader.convertLights();
-    if (!loader.error.empty()) {
-      result.error = "glTF '" + path + "': " + loader.error;
-      return result;
-    }
-    for (const tinygltf::Image& img : model.images) {
-      result.scene.textures.push_back(convertImage(img));
-      if (result.scene.textures.back().rgba8.empty())
-        result.warnings.push_back("image '" + img.uri + "' could not be decoded; texture ignored");
-    }
-    loader.convertMaterials();
-    // Textures that failed to decode must not be referenced.
-    for (Material& m : result.scene.materials)
-      for (int* t : {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture, &m.emissiveTexture,
-                     &m.occlusionTexture})
-        if (*t >= 0 && result.scene.textures[*t].rgba8.empty()) *t = -1;
-
-    // glTF: the file's "scene", else scene 0 (an application choice the spec allows), else every root node.
-    std::vector<int> roots;
-    if (model.defaultScene >= int(model.scenes.size())) {
-      result.error = "glTF '" + path + "': the default scene " + std::to_string(model.defaultScene) +
-                     " is out of range (the file has " + std::to_string(model.scenes.size()) + " scenes)";
-      return result;
-    }
-    const int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : (model.scenes.empty() ? -1 : 0);
-    if (sceneIndex >= 0) {
-      roots = model.scenes[sceneIndex].nodes;
-    } else {  // no scene declared: every node that is nobody's child is a root
-      std::vector<bool> isChild(model.nodes.size(), false);
-      for (const auto& n : model.nodes)
-        for (int c : n.children)
-          if (c >= 0 && c < int(isChild.size())) isChild[c] = true;
-      for (size_t i = 0; i < model.nodes.size(); ++i)
-        if (!isChild[i]) roots.push_back(int(i));
-    }
-    for (int r : roots) loader.visit(r, glm::mat4(1.0f), 0);
-    if (!loader.error.empty()) {
-      result.error = "glTF '" + path + "': " + loader.error;
-      return result;
-    }
-    // Primitives without a material use a default one appended at the end.
-    bool needsDefault = false;
-    for (const MeshData& m : result.scene.meshes) needsDefault |= m.material >= result.scene.materials.size();
-    if (needsDefault) {
-      uint32_t index = uint32_t(result.scene.materials.size());
-      result.scene.materials.push_back(Material{.name = "gltf default"});
-      for (MeshData& m : result.scene.meshes)
-        if (m.material > index) m.material = index;
-    }
-    if (result.scene.instances.empty()) {
-      result.error = "glTF '" + path + "' contains no renderable triangles";
-      for (size_t w = 0; w < result.warnings.size() && w < 3; ++w)
-        result.error += (w ? "; " : " (") + result.warnings[w];
-      if (!result.warnings.empty()) result.error += result.warnings.size() > 3 ? "; ...)" : ")";
-    }
-    // Whatever the checks above did not name in glTF terms (e.g. a cycle among unvisited nodes).
-    else if (Status s = ScenePose().reset(result.scene); !s)
-      result.error = "glTF '" + path + "': " + s.error;
+    convertModel(model, name, result);
   } catch (const std::exception& e) {
     result.error = std::string("glTF loading failed: ") + e.what();
   }
   return result;
+}
+
+SceneLoadResult loadGltf(const std::string& path) {
+  SceneLoadResult result;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    result.error = "glTF file not found: " + path;
+    return result;
+  }
+  std::ifstream file(path, std::ios::binary);
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (!file && !file.eof()) {
+    result.error = "glTF file cannot be read: " + path;
+    return result;
+  }
+  const std::string ext = std::filesystem::path(path).extension().string();
+  GltfMemoryDesc desc;
+  desc.bytes = bytes;
+  desc.binary = ext == ".glb" || ext == ".GLB";
+  desc.baseDir = std::filesystem::path(path).parent_path().string();
+  desc.name = path;
+  return loadGltfFromMemory(desc);
 }
 
 }  // namespace sample_engine

@@ -147,8 +147,8 @@ struct MeshDesc {
   // (addresses, counts, format, stride), which shares a BLAS only between registrations of the same range.
   uint64_t contentKey = 0;
   const void* hostVertices = nullptr;  // optional CPU copy, laid out like the GPU buffer (vertexCount*stride)
-  const void* hostIndices = nullptr;   // optional CPU copy of the indices (triangleCount*3 indices)
-  const char* debugName = nullptr;     // optional; appears in error messages
+  const void* hostIndices = nullptr;   // optional CPU copy of the indices (triangleCount*3 indices, any alignment)
+  const char* debugName = nullptr;     // optional; appears in error messages (copied: need not outlive the call)
 
   // Optional vertex attributes, read (by device address, in place) where reflection rays hit the mesh. The
   // same vertex indexing as the positions. 0 = absent: hits use the triangle's geometric normal and

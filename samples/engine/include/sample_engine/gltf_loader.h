@@ -1,6 +1,8 @@
 // glTF 2.0 (.gltf / .glb) loading into the engine's Scene.
 #pragma once
 
+#include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -32,5 +34,27 @@ struct SceneLoadResult {
 // out-of-range node, mesh, skin or accessor index, a joint index beyond its skin's joint count, a skinned vertex whose
 // weights sum to 0, ...) fails with an error naming the value. Never throws.
 SceneLoadResult loadGltf(const std::string& path);
+
+// Which files the URIs of a glTF held in memory may read (buffers, images; data: URIs and a .glb's BIN chunk are
+// always fine). The check is lexical, on the path the URI resolves to: a symbolic link inside baseDir is followed.
+enum class GltfExternalFiles : uint8_t {
+  Anywhere = 0,   // default: relative to baseDir wherever they lead ("../textures/a.png"), as loadGltf() reads
+  InsideBaseDir,  // only files inside baseDir: a URI that leaves it (through "..", or absolute) fails naming it
+  None,           // no file at all: a URI that names a file fails naming it
+};
+
+// A glTF file's contents in memory. A zero-initialised description is valid (and loads nothing: "is empty").
+struct GltfMemoryDesc {
+  std::span<const uint8_t> bytes;  // the whole file; need not outlive the call
+  bool binary = false;             // false = .gltf (JSON), true = .glb (binary container)
+  std::string baseDir;             // folder that relative URIs start from; "" = the working directory
+  GltfExternalFiles externalFiles = GltfExternalFiles::Anywhere;
+  std::string name;  // what messages call the file in place of a path; "" = "memory"
+};
+
+// loadGltf() on bytes: the same scene, warnings and errors (which name desc.name), plus a named error for a URI that
+// desc.externalFiles refuses. loadGltf() reads the file and calls this with the file's folder as baseDir. Never
+// throws.
+SceneLoadResult loadGltfFromMemory(const GltfMemoryDesc& desc);
 
 }  // namespace sample_engine
