@@ -438,8 +438,7 @@ int main(int argc, char** argv) {
       {"reflection_roughness_threshold", hd.reflections.roughnessThreshold ? hd.reflections.roughnessThreshold
                                                                            : rb::kDefaultReflectionRoughnessThreshold},
       {"reflection_rays_per_pixel",
-       wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays)
-                       : 0u},
+       wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays) : 0u},
       {"ao_half_resolution", hybrid && wantAo && hd.ao.halfResolution},
       {"reflection_half_resolution", hybrid && wantReflections && hd.reflections.halfResolution}};
   // Adaptive rays (--adaptive): per effect, the time target (0 = the uniform rays, redistributed).
