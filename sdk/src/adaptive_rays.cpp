@@ -64,26 +64,34 @@ Status AdaptiveRayPlanner::init(Context& ctx) {
   auto storage = [&](uint32_t b, VkDescriptorType t = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE) {
     return VkDescriptorSetLayoutBinding{b, t, 1, cs, nullptr};
   };
-  Result<ComputePipeline> e = ComputePipeline::create(
-      ctx, SpirvModule::of(spirv::adaptive_estimate_comp),
-      {sampled(RB_ADAPTIVE_BINDING_DEPTH), sampled(RB_ADAPTIVE_BINDING_MOTION), sampled(RB_ADAPTIVE_BINDING_HISTORY),
-       sampled(RB_ADAPTIVE_BINDING_DISTANCE), storage(RB_ADAPTIVE_BINDING_WEIGHTS),
-       storage(RB_ADAPTIVE_BINDING_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER)},
-      sizeof(DenoiseConstants), "adaptive rays: estimate");
-  if (!e) return e.error();
-  estimate_ = e.value();
-  Result<ComputePipeline> a = ComputePipeline::create(
-      ctx, SpirvModule::of(spirv::adaptive_allocate_comp),
-      {storage(RB_ADAPTIVE_BINDING_WEIGHTS), storage(RB_ADAPTIVE_BINDING_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
-       storage(RB_ADAPTIVE_BINDING_PLAN)},
-      sizeof(AdaptivePlanConstants), "adaptive rays: allocate");
-  if (!a) return a.error();
-  allocate_ = a.value();
-  Result<GpuBuffer> b = createBuffer(ctx, kCounterBytes,
-                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                     MemoryLocation::DeviceLocal, MemoryCategory::PassBuffers, "adaptive ray counters");
-  if (!b) return b.error();
-  counters_ = b.value();
+  // Only what is missing: an earlier call may have failed half way.
+  if (!estimate_.pipeline) {
+    Result<ComputePipeline> e = ComputePipeline::create(
+        ctx, SpirvModule::of(spirv::adaptive_estimate_comp),
+        {sampled(RB_ADAPTIVE_BINDING_DEPTH), sampled(RB_ADAPTIVE_BINDING_MOTION), sampled(RB_ADAPTIVE_BINDING_HISTORY),
+         sampled(RB_ADAPTIVE_BINDING_DISTANCE), storage(RB_ADAPTIVE_BINDING_WEIGHTS),
+         storage(RB_ADAPTIVE_BINDING_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER)},
+        sizeof(DenoiseConstants), "adaptive rays: estimate");
+    if (!e) return e.error();
+    estimate_ = e.value();
+  }
+  if (!allocate_.pipeline) {
+    Result<ComputePipeline> a = ComputePipeline::create(
+        ctx, SpirvModule::of(spirv::adaptive_allocate_comp),
+        {storage(RB_ADAPTIVE_BINDING_WEIGHTS), storage(RB_ADAPTIVE_BINDING_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
+         storage(RB_ADAPTIVE_BINDING_PLAN)},
+        sizeof(AdaptivePlanConstants), "adaptive rays: allocate");
+    if (!a) return a.error();
+    allocate_ = a.value();
+  }
+  if (!counters_.valid()) {
+    Result<GpuBuffer> b = createBuffer(ctx, kCounterBytes,
+                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                       MemoryLocation::DeviceLocal, MemoryCategory::PassBuffers,
+                                       "adaptive ray counters");
+    if (!b) return b.error();
+    counters_ = b.value();
+  }
   return {};
 }
 
@@ -102,9 +110,7 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
   if (!history.mean) return false;
   DenoiseConstants dn{};
   if (Status st = internal::historyReprojection(*s.history, g, who, dn); !st) return st.error();
-  if (!estimate_.pipeline) {
-    if (Status st = init(ctx); !st) return st.error();
-  }
+  if (Status st = init(ctx); !st) return st.error();
   if (Status st = images_.ensure(ctx, g.width, g.height,
                                  {{VK_FORMAT_R16G16_SFLOAT, "adaptive ray weights"},
                                   {VK_FORMAT_R16G16_SFLOAT, "adaptive ray plan"}});

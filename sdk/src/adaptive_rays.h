@@ -29,12 +29,13 @@ class AdaptiveRayPlanner {
   // history mean in SHADER_READ_ONLY_OPTIMAL, visible to ray tracing, compute and fragment shaders.
   Result<bool> record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const AdaptiveRaySettings& settings,
                       uint32_t raysPerPixel, const PassStats& latest, const char* who);
-  VkImageView planView() const { return images_.size() ? images_[1].view : VK_NULL_HANDLE; }
-  VkImage planImage() const { return images_.size() ? images_[1].image : VK_NULL_HANDLE; }
+  VkImageView planView() const { return images_.size() > 1 ? images_[1].view : VK_NULL_HANDLE; }
+  VkImage planImage() const { return images_.size() > 1 ? images_[1].image : VK_NULL_HANDLE; }
   // The ray budget of the latest record() (UINT32_MAX when it was the uniform rays, resolved on the GPU).
   uint64_t budget() const { return budget_; }
 
  private:
+  // Creates the pipelines and counters that do not exist yet.
   Status init(Context& ctx);
   ComputePipeline estimate_, allocate_;
   PassImages images_;  // 0: weights (mean, weight), 1: the plan (rays, mean)

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <string>
+#include <utility>
 
 #include "as_service_impl.h"
 
@@ -383,6 +384,9 @@ void AccelerationStructureService::Impl::addTiming(const BuildBatchTiming& timin
 }
 
 void AccelerationStructureService::Impl::resolveBatches() {
+  auto failed = [&](VkResult r, const char* what) {
+    if (queryError) queryError = vulkanError(r, std::string("vkGetQueryPoolResults (") + what + ")");
+  };
   std::vector<BuildBatch> keep;
   for (BuildBatch& b : inFlightBatches) {
     if (!c.frameDone(b.frame)) {
@@ -400,6 +404,8 @@ void AccelerationStructureService::Impl::resolveBatches() {
       if (r == VK_SUCCESS) {
         addTiming({b.frame, b.builds, b.triangles,
                    double(c.info.timestampTicks(ticks[0], ticks[1])) * c.info.timestampPeriodNs * 1e-6});
+      } else {
+        failed(r, "BLAS build timestamps");  // a lost device: the batch goes without a timing
       }
       freeTimestampPools.push_back(b.timestamps);
     }
@@ -420,6 +426,8 @@ void AccelerationStructureService::Impl::resolveBatches() {
             e.compactedSize = sizes[i];
           }
         }
+      } else {
+        failed(r, "BLAS compacted sizes");  // the BLASes stay uncompacted
       }
       c.vk.vkDestroyQueryPool(c.desc.device, b.compactedSizes, c.allocator());
     }
@@ -429,16 +437,21 @@ void AccelerationStructureService::Impl::resolveBatches() {
 
 Status AccelerationStructureService::Impl::recordCompactions(VkCommandBuffer cmd, bool& recordedAny) {
   bool copied = false;
+  Status status;  // a failed copy stays queued for the next call; the copies recorded before it still count
   for (uint32_t i = 1; i < entries.size(); ++i) {
     BlasEntry& e = entries[i];
     if (e.state != BlasState::Built || e.compactedSize == 0 || e.compacted) continue;
     Result<StorageAllocation> alloc = storage.allocate(e.compactedSize);
-    if (!alloc) return alloc.error();
+    if (!alloc) {
+      status = alloc.error();
+      break;
+    }
     Result<VkAccelerationStructureKHR> as = createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
                                                      storage.buffer(alloc->block), alloc->offset, e.compactedSize);
     if (!as) {
       storage.free(alloc.value());
-      return as.error();
+      status = as.error();
+      break;
     }
     VkCopyAccelerationStructureInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR};
     copy.src = e.as;
@@ -468,21 +481,43 @@ Status AccelerationStructureService::Impl::recordCompactions(VkCommandBuffer cmd
     recordedAny = true;
     recordAsBarrier(c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
   }
-  return {};
+  return status;
 }
 
 Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd, std::vector<uint32_t>& batch,
                                                             VkDeviceSize scratchBytes, bool& recordedAny) {
   if (batch.empty()) return {};
   const VkDeviceSize align = scratchAlignment();
-  // Scratch: the persistent buffer when the batch fits the budget, else transient scratch for this batch.
+  // Everything that can fail comes first. A failure undoes it (nothing is recorded yet, so nothing is in use) and
+  // puts the batch back at the front of the queue: the next call builds it.
   GpuBuffer transient;
+  BuildBatch record;
+  record.frame = c.frame;
+  auto undo = [&](const Error& error) -> Status {
+    for (uint32_t idx : batch) {
+      BlasEntry& e = entries[idx];
+      if (e.as) {
+        c.vk.vkDestroyAccelerationStructureKHR(c.desc.device, e.as, c.allocator());
+        storage.free(e.storage);
+      }
+      e.as = VK_NULL_HANDLE;
+      e.storage = StorageAllocation{};
+      e.address = 0;
+      e.builtSize = e.currentSize = 0;
+    }
+    if (record.timestamps) freeTimestampPools.push_back(record.timestamps);
+    destroyBuffer(ctx, transient);
+    queue.insert(queue.begin(), batch.begin(), batch.end());
+    return error;
+  };
+
+  // Scratch: the persistent buffer when the batch fits the budget, else transient scratch for this batch.
   VkDeviceAddress scratchBase = 0;
   if (scratchBytes > desc.scratchBudgetBytes) {
     Result<GpuBuffer> t = createBuffer(ctx, scratchBytes + align,
                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
                                        MemoryLocation::DeviceLocal, MemoryCategory::Scratch, "oversized BLAS scratch");
-    if (!t) return t.error();
+    if (!t) return undo(t.error());
     transient = t.value();
     scratchBase = alignUp(transient.address, align);
   } else {
@@ -490,32 +525,53 @@ Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd,
       Result<GpuBuffer> t = createBuffer(ctx, desc.scratchBudgetBytes + align,
                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
                                          MemoryLocation::DeviceLocal, MemoryCategory::Scratch, "BLAS build scratch");
-      if (!t) return t.error();
+      if (!t) return undo(t.error());
       scratch = t.value();
     }
     scratchBase = alignUp(scratch.address, align);
+  }
+  for (uint32_t idx : batch) {
+    BlasEntry& e = entries[idx];
+    Result<StorageAllocation> alloc = storage.allocate(e.sizes.accelerationStructureSize);
+    if (!alloc) return undo(alloc.error());
+    Result<VkAccelerationStructureKHR> as = createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                     storage.buffer(alloc->block), alloc->offset,
+                                                     e.sizes.accelerationStructureSize);
+    if (!as) {
+      storage.free(alloc.value());
+      return undo(as.error());
+    }
+    e.as = as.value();
+    e.storage = alloc.value();
+  }
+  if (!desc.disableTimestamps && c.info.timestampsSupported) {
+    Result<VkQueryPool> pool = takeTimestampPool(freeTimestampPools, "build timestamps");
+    if (!pool) return undo(pool.error());
+    record.timestamps = pool.value();
+  }
+  for (uint32_t idx : batch) {
+    if (blasFlags(entries[idx]) & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR) {
+      record.compactEntries.push_back(idx);
+      record.compactGenerations.push_back(entries[idx].generation);
+    }
+  }
+  if (!record.compactEntries.empty()) {
+    VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qi.queryType = VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR;
+    qi.queryCount = static_cast<uint32_t>(record.compactEntries.size());
+    VkQueryPool pool = VK_NULL_HANDLE;
+    VkResult r = c.vk.vkCreateQueryPool(c.desc.device, &qi, c.allocator(), &pool);
+    if (r != VK_SUCCESS) return undo(vulkanError(r, "vkCreateQueryPool (compacted sizes)"));
+    record.compactedSizes = pool;
   }
 
   std::vector<VkAccelerationStructureGeometryKHR> geometries(batch.size());
   std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges(batch.size());
   std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> rangePtrs(batch.size());
   std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos(batch.size());
-  BuildBatch record;
-  record.frame = c.frame;
   VkDeviceSize offset = 0;
   for (size_t i = 0; i < batch.size(); ++i) {
     BlasEntry& e = entries[batch[i]];
-    Result<StorageAllocation> alloc = storage.allocate(e.sizes.accelerationStructureSize);
-    if (!alloc) return alloc.error();
-    Result<VkAccelerationStructureKHR> as = createAs(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
-                                                     storage.buffer(alloc->block), alloc->offset,
-                                                     e.sizes.accelerationStructureSize);
-    if (!as) {
-      storage.free(alloc.value());
-      return as.error();
-    }
-    e.as = as.value();
-    e.storage = alloc.value();
     VkAccelerationStructureDeviceAddressInfoKHR ai{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
     ai.accelerationStructure = e.as;
     e.address = c.vk.vkGetAccelerationStructureDeviceAddressKHR(c.desc.device, &ai);
@@ -535,29 +591,14 @@ Status AccelerationStructureService::Impl::recordBuildBatch(VkCommandBuffer cmd,
     info.scratchData.deviceAddress = scratchBase + offset;
     offset += alignUp(e.sizes.buildScratchSize, align);
     record.triangles += e.mesh.desc.triangleCount;
-    if (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR) {
-      record.compactEntries.push_back(batch[i]);
-      record.compactGenerations.push_back(e.generation);
-      e.compactionPending = true;
-    }
+    e.compactionPending = (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR) != 0;
   }
   record.builds = static_cast<uint32_t>(batch.size());
 
-  if (!desc.disableTimestamps && c.info.timestampsSupported) {
-    Result<VkQueryPool> pool = takeTimestampPool(freeTimestampPools, "build timestamps");
-    if (!pool) return pool.error();
-    record.timestamps = pool.value();
-    c.vk.vkCmdResetQueryPool(cmd, record.timestamps, 0, 2);
+  if (record.timestamps) c.vk.vkCmdResetQueryPool(cmd, record.timestamps, 0, 2);
+  if (record.compactedSizes) {
+    c.vk.vkCmdResetQueryPool(cmd, record.compactedSizes, 0, static_cast<uint32_t>(record.compactEntries.size()));
   }
-  if (!record.compactEntries.empty()) {
-    VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-    qi.queryType = VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR;
-    qi.queryCount = static_cast<uint32_t>(record.compactEntries.size());
-    VkResult r = c.vk.vkCreateQueryPool(c.desc.device, &qi, c.allocator(), &record.compactedSizes);
-    if (r != VK_SUCCESS) return vulkanError(r, "vkCreateQueryPool (compacted sizes)");
-    c.vk.vkCmdResetQueryPool(cmd, record.compactedSizes, 0, qi.queryCount);
-  }
-
   // Orders this batch after earlier users of the scratch memory and the storage (earlier batches, earlier
   // frames on the same queue).
   recordAsBarrier(c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
@@ -590,6 +631,7 @@ Result<uint32_t> AccelerationStructureService::recordPendingWork(VkCommandBuffer
   s.handOnDeferredRetires();
   if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "recordPendingWork: cmd is VK_NULL_HANDLE"};
   s.resolveBatches();
+  if (!s.queryError) return std::exchange(s.queryError, Status()).error();
   bool recordedAny = false;
   if (Status st = s.recordCompactions(cmd, recordedAny); !st) return st.error();
 

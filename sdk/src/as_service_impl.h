@@ -191,6 +191,7 @@ struct AccelerationStructureService::Impl {
   std::vector<BuildBatch> inFlightBatches;
   std::vector<VkQueryPool> freeTimestampPools;
   std::vector<BuildBatchTiming> timings;
+  Status queryError;  // see resolveBatches()
   std::vector<TlasSlot> tlasSlots;
   uint64_t tlasSerial = 0;
   uint32_t lastTlasSlot = UINT32_MAX;  // slot of the TLAS recorded last
@@ -227,6 +228,8 @@ struct AccelerationStructureService::Impl {
   uint32_t liveRegistrations() const;
   void destroyEntry(uint32_t index);  // retires its AS and storage; frees the slot
   Status makeRoom(VkDeviceSize bytes, const std::string& forWhat);
+  // Reads the queries of the batches whose frames are done, and releases them. A failed read (a lost device) is
+  // kept in queryError, which the next recordPendingWork() returns.
   void resolveBatches();
   void addTiming(const BuildBatchTiming& timing);
   Status recordCompactions(VkCommandBuffer cmd, bool& recordedAny);

@@ -6,20 +6,25 @@ Status AsyncSubmitter::create(Context::Impl& c, VkQueue queue, uint32_t family) 
   c_ = &c;
   queue_ = queue;
   family_ = family;
+  // Created into locals: a failed create leaves its output undefined, and destroy() destroys the members.
   VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   pi.queueFamilyIndex = family;
-  VkResult r = c.vk.vkCreateCommandPool(c.desc.device, &pi, c.allocator(), &pool_);
+  VkCommandPool pool = VK_NULL_HANDLE;
+  VkResult r = c.vk.vkCreateCommandPool(c.desc.device, &pi, c.allocator(), &pool);
   if (r != VK_SUCCESS) return vulkanError(r, "vkCreateCommandPool (async BLAS builds)");
+  pool_ = pool;
   VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
   type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
   type.initialValue = 0;
   VkSemaphoreCreateInfo si{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
-  r = c.vk.vkCreateSemaphore(c.desc.device, &si, c.allocator(), &semaphore_);
+  VkSemaphore semaphore = VK_NULL_HANDLE;
+  r = c.vk.vkCreateSemaphore(c.desc.device, &si, c.allocator(), &semaphore);
   if (r != VK_SUCCESS) {
     destroy();
     return vulkanError(r, "vkCreateSemaphore (async BLAS timeline; is the timelineSemaphore feature enabled?)");
   }
+  semaphore_ = semaphore;
   return {};
 }
 
@@ -36,13 +41,20 @@ void AsyncSubmitter::destroy() {
 
 uint64_t AsyncSubmitter::completedValue() const {
   uint64_t value = 0;
-  if (semaphore_) c_->vk.vkGetSemaphoreCounterValue(c_->desc.device, semaphore_, &value);
-  return value;
+  // On an error (a lost device) the value read last: nothing counts as done that was not seen done.
+  if (semaphore_ && c_->vk.vkGetSemaphoreCounterValue(c_->desc.device, semaphore_, &value) == VK_SUCCESS) {
+    completed_ = value;
+  }
+  return completed_;
 }
 
 Result<VkCommandBuffer> AsyncSubmitter::begin() {
   Context::Impl& c = *c_;
-  const uint64_t done = completedValue();
+  uint64_t done = 0;
+  if (VkResult r = c.vk.vkGetSemaphoreCounterValue(c.desc.device, semaphore_, &done); r != VK_SUCCESS) {
+    return vulkanError(r, "vkGetSemaphoreCounterValue (async BLAS timeline)");
+  }
+  completed_ = done;
   Slot* slot = nullptr;
   for (Slot& s : slots_) {
     if (!s.recording && s.value <= done) {

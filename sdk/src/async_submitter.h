@@ -19,7 +19,7 @@ class AsyncSubmitter {
   bool active() const { return semaphore_ != VK_NULL_HANDLE; }
 
   // A command buffer in the recording state: one whose submission the timeline shows finished (checked without
-  // blocking), else a newly allocated one.
+  // blocking), else a newly allocated one. Fails naming the call when the timeline cannot be read (a lost device).
   Result<VkCommandBuffer> begin();
   // Ends `cmd` and submits it waiting on `ready` (stages `readyStages`), signalling the next timeline value,
   // which it returns.
@@ -27,7 +27,9 @@ class AsyncSubmitter {
   // Ends a command buffer begin() gave out that will not be submitted, and makes it reusable.
   void abandon(VkCommandBuffer cmd);
 
-  uint64_t completedValue() const;  // the timeline's current value (non-blocking)
+  // The timeline's current value (non-blocking); where reading it fails (a lost device), the value read last.
+  // begin() reports such a failure.
+  uint64_t completedValue() const;
   uint64_t lastSubmitted() const { return lastValue_; }
   VkSemaphore semaphore() const { return semaphore_; }
   uint32_t family() const { return family_; }
@@ -44,6 +46,7 @@ class AsyncSubmitter {
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkSemaphore semaphore_ = VK_NULL_HANDLE;
   uint64_t lastValue_ = 0;
+  mutable uint64_t completed_ = 0;  // the timeline's value read last
   std::vector<Slot> slots_;
 };
 

@@ -25,6 +25,7 @@ Result<ComputePipeline> ComputePipeline::create(Context& ctx, const SpirvModule&
   pl.pPushConstantRanges = &range;
   r = c.vk.vkCreatePipelineLayout(c.desc.device, &pl, c.allocator(), &p.layout);
   if (r != VK_SUCCESS) {
+    p.layout = VK_NULL_HANDLE;  // undefined after a failed create
     p.destroy(ctx);
     return vulkanError(r, std::string("vkCreatePipelineLayout for ") + name);
   }

@@ -69,6 +69,9 @@ struct Denoiser::Impl {
   DenoiseOutputs outputs;
   uint32_t parity = 0;  // which of each ping-pong pair this frame writes
   bool historyValid = false;
+  // The images hold what a record() wrote, in the layouts it left them in (false from their creation until then:
+  // adaptive rays read the history only when it is true).
+  bool imagesWritten = false;
   double previousViewProjection[16] = {};
   double previousCamera[3] = {};
   explicit Impl(Context& c) : ctx(c) {}
@@ -178,14 +181,16 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
                                          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial A"},
                                          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial B"},
                                          {VK_FORMAT_R32G32_UINT, "denoiser RGB guide"}};
-  bool resized = s.images.size() == 0 || s.images[0].width != g.width || s.images[0].height != g.height;
+  // New images (a new size, or a set an earlier failure left incomplete) hold no history.
+  bool resized = s.images.size() != specs.size() || s.images[0].width != g.width || s.images[0].height != g.height;
+  if (resized) s.imagesWritten = false;  // even when ensure() fails: it replaces what there was
   if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
   if (resized) s.historyValid = false;
   const PassImages& im = s.images;
   const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   const uint32_t cur = s.parity, prev = 1 - s.parity;
 
-  s.metrics.beginRecording(ctx, cmd);
+  if (Status st = s.metrics.beginRecording(ctx, cmd); !st) return st;
   s.metrics.writeStart(ctx, cmd);
   BarrierBatch batch{vk, cmd};
   auto barrier = [&](const GpuImage& img, VkImageLayout from, VkImageLayout to, VkAccessFlags src, VkAccessFlags dst) {
@@ -238,6 +243,7 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   flush(cs, readers);
   // A history written without temporal filtering holds one frame only: the next frame starts afresh anyway.
   s.historyValid = !settings.disableTemporal;
+  s.imagesWritten = true;
   s.parity = prev;
 
   const GpuImage* last = &im[4];
@@ -292,13 +298,14 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
   // New images (a new size, or a step count that needs the second spatial image or no longer does) hold no history.
   const bool recreated = s.images.size() != specs.size() || s.images[0].width != g.width ||
                          s.images[0].height != g.height;
+  if (recreated) s.imagesWritten = false;  // even when ensure() fails: it replaces what there was
   if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
   if (recreated) s.historyValid = false;
   const PassImages& im = s.images;
   const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   const uint32_t cur = s.parity, prev = 1 - s.parity;
 
-  s.metrics.beginRecording(ctx, cmd);
+  if (Status st = s.metrics.beginRecording(ctx, cmd); !st) return st;
   s.metrics.writeStart(ctx, cmd);
   BarrierBatch batch{vk, cmd};
   const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
@@ -338,6 +345,7 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
   for (uint32_t i : {cur, 2 + cur, 4u}) batch.add(im[i], gen, ro, write, read);
   // A history written without temporal filtering holds one frame only: the next frame starts afresh anyway.
   s.historyValid = !settings.disableTemporal;
+  s.imagesWritten = true;
   s.parity = prev;
 
   pc.flags = flags;
@@ -457,7 +465,7 @@ DenoiserHistory latestHistory(const Denoiser& denoiser, const GBufferDesc& g) {
   const Denoiser::Impl& s = DenoiserAccess::impl(denoiser);
   DenoiserHistory h;
   // Scalar images: 0,1 the history ping-pong, 2,3 the distances; the latest record() wrote 1 - parity.
-  if (s.signal != DenoiseSignal::Scalar || s.images.size() < 4 || s.images[0].width != g.width ||
+  if (s.signal != DenoiseSignal::Scalar || !s.imagesWritten || s.images.size() < 4 || s.images[0].width != g.width ||
       s.images[0].height != g.height) {
     return h;
   }

@@ -72,14 +72,16 @@ Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFla
   }
   out.memory = memory.value();
   out.allocatedBytes = req.size;
-  c.vk.vkBindBufferMemory(c.desc.device, out.buffer, out.memory, 0);
-  if (location != MemoryLocation::DeviceLocal) {
+  r = c.vk.vkBindBufferMemory(c.desc.device, out.buffer, out.memory, 0);
+  const char* failed = r != VK_SUCCESS ? "vkBindBufferMemory" : nullptr;
+  if (!failed && location != MemoryLocation::DeviceLocal) {
     r = c.vk.vkMapMemory(c.desc.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
-    if (r != VK_SUCCESS) {
-      c.vk.vkDestroyBuffer(c.desc.device, out.buffer, c.allocator());
-      c.vk.vkFreeMemory(c.desc.device, out.memory, c.allocator());
-      return vulkanError(r, std::string("vkMapMemory for ") + what);
-    }
+    if (r != VK_SUCCESS) failed = "vkMapMemory";
+  }
+  if (failed) {
+    c.vk.vkDestroyBuffer(c.desc.device, out.buffer, c.allocator());
+    c.vk.vkFreeMemory(c.desc.device, out.memory, c.allocator());
+    return vulkanError(r, std::string(failed) + " for " + what);
   }
   if (deviceAddress) {
     VkBufferDeviceAddressInfo addr{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
@@ -136,7 +138,12 @@ Result<GpuImage> createStorageImage(Context& ctx, uint32_t width, uint32_t heigh
   }
   out.memory = memory.value();
   out.allocatedBytes = req.size;
-  c.vk.vkBindImageMemory(c.desc.device, out.image, out.memory, 0);
+  r = c.vk.vkBindImageMemory(c.desc.device, out.image, out.memory, 0);
+  if (r != VK_SUCCESS) {
+    c.vk.vkDestroyImage(c.desc.device, out.image, c.allocator());
+    c.vk.vkFreeMemory(c.desc.device, out.memory, c.allocator());
+    return vulkanError(r, std::string("vkBindImageMemory for ") + what);
+  }
   VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   view.image = out.image;
   view.viewType = VK_IMAGE_VIEW_TYPE_2D;

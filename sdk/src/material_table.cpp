@@ -58,8 +58,10 @@ Result<std::unique_ptr<MaterialTable>> MaterialTable::create(Context& context) {
   si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
   si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
   si.maxLod = VK_LOD_CLAMP_NONE;
-  VkResult r = c.vk.vkCreateSampler(c.desc.device, &si, c.allocator(), &impl->textureSampler);
+  VkSampler sampler = VK_NULL_HANDLE;  // not the member: a failed create leaves its output undefined
+  VkResult r = c.vk.vkCreateSampler(c.desc.device, &si, c.allocator(), &sampler);
   if (r != VK_SUCCESS) return vulkanError(r, "vkCreateSampler (material textures)");
+  impl->textureSampler = sampler;
   std::unique_ptr<MaterialTable> table(new MaterialTable(std::move(impl)));
   Material defaultMaterial;
   if (Status s = table->setMaterials(std::span(&defaultMaterial, 1), {}); !s) return s.error();

@@ -116,7 +116,7 @@ void PassCore::bind(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w
 Status PassCore::begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
                        const std::vector<PassImages::Spec>& outputs) {
   if (Status s = images.ensure(ctx, g.width, g.height, outputs); !s) return s;
-  metrics.beginRecording(ctx, cmd);
+  if (Status s = metrics.beginRecording(ctx, cmd); !s) return s;
   metrics.writeStart(ctx, cmd);
   images.beginWrite(ctx, cmd);
   return {};

@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <string>
+#include <utility>
 
 #include "context_impl.h"
 #include "memory_barrier.h"
@@ -19,6 +20,7 @@ constexpr VkPipelineStageFlags kCounterShaderStages = VK_PIPELINE_STAGE_RAY_TRAC
 Status PassMetrics::init(Context& ctx, const char* passName, bool countsRays) {
   Context::Impl& c = internal::contextImpl(ctx);
   const uint32_t slots = c.desc.framesInFlight;
+  name_ = passName;
   if (countsRays) {
     const VkDeviceSize bytes = VkDeviceSize(slots) * kCountersPerFrame * sizeof(uint32_t);
     Result<GpuBuffer> b = createBuffer(ctx, bytes,
@@ -42,8 +44,10 @@ Status PassMetrics::init(Context& ctx, const char* passName, bool countsRays) {
     VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
     qi.queryCount = 2 * slots;
-    VkResult r = c.vk.vkCreateQueryPool(c.desc.device, &qi, c.allocator(), &timestamps_);
+    VkQueryPool pool = VK_NULL_HANDLE;  // not the member: a failed create leaves its output undefined
+    VkResult r = c.vk.vkCreateQueryPool(c.desc.device, &qi, c.allocator(), &pool);
     if (r != VK_SUCCESS) return vulkanError(r, std::string("vkCreateQueryPool for ") + passName);
+    timestamps_ = pool;
   }
   return {};
 }
@@ -76,9 +80,12 @@ void PassMetrics::collect(Context& ctx) {
     }
     if (timing_) {
       uint64_t ticks[2] = {0, 0};
-      if (c.vk.vkGetQueryPoolResults(c.desc.device, timestamps_, 2 * slot, 2, sizeof ticks, ticks, sizeof(uint64_t),
-                                     VK_QUERY_RESULT_64_BIT) == VK_SUCCESS) {
+      const VkResult r = c.vk.vkGetQueryPoolResults(c.desc.device, timestamps_, 2 * slot, 2, sizeof ticks, ticks,
+                                                    sizeof(uint64_t), VK_QUERY_RESULT_64_BIT);
+      if (r == VK_SUCCESS) {
         s.gpuMs = double(c.info.timestampTicks(ticks[0], ticks[1])) * c.info.timestampPeriodNs * 1e-6;
+      } else if (r != VK_NOT_READY && readError_) {
+        readError_ = vulkanError(r, std::string("vkGetQueryPoolResults (") + name_ + " timestamps)");
       }
     }
     if (s.frame >= latest_.frame) latest_ = s;
@@ -86,13 +93,14 @@ void PassMetrics::collect(Context& ctx) {
   }
 }
 
-void PassMetrics::beginRecording(Context& ctx, VkCommandBuffer cmd) {
+Status PassMetrics::beginRecording(Context& ctx, VkCommandBuffer cmd) {
   collect(ctx);
+  if (!readError_) return std::exchange(readError_, Status());
   Context::Impl& c = internal::contextImpl(ctx);
   const uint32_t slot = static_cast<uint32_t>(c.frame % c.desc.framesInFlight);
   recordedFrame_[slot] = c.frame;
   if (timing_) c.vk.vkCmdResetQueryPool(cmd, timestamps_, 2 * slot, 2);
-  if (!counters_.valid()) return;
+  if (!counters_.valid()) return {};
   // After any earlier use of the counters in this command buffer (the pass recorded twice in a frame): clear, then
   // let the shaders add.
   // TRANSFER_WRITE in the first scope: the earlier recording's fill and readback copy (write after write).
@@ -103,6 +111,7 @@ void PassMetrics::beginRecording(Context& ctx, VkCommandBuffer cmd) {
   c.vk.vkCmdFillBuffer(cmd, counters_.buffer, slot * counterBytes(), counterBytes(), 0u);
   recordMemoryBarrier(c.vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kCounterShaderStages,
                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  return {};
 }
 
 void PassMetrics::writeStart(Context& ctx, VkCommandBuffer cmd) {

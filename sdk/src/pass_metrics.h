@@ -27,8 +27,9 @@ class PassMetrics {
   void retire(Context& ctx);
 
   // Collects finished frames, then clears this frame's counters on the GPU (a fill behind a barrier). Call before
-  // recording the pass, outside a render pass.
-  void beginRecording(Context& ctx, VkCommandBuffer cmd);
+  // recording the pass, outside a render pass. Fails, recording nothing, when a finished frame's timestamps cannot
+  // be read (a lost device); the error names the read.
+  Status beginRecording(Context& ctx, VkCommandBuffer cmd);
   void writeStart(Context& ctx, VkCommandBuffer cmd);
   // The end timestamp, then the copy of this frame's counters to the host-visible readback buffer.
   void writeEnd(Context& ctx, VkCommandBuffer cmd);
@@ -36,7 +37,7 @@ class PassMetrics {
   VkBuffer counterBuffer() const { return counters_.buffer; }
   VkDeviceSize counterOffset(Context& ctx) const;
   VkDeviceSize counterBytes() const { return kCountersPerFrame * sizeof(uint32_t); }
-  // Collects finished frames first.
+  // Collects finished frames first (a frame whose timestamps cannot be read keeps gpuMs 0).
   const PassStats& latest(Context& ctx) {
     collect(ctx);
     return latest_;
@@ -53,6 +54,8 @@ class PassMetrics {
   std::vector<uint64_t> recordedFrame_;  // per slot; UINT64_MAX = nothing pending
   PassStats latest_;
   bool timing_ = false;
+  const char* name_ = "";  // the pass, for errors
+  Status readError_;       // a failed read of finished timestamps, for the next beginRecording() to report
 };
 
 }  // namespace rb

@@ -137,7 +137,7 @@ Status PrimaryRayPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, const P
   w.storageImage(RB_PRIMARY_BINDING_HIT_IDS, targets.hitIds);
   w.storageBuffer(RB_BINDING_RAY_COUNTERS, s.core.metrics.counterBuffer(), s.core.metrics.counterOffset(s.ctx),
                   s.core.metrics.counterBytes());
-  s.core.metrics.beginRecording(s.ctx, cmd);
+  if (Status st = s.core.metrics.beginRecording(s.ctx, cmd); !st) return st;
   s.core.metrics.writeStart(s.ctx, cmd);
   s.core.bind(s.ctx, cmd, w, &pc, sizeof(pc));
   s.core.pipeline.trace(s.ctx, cmd, targets.width, targets.height);

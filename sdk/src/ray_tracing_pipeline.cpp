@@ -45,6 +45,7 @@ Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTra
   pl.pPushConstantRanges = &range;
   r = c.vk.vkCreatePipelineLayout(c.desc.device, &pl, c.allocator(), &p.layout);
   if (r != VK_SUCCESS) {
+    p.layout = VK_NULL_HANDLE;  // undefined after a failed create
     p.destroy(ctx);
     return vulkanError(r, std::string("vkCreatePipelineLayout for ") + desc.name);
   }

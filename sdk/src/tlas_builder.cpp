@@ -249,9 +249,12 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
       VkAccelerationStructureKHR old = slot.tlas;
       c.retire([&c, old] { c.vk.vkDestroyAccelerationStructureKHR(c.desc.device, old, c.allocator()); });
       slot.tlas = VK_NULL_HANDLE;
+      // Until this slot's new TLAS is built, nothing may refit from it (a failure below leaves it unbuilt).
+      if (s.lastTlasSlot == slotIndex) s.lastTlasSlot = UINT32_MAX;
     }
     if (slot.storageCapacity < sizes.accelerationStructureSize) {
       retireBuffer(s.ctx, slot.storage);
+      slot.storageCapacity = 0;  // a failure below leaves no storage: the next call creates it
       Status st = ensureBuffer(s.ctx, slot.storage, sizes.accelerationStructureSize,
                                VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR |
                                    VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,

@@ -330,7 +330,7 @@ std::string Deformer::submit(uint32_t slot, uint64_t value, const ScenePose& pos
   si.pCommandBufferInfos = &cbi;
   si.signalSemaphoreInfoCount = 1;
   si.pSignalSemaphoreInfos = &signal;
-  const VkResult r = vkQueueSubmit2(ctx_->queue, 1, &si, VK_NULL_HANDLE);
+  const VkResult r = ctx_->queueSubmit2(ctx_->queue, 1, &si, VK_NULL_HANDLE);
   pendingWaits_.clear();
   if (r != VK_SUCCESS) return vkFailure("vkQueueSubmit2 (deformation)", r);
   sl.timingPending = sl.timestamps != VK_NULL_HANDLE;

@@ -251,9 +251,24 @@ Status Engine::setRenderSize(uint32_t width, uint32_t height) {
 // Frames, timings
 
 std::string Engine::Impl::waitFrame(FrameResources& frame) {
-  SE_VK_TRY(vkWaitForFences(ctx.device, 1, &frame.fence, VK_TRUE, UINT64_MAX));
+  if (frame.inFlight) {
+    // Only a submitted frame: the fence of one whose submit failed would never signal.
+    if (VkResult r = ctx.waitForFences(ctx.device, 1, &frame.fence, VK_TRUE, UINT64_MAX); r != VK_SUCCESS)
+      return gpuFailure("vkWaitForFences (frame slot)", r);
+    frame.inFlight = false;
+  }
   collectTimings(frame);
   return {};
+}
+
+std::string Engine::Impl::gpuFailure(const char* what, VkResult r) {
+  if (r == VK_ERROR_DEVICE_LOST) deviceLost = true;
+  return vkFailure(what, r);
+}
+
+std::string Engine::Impl::lostDeviceError(const char* call) const {
+  return std::string(call) + ": the device was lost earlier (VK_ERROR_DEVICE_LOST); nothing more can be rendered "
+                             "with it: destroy the engine and create a new one";
 }
 
 void Engine::Impl::collectTimings(FrameResources& frame) {
@@ -285,6 +300,7 @@ void Engine::Impl::collectTimings(FrameResources& frame) {
 }
 
 Status Engine::waitIdle() {
+  if (impl_->deviceLost) return Status::failure(impl_->lostDeviceError("waitIdle"));
   // Oldest first, so the newest frame's timings win.
   std::array<FrameResources*, kFramesInFlight> order;
   for (uint32_t i = 0; i < kFramesInFlight; ++i) order[i] = &impl_->frames[i];
@@ -292,7 +308,7 @@ Status Engine::waitIdle() {
   for (FrameResources* f : order)
     if (std::string e = impl_->waitFrame(*f); !e.empty()) return Status::failure(e);
   VkResult r = vkDeviceWaitIdle(impl_->ctx.device);
-  if (r != VK_SUCCESS) return Status::failure(vkFailure("vkDeviceWaitIdle", r));
+  if (r != VK_SUCCESS) return Status::failure(impl_->gpuFailure("vkDeviceWaitIdle", r));
   // Every submission is done, so every wait a hook left for the next deformation is met: dropping them lets
   // the add-on that owns their semaphores (e.g. an adapter being destroyed) release them.
   impl_->deformer.pendingWaits().clear();

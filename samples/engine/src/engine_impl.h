@@ -52,6 +52,7 @@ struct FrameResources {
   VkDescriptorSet localIrradianceSet = VK_NULL_HANDLE;
   VkQueryPool timestamps = VK_NULL_HANDLE;
   bool timingsPending = false;  // submitted with timestamps, not read back yet
+  bool inFlight = false;        // submitted: the fence signals when it is done (a failed submit leaves it unsignaled)
   bool probeCaptured = false;   // this frame recorded a probe capture
   uint64_t frameNumber = 0;
 };
@@ -118,6 +119,8 @@ struct Engine::Impl {
   LocalShadowStats localShadowStats;
   bool localIrradianceRendered = false;  // the last submitted frame wrote targets.localIrradiance
   uint64_t timingsFrameNumber = 0;
+  // A submit or a fence wait returned VK_ERROR_DEVICE_LOST: every later frame, wait and readback fails at once.
+  bool deviceLost = false;
 
   ~Impl();
   std::string init(const EngineConfig& config);
@@ -126,6 +129,9 @@ struct Engine::Impl {
   void destroyTargets();
   void collectTimings(FrameResources& frame);
   std::string waitFrame(FrameResources& frame);
+  // The error of a failed submit or wait (`what` names the call); remembers a lost device.
+  std::string gpuFailure(const char* what, VkResult r);
+  std::string lostDeviceError(const char* call) const;
 
   // frame_recorder.cpp
   std::string renderFrame(const FrameParams& params);

@@ -35,6 +35,7 @@ glm::mat4 lightViewProjection(const Bounds& bounds, const glm::vec3& towardsSun,
 }  // namespace
 
 std::string Engine::Impl::renderFrame(const FrameParams& params) {
+  if (deviceLost) return lostDeviceError("renderFrame");
   if (targets.extent.width == 0) return "renderFrame: no render size (call setRenderSize or attachSurface)";
   static const Scene kNoScene;
   if (Status s = checkPlayback(sceneLoaded ? scene.cpu : kNoScene, params.time, params.animations); !s)
@@ -183,7 +184,9 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
     si.pSignalSemaphoreInfos = &signalInfo;
   }
   SE_VK_TRY(vkResetFences(ctx.device, 1, &frame.fence));
-  SE_VK_TRY(vkQueueSubmit2(ctx.queue, 1, &si, frame.fence));
+  if (VkResult r = ctx.queueSubmit2(ctx.queue, 1, &si, frame.fence); r != VK_SUCCESS)
+    return gpuFailure("vkQueueSubmit2 (frame)", r);
+  frame.inFlight = true;
   frame.timingsPending = frame.timestamps != VK_NULL_HANDLE;
   lastSubmittedSlot = slot;
   currentFrame = (currentFrame + 1) % kFramesInFlight;

@@ -9,7 +9,14 @@ namespace sample_engine::detail {
 
 std::string vkResultName(VkResult r);
 
-inline std::string vkFailure(const char* what, VkResult r) { return std::string(what) + " failed: " + vkResultName(r); }
+inline std::string vkFailure(const char* what, VkResult r) {
+  std::string message = std::string(what) + " failed: " + vkResultName(r);
+  if (r == VK_ERROR_DEVICE_LOST) {
+    message += " (device lost: the GPU stopped executing this device's work, e.g. after a fault, a hang or a driver "
+               "reset; nothing more can be rendered with it: destroy the engine and create a new one)";
+  }
+  return message;
+}
 
 }  // namespace sample_engine::detail
 

@@ -92,6 +92,8 @@ struct Candidate {
 }  // namespace
 
 std::string VulkanContext::create(const EngineConfig& config) {
+  queueSubmit2 = config.queueSubmit2 ? config.queueSubmit2 : &vkQueueSubmit2;
+  waitForFences = config.waitForFences ? config.waitForFences : &vkWaitForFences;
   // --- Instance ---
   std::vector<const char*> layers;
   std::vector<std::string> instanceExts = config.instanceExtensions;

@@ -33,6 +33,9 @@ struct VulkanContext {
   float timestampPeriodNs = 1.0f;
   bool timestampsSupported = false;
   VkPhysicalDeviceProperties properties{};
+  // The frame loop's submit and fence wait: the loader's, or EngineConfig's test hooks.
+  PFN_vkQueueSubmit2 queueSubmit2 = nullptr;
+  PFN_vkWaitForFences waitForFences = nullptr;
   std::unique_ptr<ValidationCounters> counters = std::make_unique<ValidationCounters>();
 
   // Returns an error message, empty on success. On failure the partially created objects are destroyed

@@ -371,7 +371,9 @@ class AccelerationStructureService {
   // Records compaction copies and queued builds into `cmd` within the scratch budget, followed by a barrier that
   // makes them visible to TLAS builds; in DynamicBuildMode::InFrame and the async fallback also the frame's
   // dynamic work (first builds, refits, rebuilds and their measure, once per frame), which binds a compute
-  // pipeline and push constants in `cmd`. Returns how many builds are still queued.
+  // pipeline and push constants in `cmd`. Returns how many builds are still queued. On an error the builds it could
+  // not record stay queued for the next call; a failed read of earlier builds' queries (a lost device) is returned
+  // too, naming vkGetQueryPoolResults.
   Result<uint32_t> recordPendingWork(VkCommandBuffer cmd);
   // Writes this frame slot's instance buffer and records the TLAS build, followed by a barrier that makes the
   // TLAS readable by ray tracing shaders. Instances of meshes not built yet are skipped (counted). Once per

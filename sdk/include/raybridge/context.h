@@ -10,6 +10,12 @@
 // drops when the memory is actually freed. Exceptions: ~AccelerationStructureService and ~Context, whose
 // contract is that the GPU is done (see there).
 //
+// Failures: a call whose Vulkan call fails (out of memory, say) returns ErrorCode::VulkanError naming that call
+// and its VkResult, and leaves its object consistent: the engine destroys it (nothing leaks) or calls again (the
+// next frame), which picks up where the failure stopped. A lost device shows as the error of the next call that reads
+// query results (VK_ERROR_DEVICE_LOST from vkGetQueryPoolResults: a pass's or Denoiser's record(),
+// recordPendingWork()); the statistics then go without timings, and destruction stays clean (docs/reliability.md).
+//
 // Thread safety: a Context is externally synchronised. Calls on one context (and on the services and passes
 // created from it) must not overlap; distinct contexts may be used from distinct threads.
 #pragma once

@@ -113,6 +113,13 @@ struct EngineConfig {
   // first discrete GPU, else the first device that works.
   std::string deviceNameFilter;
   std::string applicationName = "raybridge-sample-engine";
+  // Test hooks (failure injection): the functions the frame loop submits with (each frame's and its deformation's
+  // vkQueueSubmit2) and waits for a frame slot's fence with. nullptr = the loader's vkQueueSubmit2 and
+  // vkWaitForFences. A replacement forwards to those, or returns an error such as VK_ERROR_DEVICE_LOST to see how
+  // the engine reports it: renderFrame() and waitIdle() return the error, and after a lost device every later call
+  // fails at once saying so; the engine can still be destroyed.
+  PFN_vkQueueSubmit2 queueSubmit2 = nullptr;
+  PFN_vkWaitForFences waitForFences = nullptr;
 };
 
 // Limits of ShadowSettings (see there).
