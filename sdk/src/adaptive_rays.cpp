@@ -9,6 +9,7 @@
 #include "denoiser_history.h"
 #include "image_barriers.h"
 #include "memory_barrier.h"
+#include "pass_core.h"
 #include "raybridge_shaders.h"
 
 namespace rb {
@@ -192,6 +193,21 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
   vk.vkCmdPipelineBarrier(cmd, cs, rt | cs | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1,
                           &planned);
   return true;
+}
+
+Result<bool> AdaptiveRayPlanner::recordForPass(PassCore& core, Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
+                                               const AdaptiveRaySettings& settings, uint32_t raysPerPixel,
+                                               const PassStats& latest, const char* who, DescriptorWrites& w) {
+  if (!settings.enabled) return false;
+  Result<bool> planned = record(ctx, cmd, g, settings, raysPerPixel, latest, who);
+  if (!planned) {
+    core.end(ctx, cmd);
+    return planned.error();
+  }
+  if (planned.value()) {
+    w.sampledImage(RB_BINDING_RAY_PLAN, planView(), core.sampler, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  }
+  return planned;
 }
 
 }  // namespace rb

@@ -15,6 +15,8 @@
 
 namespace rb {
 
+struct PassCore;
+
 class AdaptiveRayPlanner {
  public:
   // Checks the settings (`needHistory` = false: all but AdaptiveRaySettings::history, which the caller fills
@@ -29,6 +31,13 @@ class AdaptiveRayPlanner {
   // history mean in SHADER_READ_ONLY_OPTIMAL, visible to ray tracing, compute and fragment shaders.
   Result<bool> record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const AdaptiveRaySettings& settings,
                       uint32_t raysPerPixel, const PassStats& latest, const char* who);
+  // What a pass does with it each frame, between its PassCore::begin() and its trace: record() when `settings` are
+  // enabled, and bind the plan at RB_BINDING_RAY_PLAN of `w` with the pass's sampler. On an error the pass's
+  // recording is ended (its outputs stay in a known layout; nothing is traced). Returns whether the frame was
+  // planned: the pass then traces with its adaptive ray generation module.
+  Result<bool> recordForPass(PassCore& core, Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
+                             const AdaptiveRaySettings& settings, uint32_t raysPerPixel, const PassStats& latest,
+                             const char* who, DescriptorWrites& w);
   VkImageView planView() const { return images_.size() > 1 ? images_[1].view : VK_NULL_HANDLE; }
   VkImage planImage() const { return images_.size() > 1 ? images_[1].image : VK_NULL_HANDLE; }
   // The ray budget of the latest record() (UINT32_MAX when it was the uniform rays, resolved on the GPU).

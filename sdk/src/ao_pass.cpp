@@ -93,20 +93,12 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   const PassStats latest = s.core.metrics.latest(s.ctx);
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}}); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
-  bool planned = false;
-  if (settings.adaptive.enabled) {
-    // With half resolution the plan covers every pixel and the traced quarter uses its entries: a quarter of the
-    // budget is traced (a time target compensates, it measures the rays traced).
-    Result<bool> r = s.planner.record(s.ctx, cmd, g, settings.adaptive, pc.raysPerPixel, latest, "AoPass");
-    if (!r) {
-      s.core.end(s.ctx, cmd);  // the outputs stay in a known layout; nothing was traced
-      return r.error();
-    }
-    planned = r.value();
-  }
-  if (planned) {
-    w.sampledImage(RB_BINDING_RAY_PLAN, s.planner.planView(), s.core.sampler, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  }
+  // With half resolution the plan covers every pixel and the traced quarter uses its entries: a quarter of the
+  // budget is traced (a time target compensates: it scales the budget it planned by the time measured).
+  Result<bool> plan = s.planner.recordForPass(s.core, s.ctx, cmd, g, settings.adaptive, pc.raysPerPixel, latest,
+                                              "AoPass", w);
+  if (!plan) return plan.error();
+  const bool planned = plan.value();
   const RayTracingPipeline* variant = planned ? &s.adaptivePipeline : nullptr;
   if (settings.halfResolution) {
     w.storageImage(RB_AO_BINDING_OUTPUT, s.half.samplesView());

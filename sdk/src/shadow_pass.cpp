@@ -163,18 +163,12 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   };
   s.core.writeCommon(s.ctx, w, g, tlas);
   writeOutputs(w);
-  bool planned = false;
-  if (adaptive) {
-    Result<bool> r = s.planner.record(s.ctx, cmd, g, settings.adaptive, pc.raysPerPixel, latest, "ShadowPass");
-    if (!r) {
-      s.core.end(s.ctx, cmd);  // the outputs stay in a known layout; nothing was traced
-      return r.error();
-    }
-    planned = r.value();
-  }
-  if (planned) {
-    w.sampledImage(RB_BINDING_RAY_PLAN, s.planner.planView(), s.core.sampler, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  }
+  AdaptiveRaySettings planning = settings.adaptive;
+  planning.enabled = adaptive;  // a hard light traces its one ray uniformly
+  Result<bool> plan = s.planner.recordForPass(s.core, s.ctx, cmd, g, planning, pc.raysPerPixel, latest, "ShadowPass",
+                                              w);
+  if (!plan) return plan.error();
+  const bool planned = plan.value();
   const RayTracingPipeline* variant = planned ? &s.adaptivePipeline : nullptr;
   if (!settings.tileClassifier) {
     s.core.traceAndEnd(s.ctx, cmd, w, pc, g, variant);
