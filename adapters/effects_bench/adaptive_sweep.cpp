@@ -35,7 +35,6 @@ struct Effect {
   rb::PassStats Stats::*denoise = nullptr;
   const char* rawImage = "";
   const char* denoisedImage = "";
-  rb::AdaptiveRaySettings rb::HybridEffectsDesc::*adaptive = nullptr;
   std::function<void(rb::HybridEffectsDesc&, uint32_t)> setRays;
   std::vector<uint32_t> rays;
   uint32_t referenceRays = 0;
