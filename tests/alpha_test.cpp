@@ -630,7 +630,6 @@ TEST_CASE("the effects front end alpha-tests its shadows exactly like the shadow
   frontEnd.light.direction[2] = float(kToSun.z);
   std::vector<float> visibility;
   uint32_t nonOpaqueInstances = 0;
-  rb::PassStats stats;
   runAlphaFrames(
       fx, s, cpu, 1, {},
       [&](const rb::GBufferDesc& desc) {

@@ -196,3 +196,45 @@ TEST_CASE("meshes registered and released on other threads while frames are reco
   service.value().reset();
   for (UploadedMesh& m : uploads) fx.destroy(m);
 }
+
+TEST_CASE("validation errors raised on several threads at once are all kept", "[context][validation][threads]") {
+  // The debug messenger calls back on the thread that made the Vulkan call: with registerMesh on streaming
+  // threads, that is any thread. A deliberate misuse (a zero-sized buffer) on a device of its own, from several
+  // threads at once, while this thread reads the count (the ThreadSanitizer job runs this case).
+  rb::HeadlessDeviceDesc desc;
+  desc.enableValidation = true;
+  desc.requireValidation = true;
+  auto dev = rb::HeadlessDevice::create(desc);
+  RB_REQUIRE_OK(dev);
+  rb::HeadlessDevice& device = *dev.value();
+  REQUIRE(device.validationEnabled());
+  auto createBuffer = reinterpret_cast<PFN_vkCreateBuffer>(device.deviceProc("vkCreateBuffer"));
+  auto destroyBuffer = reinterpret_cast<PFN_vkDestroyBuffer>(device.deviceProc("vkDestroyBuffer"));
+  constexpr int kCallsPerThread = 100;
+  std::atomic<int> running{kThreads};
+  std::atomic<bool> go{false};  // all threads start together, so their calls overlap
+  auto misuse = [&] {
+    while (!go.load()) std::this_thread::yield();
+    for (int i = 0; i < kCallsPerThread; ++i) {
+      VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+      info.size = 0;  // invalid: size must be greater than 0
+      info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+      VkBuffer buffer = VK_NULL_HANDLE;
+      if (createBuffer(device.device(), &info, nullptr, &buffer) == VK_SUCCESS && buffer)
+        destroyBuffer(device.device(), buffer, nullptr);
+    }
+    --running;
+  };
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) threads.emplace_back(misuse);
+  go = true;
+  uint32_t seen = 0;
+  while (running.load() > 0) {
+    seen = std::max(seen, device.validationErrorCount());
+    (void)device.validationErrors();
+  }
+  for (std::thread& t : threads) t.join();
+  CHECK(device.validationErrorCount() >= uint32_t(kThreads * kCallsPerThread));
+  CHECK(device.validationErrors().size() == device.validationErrorCount());
+  CHECK(seen <= device.validationErrorCount());
+}

@@ -203,9 +203,10 @@ se::Result<EffectResult> runShadowSweep(FrameDriver& driver, const SweepPlan& pl
     rs.setting = "map " + std::to_string(size) + ", PCF " + std::to_string(pcf);
     rs.id = "map" + std::to_string(size) + "_pcf" + std::to_string(pcf);
     rs.params = {{"map_size", size}, {"pcf_kernel", pcf}};
-    rs.apply = [size, pcf](se::FrameParams& p) {
-      p.shadow.mapSize = size;
-      p.shadow.pcfKernelSize = pcf;
+    // Init-captures: Clang before 16 cannot capture structured bindings by name.
+    rs.apply = [mapSize = size, kernel = pcf](se::FrameParams& p) {
+      p.shadow.mapSize = mapSize;
+      p.shadow.pcfKernelSize = kernel;
     };
     fx.raster.push_back(std::move(rs));
   }

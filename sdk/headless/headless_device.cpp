@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,9 @@ struct HeadlessDevice::Impl {
   bool validation = false;
   uint32_t framesInFlight = 2;
   std::string name;
+  // The debug messenger calls onMessage on whichever thread made the Vulkan call (registerMesh runs on streaming
+  // threads), possibly on several at once and while another thread reads the count: `errors` has its own mutex.
+  mutable std::mutex errorsMutex;
   std::vector<std::string> errors;
   VkPhysicalDeviceMemoryProperties memoryProperties{};
 
@@ -61,6 +65,7 @@ struct HeadlessDevice::Impl {
                                                   const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
     if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
       auto* self = static_cast<Impl*>(user);
+      std::lock_guard<std::mutex> lock(self->errorsMutex);
       self->errors.emplace_back(data->pMessage ? data->pMessage : "(no message)");
       if (self->errors.size() <= 20) std::fprintf(stderr, "[validation] %s\n", self->errors.back().c_str());
     }
@@ -277,8 +282,14 @@ PFN_vkGetInstanceProcAddr HeadlessDevice::getInstanceProcAddr() const { return i
 PFN_vkVoidFunction HeadlessDevice::instanceProc(const char* name) const { return impl_->gipa(impl_->instance, name); }
 PFN_vkVoidFunction HeadlessDevice::deviceProc(const char* name) const { return impl_->gdpa(impl_->device, name); }
 std::string HeadlessDevice::deviceName() const { return impl_->name; }
-uint32_t HeadlessDevice::validationErrorCount() const { return static_cast<uint32_t>(impl_->errors.size()); }
-const std::vector<std::string>& HeadlessDevice::validationErrors() const { return impl_->errors; }
+uint32_t HeadlessDevice::validationErrorCount() const {
+  std::lock_guard<std::mutex> lock(impl_->errorsMutex);
+  return static_cast<uint32_t>(impl_->errors.size());
+}
+std::vector<std::string> HeadlessDevice::validationErrors() const {
+  std::lock_guard<std::mutex> lock(impl_->errorsMutex);
+  return impl_->errors;
+}
 bool HeadlessDevice::validationEnabled() const { return impl_->validation; }
 
 ContextDesc HeadlessDevice::contextDesc() const {

@@ -286,8 +286,10 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
 std::string Deformer::submit(uint32_t slot, uint64_t value, const ScenePose& pose) {
   Slot& sl = slots_[slot];
   char* mapped = static_cast<char*>(sl.pose.mapped);
-  std::memcpy(mapped, pose.packedJointMatrices().data(), jointBytes_);  // host-coherent
-  std::memcpy(mapped + jointBytes_, pose.packedMorphWeights().data(), weightBytes_);
+  // host-coherent. A model without skins (or without morph targets) has an empty span, whose data() may be null:
+  // memcpy from a null pointer is undefined even for 0 bytes (UBSan's nonnull-attribute check).
+  if (jointBytes_ != 0) std::memcpy(mapped, pose.packedJointMatrices().data(), jointBytes_);
+  if (weightBytes_ != 0) std::memcpy(mapped + jointBytes_, pose.packedMorphWeights().data(), weightBytes_);
 
   VkCommandBuffer cmd = sl.cmd;
   SE_VK_TRY(vkResetCommandBuffer(cmd, 0));

@@ -22,8 +22,7 @@ using pose_reference::GltfDocumentBuilder;
 
 namespace {
 
-constexpr int kFloat = 5126, kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123,
-              kUnsignedInt = 5125;
+constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123, kUnsignedInt = 5125;
 constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 constexpr int kPoints = 0, kLines = 1, kTriangles = 4, kStrip = 5, kFan = 6;
 

@@ -7,7 +7,9 @@
 // `HeadlessDeviceDesc::deviceNameFilter` or the environment variable RAYBRIDGE_DEVICE (a case-insensitive
 // substring of the device name, e.g. "llvmpipe" or "H100") overrides the choice.
 //
-// Thread safety: not thread-safe; use one HeadlessDevice from one thread at a time.
+// Thread safety: not thread-safe; use one HeadlessDevice from one thread at a time. Except: its validation
+// messages arrive on whichever thread calls Vulkan on the device (e.g. AccelerationStructureService::registerMesh
+// on a streaming thread), so validationErrorCount() and validationErrors() may be called from any thread.
 #pragma once
 
 #include <raybridge/context.h>
@@ -64,9 +66,10 @@ class HeadlessDevice {
   ContextDesc contextDesc() const;
   std::string deviceName() const;
 
-  // Validation messages of severity error seen since creation (always 0 when validation is off).
+  // Validation messages of severity error seen since creation (always 0 when validation is off); a copy, as
+  // another thread may be adding one.
   uint32_t validationErrorCount() const;
-  const std::vector<std::string>& validationErrors() const;
+  std::vector<std::string> validationErrors() const;
   bool validationEnabled() const;
 
   // One-shot recording: begin() returns a command buffer in the recording state; submitAndWait() ends,
