@@ -25,6 +25,7 @@ const float kKernel[3] = float[3](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
 // not this weight, keeps noise-free pixels and edges as they are (measured on the [denoise] tests: 4 left 4-ray AO
 // of unknown noise at 0.0325 RMSE, 6 at 0.0311).
 const float kValueSigmas = 6.0;
+const float kLog2e = 1.4426950408889634;
 
 // The final step's estimate of the filter's squared bias around the pixel: the previous steps' change of each
 // pixel of the 3x3 neighbourhood on the same surface (`same`), squared and averaged, less the noise that change
@@ -61,16 +62,32 @@ void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (any(greaterThanEqual(pixel, pc.size))) return;
   ivec2 ip = ivec2(pixel);
+#ifdef RB_DN_ATROUS_FINAL
+  {
+    // A converged pixel keeps its temporal value whatever the filter gives (rbDnLimitedShift's gain is 0, the same
+    // expression): skip the filter. Bit-identical to filtering and discarding; it is most of the pixels of a
+    // converged signal (lit ground, open sky light, many rays or a full history).
+    vec2 temporal = texelFetch(temporalIn, ip, 0).rg;
+    if (sqrt(max(temporal.g, 0.0)) / pc.convergedNoise - 1.0 <= 0.0) {
+      imageStore(signalOut, ip, vec4(temporal.r));
+      return;
+    }
+  }
+#endif
   vec2 centre = texelFetch(signalIn, ip, 0).rg;
   float depth = texelFetch(gDepth, ip, 0).r;
   if (rbDnSky(depth)) {
     store(ip, centre.r, centre.g, 0.0);
     return;
   }
-  vec3 p = rbDnCameraRelative(pixel, depth);
+  // Positions in view space, the centre's normal turned into it (viewToWorld is a rotation: its transpose is its
+  // inverse): the plane distances are the world-space ones, without a rotation per tap.
+  vec3 p = rbDnViewPosition(pixel, depth);
   vec3 n = rbDnNormal(texelFetch(gNormal, ip, 0));
+  vec3 nView = n * pc.viewToWorld;
   int step = int(pc.atrousStep);
   float tolerance = length(p) * pc.depthSigma * float(step) + 1e-6;
+  float invSigma = 1.0 / (kValueSigmas * sqrt(max(centre.g, 0.0)) + 1e-4);
   float sum = 0.0, weights = 0.0, variances = 0.0;
   bool same[9];  // the 3x3 neighbourhood (step 1) on the centre's surface: the final step's bias estimate
   for (int k = 0; k < 9; ++k) same[k] = false;
@@ -80,16 +97,19 @@ void main() {
       if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(pc.size)))) continue;
       float qd = texelFetch(gDepth, q, 0).r;
       if (rbDnSky(qd)) continue;
-      vec3 qp = rbDnCameraRelative(uvec2(q), qd);
+      vec3 qp = rbDnViewPosition(uvec2(q), qd);
       vec3 qn = rbDnNormal(texelFetch(gNormal, q, 0));
       vec2 qv = texelFetch(signalIn, q, 0).rg;
       // Distance of the neighbour from the centre's tangent plane, relative to the view distance: flat
       // surfaces seen at a grazing angle keep their weight, steps in depth lose it.
-      float planeDistance = abs(dot(qp - p, n)) / tolerance;
+      float planeDistance = abs(dot(qp - p, nView)) / tolerance;
       if (step == 1 && abs(dx) <= 1 && abs(dy) <= 1) same[(dy + 1) * 3 + dx + 1] = planeDistance < 1.0;
-      float sigma = kValueSigmas * sqrt(max(centre.g, 0.0)) + 1e-4;
-      float w = kKernel[abs(dx)] * kKernel[abs(dy)] * exp(-planeDistance - abs(qv.r - centre.r) / sigma) *
-                pow(max(dot(n, qn), 0.0), pc.normalPower);
+      // exp(-planeDistance - valueDistance) * cos^normalPower as one exp2 (one transcendental fewer per tap).
+      float cosine = dot(n, qn);
+      float w = cosine > 0.0 ? kKernel[abs(dx)] * kKernel[abs(dy)] *
+                                   exp2(pc.normalPower * log2(cosine) -
+                                        kLog2e * (planeDistance + abs(qv.r - centre.r) * invSigma))
+                             : 0.0;
       sum += w * (qv.r - centre.r);  // differences: equal values give the centre exactly, without rounding
       variances += w * w * max(qv.g, 0.0);
       weights += w;
@@ -102,7 +122,7 @@ void main() {
     for (int k = 0; k < 9; ++k) {
       ivec2 q = clamp(ip + ivec2(k % 3 - 1, k / 3 - 1), ivec2(0), ivec2(pc.size) - 1);
       float qd = texelFetch(gDepth, q, 0).r;
-      same[k] = !rbDnSky(qd) && abs(dot(rbDnCameraRelative(uvec2(q), qd) - p, n)) * float(step) < tolerance;
+      same[k] = !rbDnSky(qd) && abs(dot(rbDnViewPosition(uvec2(q), qd) - p, nView)) * float(step) < tolerance;
     }
   }
 #endif

@@ -28,14 +28,20 @@ vec3 rbDecodeNormal(vec4 texel, uint encoding) {
 // With standard depth (near 1 far away) w = a * depth + b cancels almost completely; pass
 // wAtDepthOne = a + b (computed in double on the CPU) and w is formed as wAtDepthOne + a * (depth - 1), where
 // depth - 1 is exact. With reversed-Z pass reversedZ = true: the direct form has no cancellation there.
-vec3 rbReconstructCameraRelative(uvec2 pixel, vec2 size, float depth, mat4 inverseProjection, mat3 viewToWorld,
-                                 float wAtDepthOne, bool reversedZ) {
+// rbReconstructViewPosition: the same point in view space (before the rotation into world axes).
+vec3 rbReconstructViewPosition(uvec2 pixel, vec2 size, float depth, mat4 inverseProjection, float wAtDepthOne,
+                               bool reversedZ) {
   vec2 ndc = (vec2(pixel) + 0.5) / size * 2.0 - 1.0;
   vec3 xyz = (inverseProjection * vec4(ndc, depth, 1.0)).xyz;
   float wxy = inverseProjection[0][3] * ndc.x + inverseProjection[1][3] * ndc.y;
   float w = reversedZ ? wxy + inverseProjection[2][3] * depth + inverseProjection[3][3]
                       : wxy + (wAtDepthOne + inverseProjection[2][3] * (depth - 1.0));
-  return viewToWorld * (xyz / w);
+  return xyz / w;
+}
+
+vec3 rbReconstructCameraRelative(uvec2 pixel, vec2 size, float depth, mat4 inverseProjection, mat3 viewToWorld,
+                                 float wAtDepthOne, bool reversedZ) {
+  return viewToWorld * rbReconstructViewPosition(pixel, size, depth, inverseProjection, wAtDepthOne, reversedZ);
 }
 
 #endif

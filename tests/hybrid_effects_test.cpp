@@ -22,6 +22,7 @@ TEST_CASE("preset names round-trip and the table matches the thesis", "[presets]
     const rb::PresetDesc d = rb::presetDesc(p);
     CHECK(bool(d.effects & rb::kEffectShadows) == (d.shadowRaysPerPixel > 0));
     CHECK(bool(d.effects & rb::kEffectAo) == (d.aoRaysPerPixel > 0));
+    CHECK(d.aoHalfResolution == bool(d.effects & rb::kEffectAo));         // every preset with AO traces it at half res
     CHECK((d.raster.mapSize == 0) == !(d.effects & rb::kEffectShadows));  // a raster shadow map iff shadows
   }
   CHECK(rb::parsePreset("shadows") == rb::Preset::SoftShadows);  // the old single-effect name
@@ -43,6 +44,10 @@ TEST_CASE("preset names round-trip and the table matches the thesis", "[presets]
   base.reflections.roughnessThreshold = 0.7f;
   const rb::HybridEffectsDesc low = rb::withPreset(base, rb::Preset::Low);
   CHECK(low.effects == (rb::kEffectShadows | rb::kEffectAo));
+  CHECK(low.ao.halfResolution);
+  CHECK(low.ao.range == 3.0f);
+  CHECK(low.reflections.roughnessThreshold == 0.7f);
+  CHECK(rb::withPreset(low, rb::Preset::HardShadows).ao.halfResolution);  // no AO in the preset: AO fields kept
   CHECK((low.shadows.raysPerPixel == 1 && low.ao.raysPerPixel == 4 && low.ao.range == 3.0f));
   CHECK(low.reflections.roughnessThreshold == 0.7f);
 }

@@ -31,7 +31,8 @@ std::string presetTable() {
     if (d.effects & rb::kEffectShadows)
       parts.push_back(d.shadowRaysPerPixel > 1 ? "soft shadows " + std::to_string(d.shadowRaysPerPixel) + " rays"
                                                : std::string("hard shadows"));
-    if (d.effects & rb::kEffectAo) parts.push_back("AO " + std::to_string(d.aoRaysPerPixel) + " rays");
+    if (d.effects & rb::kEffectAo)
+      parts.push_back("AO " + std::to_string(d.aoRaysPerPixel) + " rays" + (d.aoHalfResolution ? " at half res" : ""));
     if (d.effects & rb::kEffectReflections) parts.push_back("reflections");
     line += parts.empty() ? std::string("no effect") : rbCli::joinNames(parts, ", ");
     if (d.raster.mapSize)
@@ -218,10 +219,13 @@ void addOptions(CLI::App& app, RenderOptions& o) {
       ->check(rbCli::zeroOrWholeNumber(1, 64, "exact"));
   app.add_option_function<std::string>(
          "--half-res",
-         [&o](const std::string& value) { parseHalfResolution(value, o.halfResAo, o.halfResReflections); },
+         [&o](const std::string& value) {
+           parseHalfResolution(value, o.halfResAo, o.halfResReflections);
+           o.halfResGiven = true;
+         },
          "effects traced at half resolution (one pixel per 2x2 block, rotating over 4\n"
          "frames) and upsampled by depth and normals, comma-separated from ao,reflections,\n"
-         "or none (default none)")
+         "or none (default: the preset's; every preset with AO traces it at half resolution)")
       ->type_name("LIST")
       ->check(halfResolutionValidator());
   app.add_flag_callback(
@@ -394,7 +398,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.disableDenoiser = !o.denoise;
   h.ao.adaptive.enabled = o.adaptiveAoMs.has_value();
   h.ao.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
-  h.ao.halfResolution = o.halfResAo;
+  h.ao.halfResolution = o.halfResGiven ? o.halfResAo : p.aoHalfResolution;
 
   const uint32_t lightRays = o.lightRays ? *o.lightRays : kDefaultLightRays;
   h.localLights.mode = lightRays ? rb::ManyLightMode::Stochastic : rb::ManyLightMode::Exact;

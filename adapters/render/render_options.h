@@ -44,7 +44,9 @@ struct RenderOptions {
   // light that reaches the pixel). Else kDefaultLightRays below.
   std::optional<uint32_t> lightRays;
   // --half-res ao,reflections (any subset, or none): the effects traced at half resolution with the depth-aware
-  // upsample (HybridEffectsDesc::ao/reflections.halfResolution). Default none.
+  // upsample (HybridEffectsDesc::ao/reflections.halfResolution). Unset: the preset's (AO at half resolution in
+  // every preset with AO, presets.h); `--half-res none` traces both at full resolution.
+  bool halfResGiven = false;
   bool halfResAo = false, halfResReflections = false;
   bool denoise = true;          // --no-denoise
   bool tileClassifier = false;  // --tile-classifier: HybridEffectsDesc::shadows.tileClassifier

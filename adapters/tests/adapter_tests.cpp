@@ -445,7 +445,10 @@ TEST_CASE("all eleven presets render in both modes; raster mode follows the pres
       // Soft shadows (more than one ray) are denoised, hard ones never; the reported rays per pixel are the table's.
       CHECK(passes.contains("shadow_denoise") == (want.shadowRaysPerPixel > 1));
       if (want.effects & rb::kEffectShadows) CHECK(stats["sun"]["rays_per_pixel"] == want.shadowRaysPerPixel);
-      if (want.effects & rb::kEffectAo) CHECK(stats["effects"]["ao_rays_per_pixel"] == want.aoRaysPerPixel);
+      if (want.effects & rb::kEffectAo) {
+        CHECK(stats["effects"]["ao_rays_per_pixel"] == want.aoRaysPerPixel);
+        CHECK(stats["effects"]["ao_half_resolution"] == want.aoHalfResolution);
+      }
       if (want.effects == 0) CHECK(stats["rays_traced"] == 0);
       else
         CHECK(stats["rays_traced"].get<uint64_t>() > 0);

@@ -111,7 +111,10 @@ HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset) {
   const PresetDesc p = presetDesc(preset);
   base.effects = p.effects;
   if (p.effects & kEffectShadows) base.shadows.raysPerPixel = p.shadowRaysPerPixel;
-  if (p.effects & kEffectAo) base.ao.raysPerPixel = p.aoRaysPerPixel;
+  if (p.effects & kEffectAo) {
+    base.ao.raysPerPixel = p.aoRaysPerPixel;
+    base.ao.halfResolution = p.aoHalfResolution;
+  }
   return base;
 }
 

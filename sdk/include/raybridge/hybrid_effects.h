@@ -110,7 +110,7 @@ struct HybridEffectsDesc {
   bool worldSpaceTlas = false;  // false = camera-relative (recommended)
 };
 
-// `base` with the preset's effect set and ray counts (every other field is kept).
+// `base` with the preset's effect set, ray counts and AO resolution (every other field is kept).
 HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset);
 
 // Flags of HybridFrame::flags.
