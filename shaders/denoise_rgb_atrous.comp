@@ -22,6 +22,7 @@ layout(set = 0, binding = RB_RGB_ATROUS_BINDING_SIGNAL_OUT, rgba16f) uniform wri
 const float kKernel[2] = float[2](1.0 / 2.0, 1.0 / 4.0);
 // The colour tolerance in standard deviations (SVGF's luminance one is 4; an RGB distance is larger).
 const float kColourSigma = 2.5;
+const float kLog2e = 1.4426950408889634;
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -64,8 +65,11 @@ void main() {
     if (qdist <= 0.0) continue;
     vec3 qp = normalize(a0 + float(o.x * step) * ax + float(o.y * step) * ay) * qdist;
     float planeDistance = abs(dot(qp - p, n)) / tolerance;
-    float w = kKernel[abs(o.x)] * kKernel[abs(o.y)] * exp(-planeDistance) *
-              pow(max(dot(n, rbDnGuideNormal(qg)), 0.0), pc.normalPower);
+    // exp(-planeDistance) * cos^normalPower as one exp2 (one transcendental fewer per tap).
+    float cosine = dot(n, rbDnGuideNormal(qg));
+    float w = cosine > 0.0 ? kKernel[abs(o.x)] * kKernel[abs(o.y)] *
+                                 exp2(pc.normalPower * log2(cosine) - kLog2e * planeDistance)
+                           : 0.0;
     values[k] = texelFetch(signalIn, q, 0);
     geometric[k] = w;
     tapVariances += w * values[k].a * values[k].a;

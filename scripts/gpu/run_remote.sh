@@ -336,7 +336,9 @@ fi
 # ---- adaptive: docs/performance.md's "trace only where needed" and half resolution. The probe, then
 # raybridge-effects-bench --scenario adaptive (uniform against adaptive rays after 8 accumulated frames) and the
 # speed-vs-error sweep of AO and reflections (full and half resolution rows) at RB_ADAPTIVE_SIZE, then the Ultra
-# preset on the performance and demo scenes with per-effect time targets and half resolution (RB_ADAPTIVE_ULTRA).
+# preset on the performance and demo scenes with per-effect time targets and half resolution (RB_ADAPTIVE_ULTRA:
+# `uniform` is the thesis's Ultra, AO at full resolution; `preset` is the preset as it is, AO at half resolution).
+# RB_ADAPTIVE_BENCH=0 leaves the two effects-bench sweeps out (the Ultra rows only).
 # perf_report.py writes adaptive_perf_gpu.json from the renders. Validation off.
 if want adaptive; then
   : >"$OUT/adaptive_gpu.log"
@@ -346,9 +348,9 @@ if want adaptive; then
     RAYBRIDGE_VALIDATION=0 step "probe k10" 60 "$OUT/probe_gpu.log" "$RT/probe/probe" --width 2560 --height 1440 \
       --rays 64 --k 10 --ground-tiles 64 --reps 7
   fi
-  RAYBRIDGE_VALIDATION=0 step "effects adaptive" 200 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-effects-bench" \
+  [ "${RB_ADAPTIVE_BENCH:-1}" = 1 ] && RAYBRIDGE_VALIDATION=0 step "effects adaptive" 200 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-effects-bench" \
     --scenario adaptive --effects shadows,ao --width "$AW" --height "$AH" --out "$OUT/effects_adaptive_gpu.json"
-  RAYBRIDGE_VALIDATION=0 step "effects half" 200 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-effects-bench" \
+  [ "${RB_ADAPTIVE_BENCH:-1}" = 1 ] && RAYBRIDGE_VALIDATION=0 step "effects half" 200 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-effects-bench" \
     --effects ao,reflections --width "$AW" --height "$AH" --out "$OUT/effects_half_gpu.json"
   AFRAMES="${RB_PERF_FRAMES:-40}"
   for scene in perf demo; do
@@ -360,10 +362,12 @@ if want adaptive; then
       RAYBRIDGE_VALIDATION=0 step "adaptive ${scene} ${tag}" 90 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-render" \
         --width "$AW" --height "$AH" --dump "${sargs[@]}" --preset ultra --frames "$AFRAMES" "${va[@]}" \
         --out "$ADIR/${scene}__hybrid__ultra__${tag}"
-    done <<<"${RB_ADAPTIVE_ULTRA:-uniform|
+    done <<<"${RB_ADAPTIVE_ULTRA:-uniform|--half-res none
+preset|
 adaptive|--adaptive ao,shadows
 half|--half-res ao,reflections
-budget|--adaptive ao=0.6,shadows=0.5 --half-res ao,reflections}"
+budget|--adaptive ao=0.6,shadows=0.5 --half-res ao,reflections
+budget-tight|--adaptive ao=0.5,shadows=0.4 --half-res ao,reflections}"
   done
   step "adaptive report" 30 "$OUT/adaptive_gpu.log" python3 "$ROOT/scripts/perf_report.py" \
     --probe-log "$OUT/probe_gpu.log" --renders "$ADIR" --command "bash scripts/gpu/run_remote.sh adaptive" \
