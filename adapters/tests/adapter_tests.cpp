@@ -383,10 +383,12 @@ TEST_CASE("pass memory follows the enabled effects at run time", "[adapter][memo
   const rb::HybridStats stats = fx.stats();
   CHECK(stats.ao.rays > 0);
   CHECK(stats.reflection.rays > 0);
-  // Ultra: 8 soft shadow rays and 16 AO rays per lit/surface pixel, at most.
+  // Ultra: 8 soft shadow rays per lit pixel, 16 AO rays per surface pixel of one in each 2x2 block (AO at half
+  // resolution), at most.
+  CHECK(fx.desc().ao.halfResolution);
   CHECK(stats.shadow.rays <= uint64_t(64 * 48 * 8));
-  CHECK(stats.ao.rays <= uint64_t(64 * 48 * 16));
-  CHECK(stats.ao.rays > uint64_t(64 * 48 * 4));
+  CHECK(stats.ao.rays <= uint64_t(32 * 24 * 16));
+  CHECK(stats.ao.rays > uint64_t(32 * 24 * 4));
 
   rb::HybridEffectsDesc raw = fx.desc();  // the denoisers go, the passes stay
   raw.shadows.disableDenoiser = raw.ao.disableDenoiser = true;

@@ -2,8 +2,9 @@
 # Runs the benchmark and the tests on the GPU machine (NVIDIA, no Vulkan loader, no network) from the folder
 # .devcarry/ that scripts/gpu/prepare.sh assembled and the device tool carried. Run from the repository root:
 #
-#   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, render, effects, animated, lights,
-#                                                          perf, adaptive, soak (default all)
+#   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, inject, render, effects, animated,
+#                                                          lights, perf, adaptive, soak (default all; inject,
+#                                                          the failure-injection cases, runs only when named)
 #
 # Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
 # tests_gpu.log, effects_gpu.json, effects_gpu.log, render_gpu.tar.gz (render logs, stats.json and final.png
@@ -26,7 +27,7 @@ set -u
 
 MODE="${1:-all}"
 for m in ${MODE//,/ }; do
-  case "$m" in all|bench|tests|render|effects|animated|lights|perf|adaptive|soak) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, render, effects, animated, lights, perf, adaptive or soak" >&2; exit 2 ;; esac
+  case "$m" in all|bench|tests|inject|render|effects|animated|lights|perf|adaptive|soak) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, inject, render, effects, animated, lights, perf, adaptive or soak" >&2; exit 2 ;; esac
 done
 want() { [ "$MODE" = all ] || [[ ",$MODE," == *",$1,"* ]]; }
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -393,6 +394,14 @@ if want tests; then
     RAYBRIDGE_VALIDATION=1 step "test $name" 240 "$OUT/tests_gpu.log" "$RT/bin/$exe" "${targs[@]}"
   done <"$RT/tests.txt"
   grep -E '^(All tests passed|test cases:)|FAILED|validation\]' "$OUT/tests_gpu.log" | head -n 40
+fi
+# ---- inject: raybridge_tests' failure-injection cases ([inject]), left out of `tests`: every SDK allocation site
+# fails in turn, and every pass is recreated after each (minutes of pipeline compilation on the GPU).
+if [[ ",$MODE," == *,inject,* ]]; then
+  : >"$OUT/inject_gpu.log"
+  RAYBRIDGE_VALIDATION=1 step "test raybridge_tests [inject]" "${RB_INJECT_LIMIT:-540}" "$OUT/inject_gpu.log" \
+    "$RT/bin/raybridge_tests" "[inject]" -d yes
+  grep -E '^(All tests passed|test cases:)|FAILED|validation\]|scenario|sites' "$OUT/inject_gpu.log" | head -n 40
 fi
 
 finish
