@@ -13,6 +13,9 @@ namespace sample_engine::detail {
 std::string readFloats(const tinygltf::Model& model, int accessorIndex, int components, std::vector<float>& out);
 // The accessor as `components` per element, however many it has (0 = all of them).
 std::string readAllFloats(const tinygltf::Model& model, int accessorIndex, std::vector<float>& out, int& components);
+// The accessor's indices; it must be SCALAR UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT (glTF 3.7.2.1).
 std::string readIndices(const tinygltf::Model& model, int accessorIndex, std::vector<uint32_t>& out);
+// "VEC3 FLOAT", "VEC4 normalized UNSIGNED_BYTE", ...: an accessor's format for messages.
+std::string formatName(const tinygltf::Accessor& accessor);
 
 }  // namespace sample_engine::detail

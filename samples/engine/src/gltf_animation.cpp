@@ -1,6 +1,7 @@
 #include "gltf_animation.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -49,6 +50,29 @@ std::string convertNodes(const tinygltf::Model& model, Scene& scene) {
                " and node " + std::to_string(p) + " (glTF nodes form a tree)";
       scene.nodes[size_t(c)].parent = p;
     }
+  // With one parent per node, a cycle (A -> B -> A) is a parent chain that comes back to a node of the same walk.
+  // Each node is walked once (0: not yet, 1: on this walk, 2: done), so a long chain costs linear time.
+  std::vector<uint8_t> state(size_t(count), 0);
+  std::vector<int> walk;
+  for (int n = 0; n < count; ++n) {
+    walk.clear();
+    int at = n;
+    for (; at >= 0 && state[size_t(at)] == 0; at = scene.nodes[size_t(at)].parent) {
+      state[size_t(at)] = 1;
+      walk.push_back(at);
+    }
+    if (at >= 0 && state[size_t(at)] == 1) {
+      std::string chain = std::to_string(at);
+      int steps = 0;
+      for (int c = scene.nodes[size_t(at)].parent; steps < 8; c = scene.nodes[size_t(c)].parent, ++steps) {
+        chain += " -> " + std::to_string(c);
+        if (c == at) break;
+      }
+      return nodeName(model, at) + " is its own ancestor (parents " + chain + (steps == 8 ? " -> ..." : "") +
+             "; glTF nodes form a tree)";
+    }
+    for (int w : walk) state[size_t(w)] = 2;
+  }
   return {};
 }
 
@@ -71,6 +95,10 @@ std::string convertSkins(const tinygltf::Model& model, Scene& scene) {
       if (f.size() / 16 < out.joints.size())
         return where + ": " + std::to_string(f.size() / 16) + " inverse bind matrices for " +
                std::to_string(out.joints.size()) + " joints";
+      for (size_t i = 0; i < out.joints.size() * 16; ++i)
+        if (!std::isfinite(f[i]))
+          return where + ", inverseBindMatrices accessor " + std::to_string(in.inverseBindMatrices) + ": matrix " +
+                 std::to_string(i / 16) + " has a non-finite element";
       out.inverseBindMatrices.resize(out.joints.size());
       for (size_t j = 0; j < out.joints.size(); ++j) out.inverseBindMatrices[j] = glm::make_mat4(&f[j * 16]);
     }
@@ -97,11 +125,34 @@ std::string convertAnimations(const tinygltf::Model& model, Scene& scene, std::v
         o.interpolation = AnimationInterpolation::CubicSpline;
       else
         return at + ": unknown interpolation '" + smp.interpolation + "' (LINEAR, STEP or CUBICSPLINE)";
+      // Key times are SCALAR FLOAT, outputs FLOAT or normalized integers (glTF 3.11): the reader would convert any
+      // format, so a wrong one would animate garbage.
+      if (smp.input >= 0 && smp.input < int(model.accessors.size())) {
+        const tinygltf::Accessor& input = model.accessors[size_t(smp.input)];
+        if (input.type != TINYGLTF_TYPE_SCALAR || input.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
+          return at + ": input accessor " + std::to_string(smp.input) + " is " + formatName(input) +
+                 "; key times must be SCALAR FLOAT";
+      }
+      if (smp.output >= 0 && smp.output < int(model.accessors.size())) {
+        const tinygltf::Accessor& output = model.accessors[size_t(smp.output)];
+        if (output.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT && !output.normalized)
+          return at + ": output accessor " + std::to_string(smp.output) + " is " + formatName(output) +
+                 "; animation outputs must be FLOAT or normalized integers";
+      }
       if (std::string e = readFloats(model, smp.input, 1, o.times); !e.empty()) return at + ", input: " + e;
       if (o.times.empty()) return at + ": input accessor " + std::to_string(smp.input) + " has no keys";
       int components = 0;
       if (std::string e = readAllFloats(model, smp.output, o.values, components); !e.empty())
         return at + ", output: " + e;
+      // A non-finite key time or value would make every pose of the animation NaN.
+      for (size_t k = 0; k < o.times.size(); ++k)
+        if (!std::isfinite(o.times[k]))
+          return at + ": input accessor " + std::to_string(smp.input) + ", key " + std::to_string(k) +
+                 ": the time is not finite";
+      for (size_t v = 0; v < o.values.size(); ++v)
+        if (!std::isfinite(o.values[v]))
+          return at + ": output accessor " + std::to_string(smp.output) + ", element " +
+                 std::to_string(v / size_t(components)) + ": a non-finite value";
       const size_t perKey = o.interpolation == AnimationInterpolation::CubicSpline ? 3 : 1;
       if (o.values.size() % (o.times.size() * perKey) != 0)
         return at + ": " + std::to_string(o.values.size() / size_t(components)) + " output elements for " +

@@ -8,12 +8,14 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <tiny_gltf.h>
 
 #include "gltf_accessors.h"
 #include "gltf_animation.h"
+#include "gltf_document_check.h"
 #include "sample_engine/animation.h"
 #include "sample_engine/gltf_loader.h"
 
@@ -63,6 +65,99 @@ UvMapping uvMapping(int texCoord, const tinygltf::ExtensionMap& extensions) {
 }
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// A message from tinygltf or a URI, shortened: either can hold a whole data: URI.
+std::string shortened(const std::string& text, size_t maxLine = 200) {
+  std::string out;
+  for (size_t begin = 0; begin < text.size();) {
+    size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    const std::string line = text.substr(begin, end - begin);
+    if (!line.empty())
+      out += (out.empty() ? "" : "; ") + (line.size() > maxLine ? line.substr(0, maxLine) + "..." : line);
+    begin = end + 1;
+  }
+  return out;
+}
+
+// The accessor formats glTF 2.0 (with KHR_mesh_quantization) allows for the vertex attributes the engine reads;
+// the reader would convert any of them, so a wrong one would load as garbage instead of failing.
+enum FormatBits : uint32_t {
+  kFloat = 1u << 0,
+  kByte = 1u << 1,
+  kByteNormalized = 1u << 2,
+  kUnsignedByte = 1u << 3,
+  kUnsignedByteNormalized = 1u << 4,
+  kShort = 1u << 5,
+  kShortNormalized = 1u << 6,
+  kUnsignedShort = 1u << 7,
+  kUnsignedShortNormalized = 1u << 8,
+  kAnyInteger8Or16 = kByte | kByteNormalized | kUnsignedByte | kUnsignedByteNormalized | kShort | kShortNormalized |
+                     kUnsignedShort | kUnsignedShortNormalized,
+};
+
+uint32_t formatBit(const tinygltf::Accessor& a) {
+  switch (a.componentType) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return a.normalized ? 0u : uint32_t(kFloat);
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return a.normalized ? kByteNormalized : kByte;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return a.normalized ? kUnsignedByteNormalized : kUnsignedByte;
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return a.normalized ? kShortNormalized : kShort;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return a.normalized ? kUnsignedShortNormalized : kUnsignedShort;
+    default: return 0;
+  }
+}
+
+struct AttributeFormat {
+  int type;
+  uint32_t allowed;
+  const char* text;
+};
+
+// POSITION, NORMAL, TANGENT, TEXCOORD_n, JOINTS_n, WEIGHTS_n (glTF 3.7.2.1, KHR_mesh_quantization); `target`: a
+// morph target's POSITION / NORMAL.
+const AttributeFormat* attributeFormat(const std::string& name, bool target) {
+  static const AttributeFormat position{TINYGLTF_TYPE_VEC3, kFloat | kAnyInteger8Or16,
+                                        "VEC3 FLOAT (or 8- or 16-bit integers with KHR_mesh_quantization)"};
+  static const AttributeFormat normal{TINYGLTF_TYPE_VEC3, kFloat | kByteNormalized | kShortNormalized,
+                                      "VEC3 FLOAT (or normalized BYTE or SHORT)"};
+  static const AttributeFormat tangent{TINYGLTF_TYPE_VEC4, kFloat | kByteNormalized | kShortNormalized,
+                                       "VEC4 FLOAT (or normalized BYTE or SHORT)"};
+  static const AttributeFormat texCoord{TINYGLTF_TYPE_VEC2, kFloat | kAnyInteger8Or16,
+                                        "VEC2 FLOAT (or 8- or 16-bit integers)"};
+  static const AttributeFormat joints{TINYGLTF_TYPE_VEC4, kUnsignedByte | kUnsignedShort,
+                                      "VEC4 UNSIGNED_BYTE or UNSIGNED_SHORT"};
+  static const AttributeFormat weights{TINYGLTF_TYPE_VEC4, kFloat | kUnsignedByteNormalized | kUnsignedShortNormalized,
+                                       "VEC4 FLOAT (or normalized UNSIGNED_BYTE or UNSIGNED_SHORT)"};
+  static const AttributeFormat delta{TINYGLTF_TYPE_VEC3, kFloat | kByte | kByteNormalized | kShort | kShortNormalized,
+                                     "VEC3 FLOAT (or BYTE or SHORT with KHR_mesh_quantization)"};
+  if (target) return name == "POSITION" || name == "NORMAL" ? &delta : nullptr;
+  if (name == "POSITION") return &position;
+  if (name == "NORMAL") return &normal;
+  if (name == "TANGENT") return &tangent;
+  if (name.rfind("TEXCOORD_", 0) == 0) return &texCoord;
+  if (name.rfind("JOINTS_", 0) == 0) return &joints;
+  if (name.rfind("WEIGHTS_", 0) == 0) return &weights;
+  return nullptr;
+}
+
+// Replaces the non-finite values of a UV or tangent array (they would only sample a wrong texel or tilt a normal
+// map; positions and normals skip their triangles instead) and says so.
+template <typename Vec>
+void replaceNonFinite(std::vector<Vec>& values, const Vec& stand, const std::string& what,
+                      std::vector<std::string>& warnings) {
+  size_t first = values.size(), count = 0;
+  for (size_t v = 0; v < values.size(); ++v)
+    for (int c = 0; c < Vec::length(); ++c)
+      if (!std::isfinite(values[v][c])) {
+        first = std::min(first, v);
+        ++count;
+        values[v] = stand;
+        break;
+      }
+  if (count)
+    warnings.push_back(what + " has non-finite values (first at vertex " + std::to_string(first) + "); replaced " +
+                       std::to_string(count) + " of " + std::to_string(values.size()) + " by a default");
+}
 
 TextureData convertImage(const tinygltf::Image& img) {
   TextureData t;
@@ -178,7 +273,18 @@ struct Loader {
     }
   }
 
-  // Converts one primitive; returns false (with a warning) when it is skipped.
+  // The accessor of an attribute the engine reads has a format glTF allows for it (see attributeFormat).
+  bool checkFormat(const std::string& where, const std::string& name, int accessor, bool target) {
+    const AttributeFormat* format = attributeFormat(name, target);
+    if (!format || accessor < 0 || accessor >= int(model.accessors.size())) return true;  // range: readFloats
+    const tinygltf::Accessor& a = model.accessors[size_t(accessor)];
+    if (a.type == format->type && (formatBit(a) & format->allowed)) return true;
+    fail(where + ": " + name + " accessor " + std::to_string(accessor) + " is " + detail::formatName(a) + "; " + name +
+         " must be " + format->text);
+    return false;
+  }
+
+  // Converts one primitive; returns false (with a warning) when it is skipped, or after fail().
   bool convertPrimitive(const tinygltf::Mesh& mesh, size_t index, MeshData& out) {
     const tinygltf::Primitive& prim = mesh.primitives[index];
     const std::string where = "mesh '" + mesh.name + "' primitive " + std::to_string(index);
@@ -188,14 +294,17 @@ struct Loader {
                                 ") is not a triangle mode (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN)");
       return false;
     }
+    for (const auto& [name, accessor] : prim.attributes)
+      if (!checkFormat(where, name, accessor, false)) return false;
     auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) {
       result.warnings.push_back(where + ": skipped, no POSITION attribute");
       return false;
     }
+    // A file whose accessors do not fit their data is corrupt: it fails (naming the accessor), never loads in part.
     std::vector<float> f;
     if (std::string e = readFloats(model, pos->second, 3, f); !e.empty()) {
-      result.warnings.push_back(where + ": skipped, POSITION: " + e);
+      fail(where + ", POSITION: " + e);
       return false;
     }
     out.name = mesh.name.empty() ? "mesh" : mesh.name;
@@ -205,7 +314,7 @@ struct Loader {
       auto it = prim.attributes.find(name);
       if (it == prim.attributes.end()) return;
       if (std::string e = readFloats(model, it->second, comps, f); !e.empty()) {
-        result.warnings.push_back(where + ": ignoring " + name + ": " + e);
+        fail(where + ", " + name + ": " + e);
         return;
       }
       if (f.size() / comps != out.positions.size()) {
@@ -219,21 +328,31 @@ struct Loader {
     optional("TEXCOORD_0", 2, out.uvs);
     optional("TEXCOORD_1", 2, out.uvs1);
     optional("TANGENT", 4, out.tangents);
-    if (!readDeformation(prim, where, out)) return false;
+    if (!error.empty() || !readDeformation(prim, where, out)) return false;
     for (double w : mesh.weights) out.morphWeights.push_back(float(w));
     if (prim.indices >= 0) {
       if (std::string e = readIndices(model, prim.indices, out.indices); !e.empty()) {
-        result.warnings.push_back(where + ": skipped, indices: " + e);
+        fail(where + ": " + e);
         return false;
       }
-      for (uint32_t i : out.indices)
-        if (i >= out.positions.size()) {
-          result.warnings.push_back(where + ": skipped, index out of range");
+      for (size_t i = 0; i < out.indices.size(); ++i)
+        if (out.indices[i] >= out.positions.size()) {
+          fail(where + ": index accessor " + std::to_string(prim.indices) + ": index " + std::to_string(i) + " = " +
+               std::to_string(out.indices[i]) + " is out of range (the primitive has " +
+               std::to_string(out.positions.size()) + " vertices)");
           return false;
         }
     }
     if (strip || fan) toTriangleList(strip, out);
     skipNonFinite(prim, where, out);
+    auto accessorOf = [&](const char* name) { return " accessor " + std::to_string(prim.attributes.at(name)); };
+    if (!out.uvs.empty())
+      replaceNonFinite(out.uvs, glm::vec2(0.0f), where + ": TEXCOORD_0" + accessorOf("TEXCOORD_0"), result.warnings);
+    if (!out.uvs1.empty())
+      replaceNonFinite(out.uvs1, glm::vec2(0.0f), where + ": TEXCOORD_1" + accessorOf("TEXCOORD_1"), result.warnings);
+    if (!out.tangents.empty())
+      replaceNonFinite(out.tangents, glm::vec4(1, 0, 0, 1), where + ": TANGENT" + accessorOf("TANGENT"),
+                       result.warnings);
     out.material = prim.material >= 0 ? uint32_t(prim.material) : uint32_t(result.scene.materials.size());
     if (prim.material >= 0 && size_t(prim.material) < bakedUv.size())
       bakeUvs(bakedUv[size_t(prim.material)], where, out);
@@ -332,6 +451,12 @@ struct Loader {
            " vertices");
       return false;
     }
+    for (size_t i = 0; i < f.size(); ++i)
+      if (!std::isfinite(f[i])) {
+        fail(what + ": accessor " + std::to_string(accessor) + " has a non-finite value at vertex " +
+             std::to_string(i / size_t(comps)));
+        return false;
+      }
     return true;
   }
 
@@ -366,7 +491,8 @@ struct Loader {
                                       : name == "NORMAL" ? &target.normalDeltas
                                                          : nullptr;
         if (!dst) continue;  // TANGENT deltas: tangents are only skinned
-        if (!readVertexAttribute(accessor, at + " " + name, 3, n, f)) return false;
+        if (!checkFormat(at, name, accessor, true) || !readVertexAttribute(accessor, at + " " + name, 3, n, f))
+          return false;
         dst->resize(n);
         std::memcpy(dst->data(), f.data(), n * sizeof(glm::vec3));
       }
@@ -482,8 +608,10 @@ struct Loader {
     if (nodeIndex < 0 || nodeIndex >= int(model.nodes.size()))
       return fail("scene node " + std::to_string(nodeIndex) + " is out of range (the file has " +
                   std::to_string(model.nodes.size()) + " nodes)");
-    if (depth > 1024)
-      return fail("node " + std::to_string(nodeIndex) + ": the hierarchy is deeper than 1024 (a cycle?)");
+    if (depth >= kMaxGltfNodeDepth)  // visit() recurses: the limit keeps it off the end of the stack
+      return fail(
+          "node " + std::to_string(nodeIndex) + " is " + std::to_string(depth + 1) +
+          " levels deep, deeper than the loader's limit kMaxGltfNodeDepth = " + std::to_string(kMaxGltfNodeDepth));
     const tinygltf::Node& node = model.nodes[size_t(nodeIndex)];
     glm::mat4 world = parent * result.scene.nodes[size_t(nodeIndex)].localTransform();
     const std::string name = "node " + std::to_string(nodeIndex) + " '" + node.name + "'";
@@ -578,12 +706,47 @@ bool gatedReadWholeFile(std::vector<unsigned char>* out, std::string* err, const
   return tinygltf::ReadWholeFile(out, err, path, nullptr);
 }
 
+// Why each image that did not decode failed (tinygltf's own decoder fails the whole file on one bad image; the
+// loader drops its textures with a warning instead, as it does for a missing image file).
+struct ImageDecodeFailures {
+  std::map<int, std::string> reasons;  // image index -> why
+};
+
+bool decodeImage(tinygltf::Image* image, const int index, std::string* err, std::string* warn, int width, int height,
+                 const unsigned char* bytes, int size, void* user) {
+  (void)err;
+  std::string why;
+  // No option (nullptr): 4 channels, as convertImage expects.
+  if (tinygltf::LoadImageData(image, index, &why, warn, width, height, bytes, size, nullptr)) return true;
+  if (size_t cut = why.find(" for image["); cut != std::string::npos) why.erase(cut);
+  static_cast<ImageDecodeFailures*>(user)->reasons[index] = (image->mimeType.empty() ? std::string()
+                                                                                     : image->mimeType + ", ") +
+                                                            std::to_string(size) + " bytes: " + shortened(why);
+  image->image.clear();
+  image->width = image->height = 0;
+  return true;
+}
+
+// Why image `i` has no texels, for the warning.
+std::string imageProblem(const tinygltf::Image& img, int i, const ImageDecodeFailures& failures) {
+  std::string name = "image " + std::to_string(i) + " '" + img.name + "'";
+  if (auto it = failures.reasons.find(i); it != failures.reasons.end())
+    return name + " cannot be decoded (" + it->second + ")";
+  if (img.uri.rfind("data:", 0) == 0)
+    return name + ": its data: URI of type '" + shortened(img.uri.substr(5, img.uri.find(',') - 5), 40) +
+           "' is not one the loader reads (base64 PNG, JPEG, BMP or GIF)";
+  if (!img.uri.empty()) return name + ": its file '" + shortened(img.uri, 80) + "' is missing, empty or unreadable";
+  return name + " has no pixels";
+}
+
 // Everything after parsing: the model into result.scene (or result.error, which names `path`).
-void convertModel(const tinygltf::Model& model, const std::string& path, SceneLoadResult& result) {
+void convertModel(const tinygltf::Model& model, const std::string& path, const ImageDecodeFailures& imageFailures,
+                  SceneLoadResult& result) {
   for (const std::string& required : model.extensionsRequired)
     if (std::find(std::begin(kSupportedExtensions), std::end(kSupportedExtensions), required) ==
         std::end(kSupportedExtensions)) {
       result.error = "glTF '" + path + "' requires extension " + required +
+                     (required == "KHR_draco_mesh_compression" ? " (Draco-compressed meshes are unsupported)" : "") +
                      ", which the sample engine does not support (it supports KHR_mesh_quantization, "
                      "KHR_texture_transform, KHR_materials_emissive_strength and KHR_lights_punctual)";
       return;
@@ -601,10 +764,11 @@ void convertModel(const tinygltf::Model& model, const std::string& path, SceneLo
     result.error = "glTF '" + path + "': " + loader.error;
     return;
   }
-  for (const tinygltf::Image& img : model.images) {
-    result.scene.textures.push_back(convertImage(img));
+  for (size_t i = 0; i < model.images.size(); ++i) {
+    result.scene.textures.push_back(convertImage(model.images[i]));
     if (result.scene.textures.back().rgba8.empty())
-      result.warnings.push_back("image '" + img.uri + "' could not be decoded; texture ignored");
+      result.warnings.push_back(imageProblem(model.images[i], int(i), imageFailures) +
+                                "; the textures that use it are ignored");
   }
   loader.convertMaterials();
   // Textures that failed to decode must not be referenced.
@@ -623,6 +787,14 @@ void convertModel(const tinygltf::Model& model, const std::string& path, SceneLo
   const int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : (model.scenes.empty() ? -1 : 0);
   if (sceneIndex >= 0) {
     roots = model.scenes[sceneIndex].nodes;
+    // A root with a parent would be instanced twice (glTF: scene nodes are roots).
+    for (int r : roots)
+      if (r >= 0 && r < int(result.scene.nodes.size()) && result.scene.nodes[size_t(r)].parent >= 0) {
+        result.error = "glTF '" + path + "': scene " + std::to_string(sceneIndex) + " lists node " + std::to_string(r) +
+                       " '" + model.nodes[size_t(r)].name + "' as a root, but it is a child of node " +
+                       std::to_string(result.scene.nodes[size_t(r)].parent);
+        return;
+      }
   } else {  // no scene declared: every node that is nobody's child is a root
     std::vector<bool> isChild(model.nodes.size(), false);
     for (const auto& n : model.nodes)
@@ -669,12 +841,37 @@ SceneLoadResult loadGltfFromMemory(const GltfMemoryDesc& desc) {
       result.error = "glTF '" + name + "' has " + std::to_string(desc.bytes.size()) + " bytes; at most 4 GiB load";
       return result;
     }
+    // What tinygltf does not check, or checks after reading past the data (gltf_document_check.h). The JSON is
+    // parsed twice (here and by tinygltf); the first copy is dropped before the second is made.
+    {
+      detail::GlbChunks chunks;
+      std::span<const uint8_t> text = desc.bytes;
+      if (desc.binary) {
+        if (std::string e = detail::splitGlb(desc.bytes, chunks); !e.empty()) {
+          result.error = "failed to parse glTF '" + name + "': " + e;
+          return result;
+        }
+        text = chunks.json;
+      }
+      nlohmann::json doc;
+      if (std::string e = detail::parseJson(text, doc); !e.empty()) {
+        result.error = "failed to parse glTF '" + name + "': " + e;
+        return result;
+      }
+      const std::optional<size_t> bin = chunks.bin ? std::optional<size_t>(chunks.bin->size()) : std::nullopt;
+      if (std::string e = detail::checkDocument(doc, desc.binary, bin); !e.empty()) {
+        result.error = "glTF '" + name + "': " + e;
+        return result;
+      }
+    }
     ExternalFileGate gate;
     gate.policy = desc.externalFiles;
     gate.prefix = desc.baseDir.empty() || desc.baseDir.back() == '/' ? desc.baseDir : desc.baseDir + "/";
     tinygltf::TinyGLTF gltf;
     gltf.SetFsCallbacks(
         tinygltf::FsCallbacks{gatedFileExists, tinygltf::ExpandFilePath, gatedReadWholeFile, nullptr, &gate});
+    ImageDecodeFailures imageFailures;
+    gltf.SetImageLoader(decodeImage, &imageFailures);
     tinygltf::Model model;
     std::string err, warn;
     const auto size = static_cast<unsigned int>(desc.bytes.size());
@@ -684,19 +881,19 @@ SceneLoadResult loadGltfFromMemory(const GltfMemoryDesc& desc) {
                                              size, desc.baseDir);
     if (!gate.refused.empty()) {
       result.error =
-          "glTF '" + name + "': the URI '" + gate.refused + "' names " +
+          "glTF '" + name + "': the URI '" + shortened(gate.refused, 80) + "' names " +
           (desc.externalFiles == GltfExternalFiles::None
                ? std::string("an external file, which GltfExternalFiles::None refuses (embed it as a data: URI)")
                : "a file outside the base folder '" + desc.baseDir +
                      "', which GltfExternalFiles::InsideBaseDir refuses");
       return result;
     }
-    if (!warn.empty()) result.warnings.push_back(warn);
+    if (!warn.empty()) result.warnings.push_back(shortened(warn));
     if (!ok) {
-      result.error = "failed to parse glTF '" + name + "': " + (err.empty() ? "unknown error" : err);
+      result.error = "failed to parse glTF '" + name + "': " + (err.empty() ? "unknown error" : shortened(err));
       return result;
     }
-    convertModel(model, name, result);
+    convertModel(model, name, imageFailures, result);
   } catch (const std::exception& e) {
     result.error = std::string("glTF loading failed: ") + e.what();
   }

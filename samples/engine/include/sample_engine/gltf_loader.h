@@ -10,6 +10,10 @@
 
 namespace sample_engine {
 
+// The deepest node hierarchy loadGltf() accepts: a scene node deeper than this fails naming it (the loader walks
+// the hierarchy recursively).
+inline constexpr int kMaxGltfNodeDepth = 1024;
+
 struct SceneLoadResult {
   Scene scene;
   std::string error;                  // empty on success
@@ -30,9 +34,30 @@ struct SceneLoadResult {
 // node (so it follows the node's animation) and transform = its rest-pose world transform; the light's
 // fields as the file gives them (absent range = 0 = unlimited; spot cones default to 0 and pi/4). A bad light
 // (unknown type, negative colour or intensity, a given range <= 0, inner cone >= outer or outer > pi/2, a
-// light index out of range, more than kMaxPunctualLights) fails naming the light index and the field. Bad input (an
-// out-of-range node, mesh, skin or accessor index, a joint index beyond its skin's joint count, a skinned vertex whose
-// weights sum to 0, ...) fails with an error naming the value. Never throws.
+// light index out of range, more than kMaxPunctualLights) fails naming the light index and the field.
+//
+// Malformed input fails with an error naming the member (as a JSON path such as nodes[2].mesh, or the glTF object:
+// "accessor 3", "mesh 'body' primitive 0") and the value, before anything is allocated for it: JSON that does not
+// parse (path, line and column; JSON cannot write NaN or infinity, and a literal beyond a double such as 1e999 fails
+// here), nesting deeper than 128 levels; a .glb whose magic, version (2), length or chunk lengths do not match its
+// bytes; a member of the wrong type, an index that is negative, fractional or out of range, a list of nodes or joints
+// that names one twice; a buffer whose data is not byteLength bytes (data: URIs must be base64), a buffer view past
+// its buffer, an accessor past its buffer view, with a byteStride shorter than its element or data not aligned to
+// its components, an accessor without a buffer view counting more elements than the file's buffers hold bytes;
+// an accessor whose type or component type its use does not allow (POSITION VEC3 FLOAT or, with
+// KHR_mesh_quantization, 8/16-bit integers; indices SCALAR UNSIGNED_BYTE/SHORT/INT; JOINTS_n VEC4 UNSIGNED_BYTE/SHORT;
+// ...), an index value >= the primitive's vertex count, a joint index beyond its skin's joint count, a skinned
+// vertex whose weights sum to 0; a non-finite animation key time or value, inverse bind matrix, skin weight or morph
+// target delta; a node that is its own ancestor or the child of two nodes, a scene root that has a parent, a scene
+// node deeper than kMaxGltfNodeDepth; an extension in extensionsRequired the loader does not support; a primitive
+// compressed with KHR_draco_mesh_compression without uncompressed accessors (Draco is unsupported); an image whose
+// data: URI holds no bytes.
+// Tolerated, with a warning naming what was skipped: a primitive that is not triangles (points, lines) or has no
+// POSITION is skipped (a file left without any triangle fails); triangles with a non-finite position or normal are
+// skipped; non-finite TEXCOORD_n values become 0 and non-finite tangents (1, 0, 0, 1); a NORMAL, TANGENT or
+// TEXCOORD_n whose count differs from POSITION's is ignored; an image that cannot be
+// decoded (corrupt, truncated, 0 x 0 pixels, a format stb_image does not read such as KTX2 or WebP, a missing or
+// empty file) leaves the materials that use it untextured. Never throws.
 SceneLoadResult loadGltf(const std::string& path);
 
 // Which files the URIs of a glTF held in memory may read (buffers, images; data: URIs and a .glb's BIN chunk are
