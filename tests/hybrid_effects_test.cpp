@@ -114,7 +114,7 @@ TEST_CASE("the front end's hard shadows and AO equal the passes recorded one by 
 
   rb::HybridEffectsDesc desc = rb::withPreset({}, rb::Preset::Low);  // hard shadows, AO 4 rays
   desc.ao.disableDenoiser = true;                                    // compare the raw AO
-  desc.ao.halfResolution = false;  // as the AO pass below, which traces every pixel
+  desc.ao.halfResolution = false;                                    // as the AO pass below, which traces every pixel
   desc.ao.range = 2.0f;
   auto effects = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
   RB_REQUIRE_OK(effects);
