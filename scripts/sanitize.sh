@@ -92,8 +92,8 @@ if [ "$what" = asan ] || [ "$what" = all ]; then
   cmake --build build-asan -j "$jobs" --target raybridge_tests sample_engine_tests pose_reference_tests \
     minimal_integration_test raybridge_adapter_tests raybridge_render_conformance_tests \
     raybridge_animated_conformance_tests raybridge_far_origin_tests raybridge_lights_conformance_tests \
-    raybridge_camera_path_tests raybridge_flythrough_tests raybridge-bench raybridge-effects-bench \
-    raybridge-animated-bench
+    raybridge_camera_path_tests raybridge_flythrough_tests raybridge_render_malformed_input_tests \
+    raybridge-bench raybridge-effects-bench raybridge-animated-bench
   echo "sanitize: asan build took $(($(date +%s) - start)) s"
   start=$(date +%s)
   reports="$root/build-asan/sanitizer-report"
@@ -112,7 +112,8 @@ if [ "$what" = asan ] || [ "$what" = all ]; then
     run sample_engine_tests $b/samples/engine/sample_engine_tests
     run pose_reference_tests $b/samples/engine/tests/reference/pose_reference_tests
     run minimal_integration_test $b/samples/minimal_integration/tests/minimal_integration_test
-    for t in adapter render_conformance animated_conformance far_origin lights_conformance camera_path flythrough; do
+    for t in adapter render_conformance animated_conformance far_origin lights_conformance camera_path flythrough \
+      render_malformed_input; do
       run "raybridge_${t}_tests" "$b/adapters/tests/raybridge_${t}_tests"
     done
     # The smoke runs of ctest (bench_smoke, effects_bench_smoke, animated_bench_smoke), with the same arguments.

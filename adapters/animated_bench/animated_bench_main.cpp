@@ -267,7 +267,8 @@ int main(int argc, char** argv) {
   if (const char* v = std::getenv("RAYBRIDGE_VALIDATION"); v && std::string(v) == "1") o.validation = true;
   // The models come from the shared folder; without them there is nothing to animate.
   if (auto probe = rbAnimated::makeAnimatedScene(o.scenes, 1); !probe) {
-    std::printf("raybridge-animated-bench: skipped: %s\n", probe.error.c_str());
+    std::printf("raybridge-animated-bench: skipped: %s; pass --scenes with the folder of the shared glTF models\n",
+                probe.error.c_str());
     return 0;
   }
 

@@ -53,9 +53,7 @@ se::Result<AnimatedScene> makeAnimatedScene(const std::string& scenesDir, uint32
                   glm::translate(glm::mat4(1.0f), -glm::vec3(b.center().x, b.min.y, b.center().z));
     models.push_back(std::move(m));
   }
-  if (models.empty())
-    return R::failure("no character model found (looked for " + missing +
-                      "); pass --scenes with the folder of the shared glTF models");
+  if (models.empty()) return R::failure("no character model found (looked for " + missing + ")");
 
   AnimatedScene out;
   out.scene = se::makeDefaultDemoScene();

@@ -28,7 +28,8 @@ struct AnimatedScene {
 const std::vector<std::string>& characterModels();
 // The characters stand on a square grid centred on the demo scene's centre (the benchmark), or on `gridCentreXZ`
 // when given (raybridge-render --characters puts them in front of the demo's objects, in view of its camera).
-// Fails (naming the folder and the missing files) when none of characterModels() is in `scenesDir`.
+// Fails (naming the folder and the missing files) when none of characterModels() is in `scenesDir`; the caller adds
+// which of its options names the folder.
 sample_engine::Result<AnimatedScene> makeAnimatedScene(const std::string& scenesDir, uint32_t characters,
                                                        std::optional<glm::vec2> gridCentreXZ = std::nullopt);
 

@@ -2,12 +2,15 @@
 // maps, SSAO and reflection probe), hybrid mode (Raybridge's ray-traced shadows, AO, reflections and shadowed
 // local lights through the adapter) or ray-traced mode (no raster shading: Raybridge shades primary rays into the
 // engine's HDR target), plus optional dumps and stats.
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -32,10 +35,63 @@ int fail(const std::string& message, int code = 1) {
   return code;
 }
 
+// The first of `path` and its parents that exists and is not a folder, or "" (what makes a folder uncreatable).
+std::string fileInTheWay(const std::filesystem::path& path) {
+  std::error_code ec;
+  for (std::filesystem::path p = path; !p.empty(); p = p.parent_path()) {
+    const std::filesystem::file_status s = std::filesystem::status(p, ec);
+    if (std::filesystem::exists(s) && !std::filesystem::is_directory(s)) return p.string();
+    if (p == p.parent_path()) break;
+  }
+  return {};
+}
+
+// --out, checked before the scene loads and before any Vulkan work: the folder is created and a probe file written
+// into it and removed, so that a folder that cannot take the images fails at once rather than after the render.
+// The probe's name is longer than any file the command writes, so a folder at the path-length limit fails here too.
+std::string prepareOutputFolder(const std::string& folder) {
+  namespace fs = std::filesystem;
+  const std::string what = "--out: the folder '" + folder + "'";
+  const std::string advice = "; give a folder that can be created and written to";
+  if (const std::string file = fileInTheWay(folder); !file.empty())
+    return what + " cannot be created: '" + file + "' is a file, not a folder" + advice;
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) return what + " cannot be created: " + ec.message() + advice;
+  const fs::path probe = fs::path(folder) / (".raybridge-render-write-test-" + std::to_string(getpid()));
+  errno = 0;
+  std::FILE* f = std::fopen(probe.c_str(), "wbx");  // x: never replaces a file of the same name
+  if (!f) return what + " cannot be written to: " + std::strerror(errno) + advice;
+  int error = std::fputs("probe\n", f) < 0 || std::fflush(f) != 0 ? (errno ? errno : EIO) : 0;
+  if (std::fclose(f) != 0 && !error) error = errno ? errno : EIO;
+  fs::remove(probe, ec);
+  if (error) return what + " cannot be written to: " + std::strerror(error) + advice;
+  return {};
+}
+
+// "" if `path` is an existing regular file, else what it is instead, for "--scene: 'x' ...".
+std::string notARegularFile(const std::string& path, const std::string& kind) {
+  std::error_code ec;
+  const std::filesystem::file_status s = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(s))
+    return "file '" + path + "' does not exist (" + (ec ? ec.message() : std::string("No such file or directory")) +
+           ")";
+  if (std::filesystem::is_directory(s)) return "'" + path + "' is a folder, not " + kind;
+  if (!std::filesystem::is_regular_file(s)) return "'" + path + "' is not a regular file; give " + kind;
+  return {};
+}
+
 se::Result<se::Scene> loadScene(const RenderOptions& o, std::vector<se::AnimationPlayback>& playbacks) {
   using R = se::Result<se::Scene>;
   const std::string modelsDir = o.modelsFrom.empty() ? std::string(RAYBRIDGE_SOURCE_DIR) + "/../shared/scenes"
                                                      : o.modelsFrom;
+  if (!o.modelsFrom.empty()) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(o.modelsFrom, ec))
+      return R::failure("--models-from: '" + o.modelsFrom + "' " +
+                        (std::filesystem::exists(o.modelsFrom, ec) ? "is not a folder" : "does not exist") +
+                        "; give the folder of the shared glTF models");
+  }
   if (o.perfScene) {
     PerfSceneInfo info;
     auto perf = makePerfScene(
@@ -51,14 +107,15 @@ se::Result<se::Scene> loadScene(const RenderOptions& o, std::vector<se::Animatio
     const std::string& dir = modelsDir;
     // In front of the demo's objects, facing its camera's view (the benchmark centres them on the scene).
     auto animated = rbAnimated::makeAnimatedScene(dir, o.characters, glm::vec2(0.0f, 5.5f));
-    if (!animated) return R::failure("--characters: " + animated.error);
+    if (!animated)
+      return R::failure("--characters: " + animated.error +
+                        "; --models-from gives the folder of the shared glTF models");
     playbacks = animated.value.playbacks;
     return R::success(std::move(animated.value.scene));
   }
   if (o.scene.empty()) return R::success(se::makeDefaultDemoScene());
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(o.scene, ec))
-    return R::failure("--scene: file '" + o.scene + "' does not exist or is not a file");
+  if (std::string e = notARegularFile(o.scene, "a glTF file (.gltf or .glb)"); !e.empty())
+    return R::failure("--scene: " + e);
   se::SceneLoadResult r = se::loadGltf(o.scene);
   for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", o.scene.c_str(), w.c_str());
   if (!r.ok()) return R::failure("--scene: cannot load glTF '" + o.scene + "': " + r.error);
@@ -89,16 +146,49 @@ se::Camera chooseCamera(const RenderOptions& o, const se::Scene& scene, const se
   return c;
 }
 
+// Frame k's time on the camera path: k/(N-1) of the path (the last frame at its end), or k/fps clamped to the end.
+double pathTime(const RenderOptions& o, const rbCameraPath::CameraPath& path, uint32_t k) {
+  const double duration = path.totalDuration();
+  return o.fps ? std::min(double(k) / *o.fps, duration) : double(k) * duration / double(std::max(o.frames - 1, 1u));
+}
+
+// A view straight up or down has no defined up for the engine's camera: an error naming the time, else "".
+std::string checkPathPose(const rbCameraPath::CameraPose& pose, double t) {
+  if (std::abs(pose.forward()[1]) <= 0.9999) return {};
+  return "--camera-path: at t = " + std::to_string(t) +
+         " s the camera looks straight up or down; the engine's camera keeps +Y up, so tilt the orientation a little";
+}
+
+// The path's cameras against the command's camera limits (render_options.h), before any Vulkan work: every
+// keyframe's position and fov (the poses between are interpolated from them), and the pose of every frame rendered.
+std::string checkPathCameras(const RenderOptions& o, const rbCameraPath::CameraPath& path) {
+  static const char* const axes[3] = {"x", "y", "z"};
+  for (size_t i = 0; i < path.keys.size(); ++i) {
+    const std::string where = "--camera-path: '" + o.cameraPath + "': keyframe " + std::to_string(i) + ": ";
+    for (size_t c = 0; c < 3; ++c) {
+      const double v = path.keys[i].position[c];
+      if (std::string e = checkCameraCoordinate(v, std::string("position ") + axes[c] + " " + formatNumber(v));
+          !e.empty())
+        return where + e;
+    }
+    if (std::string e = checkFovY(path.keys[i].fovYDegrees, "fovy_degrees " + formatNumber(path.keys[i].fovYDegrees));
+        !e.empty())
+      return where + e;
+  }
+  for (uint32_t k = 0; k < o.frames; ++k) {
+    const double t = pathTime(o, path, k);
+    if (std::string e = checkPathPose(path.at(t), t); !e.empty()) return e;
+  }
+  return {};
+}
+
 // The camera on the path at time t. se::Camera is eye, target and fov with up = +Y, so the orientation's roll
 // about the view direction cannot be represented and is ignored; a view straight up or down has no defined
 // up and is an error naming the time.
 se::Result<se::Camera> pathCamera(const rbCameraPath::CameraPath& path, double t, const se::Bounds& bounds) {
   const rbCameraPath::CameraPose pose = path.at(t);
   const std::array<double, 3> f = pose.forward();
-  if (std::abs(f[1]) > 0.9999)
-    return se::Result<se::Camera>::failure(
-        "--camera-path: at t = " + std::to_string(t) +
-        " s the camera looks straight up or down; the engine's camera keeps +Y up, so tilt the orientation a little");
+  if (std::string e = checkPathPose(pose, t); !e.empty()) return se::Result<se::Camera>::failure(e);
   const glm::dvec3 eye(pose.position[0], pose.position[1], pose.position[2]);
   // The target is as far as the eye is from the origin (at least 1): far from the origin a unit step would lose
   // the direction's precision in float.
@@ -197,13 +287,37 @@ int main(int argc, char** argv) {
   const bool hybrid = o.mode == Mode::Hybrid, rayTraced = o.mode == Mode::RayTraced;
   const char* modeName = hybrid ? "hybrid" : rayTraced ? "raytraced" : "raster";
 
+  // Everything the options name is checked before any Vulkan work, so bad input fails fast: the output folder,
+  // the scene, the camera path and the animation.
+  if (std::string e = prepareOutputFolder(o.out); !e.empty()) return fail(e);
   std::vector<se::AnimationPlayback> characterPlaybacks;  // --characters: one animation per character
-  auto scene = loadScene(o, characterPlaybacks);          // before any Vulkan work, so bad input fails fast
+  auto scene = loadScene(o, characterPlaybacks);
   if (!scene) return fail(scene.error);
   rbCameraPath::CameraPath cameraPath;
-  if (!o.cameraPath.empty())
+  if (!o.cameraPath.empty()) {
     if (std::string e = rbCameraPath::loadCameraPath(o.cameraPath, cameraPath); !e.empty())
       return fail("--camera-path: " + e);
+    if (std::string e = checkPathCameras(o, cameraPath); !e.empty()) return fail(e);
+  }
+  se::FrameParams params;
+  int animation = -1;  // the animation that plays (index into Scene::animations), -1 = the scene has none
+  if (!characterPlaybacks.empty()) {
+    params.animations = characterPlaybacks;
+    animation = int(characterPlaybacks[0].animation);
+  } else if (!scene.value.animations.empty()) {
+    std::optional<uint32_t> index = o.animation.empty() ? std::optional<uint32_t>(0)
+                                                        : scene.value.animationIndex(o.animation);
+    if (!index) {
+      std::string names;
+      for (size_t i = 0; i < scene.value.animations.size(); ++i)
+        names += (i ? ", " : "") + std::to_string(i) + " '" + scene.value.animations[i].name + "'";
+      return fail("--animation: the scene has no animation " + o.animation + "; its animations are " + names);
+    }
+    animation = int(*index);
+    params.animations = {{*index, 0.0}};
+  } else if (!o.animation.empty()) {
+    return fail("--animation " + o.animation + ": the scene has no animations");
+  }
 
   // The same device in every mode (Raybridge's extensions enabled), so the modes compare like for like.
   rb::RequiredFeatures features;
@@ -217,26 +331,6 @@ int main(int argc, char** argv) {
   if (se::Status s = engine.loadScene(scene.value); !s) return fail(s.error);
   if (se::Status s = engine.setRenderSize(o.width, o.height); !s) return fail(s.error);
 
-  se::FrameParams params;
-  int animation = -1;  // the animation that plays (index into Scene::animations), -1 = the scene has none
-  if (!characterPlaybacks.empty()) {
-    if (!o.animation.empty()) return fail("--animation: with --characters every character plays its own animation");
-    params.animations = characterPlaybacks;
-    animation = int(characterPlaybacks[0].animation);
-  } else if (!engine.scene().animations.empty()) {
-    std::optional<uint32_t> index = o.animation.empty() ? std::optional<uint32_t>(0)
-                                                        : engine.scene().animationIndex(o.animation);
-    if (!index) {
-      std::string names;
-      for (size_t i = 0; i < engine.scene().animations.size(); ++i)
-        names += (i ? ", " : "") + std::to_string(i) + " '" + engine.scene().animations[i].name + "'";
-      return fail("--animation: the scene has no animation " + o.animation + "; its animations are " + names);
-    }
-    animation = int(*index);
-    params.animations = {{*index, 0.0}};
-  } else if (!o.animation.empty()) {
-    return fail("--animation " + o.animation + ": the scene has no animations");
-  }
   std::string cameraSource;
   params.camera = chooseCamera(o, engine.scene(), engine.sceneBounds(), cameraSource);
   if (!o.cameraPath.empty()) cameraSource = "path";
@@ -320,14 +414,10 @@ int main(int argc, char** argv) {
   };
   // --camera-path: frame k at k/(N-1) of the path (the last frame at its end), or k/fps clamped to the end.
   const double pathDuration = cameraPath.totalDuration();
-  auto pathTime = [&](uint32_t k) {
-    return o.fps ? std::min(double(k) / *o.fps, pathDuration)
-                 : double(k) * pathDuration / double(std::max(o.frames - 1, 1u));
-  };
   double capturedPathTime = 0.0;
   auto placeCamera = [&](uint32_t k) -> se::Status {
     if (o.cameraPath.empty()) return se::Status::success();
-    capturedPathTime = pathTime(k);
+    capturedPathTime = pathTime(o, cameraPath, k);
     auto camera = pathCamera(cameraPath, capturedPathTime, engine.sceneBounds());
     if (!camera) return se::Status::failure(camera.error);
     params.camera = camera.value;
@@ -374,9 +464,10 @@ int main(int argc, char** argv) {
   if (adapter && !adapter->lastError().empty()) return fail("Raybridge: " + adapter->lastError());
   if (!captureError.empty()) return fail(captureError);
 
+  // The folder was checked at the start; it is created again in case it went away during the render.
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
-  if (ec) return fail("--out: cannot create folder '" + o.out + "': " + ec.message());
+  if (ec) return fail("--out: the folder '" + o.out + "' cannot be created: " + ec.message());
   const std::filesystem::path out(o.out);
   if (se::Status s = se::writePng((out / "final.png").string(), ldr.value); !s) return fail(s.error);
   if (se::Status s = se::writeExr((out / "final.exr").string(), hdr.value); !s) return fail(s.error);
@@ -616,9 +707,7 @@ int main(int argc, char** argv) {
       }
     }
     if (!e.empty()) return fail(e);
-    std::ofstream json(out / "stats.json");
-    json << stats.dump(2) << "\n";
-    if (!json) return fail("cannot write " + (out / "stats.json").string());
+    if (se::Status s = se::writeFile((out / "stats.json").string(), stats.dump(2) + "\n"); !s) return fail(s.error);
     written.push_back("stats.json");
     std::printf("wrote");
     for (size_t i = 0; i < written.size(); ++i) std::printf("%s %s", i ? "," : "", written[i].c_str());

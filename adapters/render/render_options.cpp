@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <optional>
 #include <vector>
@@ -105,6 +106,46 @@ std::string parseAdaptive(const std::string& value, RenderOptions* o) {
   return {};
 }
 
+// --camera's eye, target and fov (v, parsed from `text`): "" or what is wrong, naming the value and the valid range.
+std::string checkCamera(const std::vector<float>& v, const std::string& text) {
+  std::vector<std::string> items;  // the numbers as given, for the messages
+  for (size_t start = 0, comma = 0; comma != std::string::npos; start = comma + 1) {
+    comma = text.find(',', start);
+    items.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+  }
+  static const char* const names[6] = {"ex", "ey", "ez", "tx", "ty", "tz"};
+  for (size_t i = 0; i < 6; ++i)
+    if (std::string e = checkCameraCoordinate(v[i], std::string(names[i]) + " " + items[i]); !e.empty())
+      return e + " in '" + text + "'";
+  const glm::dvec3 eye(v[0], v[1], v[2]), target(v[3], v[4], v[5]);
+  if (eye == target) return "eye equals target (" + text + "); the view direction is undefined";
+  const double apart = glm::length(target - eye), least = minEyeTargetDistance(eye, target);
+  if (apart < least)
+    return "eye and target are " + formatNumber(apart) + " apart in '" + text +
+           "'; the view direction needs them at least " + formatNumber(least) + " apart";
+  return checkFovY(v[6], "fovy " + items[6]);
+}
+
+// Every value of --camera is checked (a repeated option keeps the last, but a bad earlier one is still an error).
+CLI::Validator cameraValidator() {
+  return CLI::Validator(
+      [](std::string& value) {
+        std::vector<float> v;
+        if (std::string e = rbCli::parseNumberList(value, 7, v); !e.empty()) return e;
+        return checkCamera(v, value);
+      },
+      "");
+}
+
+// --sun's unit direction, or none for a zero vector. Scaled by the largest component before normalising: the squared
+// length of 1e30,1e30,1e30 overflows a float, and that of 1e-30,0,0 underflows to 0, though both are directions.
+std::optional<glm::vec3> sunDirection(const std::vector<float>& v) {
+  const glm::vec3 d(v[0], v[1], v[2]);
+  const float largest = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  if (largest == 0.0f) return std::nullopt;
+  return glm::normalize(d / largest);
+}
+
 void addOptions(CLI::App& app, RenderOptions& o) {
   rbCli::prepare(app);
   app.description(
@@ -131,18 +172,12 @@ void addOptions(CLI::App& app, RenderOptions& o) {
            o.eye = glm::vec3(v[0], v[1], v[2]);
            o.target = glm::vec3(v[3], v[4], v[5]);
            o.fovYDegrees = v[6];
-           if (*o.eye == *o.target)
-             throw CLI::ValidationError("--camera",
-                                        "eye equals target (" + value + "); the view direction is undefined");
-           if (!(o.fovYDegrees > 0.0f && o.fovYDegrees < 180.0f))
-             throw CLI::ValidationError("--camera",
-                                        "fovy " + value.substr(value.rfind(',') + 1) + " is outside (0, 180) degrees");
          },
          "eye, target, vertical fov in degrees; up = +Y, right-handed, pixel (0,0) top-left,\n"
-         "primary rays through pixel centres (default: the scene's camera, else framed on the\n"
-         "scene bounds)")
+         "primary rays through pixel centres; coordinates within +-1e9, fov in [0.01, 180)\n"
+         "(default: the scene's camera, else framed on the scene bounds)")
       ->type_name("ex,ey,ez,tx,ty,tz,fovy")
-      ->check(rbCli::numberList(7));
+      ->check(cameraValidator());
   app.add_option("--camera-path", o.cameraPath,
                  "camera keyframes (JSON: position, orientation quaternion, duration; see\n"
                  "samples/common/camera_path.h); frame k of --frames N is at k/(N-1) of the path,\n"
@@ -153,14 +188,19 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "--sun",
          [&o](const std::string& value) {
            std::vector<float> v;
-           rbCli::parseNumberList(value, 3, v);
-           o.sun = glm::vec3(v[0], v[1], v[2]);
-           if (glm::length(*o.sun) < 1e-6f)
-             throw CLI::ValidationError("--sun", "the direction " + value + " has zero length");
+           rbCli::parseNumberList(value, 3, v);  // validated by the check below
+           o.sun = sunDirection(v);
          },
          "direction towards the sun (default: the scene's sun)")
       ->type_name("dx,dy,dz")
-      ->check(rbCli::numberList(3));
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            std::vector<float> v;
+            if (std::string e = rbCli::parseNumberList(value, 3, v); !e.empty()) return e;
+            if (sunDirection(v)) return std::string();
+            return "the direction " + value + " has zero length; give a direction towards the sun, e.g. 0.3,1,0.2";
+          },
+          ""));
 
   app.add_option_function<std::string>(
          "--preset", [&o](const std::string& value) { o.preset = *rb::parsePreset(value); },
@@ -184,7 +224,7 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "angular radius of the sun, 0 = hard shadows (default: 0.5 when the shadows\n"
          "are soft)")
       ->type_name("DEG")
-      ->check(rbCli::realNumber(rbCli::atLeast(0.0), rbCli::below(45.0), " degrees"));
+      ->check(rbCli::floatNumber(rbCli::atLeast(0.0), rbCli::below(45.0), " degrees"));
   app.add_option_function<uint32_t>(
          "--shadow-rays", [&o](const uint32_t& v) { o.shadowRays = v; },
          "rays per pixel for shadows, 1 = hard (default: the preset's, else 4)")
@@ -197,7 +237,7 @@ void addOptions(CLI::App& app, RenderOptions& o) {
   app.add_option_function<float>(
          "--ao-range", [&o](const float& v) { o.aoRange = v; }, "AO ray length in world units (default 1)")
       ->type_name("R")
-      ->check(rbCli::realNumber(rbCli::above(0.0), rbCli::unbounded(), " (world units)"));
+      ->check(rbCli::floatNumber(rbCli::above(0.0), rbCli::unbounded(), " (world units)"));
   rbCli::addEnum(app, "--ao-estimator", o.aoEstimator,
                  {{"binary", rb::AoEstimator::Binary}, {"distance", rb::AoEstimator::DistanceWeighted}},
                  "AO hits count as occluded, or t/range open (default binary)");
@@ -205,7 +245,7 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "--reflection-roughness", [&o](const float& v) { o.reflectionRoughness = v; },
          "roughness threshold: rougher surfaces trace no reflection ray (default 0.5)")
       ->type_name("T")
-      ->check(rbCli::realNumber(rbCli::above(0.0), rbCli::atMost(1.0)));
+      ->check(rbCli::floatNumber(rbCli::above(0.0), rbCli::atMost(1.0)));
   app.add_option_function<uint32_t>(
          "--reflection-rays", [&o](const uint32_t& v) { o.reflectionRays = v; },
          "reflection rays per glossy pixel (default 4)")
@@ -341,6 +381,29 @@ std::string effectSetToString(rb::EffectSet effects) {
   return rbCli::join(names, ",");
 }
 
+std::string formatNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+std::string checkCameraCoordinate(double value, const std::string& what) {
+  if (std::abs(value) <= kMaxCameraCoordinate) return {};
+  return what + " is outside [-" + formatNumber(kMaxCameraCoordinate) + ", " + formatNumber(kMaxCameraCoordinate) +
+         "] (world units)";
+}
+
+double minEyeTargetDistance(const glm::dvec3& eye, const glm::dvec3& target) {
+  const double largest = std::max({1.0, std::abs(eye.x), std::abs(eye.y), std::abs(eye.z), std::abs(target.x),
+                                   std::abs(target.y), std::abs(target.z)});
+  return kMinEyeTargetDistance * largest;
+}
+
+std::string checkFovY(double degrees, const std::string& what) {
+  if (degrees >= kMinFovYDegrees && degrees < kMaxFovYDegrees) return {};
+  return what + " is outside [" + formatNumber(kMinFovYDegrees) + ", " + formatNumber(kMaxFovYDegrees) + ") degrees";
+}
+
 std::string parseHalfResolution(std::string_view text, bool& ao, bool& reflections) {
   if (text == "none") {
     ao = reflections = false;
@@ -419,6 +482,8 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
   CLI::App app{"", "raybridge-render"};
   addOptions(app, o);
   if (std::string e = rbCli::parse(app, argc, argv, o.help); !e.empty() || o.help) return e;
+  if (o.characters && !o.animation.empty())
+    return "--animation: with --characters every character plays its own animation; drop --animation";
   if (!o.cameraPath.empty() && o.eye) return "--camera-path and --camera both set the camera; give only one of them";
   if (o.characters && !o.scene.empty())
     return "--characters: adds characters to the demo scene; it cannot be combined with --scene";

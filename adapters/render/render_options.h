@@ -22,14 +22,15 @@ enum class Mode { Raster, Hybrid, RayTraced };
 struct RenderOptions {
   std::string scene;  // empty = the engine's procedural demo scene
   uint32_t width = 1280, height = 720;
-  // Eye, target, vertical fov in degrees; empty = the scene's own camera, else framed on the scene bounds.
+  // Eye, target, vertical fov in degrees, within the camera limits below; empty = the scene's own camera, else
+  // framed on the scene bounds.
   std::optional<glm::vec3> eye, target;
   float fovYDegrees = 0.0f;
   // --camera-path FILE: the camera follows the JSON keyframes of samples/common/camera_path.h (not with --camera).
   // Frame k of `frames` is at path time k * total / max(frames - 1, 1), or k / fps with --fps (clamped to the
   // path's end); the captured frame is the last. Empty = no path.
   std::string cameraPath;
-  std::optional<glm::vec3> sun;  // towards the sun; empty = the scene's sun, else the engine's default
+  std::optional<glm::vec3> sun;  // towards the sun, unit length; empty = the scene's sun, else the engine's default
   // Effects and their quality: the preset gives defaults, explicit options win (see resolve()).
   rb::Preset preset = rb::Preset::High;
   std::optional<rb::EffectSet> effects;   // --effects: overrides the preset's set
@@ -111,6 +112,23 @@ std::string effectSetToString(rb::EffectSet effects);
 // "" or an error naming the bad item ("'shadows' in 'ao,shadows' is not an effect with half-resolution tracing (ao,
 // reflections)").
 std::string parseHalfResolution(std::string_view text, bool& ao, bool& reflections);
+
+// The cameras the command renders (--camera, and every --camera-path keyframe): coordinates within
+// +-kMaxCameraCoordinate world units (squared lengths stay finite in float, and the camera-relative frame keeps a
+// usable precision), eye and target at least kMinEyeTargetDistance apart relative to their largest coordinate (at
+// least 1), so that the view direction has one, and a vertical fov in [kMinFovYDegrees, kMaxFovYDegrees) (below, the
+// projection's 1/tan overflows a float).
+inline constexpr double kMaxCameraCoordinate = 1e9;
+inline constexpr double kMinEyeTargetDistance = 1e-6;
+inline constexpr double kMinFovYDegrees = 0.01, kMaxFovYDegrees = 180.0;
+// "" or "<what> is outside [-1e+09, 1e+09] (world units)"; `what` names the value, e.g. "ex 1e10".
+std::string checkCameraCoordinate(double value, const std::string& what);
+// The least distance between eye and target (see kMinEyeTargetDistance).
+double minEyeTargetDistance(const glm::dvec3& eye, const glm::dvec3& target);
+// "" or "<what> is outside [0.01, 180) degrees"; `what` names the value, e.g. "fovy 0".
+std::string checkFovY(double degrees, const std::string& what);
+// %g of v, for messages.
+std::string formatNumber(double v);
 
 // Parses argv; returns an error message naming the option and the bad value, or "" on success (options.help is
 // set for -h/--help: print renderUsage() and exit 0).

@@ -84,7 +84,7 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--scene " + (dir / "missing.gltf").string(), "missing.gltf' does not exist"},
       {"--scene " + malformed.string(), "cannot load glTF"},
       {"--camera 1,2,3,1,2,3,45", "--camera: eye equals target"},
-      {"--camera 1,2,3,0,0,0,180", "--camera: fovy 180 is outside (0, 180)"},
+      {"--camera 1,2,3,0,0,0,180", "--camera: fovy 180 is outside [0.01, 180) degrees"},
       {"--width 0", "--width: 0 is outside 1..16384"},
       {"--height 100000", "--height: 100000 is outside 1..16384"},
       {"--width abc", "--width: 'abc' is not a whole number in 1..16384"},

@@ -139,6 +139,7 @@ TEST_CASE("raybridge-render --perf-scene composes the shared models on a fine gr
 
 TEST_CASE("raybridge-render --perf-scene: bad uses name the option", "[flythrough][render][bad-input]") {
   const fs::path dir = tempDir("bad");
+  fs::create_directories(dir / "no_models_here");  // a folder without the models (a missing one fails before)
   struct Case {
     std::string args, expected;
   };

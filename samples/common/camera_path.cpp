@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -256,11 +257,19 @@ std::string parseCameraPath(std::string_view text, CameraPath& out) {
 }
 
 std::string loadCameraPath(const std::string& path, CameraPath& out) {
+  // Only a regular file: a folder opens and reads as empty, and /dev/zero or a FIFO would never end (or open).
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status))
+    return "'" + path + "': cannot be opened: " + (ec ? ec.message() : std::string("No such file or directory"));
+  if (std::filesystem::is_directory(status)) return "'" + path + "': is a folder, not a camera path file";
+  if (!std::filesystem::is_regular_file(status)) return "'" + path + "': is not a regular file";
   std::ifstream file(path, std::ios::binary);
-  if (!file) return "'" + path + "': cannot be opened (missing or unreadable)";
+  if (!file) return "'" + path + "': cannot be opened (unreadable)";
   std::ostringstream text;
   text << file.rdbuf();
   if (!file && !file.eof()) return "'" + path + "': cannot be read";
+  if (text.str().empty()) return "'" + path + "': is empty; a camera path is a JSON object (see camera_path.h)";
   if (std::string e = parseCameraPath(text.str(), out); !e.empty()) return "'" + path + "': " + e;
   return {};
 }

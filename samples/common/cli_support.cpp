@@ -18,6 +18,13 @@ std::string number(double v) {
   return buf;
 }
 
+// Every digit of v: parsing it gives v back.
+std::string number17(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
 // Digits only; values too large for uint64_t come back as UINT64_MAX (outside any range we use).
 bool parseWhole(std::string_view text, uint64_t& out) {
   if (text.empty() || text.find_first_not_of("0123456789") != std::string_view::npos) return false;
@@ -29,17 +36,28 @@ bool parseWhole(std::string_view text, uint64_t& out) {
   return true;
 }
 
+// CLI11 converts an option's value after the validators accepted it, reading "0640" as octal (416) and failing
+// on "09": a leading zero is refused here, naming the number meant.
+std::string leadingZeroError(std::string_view text, uint64_t value, const std::string& valid) {
+  if (text.size() < 2 || text[0] != '0') return {};
+  return quote(text) + " has a leading zero; give " + std::to_string(value) + " (" + valid + ")";
+}
+
 std::string wholeError(std::string_view text, uint64_t min, uint64_t max, uint64_t& out) {
   if (!parseWhole(text, out)) return quote(text) + " is not a whole number in " + range(min, max);
   if (out < min || out > max) return std::string(text) + " is outside " + range(min, max);
-  return {};
+  return leadingZeroError(text, out, range(min, max));
 }
 
-bool parseFloat(std::string_view text, float& out) {
+constexpr double kFloatMax = 3.4028234663852886e38;  // FLT_MAX
+
+// An item of a number list: "" or the error's predicate ("is not a number", "is not finite; ...").
+std::string floatItemError(std::string_view text, float& out) {
   double d = 0.0;
-  if (!parseReal(text, {}, {}, "", d).empty()) return false;
+  if (std::string e = parseReal(text, {}, {}, "", d); !e.empty()) return e.substr(quote(text).size());
   out = float(d);
-  return std::isfinite(out);
+  if (!std::isfinite(out)) return " is too large for a 32-bit float (magnitude above " + number(kFloatMax) + ")";
+  return {};
 }
 
 }  // namespace
@@ -82,7 +100,7 @@ CLI::Validator zeroOrWholeNumber(uint64_t min, uint64_t max, const std::string& 
           return quote(value) + " is not a whole number in " + range(min, max) + " (or 0 = " + zeroMeaning + ")";
         if (v != 0 && (v < min || v > max))
           return value + " is outside " + range(min, max) + " (or 0 = " + zeroMeaning + ")";
-        return {};
+        return leadingZeroError(value, v, range(min, max) + ", or 0 = " + zeroMeaning);
       },
       "0|" + range(min, max));
 }
@@ -128,6 +146,34 @@ CLI::Validator realNumber(Bound low, Bound high, const std::string& suffix) {
       desc);
 }
 
+std::string parseFloatReal(std::string_view text, Bound low, Bound high, const std::string& suffix, float& out) {
+  double v = 0.0;
+  if (std::string e = parseReal(text, {}, {}, suffix, v); !e.empty()) return e;
+  const float f = float(v);
+  if (!std::isfinite(f))
+    return quote(text) + " is too large for a 32-bit float (magnitude above " + number(kFloatMax) + ")";
+  // The bounds apply to the value the option gets: 1e-50 is 0 as a float.
+  double rounded = 0.0;
+  if (std::string e = parseReal(number17(f), low, high, suffix, rounded); !e.empty()) {
+    std::string m = parseReal(text, low, high, suffix, rounded);
+    if (m.empty()) m = std::string(text) + " is " + number(f) + " as a 32-bit float, which" + e.substr(e.find(' '));
+    return m;
+  }
+  out = f;
+  return {};
+}
+
+CLI::Validator floatNumber(Bound low, Bound high, const std::string& suffix) {
+  CLI::Validator v = realNumber(low, high, suffix);
+  const std::string desc = v.get_description();
+  return CLI::Validator(
+      [low, high, suffix](std::string& value) {
+        float f = 0.0f;
+        return parseFloatReal(value, low, high, suffix, f);
+      },
+      desc);
+}
+
 CLI::Validator nonEmpty(const std::string& what) {
   return CLI::Validator(
       [what](std::string& value) { return value.empty() ? "the " + what + " is empty" : std::string(); }, "");
@@ -151,7 +197,7 @@ std::string parseNumberList(std::string_view text, size_t count, std::vector<flo
     const std::string_view item = text.substr(start,
                                               comma == std::string_view::npos ? std::string_view::npos : comma - start);
     float v = 0.0f;
-    if (!parseFloat(item, v)) return quote(item) + " in " + quote(text) + " is not a number";
+    if (std::string e = floatItemError(item, v); !e.empty()) return quote(item) + " in " + quote(text) + e;
     out.push_back(v);
     if (comma == std::string_view::npos) break;
     start = comma + 1;

@@ -30,8 +30,9 @@ std::string join(const std::vector<std::string>& names, std::string_view separat
 // "a", "a or b", "a, b or c" (lastSeparator " or "; ", " gives a plain list).
 std::string joinNames(const std::vector<std::string>& names, std::string_view lastSeparator = " or ");
 
-// Whole number in min..max: "'abc' is not a whole number in 1..64", "0 is outside 1..64". The description
-// (shown in --help after the type name) is "min..max".
+// Whole number in min..max: "'abc' is not a whole number in 1..64", "0 is outside 1..64", "'010' has a leading
+// zero; give 10 (1..64)" (CLI11's conversion would read it as octal). The description (shown in --help after the
+// type name) is "min..max".
 CLI::Validator wholeNumber(uint64_t min, uint64_t max);
 // Returns "" and sets `out`, or the error above.
 std::string parseWholeNumber(std::string_view text, uint64_t min, uint64_t max, uint64_t& out);
@@ -55,6 +56,12 @@ inline Bound unbounded() { return {}; }
 CLI::Validator realNumber(Bound low, Bound high = unbounded(), const std::string& unit = "");
 // Returns "" and sets `out`, or the error above.
 std::string parseReal(std::string_view text, Bound low, Bound high, const std::string& unit, double& out);
+// As realNumber, for an option stored in a float: the value as a 32-bit float must be finite and within the bounds
+// ("'1e39' is too large for a 32-bit float (magnitude above 3.40282e+38)", "1e-50 is 0 as a 32-bit float, which
+// must be greater than 0").
+CLI::Validator floatNumber(Bound low, Bound high = unbounded(), const std::string& unit = "");
+// Returns "" and sets `out`, or the error above.
+std::string parseFloatReal(std::string_view text, Bound low, Bound high, const std::string& unit, float& out);
 
 // A value that is not empty: "the <what> is empty" (e.g. what = "file name").
 CLI::Validator nonEmpty(const std::string& what);
@@ -62,8 +69,9 @@ CLI::Validator nonEmpty(const std::string& what);
 // A name from `names`: "'cosine' is not binary or distance".
 CLI::Validator oneOf(std::vector<std::string> names);
 
-// "x,y,z,...": exactly `count` finite numbers. Errors: "'x' in '1,x,0' is not a number", "expected 3
-// comma-separated numbers, got 2 in '1,2'".
+// "x,y,z,...": exactly `count` numbers, finite as 32-bit floats. Errors: "'x' in '1,x,0' is not a number", "'nan' in
+// 'nan,0,0' is not finite; give a finite number", "'1e39' in '1e39,0,0' is too large for a 32-bit float (magnitude
+// above 3.40282e+38)", "expected 3 comma-separated numbers, got 2 in '1,2'".
 std::string parseNumberList(std::string_view text, size_t count, std::vector<float>& out);
 CLI::Validator numberList(size_t count);
 // "1,10,50": one or more whole numbers in min..max.

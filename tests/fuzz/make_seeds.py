@@ -191,6 +191,10 @@ def main():
         "perf": "--perf-scene\n--perf-ground\n64\n--perf-copies\n2\n--device\nllvmpipe\n--validation",
         "camera_path": "--camera-path\npath.json\n--mode\nraytraced\n--frames\n5\n--fps\n24",
         "help": "--help",
+        # Valid values at the edges of what the parser accepts (a sun whose squared length overflows a float, the
+        # narrowest fov, a hex float, the largest AO range), and the repeated option that keeps the last value.
+        "edges": "--sun\n1e30,1e30,1e30\n--camera\n0,6,0,0,0,0,0.01\n--sun-radius\n0x1p-2\n--ao-range\n3e38"
+                 "\n--width\n64\n--width\n16",
     }
     for name, text in options.items():
         write("render_options", name + ".txt", text)

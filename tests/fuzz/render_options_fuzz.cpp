@@ -57,9 +57,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (o.eye) {
     check(o.target.has_value(), "--camera sets eye and target");
     check(*o.eye != *o.target, "--camera eye differs from target");
-    check(o.fovYDegrees > 0.0f && o.fovYDegrees < 180.0f, "--camera fov in (0, 180)");
+    check(o.fovYDegrees >= rbRender::kMinFovYDegrees && o.fovYDegrees < rbRender::kMaxFovYDegrees,
+          "--camera fov in [kMinFovYDegrees, kMaxFovYDegrees)");
+    for (int c = 0; c < 3; ++c)
+      check(std::abs((*o.eye)[c]) <= rbRender::kMaxCameraCoordinate &&
+                std::abs((*o.target)[c]) <= rbRender::kMaxCameraCoordinate,
+            "--camera coordinates within kMaxCameraCoordinate");
+    const glm::vec3 forward = *o.target - *o.eye;  // as the engine's view matrix computes it, in float
+    check(std::isfinite(glm::dot(forward, forward)) && glm::dot(forward, forward) > 0.0f,
+          "--camera has a view direction in float");
   }
-  check(!o.sun || glm::length(*o.sun) > 0.0f, "--sun has a length");
+  check(!o.sun || std::abs(glm::length(*o.sun) - 1.0f) < 1e-5f, "--sun is a unit vector");
   check(!o.sunRadiusDegrees || (*o.sunRadiusDegrees >= 0.0f && *o.sunRadiusDegrees < 45.0f), "--sun-radius range");
   check(!o.aoRange || (std::isfinite(*o.aoRange) && *o.aoRange > 0.0f), "--ao-range finite and > 0");
   check(!o.reflectionRoughness || (*o.reflectionRoughness > 0.0f && *o.reflectionRoughness <= 1.0f),

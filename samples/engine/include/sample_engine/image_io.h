@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -35,9 +36,14 @@ struct ImageRGBA32F {
   }
 };
 
+// The writers encode in memory and then write the file through writeFile, so a failed write is an error.
 Status writePng(const std::string& path, const ImageRGBA8& image);
 // halfFloat = true writes RGBA half, otherwise RGBA float.
 Status writeExr(const std::string& path, const ImageRGBA32F& image, bool halfFloat = true);
+// Writes `bytes` to the file at `path` (created or replaced) and checks every step, the close included, so that a
+// full disk or a failing device is an error ("cannot write <path>: No space left on device") rather than a short
+// file. A regular file left part-written is removed.
+Status writeFile(const std::string& path, std::string_view bytes);
 
 // CPU reference of the tonemap pass (exposure, ACES fit, sRGB encode), to predict output colors.
 glm::vec3 tonemapLinear(const glm::vec3& hdr, float exposure);  // result is linear in [0,1]
