@@ -16,6 +16,7 @@
 #include <catch2/catch_test_macros.hpp>
 #include <nlohmann/json.hpp>
 
+#include "base64.h"
 #include "engine_test_support.h"
 #include "sample_engine/engine.h"
 #include "sample_engine/gltf_loader.h"
@@ -32,19 +33,7 @@ const float kNaN = std::numeric_limits<float>::quiet_NaN(), kInf = std::numeric_
 // The base asset's data: accessor i reads all of buffer view i.
 enum Data : int { kPositions, kNormals, kUvs, kJoints, kWeights, kIndices, kTimes, kTranslations, kInverseBinds };
 
-std::string base64(std::span<const uint8_t> bytes) {
-  static const char* const kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    const uint32_t n = uint32_t(bytes[i]) << 16 | (i + 1 < bytes.size() ? uint32_t(bytes[i + 1]) << 8 : 0) |
-                       (i + 2 < bytes.size() ? bytes[i + 2] : 0);
-    out += kDigits[n >> 18];
-    out += kDigits[(n >> 12) & 63];
-    out += i + 1 < bytes.size() ? kDigits[(n >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? kDigits[n & 63] : '=';
-  }
-  return out;
-}
+using test_support::base64;
 
 std::filesystem::path scratchDir() {
   static const std::filesystem::path dir = [] {
