@@ -49,9 +49,9 @@ float biasSquared(ivec2 ip, bool same[9]) {
 #endif
 }
 
-void store(ivec2 ip, float value, float variance, float bias2) {
+// `temporal`: the pixel's temporal value and variance (the final step's anchor; unused before it).
+void store(ivec2 ip, vec2 temporal, float value, float variance, float bias2) {
 #ifdef RB_DN_ATROUS_FINAL
-  vec2 temporal = texelFetch(temporalIn, ip, 0).rg;
   imageStore(signalOut, ip, vec4(rbDnLimitedShift(temporal.r, temporal.g, value, bias2)));
 #else
   imageStore(signalOut, ip, vec4(value, variance, 0.0, 0.0));
@@ -63,21 +63,21 @@ void main() {
   if (any(greaterThanEqual(pixel, pc.size))) return;
   ivec2 ip = ivec2(pixel);
 #ifdef RB_DN_ATROUS_FINAL
-  {
-    // A converged pixel keeps its temporal value whatever the filter gives (rbDnLimitedShift's gain is 0, the same
-    // expression): skip the filter. Bit-identical to filtering and discarding; it is most of the pixels of a
-    // converged signal (lit ground, open sky light, many rays or a full history).
-    vec2 temporal = texelFetch(temporalIn, ip, 0).rg;
-    if (sqrt(max(temporal.g, 0.0)) / pc.convergedNoise - 1.0 <= 0.0) {
-      imageStore(signalOut, ip, vec4(temporal.r));
-      return;
-    }
+  // A converged pixel keeps its temporal value whatever the filter gives (rbDnLimitedShift's gain is 0, the same
+  // expression): skip the filter. Bit-identical to filtering and discarding; it is most of the pixels of a
+  // converged signal (lit ground, open sky light, many rays or a full history).
+  vec2 temporal = texelFetch(temporalIn, ip, 0).rg;
+  if (sqrt(max(temporal.g, 0.0)) / pc.convergedNoise - 1.0 <= 0.0) {
+    imageStore(signalOut, ip, vec4(temporal.r));
+    return;
   }
+#else
+  vec2 temporal = vec2(0.0);
 #endif
   vec2 centre = texelFetch(signalIn, ip, 0).rg;
   float depth = texelFetch(gDepth, ip, 0).r;
   if (rbDnSky(depth)) {
-    store(ip, centre.r, centre.g, 0.0);
+    store(ip, temporal, centre.r, centre.g, 0.0);
     return;
   }
   // Positions in view space, the centre's normal turned into it (viewToWorld is a rotation: its transpose is its
@@ -126,5 +126,5 @@ void main() {
     }
   }
 #endif
-  store(ip, centre.r + sum / weights, variances / (weights * weights), biasSquared(ip, same));
+  store(ip, temporal, centre.r + sum / weights, variances / (weights * weights), biasSquared(ip, same));
 }
