@@ -128,7 +128,7 @@ struct DenoiseConstants {
   float convergedNoise;         // 224: scalar: noise standard deviation under which the value passes unfiltered
 };
 
-// The allocation step of adaptive rays (adaptive_allocate.comp). 32 bytes.
+// The allocation step of adaptive rays (adaptive_allocate.comp, adaptive_allocate_tiles.comp). 40 bytes.
 struct AdaptivePlanConstants {
   uvec2 size;         //  0: width, height in pixels
   uint budget;        //  8: most rays this frame (0xFFFFFFFF = no cap)
@@ -137,6 +137,7 @@ struct AdaptivePlanConstants {
   uint maxRays;       // 20: no pixel gets more
   uint frameIndex;    // 24: the rounding noise's seed
   uint pad0;          // 28
+  uvec2 tileSize;     // 32: adaptive_allocate_tiles.comp: the tile in pixels (powers of two, at most 16)
 };
 
 // The refit-quality measure of dynamic BLASes (blas_cluster_bounds.comp). 48 bytes.

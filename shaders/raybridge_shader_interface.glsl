@@ -70,7 +70,7 @@
 #define RB_UPSAMPLE_BINDING_SAMPLES 3              // the half-resolution image the pass traced into
 #define RB_UPSAMPLE_BINDING_OUTPUT 4               // the pass's full-resolution output
 
-// The adaptive ray planning dispatches (adaptive_estimate.comp, adaptive_allocate.comp).
+// The adaptive ray planning dispatches (adaptive_estimate.comp, adaptive_allocate.comp, adaptive_allocate_tiles.comp).
 #define RB_ADAPTIVE_BINDING_DEPTH 0
 #define RB_ADAPTIVE_BINDING_MOTION 1    // the depth image again without motion vectors
 #define RB_ADAPTIVE_BINDING_HISTORY 2   // the denoiser's history of last frame (mean, frames)

@@ -3,8 +3,10 @@
 #include <raybridge/raybridge.h>
 
 #include <catch2/catch_test_macros.hpp>
+#include <catch2/generators/catch_generators.hpp>
 #include <glm/gtc/packing.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -28,6 +30,48 @@ std::vector<float> readPlan(GpuFixture& fx, VkImage image, uint32_t w, uint32_t 
     out[i] = glm::unpackHalf1x16(half);
   }
   return out;
+}
+
+// A plan's tiles (of tw x th pixels, aligned to multiples of themselves): the surface pixels of a tile share one
+// count, sky pixels have none. `mixed` counts the tiles where they do not; `surfaceTiles` those with a surface pixel.
+struct TileCheck {
+  uint32_t mixed = 0, skyWithRays = 0, surfaceTiles = 0;
+};
+TileCheck checkTiles(const std::vector<float>& plan, const CpuGBuffer& cpu, uint32_t w, uint32_t h, uint32_t tw,
+                     uint32_t th) {
+  TileCheck c;
+  for (uint32_t ty = 0; ty < h; ty += th) {
+    for (uint32_t tx = 0; tx < w; tx += tw) {
+      float count = -1.0f;
+      bool mixed = false;
+      for (uint32_t y = ty; y < std::min(ty + th, h); ++y) {
+        for (uint32_t x = tx; x < std::min(tx + tw, w); ++x) {
+          const size_t p = size_t(y) * w + x;
+          if (!cpu.hit[p]) {
+            c.skyWithRays += plan[2 * p] != 0.0f;
+          } else if (count < 0.0f) {
+            count = plan[2 * p];
+          } else {
+            mixed = mixed || plan[2 * p] != count;
+          }
+        }
+      }
+      c.surfaceTiles += count >= 0.0f;
+      c.mixed += mixed;
+    }
+  }
+  return c;
+}
+
+// The planned rays summed over the image.
+uint64_t plannedRays(const std::vector<float>& plan) {
+  uint64_t sum = 0;
+  for (size_t i = 0; i < plan.size(); i += 2) sum += uint64_t(plan[i]);
+  return sum;
+}
+
+const char* granularityName(rb::AdaptiveRayGranularity g) {
+  return g == rb::AdaptiveRayGranularity::Tile ? "tile" : "pixel";
 }
 
 struct AdaptiveScene {
@@ -123,8 +167,12 @@ TEST_CASE("the ray budget controller settles on its time target despite a fixed 
 }
 
 TEST_CASE("adaptive AO traces no more rays than its budget, the plan matches the counters, and rays go where the "
-          "history is uncertain",
+          "history is uncertain (per pixel and per tile)",
           "[adaptive][ao]") {
+  const rb::AdaptiveRayGranularity granularity = GENERATE(rb::AdaptiveRayGranularity::Pixel,
+                                                          rb::AdaptiveRayGranularity::Tile);
+  INFO("granularity " << granularityName(granularity));
+  const bool tiles = granularity == rb::AdaptiveRayGranularity::Tile;
   GpuFixture fx;
   const uint32_t w = 64, h = 48;
   AdaptiveScene s(fx, w, h);
@@ -134,6 +182,7 @@ TEST_CASE("adaptive AO traces no more rays than its budget, the plan matches the
   desc.ao.raysPerPixel = 4;
   desc.ao.range = 2.0f;
   desc.ao.adaptive.enabled = true;
+  desc.ao.adaptive.granularity = granularity;
   desc.ao.adaptive.maxRaysPerFrame = 3 * uint64_t(s.surfacePixels);  // under the uniform 4 per pixel
   auto fxr = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
   RB_REQUIRE_OK(fxr);
@@ -164,7 +213,13 @@ TEST_CASE("adaptive AO traces no more rays than its budget, the plan matches the
     CHECK(rays <= desc.ao.adaptive.maxRaysPerFrame);
     CHECK(rays >= desc.ao.adaptive.maxRaysPerFrame * 9 / 10);  // and the budget is spent
     CHECK(maxRays <= rb::kDefaultAdaptiveMaxRaysFactor * 4);
-    if (i == 5) {
+    if (tiles) {
+      // The default tile: one count per 8x8 block of surface pixels.
+      const TileCheck t = checkTiles(plan, s.cpu, w, h, rb::kDefaultAdaptiveTileWidth, rb::kDefaultAdaptiveTileHeight);
+      CHECK(t.mixed == 0);
+      CHECK(t.skyWithRays == 0);
+    }
+    if (i == 5 && !tiles) {
       // Where the history is settled at fully open (1) or closed (0) the estimate is certain; where it is in
       // between (corners, contact) it is not: those pixels get more rays.
       double certainRays = 0, uncertainRays = 0;
@@ -185,11 +240,118 @@ TEST_CASE("adaptive AO traces no more rays than its budget, the plan matches the
       INFO("mean rays: certain pixels " << certainRays / certain << ", uncertain " << uncertainRays / uncertain);
       CHECK(uncertainRays / uncertain > 2.0 * (certainRays / certain));
     }
+    if (i == 5 && tiles) {
+      // Per tile: the tiles whose pixels' histories are the most uncertain on average (binomial variance of the
+      // reprojected mean) get more rays per pixel than the most certain ones.
+      std::vector<std::pair<double, double>> byTile;  // (mean variance, rays per surface pixel)
+      const uint32_t tw = rb::kDefaultAdaptiveTileWidth, th = rb::kDefaultAdaptiveTileHeight;
+      for (uint32_t ty = 0; ty < h; ty += th) {
+        for (uint32_t tx = 0; tx < w; tx += tw) {
+          double variance = 0.0, rays = 0.0;
+          uint32_t n = 0;
+          for (uint32_t y = ty; y < std::min(ty + th, h); ++y) {
+            for (uint32_t x = tx; x < std::min(tx + tw, w); ++x) {
+              const size_t p = size_t(y) * w + x;
+              if (!s.cpu.hit[p]) continue;
+              const double mean = plan[2 * p + 1];
+              variance += mean * (1.0 - mean);
+              rays += plan[2 * p];
+              ++n;
+            }
+          }
+          if (n >= tw * th / 2) byTile.push_back({variance / n, rays / n});
+        }
+      }
+      REQUIRE(byTile.size() >= 16);
+      std::sort(byTile.begin(), byTile.end());
+      const size_t quarter = byTile.size() / 4;
+      double certainRays = 0, uncertainRays = 0;
+      for (size_t k = 0; k < quarter; ++k) {
+        certainRays += byTile[k].second;
+        uncertainRays += byTile[byTile.size() - 1 - k].second;
+      }
+      INFO(byTile.size() << " tiles; mean rays per pixel: most certain quarter " << certainRays / quarter
+                         << ", most uncertain quarter " << uncertainRays / quarter << "; variance "
+                         << byTile.front().first << " .. " << byTile.back().first);
+      CHECK(uncertainRays > 1.5 * certainRays);
+    }
   }
 }
 
-TEST_CASE("adaptive soft shadows stay within the uniform rays by default and follow a time target down",
+TEST_CASE("adaptive rays per tile: every surface pixel of a tile gets the same rays within the budget, at full and "
+          "half resolution, with any tile shape and over the shadow classifier's tiles",
+          "[adaptive][tiles]") {
+  GpuFixture fx;
+  const uint32_t w = 64, h = 48;
+  AdaptiveScene s(fx, w, h);
+  REQUIRE(s.surfacePixels > 1000);
+  const rb::HybridFrame frame = s.frame();
+  // Runs `frames` frames after the uniform first and checks each plan's tiles of tw x th pixels and its budget.
+  auto run = [&](rb::HybridEffects& effects, bool ao, uint32_t tw, uint32_t th, uint64_t budget, bool exactCounts) {
+    fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });
+    for (int i = 0; i < 4; ++i) {
+      fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });
+      const VkImage image = ao ? effects.aoPass()->outputs().rayPlan : effects.shadowPass()->outputs().rayPlan;
+      REQUIRE(image != VK_NULL_HANDLE);
+      const std::vector<float> plan = readPlan(fx, image, w, h);
+      const TileCheck t = checkTiles(plan, s.cpu, w, h, tw, th);
+      const uint64_t rays = ao ? effects.stats().ao.rays : effects.stats().shadow.rays;
+      const uint64_t planned = plannedRays(plan);
+      INFO("frame " << i << ": " << t.surfaceTiles << " tiles of " << tw << "x" << th << " pixels, " << t.mixed
+                    << " mixed; " << rays << " rays counted, " << planned << " planned, budget " << budget);
+      REQUIRE(t.surfaceTiles > 4);
+      CHECK(t.mixed == 0);
+      CHECK(t.skyWithRays == 0);
+      CHECK(planned <= budget);
+      CHECK(rays <= budget);
+      if (exactCounts) CHECK(rays == planned);
+    }
+  };
+  rb::HybridEffectsDesc desc;
+  SECTION("AO at full resolution, 8x4 tiles, a budget under the minimum of one ray everywhere") {
+    desc.effects = rb::kEffectAo;
+    desc.ao.raysPerPixel = 4;
+    desc.ao.adaptive.enabled = true;
+    desc.ao.adaptive.tileWidth = 8;
+    desc.ao.adaptive.tileHeight = 4;
+    // Half a ray per surface pixel: half the tiles get one ray per pixel, the claim cuts the rest to whole tiles.
+    desc.ao.adaptive.maxRaysPerFrame = s.surfacePixels / 2;
+    auto e = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
+    RB_REQUIRE_OK(e);
+    run(*e.value(), true, 8, 4, desc.ao.adaptive.maxRaysPerFrame, true);
+  }
+  SECTION("AO at half resolution: the default 8x8 tiles of launch cells are 16x16 pixels") {
+    desc.effects = rb::kEffectAo;
+    desc.ao.raysPerPixel = 4;
+    desc.ao.halfResolution = true;
+    desc.ao.adaptive.enabled = true;
+    desc.ao.adaptive.maxRaysPerFrame = 3ull * s.surfacePixels;
+    auto e = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
+    RB_REQUIRE_OK(e);
+    // A quarter of the plan is traced: the counters are not the plan.
+    run(*e.value(), true, 16, 16, desc.ao.adaptive.maxRaysPerFrame, false);
+  }
+  SECTION("soft shadows over the tile classifier's launch, 4x8 tiles") {
+    desc.effects = rb::kEffectShadows;
+    desc.shadows.raysPerPixel = 4;
+    desc.shadows.tileClassifier = true;
+    desc.shadows.adaptive.enabled = true;
+    desc.shadows.adaptive.tileWidth = 4;
+    desc.shadows.adaptive.tileHeight = 8;
+    auto e = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
+    RB_REQUIRE_OK(e);
+    // Pixels facing away from the light are planned rays but trace none.
+    run(*e.value(), false, 4, 8, 4ull * s.surfacePixels, false);
+  }
+}
+
+TEST_CASE("adaptive soft shadows stay within the uniform rays by default and follow a time target down (per pixel "
+          "and per tile)",
           "[adaptive][shadows]") {
+  const rb::AdaptiveRayGranularity granularity = GENERATE(rb::AdaptiveRayGranularity::Pixel,
+                                                          rb::AdaptiveRayGranularity::Tile);
+  INFO("granularity " << granularityName(granularity));
+  const bool tiles = granularity == rb::AdaptiveRayGranularity::Tile;
   GpuFixture fx;
   const uint32_t w = 48, h = 36;
   AdaptiveScene s(fx, w, h);
@@ -197,6 +359,7 @@ TEST_CASE("adaptive soft shadows stay within the uniform rays by default and fol
   desc.effects = rb::kEffectShadows;
   desc.shadows.raysPerPixel = 4;
   desc.shadows.adaptive.enabled = true;  // no cap, no time target: the uniform rays, redistributed
+  desc.shadows.adaptive.granularity = granularity;
   auto fxr = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
   RB_REQUIRE_OK(fxr);
   rb::HybridEffects& effects = *fxr.value();
@@ -216,7 +379,8 @@ TEST_CASE("adaptive soft shadows stay within the uniform rays by default and fol
       CHECK(rays <= planned);
     }
   }
-  // A time target no pass can meet: the budget falls to its floor (one ray per 64 pixels) within a few frames.
+  // A time target no pass can meet: the budget falls to its floor (one ray per 64 pixels; per tile, at least one
+  // ray in every pixel of a tile) within a few frames.
   desc.shadows.adaptive.timeBudgetMs = 1e-6f;
   RB_REQUIRE_OK(effects.setDesc(desc));
   uint64_t first = 0, last = 0;
@@ -226,7 +390,10 @@ TEST_CASE("adaptive soft shadows stay within the uniform rays by default and fol
     if (i == 0) first = last;
   }
   INFO("rays: first " << first << ", last " << last);
-  CHECK(last <= uint64_t(w) * h / 64 + 1);
+  const uint64_t floor = tiles ? std::max<uint64_t>(uint64_t(w) * h / 64 + 1,
+                                                    rb::kDefaultAdaptiveTileWidth * rb::kDefaultAdaptiveTileHeight)
+                               : uint64_t(w) * h / 64 + 1;
+  CHECK(last <= floor);
   CHECK(last < first);
 }
 
@@ -262,6 +429,16 @@ TEST_CASE("bad adaptive ray settings are named", "[adaptive][bad_input]") {
   a.adaptive.maxRaysPerPixel = 2;
   a.adaptive.minRaysPerPixel = 3;
   expectError(a, "minRaysPerPixel 3 exceeds maxRaysPerPixel 2");
+  a.adaptive.minRaysPerPixel = 0;
+  a.adaptive.tileWidth = 3;
+  expectError(a, "tileWidth 3 must be 0 (default 8x8) or a power of two at most 8");
+  a.adaptive.tileWidth = 0;
+  a.adaptive.tileHeight = 16;
+  expectError(a, "tileHeight 16 must be 0");
+  a.adaptive.tileHeight = 0;
+  a.adaptive.granularity = static_cast<rb::AdaptiveRayGranularity>(7);
+  expectError(a, "granularity has an unknown value (7)");
+  a.adaptive.granularity = rb::AdaptiveRayGranularity::Tile;
 
   rb::HybridEffectsDesc desc;
   desc.effects = rb::kEffectAo;

@@ -1,12 +1,16 @@
 // The adaptive-rays scenario (--scenario adaptive): soft shadows and AO accumulated over frames with the denoiser
 // on a still camera, uniform rays per pixel against adaptive rays (raybridge/adaptive_rays.h), each scored by the
 // RMSE of the denoised image after kAccumulatedFrames frames against the converged reference. Per uniform ray
-// count n it reports:
-//   uniform            n rays in every pixel;
-//   adaptive_equal_rays the same rays, spent where the denoiser's history is uncertain;
-//   adaptive_equal_time a GPU time target equal to the uniform row's pass time (planning included);
-//   adaptive_budget    fractions of the uniform rays (AdaptiveRaySettings::maxRaysPerFrame), from which the
-//                      summary interpolates the rays saved at the uniform row's error.
+// count n it reports, for each planning granularity G (AdaptiveRaySettings::granularity and tile):
+//   pixel (one count per pixel), tile (the default tile, 8x8 launch cells) and the warp shapes tile8x4, tile4x8:
+//   uniform                n rays in every pixel;
+//   adaptive_G_equal_rays  the same rays, spent where the denoiser's history is uncertain;
+//   adaptive_G_equal_time  a GPU time target equal to the uniform row's pass time (planning included);
+//   adaptive_G_budget      (pixel and tile) fractions of the uniform rays (AdaptiveRaySettings::maxRaysPerFrame),
+//                          from which the summary interpolates the rays saved at the uniform row's error.
+// Per tile against per pixel at equal time is the divergence measurement: a warp traces as long as its busiest
+// pixel, so per-pixel counts cost more GPU time than their rays; the 8x4 and 4x8 rows tell which warp shape the
+// device's ray generation launch uses (the shape that matches it is as fast as 8x8 and plans more finely).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -44,6 +48,20 @@ struct Effect {
 rb::AdaptiveRaySettings& adaptiveOf(rb::HybridEffectsDesc& d, const Effect& fx) {
   return fx.flag == rb::kEffectAo ? d.ao.adaptive : d.shadows.adaptive;
 }
+
+// A planning granularity the sweep compares (the row names' G).
+struct Granularity {
+  const char* name;
+  rb::AdaptiveRayGranularity granularity;
+  uint32_t tileWidth, tileHeight;  // 0 = the SDK's default tile
+  bool budgetCurve;                // also the adaptive_G_budget rows
+};
+const Granularity kGranularities[] = {
+    {"pixel", rb::AdaptiveRayGranularity::Pixel, 0, 0, true},
+    {"tile", rb::AdaptiveRayGranularity::Tile, 0, 0, true},
+    {"tile8x4", rb::AdaptiveRayGranularity::Tile, 8, 4, false},
+    {"tile4x8", rb::AdaptiveRayGranularity::Tile, 4, 8, false},
+};
 
 }  // namespace
 
@@ -145,7 +163,7 @@ se::Result<EffectResult> runAdaptiveSweep(FrameDriver& driver, const SweepPlan& 
     row.params["rays_per_surface_pixel"] = result.surfacePixels ? double(pass.rays) / double(result.surfacePixels)
                                                                 : 0.0;
     row.params["frames"] = kAccumulatedFrames;
-    progress("%s: %-20s %-28s effect %7.3f ms  rays/frame %10llu  RMSE %.5f", fx.name.c_str(), row.method.c_str(),
+    progress("%s: %-28s %-28s effect %7.3f ms  rays/frame %10llu  RMSE %.5f", fx.name.c_str(), row.method.c_str(),
              row.setting.c_str(), row.effectMs, static_cast<unsigned long long>(pass.rays), row.rmse);
     result.rows.push_back(row);
     return {};
@@ -165,67 +183,82 @@ se::Result<EffectResult> runAdaptiveSweep(FrameDriver& driver, const SweepPlan& 
     const Row u = result.rows.back();
 
     rb::AdaptiveRaySettings& a = adaptiveOf(d, fx);
-    a.enabled = true;
-    Row equalRays;
-    equalRays.method = "adaptive_equal_rays";
-    equalRays.setting = std::to_string(n) + " rays on average";
-    equalRays.id = "adaptive_rays_r" + std::to_string(n);
-    equalRays.params = {{"rays_per_pixel", n}, {"adaptive", true}};
-    if (std::string err = runOnce(d, equalRays); !err.empty()) return R::failure(err);
-    const double rmseEqualRays = result.rows.back().rmse;
+    nlohmann::json s = {{"rays_per_pixel", n}, {"uniform_rmse", u.rmse}, {"uniform_effect_ms", u.effectMs}};
+    std::string line;
+    for (const Granularity& g : kGranularities) {
+      a = rb::AdaptiveRaySettings{};
+      a.enabled = true;
+      a.granularity = g.granularity;
+      a.tileWidth = g.tileWidth;
+      a.tileHeight = g.tileHeight;
+      const std::string method = std::string("adaptive_") + g.name;
+      const nlohmann::json common = {{"rays_per_pixel", n}, {"adaptive", true}, {"granularity", g.name}};
+      Row equalRays;
+      equalRays.method = method + "_equal_rays";
+      equalRays.setting = std::to_string(n) + " rays on average";
+      equalRays.id = method + "_rays_r" + std::to_string(n);
+      equalRays.params = common;
+      if (std::string err = runOnce(d, equalRays); !err.empty()) return R::failure(err);
+      const Row r = result.rows.back();
 
-    a.timeBudgetMs = float(u.passes[0].gpuMs);
-    Row equalTime;
-    equalTime.method = "adaptive_equal_time";
-    equalTime.setting = "target " + std::to_string(a.timeBudgetMs).substr(0, 6) + " ms";
-    equalTime.id = "adaptive_time_r" + std::to_string(n);
-    equalTime.params = {{"rays_per_pixel", n}, {"adaptive", true}, {"time_budget_ms", a.timeBudgetMs}};
-    if (std::string err = runOnce(d, equalTime); !err.empty()) return R::failure(err);
-    const Row t = result.rows.back();
-    a.timeBudgetMs = 0.0f;
+      a.timeBudgetMs = float(u.passes[0].gpuMs);
+      Row equalTime;
+      equalTime.method = method + "_equal_time";
+      equalTime.setting = "target " + std::to_string(a.timeBudgetMs).substr(0, 6) + " ms";
+      equalTime.id = method + "_time_r" + std::to_string(n);
+      equalTime.params = common;
+      equalTime.params["time_budget_ms"] = a.timeBudgetMs;
+      if (std::string err = runOnce(d, equalTime); !err.empty()) return R::failure(err);
+      const Row t = result.rows.back();
+      a.timeBudgetMs = 0.0f;
+      s[std::string(g.name) + "_equal_rays_rmse"] = r.rmse;
+      s[std::string(g.name) + "_equal_rays_effect_ms"] = r.effectMs;
+      s[std::string(g.name) + "_equal_time_rmse"] = t.rmse;
+      s[std::string(g.name) + "_equal_time_effect_ms"] = t.effectMs;
+      char part[160];
+      std::snprintf(part, sizeof part, "; %s %.5f at equal rays (%.3f ms), %.5f at equal time", g.name, r.rmse,
+                    r.effectMs, t.rmse);
+      line += part;
+      if (!g.budgetCurve) continue;
 
-    // Rays saved at equal error: the least budget whose error is no worse than uniform's, interpolated.
-    std::vector<std::pair<double, double>> curve;  // (fraction of the uniform rays, RMSE)
-    for (double f : kBudgetFractions) {
-      a.maxRaysPerFrame = uint64_t(std::llround(f * n * double(result.surfacePixels)));
-      Row b;
-      b.method = "adaptive_budget";
-      b.setting = std::to_string(int(std::lround(f * 100))) + "% of " + std::to_string(n) + " rays";
-      b.id = "adaptive_budget_r" + std::to_string(n) + "_" + std::to_string(int(std::lround(f * 1000)));
-      b.params = {{"rays_per_pixel", n}, {"adaptive", true}, {"budget_fraction", f}};
-      if (std::string err = runOnce(d, b); !err.empty()) return R::failure(err);
-      curve.push_back({f, result.rows.back().rmse});
-    }
-    a.maxRaysPerFrame = 0;
-    double fractionAtEqualError = -1.0;  // < 0: even the full budget's error is above uniform's
-    for (size_t i = 0; i < curve.size(); ++i) {
-      if (curve[i].second <= u.rmse) {
-        if (i == 0) {
-          fractionAtEqualError = curve[0].first;
-        } else {
-          const auto [f0, e0] = curve[i - 1];
-          const auto [f1, e1] = curve[i];
-          fractionAtEqualError = e0 == e1 ? f1 : f0 + (f1 - f0) * (e0 - u.rmse) / (e0 - e1);
-        }
-        break;
+      // Rays saved at equal error: the least budget whose error is no worse than uniform's, interpolated.
+      std::vector<std::pair<double, double>> curve;  // (fraction of the uniform rays, RMSE)
+      for (double f : kBudgetFractions) {
+        a.maxRaysPerFrame = uint64_t(std::llround(f * n * double(result.surfacePixels)));
+        Row b;
+        b.method = method + "_budget";
+        b.setting = std::to_string(int(std::lround(f * 100))) + "% of " + std::to_string(n) + " rays";
+        b.id = method + "_budget_r" + std::to_string(n) + "_" + std::to_string(int(std::lround(f * 1000)));
+        b.params = common;
+        b.params["budget_fraction"] = f;
+        if (std::string err = runOnce(d, b); !err.empty()) return R::failure(err);
+        curve.push_back({f, result.rows.back().rmse});
       }
+      a.maxRaysPerFrame = 0;
+      double fractionAtEqualError = -1.0;  // < 0: even the full budget's error is above uniform's
+      for (size_t i = 0; i < curve.size(); ++i) {
+        if (curve[i].second <= u.rmse) {
+          if (i == 0) {
+            fractionAtEqualError = curve[0].first;
+          } else {
+            const auto [f0, e0] = curve[i - 1];
+            const auto [f1, e1] = curve[i];
+            fractionAtEqualError = e0 == e1 ? f1 : f0 + (f1 - f0) * (e0 - u.rmse) / (e0 - e1);
+          }
+          break;
+        }
+      }
+      s[std::string(g.name) + "_budget_fraction_at_equal_error"] = fractionAtEqualError;
+      s[std::string(g.name) + "_rays_saved_at_equal_error"] = fractionAtEqualError >= 0.0
+                                                                  ? nlohmann::json(1.0 - fractionAtEqualError)
+                                                                  : nlohmann::json(nullptr);
+      line += fractionAtEqualError >= 0.0
+                  ? ", rays saved at equal error " +
+                        std::to_string(int(std::lround((1.0 - fractionAtEqualError) * 100))) + "%"
+                  : ", no budget reaches uniform's error";
     }
-    nlohmann::json s = {{"rays_per_pixel", n},
-                        {"uniform_rmse", u.rmse},
-                        {"uniform_effect_ms", u.effectMs},
-                        {"adaptive_equal_rays_rmse", rmseEqualRays},
-                        {"adaptive_equal_time_rmse", t.rmse},
-                        {"adaptive_equal_time_effect_ms", t.effectMs},
-                        {"budget_fraction_at_equal_error", fractionAtEqualError}};
-    s["rays_saved_at_equal_error"] = fractionAtEqualError >= 0.0 ? nlohmann::json(1.0 - fractionAtEqualError)
-                                                                 : nlohmann::json(nullptr);
     summary.push_back(s);
-    progress("%s: %u rays: uniform RMSE %.5f; adaptive %.5f at equal rays, %.5f at equal time; rays saved at equal "
-             "error %s",
-             fx.name.c_str(), n, u.rmse, rmseEqualRays, t.rmse,
-             fractionAtEqualError >= 0.0
-                 ? (std::to_string(int(std::lround((1.0 - fractionAtEqualError) * 100))) + "%").c_str()
-                 : "none (adaptive never reaches uniform's error)");
+    progress("%s: %u rays: uniform RMSE %.5f (%.3f ms)%s", fx.name.c_str(), n, u.rmse, u.effectMs, line.c_str());
   }
   result.summary = summary;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

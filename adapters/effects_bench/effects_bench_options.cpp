@@ -54,8 +54,8 @@ void addOptions(CLI::App& app, Options& o) {
       "its error (RMSE over surface pixels) against a converged reference traced by Raybridge.");
   app.footer("Defaults: 1920x1080 on a GPU, 320x180 on a CPU device; --quick: tiny size, few settings, and checks.");
   app.add_option("--scenario", o.scenario,
-                 "what to measure: speed-vs-error (default), or adaptive (uniform against adaptive rays per pixel for "
-                 "shadows and ao, accumulated over frames)")
+                 "what to measure: speed-vs-error (default), or adaptive (uniform against adaptive rays for shadows "
+                 "and ao, planned per pixel and per warp-sized tile, accumulated over frames)")
       ->type_name("NAME")
       ->check(rbCli::oneOf({"speed-vs-error", "adaptive"}));
   app.add_option_function<std::string>(

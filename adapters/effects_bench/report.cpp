@@ -1,6 +1,7 @@
 // JSON and tables of the effects bench (see the header).
 #include "report.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 
@@ -75,10 +76,13 @@ void printTables(const std::vector<EffectResult>& results, const std::optional<R
     std::printf("\n== %s: error on the %s; reference %u rays per pixel (%u frames), noise RMSE ~%.5f\n",
                 r.effect.c_str(), r.compared.c_str(), r.reference.raysPerFrame * r.reference.frames, r.reference.frames,
                 r.reference.noiseRmse());
-    std::printf("%-16s %-18s %10s %10s %10s %10s  %s\n", "method", "setting", "effect ms", "frame ms", "RMSE", "bias",
-                "effect ms of");
+    // The method column as wide as its longest name (the adaptive scenario's run to 27 characters).
+    int methodWidth = 16;
+    for (const Row& row : r.rows) methodWidth = std::max(methodWidth, int(row.method.size()));
+    std::printf("%-*s %-18s %10s %10s %10s %10s  %s\n", methodWidth, "method", "setting", "effect ms", "frame ms",
+                "RMSE", "bias", "effect ms of");
     for (const Row& row : r.rows)
-      std::printf("%-16s %-18s %10.3f %10.3f %10.5f %+10.5f  %s\n", row.method.c_str(), row.setting.c_str(),
+      std::printf("%-*s %-18s %10.3f %10.3f %10.5f %+10.5f  %s\n", methodWidth, row.method.c_str(), row.setting.c_str(),
                   row.effectMs, row.frameMs, row.rmse, row.bias, row.effectMsOf.c_str());
   }
   std::printf("\n== traced passes: rays counted per frame and rays/s");

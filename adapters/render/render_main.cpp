@@ -532,9 +532,18 @@ int main(int argc, char** argv) {
        wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays) : 0u},
       {"ao_half_resolution", hybrid && wantAo && hd.ao.halfResolution},
       {"reflection_half_resolution", hybrid && wantReflections && hd.reflections.halfResolution}};
-  // Adaptive rays (--adaptive): per effect, the time target (0 = the uniform rays, redistributed).
+  // Adaptive rays (--adaptive): per effect, the time target (0 = the uniform rays, redistributed) and the
+  // granularity ("pixel", or the tile in launch cells, "8x8").
   for (auto [name, a] : {std::pair{"shadows", &hd.shadows.adaptive}, std::pair{"ao", &hd.ao.adaptive}}) {
-    if (a->enabled) stats["effects"]["adaptive"][name] = {{"time_budget_ms", a->timeBudgetMs}};
+    std::string granularity = "pixel";
+    if (a->granularity == rb::AdaptiveRayGranularity::Tile) {
+      const uint32_t tw = a->tileWidth ? a->tileWidth : rb::kDefaultAdaptiveTileWidth;
+      const uint32_t th = a->tileHeight ? a->tileHeight : rb::kDefaultAdaptiveTileHeight;
+      granularity = std::to_string(tw) + "x" + std::to_string(th);
+    }
+    if (a->enabled) {
+      stats["effects"]["adaptive"][name] = {{"time_budget_ms", a->timeBudgetMs}, {"granularity", granularity}};
+    }
   }
   {
     const se::LocalShadowStats ls = engine.lastLocalShadowStats();

@@ -72,15 +72,40 @@ CLI::Validator presetValidator() {
 }
 
 // Every option of the command, stored into `o` when the parse runs its callbacks.
-// --adaptive: "ao", "shadows=0.8", "ao=1.0,shadows". Fills `o` when given; returns an error message or "".
+// --adaptive: "ao", "shadows=0.8", "ao=1.0,shadows", and a granularity for both: "ao,pixel", "ao,tile=8x4".
+// Fills `o` when given; returns an error message or "".
 std::string parseAdaptive(const std::string& value, RenderOptions* o) {
   std::optional<float> shadows, ao;
+  rb::AdaptiveRayGranularity granularity = rb::AdaptiveRayGranularity::Tile;
+  uint32_t tileWidth = 0, tileHeight = 0;
+  // A tile side: a power of two from 1 to rb::kMaxAdaptiveTileSize.
+  auto side = [](const std::string& text, uint32_t& out) {
+    if (text.empty() || text.size() > 2 || text.find_first_not_of("0123456789") != std::string::npos) return false;
+    out = uint32_t(std::stoul(text));
+    return out >= 1 && out <= rb::kMaxAdaptiveTileSize && (out & (out - 1)) == 0;
+  };
   size_t start = 0;
   while (start <= value.size()) {
     const size_t end = std::min(value.find(',', start), value.size());
     const std::string item = value.substr(start, end - start);
     const size_t eq = item.find('=');
     const std::string name = item.substr(0, eq);
+    if (name == "pixel" || name == "tile") {
+      granularity = name == "pixel" ? rb::AdaptiveRayGranularity::Pixel : rb::AdaptiveRayGranularity::Tile;
+      tileWidth = tileHeight = 0;
+      if (eq != std::string::npos) {
+        const std::string shape = item.substr(eq + 1);
+        const size_t x = shape.find('x');
+        if (name == "pixel" || x == std::string::npos || !side(shape.substr(0, x), tileWidth) ||
+            !side(shape.substr(x + 1), tileHeight)) {
+          return "'" + shape + "' in '" + item + "' is not " +
+                 (name == "pixel" ? std::string("allowed (pixel takes no size)")
+                                  : "a tile WxH with sides 1, 2, 4 or 8 (e.g. tile=8x4)");
+        }
+      }
+      start = end + 1;
+      continue;
+    }
     float ms = 0.0f;
     if (eq != std::string::npos) {
       const std::string number = item.substr(eq + 1);
@@ -95,13 +120,19 @@ std::string parseAdaptive(const std::string& value, RenderOptions* o) {
     } else if (name == "ao") {
       ao = ms;
     } else {
-      return "'" + name + "' in '" + value + "' is not an effect with adaptive rays (shadows, ao)";
+      return "'" + name + "' in '" + value +
+             "' is not an effect with adaptive rays (shadows, ao) or a granularity "
+             "(pixel, tile, tile=WxH)";
     }
     start = end + 1;
   }
+  if (!shadows && !ao) return "'" + value + "' names no effect with adaptive rays (shadows, ao)";
   if (o) {
     o->adaptiveShadowsMs = shadows;
     o->adaptiveAoMs = ao;
+    o->adaptiveGranularity = granularity;
+    o->adaptiveTileWidth = tileWidth;
+    o->adaptiveTileHeight = tileHeight;
   }
   return {};
 }
@@ -327,7 +358,9 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "--adaptive", [&o](const std::string& v) { parseAdaptive(v, &o); },
          "adaptive rays per pixel for soft shadows and AO, planned from the denoiser's history:\n"
          "EFFECT[=MS],... with EFFECT shadows or ao and MS a GPU time target for its pass\n"
-         "(default: the preset's rays, redistributed); e.g. ao=1.0,shadows")
+         "(default: the preset's rays, redistributed); e.g. ao=1.0,shadows. One count per\n"
+         "8x8 tile by default (warp-uniform); add pixel for one per pixel, or tile=WxH\n"
+         "(sides 1, 2, 4 or 8), e.g. ao,tile=8x4")
       ->type_name("LIST")
       ->check(CLI::Validator([](std::string& v) { return parseAdaptive(v, nullptr); }, ""));
   app.add_flag("--perf-scene", o.perfScene,
@@ -451,6 +484,9 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.shadows.tileClassifier = o.tileClassifier;
   h.shadows.adaptive.enabled = o.adaptiveShadowsMs.has_value();
   h.shadows.adaptive.timeBudgetMs = o.adaptiveShadowsMs.value_or(0.0f);
+  h.shadows.adaptive.granularity = o.adaptiveGranularity;
+  h.shadows.adaptive.tileWidth = o.adaptiveTileWidth;
+  h.shadows.adaptive.tileHeight = o.adaptiveTileHeight;
   if ((h.effects & rb::kEffectShadows) && shadowRays > 1)
     r.sunRadiusDegrees = h.shadows.softAngularRadiusDegrees > 0.0f ? h.shadows.softAngularRadiusDegrees
                                                                    : rb::kDefaultSoftLightAngularRadiusDegrees;
@@ -461,6 +497,9 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.disableDenoiser = !o.denoise;
   h.ao.adaptive.enabled = o.adaptiveAoMs.has_value();
   h.ao.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
+  h.ao.adaptive.granularity = o.adaptiveGranularity;
+  h.ao.adaptive.tileWidth = o.adaptiveTileWidth;
+  h.ao.adaptive.tileHeight = o.adaptiveTileHeight;
   h.ao.halfResolution = o.halfResGiven ? o.halfResAo : p.aoHalfResolution;
 
   const uint32_t lightRays = o.lightRays ? *o.lightRays : kDefaultLightRays;

@@ -54,6 +54,10 @@ struct RenderOptions {
   // --adaptive EFFECT[=MS],...: adaptive rays per pixel for shadows and ao (AdaptiveRaySettings), with a GPU time
   // target in ms (0 = the uniform rays, redistributed). Unset = uniform rays.
   std::optional<float> adaptiveShadowsMs, adaptiveAoMs;
+  // --adaptive's granularity keywords, for both effects: "pixel", "tile" or "tile=WxH" (AdaptiveRaySettings::
+  // granularity, tileWidth, tileHeight; 0 = the SDK's default tile). Default: per tile.
+  rb::AdaptiveRayGranularity adaptiveGranularity = rb::AdaptiveRayGranularity::Tile;
+  uint32_t adaptiveTileWidth = 0, adaptiveTileHeight = 0;
   // Raster mode's shadow map: --shadow-map-size (0 = none, else 1024..8192) and --pcf (taps per axis, 1..9);
   // else the preset's raster counterpart.
   std::optional<uint32_t> shadowMapSize;

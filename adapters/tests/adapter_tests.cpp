@@ -112,6 +112,9 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--adaptive ao=-1", "--adaptive: '-1' in 'ao=-1' is not a time in ms greater than 0"},
       {"--adaptive ao=fast", "--adaptive: 'fast' in 'ao=fast' is not a time in ms"},
       {"--adaptive ao --no-denoise", "--adaptive: adaptive rays plan from the denoiser's history"},
+      {"--adaptive ao,tile=3x4", "--adaptive: '3x4' in 'tile=3x4' is not a tile WxH with sides 1, 2, 4 or 8"},
+      {"--adaptive ao,pixel=8x4", "--adaptive: '8x4' in 'pixel=8x4' is not allowed (pixel takes no size)"},
+      {"--adaptive pixel", "--adaptive: 'pixel' names no effect with adaptive rays (shadows, ao)"},
       {"--half-res ao,shadows",
        "--half-res: 'shadows' in 'ao,shadows' is not an effect with half-resolution tracing (ao, reflections)"},
   };

@@ -25,6 +25,14 @@ uint32_t adaptiveMaxRays(const AdaptiveRaySettings& s, uint32_t raysPerPixel) {
   return std::min(rays, kMaxAdaptiveRays);
 }
 
+uint32_t adaptiveTileWidth(const AdaptiveRaySettings& s) {
+  return s.tileWidth ? s.tileWidth : kDefaultAdaptiveTileWidth;
+}
+
+uint32_t adaptiveTileHeight(const AdaptiveRaySettings& s) {
+  return s.tileHeight ? s.tileHeight : kDefaultAdaptiveTileHeight;
+}
+
 Status AdaptiveRayPlanner::validate(const AdaptiveRaySettings& s, const char* who, bool needHistory) {
   if (!s.enabled) return {};
   auto invalid = [&](const std::string& m) {
@@ -54,10 +62,20 @@ Status AdaptiveRayPlanner::validate(const AdaptiveRaySettings& s, const char* wh
     return invalid("minRaysPerPixel " + std::to_string(s.minRaysPerPixel) + " exceeds maxRaysPerPixel " +
                    std::to_string(s.maxRaysPerPixel));
   }
+  if (s.granularity != AdaptiveRayGranularity::Tile && s.granularity != AdaptiveRayGranularity::Pixel) {
+    return invalid("granularity has an unknown value (" + std::to_string(uint32_t(s.granularity)) + ")");
+  }
+  for (auto [name, side] : {std::pair{"tileWidth", s.tileWidth}, std::pair{"tileHeight", s.tileHeight}}) {
+    if (side > kMaxAdaptiveTileSize || (side & (side - 1)) != 0) {
+      return invalid(std::string(name) + " " + std::to_string(side) + " must be 0 (default " +
+                     std::to_string(kDefaultAdaptiveTileWidth) + "x" + std::to_string(kDefaultAdaptiveTileHeight) +
+                     ") or a power of two at most " + std::to_string(kMaxAdaptiveTileSize));
+    }
+  }
   return {};
 }
 
-Status AdaptiveRayPlanner::init(Context& ctx) {
+Status AdaptiveRayPlanner::init(Context& ctx, AdaptiveRayGranularity granularity) {
   const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
   auto sampled = [&](uint32_t b) {
     return VkDescriptorSetLayoutBinding{b, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs, nullptr};
@@ -76,14 +94,17 @@ Status AdaptiveRayPlanner::init(Context& ctx) {
     if (!e) return e.error();
     estimate_ = e.value();
   }
-  if (!allocate_.pipeline) {
+  const bool tiles = granularity == AdaptiveRayGranularity::Tile;
+  ComputePipeline& allocate = tiles ? allocateTiles_ : allocate_;
+  if (!allocate.pipeline) {
     Result<ComputePipeline> a = ComputePipeline::create(
-        ctx, SpirvModule::of(spirv::adaptive_allocate_comp),
+        ctx,
+        tiles ? SpirvModule::of(spirv::adaptive_allocate_tiles_comp) : SpirvModule::of(spirv::adaptive_allocate_comp),
         {storage(RB_ADAPTIVE_BINDING_WEIGHTS), storage(RB_ADAPTIVE_BINDING_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
          storage(RB_ADAPTIVE_BINDING_PLAN)},
-        sizeof(AdaptivePlanConstants), "adaptive rays: allocate");
+        sizeof(AdaptivePlanConstants), tiles ? "adaptive rays: allocate per tile" : "adaptive rays: allocate");
     if (!a) return a.error();
-    allocate_ = a.value();
+    allocate = a.value();
   }
   if (!counters_.valid()) {
     Result<GpuBuffer> b = createBuffer(ctx, kCounterBytes,
@@ -99,6 +120,7 @@ Status AdaptiveRayPlanner::init(Context& ctx) {
 void AdaptiveRayPlanner::retire(Context& ctx) {
   estimate_.retire(ctx);
   allocate_.retire(ctx);
+  allocateTiles_.retire(ctx);
   images_.retire(ctx);
   retireBuffer(ctx, counters_);
   controller_.reset();
@@ -106,12 +128,12 @@ void AdaptiveRayPlanner::retire(Context& ctx) {
 
 Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
                                         const AdaptiveRaySettings& s, uint32_t raysPerPixel, const PassStats& latest,
-                                        const char* who) {
+                                        const char* who, uint32_t cellPixels) {
   const internal::DenoiserHistory history = internal::latestHistory(*s.history, g);
   if (!history.mean) return false;
   DenoiseConstants dn{};
   if (Status st = internal::historyReprojection(*s.history, g, who, dn); !st) return st.error();
-  if (Status st = init(ctx); !st) return st.error();
+  if (Status st = init(ctx, s.granularity); !st) return st.error();
   if (Status st = images_.ensure(ctx, g.width, g.height,
                                  {{VK_FORMAT_R16G16_SFLOAT, "adaptive ray weights"},
                                   {VK_FORMAT_R16G16_SFLOAT, "adaptive ray plan"}});
@@ -130,12 +152,18 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
   pc.minRays = s.minRaysPerPixel ? s.minRaysPerPixel : kDefaultAdaptiveMinRays;
   pc.maxRays = maxRays;
   pc.frameIndex = uint32_t(ctx.frameIndex());
+  const bool tiles = s.granularity == AdaptiveRayGranularity::Tile;
+  // A tile of launch cells, in pixels: at half resolution a warp's cells stand for twice the pixels per side.
+  pc.tileSize[0] = adaptiveTileWidth(s) * cellPixels;
+  pc.tileSize[1] = adaptiveTileHeight(s) * cellPixels;
   if (s.timeBudgetMs > 0.0f) {
     // Start from the uniform rays over the whole image; never below one ray per 64 pixels, so a measurement
-    // (which needs rays) always comes back.
+    // (which needs rays) always comes back, nor per tile below one ray in every pixel of a tile: the claim takes
+    // whole tiles, and a budget under one tile's rays would trace nothing.
     const double initial = double(std::max(raysPerPixel, 1u)) * pixels;
+    const double tilePixels = tiles ? double(pc.tileSize[0]) * pc.tileSize[1] : 1.0;
     const uint64_t r = controller_.next(ctx.frameIndex(), latest, s.timeBudgetMs, initial,
-                                        std::max(1.0, std::min(pixels / 64.0, cap)),
+                                        std::max(1.0, std::min(std::max(pixels / 64.0, tilePixels), cap)),
                                         std::min(double(maxRays) * pixels, cap));
     pc.budget = uint32_t(std::min<uint64_t>(r, UINT32_MAX));
     pc.uniformRays = 0.0f;
@@ -184,7 +212,12 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
     w.storageImage(RB_ADAPTIVE_BINDING_WEIGHTS, images_[0].view);
     w.storageBuffer(RB_ADAPTIVE_BINDING_COUNTERS, counters_.buffer, 0, kCounterBytes);
     w.storageImage(RB_ADAPTIVE_BINDING_PLAN, images_[1].view);
-    allocate_.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
+    if (tiles) {
+      // One workgroup holds 16x16 pixels: the largest tile (kMaxAdaptiveTileSize cells of 2 pixels) or several.
+      allocateTiles_.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height, 16);
+    } else {
+      allocate_.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
+    }
   }
   // The plan, read by the ray generation shader (and by tools: AoOutputs::rayPlan).
   const VkImageMemoryBarrier planned = colorImageBarrier(images_[1].image, VK_IMAGE_LAYOUT_GENERAL,
@@ -197,9 +230,10 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
 
 Result<bool> AdaptiveRayPlanner::recordForPass(PassCore& core, Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
                                                const AdaptiveRaySettings& settings, uint32_t raysPerPixel,
-                                               const PassStats& latest, const char* who, DescriptorWrites& w) {
+                                               const PassStats& latest, const char* who, DescriptorWrites& w,
+                                               uint32_t cellPixels) {
   if (!settings.enabled) return false;
-  Result<bool> planned = record(ctx, cmd, g, settings, raysPerPixel, latest, who);
+  Result<bool> planned = record(ctx, cmd, g, settings, raysPerPixel, latest, who, cellPixels);
   if (!planned) {
     core.end(ctx, cmd);
     return planned.error();

@@ -95,8 +95,9 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   s.core.writeCommon(s.ctx, w, g, tlas);
   // With half resolution the plan covers every pixel and the traced quarter uses its entries: a quarter of the
   // budget is traced (a time target compensates: it scales the budget it planned by the time measured).
+  // Its tiles are of launch cells: 2x2 pixels each at half resolution.
   Result<bool> plan = s.planner.recordForPass(s.core, s.ctx, cmd, g, settings.adaptive, pc.raysPerPixel, latest,
-                                              "AoPass", w);
+                                              "AoPass", w, settings.halfResolution ? 2u : 1u);
   if (!plan) return plan.error();
   const bool planned = plan.value();
   const RayTracingPipeline* variant = planned ? &s.adaptivePipeline : nullptr;

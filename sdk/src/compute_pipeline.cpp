@@ -72,13 +72,14 @@ void ComputePipeline::retire(Context& ctx) {
 }
 
 void ComputePipeline::dispatch(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes,
-                               const void* constants, uint32_t constantBytes, uint32_t width, uint32_t height) const {
+                               const void* constants, uint32_t constantBytes, uint32_t width, uint32_t height,
+                               uint32_t groupSide) const {
   const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
   vk.vkCmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, static_cast<uint32_t>(writes.size()),
                                writes.data());
   if (constantBytes) vk.vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, constantBytes, constants);
-  vk.vkCmdDispatch(cmd, (width + 7) / 8, (height + 7) / 8, 1);
+  vk.vkCmdDispatch(cmd, (width + groupSide - 1) / groupSide, (height + groupSide - 1) / groupSide, 1);
 }
 
 }  // namespace rb

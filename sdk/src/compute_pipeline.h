@@ -20,9 +20,10 @@ class ComputePipeline {
   // Hands the pipeline and its layouts to the context's deferred release (frames in flight may still
   // dispatch it); this object is left empty.
   void retire(Context& ctx);
-  // Binds, pushes the descriptors and constants, and dispatches 8x8 groups over width x height.
+  // Binds, pushes the descriptors and constants, and dispatches groupSide x groupSide groups over width x height
+  // (groupSide: the shader's local size).
   void dispatch(Context& ctx, VkCommandBuffer cmd, std::span<const VkWriteDescriptorSet> writes, const void* constants,
-                uint32_t constantBytes, uint32_t width, uint32_t height) const;
+                uint32_t constantBytes, uint32_t width, uint32_t height, uint32_t groupSide = 8) const;
 
   VkPipeline pipeline = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;

@@ -184,13 +184,15 @@ struct AdaptivePlanConstants {
   uint32_t maxRays;
   uint32_t frameIndex;
   uint32_t pad0;
+  uint32_t tileSize[2];  // tile granularity: the tile in pixels
 };
-static_assert(sizeof(AdaptivePlanConstants) == 32);
+static_assert(sizeof(AdaptivePlanConstants) == 40);
 RB_ASSERT_OFFSET(AdaptivePlanConstants, budget, 8);
 RB_ASSERT_OFFSET(AdaptivePlanConstants, uniformRays, 12);
 RB_ASSERT_OFFSET(AdaptivePlanConstants, minRays, 16);
 RB_ASSERT_OFFSET(AdaptivePlanConstants, maxRays, 20);
 RB_ASSERT_OFFSET(AdaptivePlanConstants, frameIndex, 24);
+RB_ASSERT_OFFSET(AdaptivePlanConstants, tileSize, 32);
 
 struct DenoiseConstants {
   float inverseProjection[16];
