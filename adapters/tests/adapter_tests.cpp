@@ -112,6 +112,8 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--adaptive ao=-1", "--adaptive: '-1' in 'ao=-1' is not a time in ms greater than 0"},
       {"--adaptive ao=fast", "--adaptive: 'fast' in 'ao=fast' is not a time in ms"},
       {"--adaptive ao --no-denoise", "--adaptive: adaptive rays plan from the denoiser's history"},
+      {"--converged-tiles 0", "--converged-tiles: 0 is outside 1..65535"},
+      {"--converged-tiles 8 --no-denoise", "--converged-tiles: converged tiles are read from the shadow denoiser's"},
       {"--half-res ao,shadows",
        "--half-res: 'shadows' in 'ao,shadows' is not an effect with half-resolution tracing (ao, reflections)"},
   };
