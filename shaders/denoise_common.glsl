@@ -5,7 +5,11 @@
 #include "raybridge_gbuffer.glsl"
 
 #include "raybridge_pass_constants.glsl"
+// A shader whose push constants embed the DenoiseConstants (shadow_converged.glsl) declares its own block and
+// defines pc as the embedded struct first.
+#ifndef RB_DN_PUSH_CONSTANTS_DECLARED
 layout(push_constant) uniform DenoisePushConstants { DenoiseConstants pc; };
+#endif
 
 bool rbDnSky(float depth) { return (pc.flags & RB_DN_REVERSED_Z) != 0u ? depth <= 0.0 : depth >= 1.0; }
 
@@ -20,6 +24,31 @@ vec3 rbDnViewPosition(uvec2 pixel, float depth) {
   return rbReconstructViewPosition(pixel, vec2(pc.size), depth, pc.inverseProjection, pc.wAtDepthOne,
                                    (pc.flags & RB_DN_REVERSED_Z) != 0u);
 }
+
+// Where the surface at `pixel` (camera-relative position `rel`) was in the latest history: `pp`, that history's
+// texel, and whether the same surface is there (its distance from last frame's camera matches what was stored).
+// The temporal pass's test, shared with the readers of its history that must agree with it (converged shadow
+// tiles: a pixel they skip is one the temporal pass finds history for).
+bool rbDnFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D distanceIn, out ivec2 pp) {
+  vec2 prevPixel;
+  vec3 prevRel = rel + pc.cameraDelta;
+  if ((pc.flags & RB_DN_MOTION) != 0u) {
+    prevPixel = vec2(pixel) + 0.5 - texelFetch(motion, ivec2(pixel), 0).xy;
+  } else {
+    vec4 clip = pc.previousViewProjection * vec4(prevRel, 1.0);
+    prevPixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
+  }
+  pp = ivec2(floor(prevPixel));
+  if ((pc.flags & RB_DN_HISTORY) == 0u || any(lessThan(pp, ivec2(0))) || any(greaterThanEqual(pp, ivec2(pc.size)))) {
+    return false;
+  }
+  float prevDist = texelFetch(distanceIn, pp, 0).r;
+  return prevDist > 0.0 && abs(prevDist - length(prevRel)) <= 0.02 * length(prevRel) + 1e-3;
+}
+
+// A scalar signal's value: a kept-history mark (RB_DN_KEPT_MARKS, -1 - v) read as the v it carries.
+float rbDnSignalValue(float v) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && v < -0.5 ? -1.0 - v : v; }
+bool rbDnKeptMark(float v) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && v < -0.5; }
 
 vec3 rbDnNormal(vec4 texel) { return rbDecodeNormal(texel, (pc.flags & RB_DN_OCTAHEDRAL) != 0u ? 1u : 0u); }
 

@@ -19,7 +19,7 @@ const float kRbDnPriorRays = 1.0;
 float rbDnNoiseVariance(sampler2D signal, ivec2 ip, float mean, float frames) {
   float v[25];
   for (int y = -2; y <= 2; ++y)
-    for (int x = -2; x <= 2; ++x) v[(y + 2) * 5 + x + 2] = texelFetch(signal, clamp(ip + ivec2(x, y), ivec2(0), ivec2(pc.size) - 1), 0).r;
+    for (int x = -2; x <= 2; ++x) v[(y + 2) * 5 + x + 2] = rbDnSignalValue(texelFetch(signal, clamp(ip + ivec2(x, y), ivec2(0), ivec2(pc.size) - 1), 0).r);
   const float rays = pc.signalRaysPerPixel * frames;
   const float c = clamp(mean, 0.0, 1.0);
   float least = 1e30;

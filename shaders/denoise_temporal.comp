@@ -23,7 +23,12 @@ void main() {
   if (any(greaterThanEqual(pixel, pc.size))) return;
   ivec2 ip = ivec2(pixel);
   const bool final = (pc.flags & RB_DN_TEMPORAL_FINAL) != 0u;
-  float value = texelFetch(signalIn, ip, 0).r;
+  const float raw = texelFetch(signalIn, ip, 0).r;
+  // A pixel of a converged shadow tile that was not traced this frame (a kept-history mark) adds no frame: its
+  // history moves to where its surface now is, unchanged. Its mark carries that same reprojected mean, the value
+  // it falls back to should the history be gone.
+  const bool kept = rbDnKeptMark(raw);
+  float value = rbDnSignalValue(raw);
   float depth = texelFetch(gDepth, ip, 0).r;
   if (rbDnSky(depth)) {
     imageStore(historyOut, ip, vec4(value, 0.0, 0.0, 0.0));
@@ -35,25 +40,13 @@ void main() {
   vec3 rel = rbDnCameraRelative(pixel, depth);
   float dist = length(rel);
   imageStore(distanceOut, ip, vec4(dist));
-  vec2 prevPixel;
-  vec3 prevRel = rel + pc.cameraDelta;
-  if ((pc.flags & RB_DN_MOTION) != 0u) {
-    prevPixel = vec2(pixel) + 0.5 - texelFetch(gMotion, ip, 0).xy;
-  } else {
-    vec4 clip = pc.previousViewProjection * vec4(prevRel, 1.0);
-    prevPixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
-  }
   float accumulated = value;
   float frames = 1.0;
-  ivec2 pp = ivec2(floor(prevPixel));
-  if ((pc.flags & RB_DN_HISTORY) != 0u && all(greaterThanEqual(pp, ivec2(0))) && all(lessThan(pp, ivec2(pc.size)))) {
-    float prevDist = texelFetch(distanceIn, pp, 0).r;
-    // The same surface: its distance from last frame's camera matches what was stored there.
-    if (prevDist > 0.0 && abs(prevDist - length(prevRel)) <= 0.02 * length(prevRel) + 1e-3) {
-      vec2 h = texelFetch(historyIn, pp, 0).xy;
-      frames = min(h.y + 1.0, float(pc.maxHistoryFrames));
-      accumulated = mix(h.x, value, 1.0 / frames);
-    }
+  ivec2 pp;
+  if (rbDnFindHistory(pixel, rel, gMotion, distanceIn, pp)) {
+    vec2 h = texelFetch(historyIn, pp, 0).xy;
+    frames = min(kept ? max(h.y, 1.0) : h.y + 1.0, float(pc.maxHistoryFrames));
+    accumulated = kept ? h.x : mix(h.x, value, 1.0 / frames);
   }
   imageStore(historyOut, ip, vec4(accumulated, frames, 0.0, 0.0));
   imageStore(valueOut, ip, vec4(accumulated, rbDnNoiseVariance(signalIn, ip, accumulated, frames), 0.0, 0.0));

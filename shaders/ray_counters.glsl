@@ -1,5 +1,6 @@
 // The ray counters every G-buffer pass adds the rays it traced to, the any-hit invocations its rays ran and, for a
-// pass with a tile classifier, the tiles it traced and skipped (read back by PassMetrics).
+// pass with a tile classifier, the tiles it traced and skipped, and of those skipped, the converged ones and the rays
+// they saved (read back by PassMetrics).
 #ifndef RAYBRIDGE_RAY_COUNTERS_GLSL
 #define RAYBRIDGE_RAY_COUNTERS_GLSL
 
@@ -10,6 +11,8 @@ layout(set = 0, binding = RB_BINDING_RAY_COUNTERS) buffer RayCounters {
   uint anyHitCount[RB_RAY_COUNTER_SLOTS];
   uint tilesTraced;
   uint tilesSkipped;
+  uint tilesConverged;
+  uint raysSaved;
 };
 
 void rbCountRays(uvec2 pixel, uint rays) { atomicAdd(rayCount[RB_RAY_COUNTER_SLOT(pixel.x, pixel.y)], rays); }

@@ -23,7 +23,7 @@ struct GBufferConstants {
   uint pad2;               // 156
 };
 
-// ShadowPass. 224 bytes.
+// ShadowPass. 228 bytes.
 struct ShadowConstants {
   GBufferConstants gbuffer;  //   0
   vec3 lightDirection;       // 160: towards a directional light, unit length
@@ -36,6 +36,7 @@ struct ShadowConstants {
   float range;               // 212: of a point or spot light; 0 = unlimited
   uint raysPerPixel;         // 216
   uint launchOverTiles;      // 220: 1 = the launch covers the tile classifier's list (shadow_tiles.glsl)
+  uint convergedTiles;       // 224: classifier: 1 = skip the tiles the tile state marks RB_TILE_SKIP_CONVERGED
 };
 
 // AoPass. 176 bytes.
@@ -126,6 +127,16 @@ struct DenoiseConstants {
   float normalPower;            // 216
   float signalRaysPerPixel;     // 220: rays per pixel of the noisy signal; 0 = unknown
   float convergedNoise;         // 224: scalar: noise standard deviation under which the value passes unfiltered
+};
+
+// The shadow pass's converged-tile dispatches (shadow_converged.glsl): the denoiser's reprojection, then the test.
+// 256 bytes.
+struct ConvergedTileConstants {
+  DenoiseConstants denoise;  //   0: historyReprojection(); signalRaysPerPixel = the shadow rays per pixel
+  uint minFrames;            // 240: a converged pixel's history holds at least this many frames
+  float maxNoise;            // 244: and the standard deviation of its measured noise is below this
+  uint refreshPeriod;        // 248: a converged tile is still traced once in this many frames
+  uint frameIndex;           // 252: which tiles refresh this frame
 };
 
 // The allocation step of adaptive rays (adaptive_allocate.comp, adaptive_allocate_tiles.comp). 40 bytes.

@@ -14,6 +14,7 @@
 #define RB_SHADOW_BINDING_VISIBILITY 5
 #define RB_SHADOW_BINDING_HIT_DISTANCE 6  // only in the module that writes it (shadow_distance.rgen)
 #define RB_SHADOW_BINDING_TILES 9         // the tile classifier's list and trace arguments (shadow_tiles.glsl)
+#define RB_SHADOW_BINDING_TILE_STATE 12   // classifier only: per tile, the converged-tile state (shadow_converged.glsl)
 #define RB_AO_BINDING_OUTPUT 5
 #define RB_REFLECTION_BINDING_ROUGHNESS_METALNESS 5  // the normal image again when roughness is in normal.w
 #define RB_REFLECTION_BINDING_RADIANCE 6
@@ -104,6 +105,20 @@
 // before the tile list (a VkTraceRaysIndirectCommandKHR, padded to 16 bytes).
 #define RB_SHADOW_TILE_SIZE 8
 #define RB_SHADOW_TILE_HEADER_UINTS 4
+// Converged-tile skipping (ShadowSettings::convergedTiles): one uint of state per tile. Bits 0-15: frames left
+// before the tile may be skipped again (set when a refresh found a change); then what this frame does with it.
+#define RB_TILE_HOLD_MASK 0xFFFFu
+#define RB_TILE_SKIP_CONVERGED 0x10000u  // converged: not traced, its pixels already hold their kept-history marks
+#define RB_TILE_REFRESH 0x20000u         // converged, but traced this frame to check its history still holds
+// The converged-tile dispatches (shadow_converged.comp, shadow_converged_check.comp).
+#define RB_CONVERGED_BINDING_DEPTH 0
+#define RB_CONVERGED_BINDING_MOTION 1  // the depth image again without motion vectors
+#define RB_CONVERGED_BINDING_HISTORY 2   // the denoiser's latest history (mean, frames)
+#define RB_CONVERGED_BINDING_DISTANCE 3  // its view distances
+#define RB_CONVERGED_BINDING_NOISE 4     // its latest temporal result: .g = the variance of the mean's noise
+#define RB_CONVERGED_BINDING_STATE 5     // the tile state buffer
+#define RB_CONVERGED_BINDING_VISIBILITY 6  // storage (shadow_converged.comp) / sampled (the check)
+#define RB_CONVERGED_BINDING_HIT_DISTANCE 7  // shadow_converged.comp, with ShadowPassDesc::outputHitDistance
 
 // ManyLightConstants::mode: the values of rb::ManyLightMode.
 #define RB_ML_STOCHASTIC 0u
@@ -119,6 +134,9 @@
 #define RB_DN_HISTORY 4u  // last frame's history is valid (temporal pass)
 #define RB_DN_MOTION 8u   // the G-buffer has motion vectors (temporal pass)
 #define RB_DN_TEMPORAL_FINAL 16u  // scalar temporal pass: no a-trous step follows, write the output too
+// Scalar temporal pass: the signal may hold kept-history marks, -1 - v for a pixel the shadow pass did not trace
+// because its tile had converged (denoise_noise.glsl): it keeps its history (v, the reprojected mean) unchanged.
+#define RB_DN_KEPT_MARKS 32u
 
 // Half-resolution tracing (AoConstants/ReflectionConstants::halfResolution): sample (i, j) of frame f traces for
 // G-buffer pixel (2i + x, 2j + y), clamped to the image, with (x, y) = (0,0), (1,1), (1,0), (0,1) for f mod 4 = 0..3:

@@ -237,7 +237,7 @@ TEST_CASE("the tile classifier skips the sky: a sky-only frame traces no tile", 
   CHECK(one == cpu.hit.size());  // sky is lit
 }
 
-TEST_CASE("the tile list is sized by the resolution and accounted as pass buffers", "[shadow][classifier]") {
+TEST_CASE("the tile list and state are sized by the resolution and accounted as pass buffers", "[shadow][classifier]") {
   GpuFixture fx;
   const TestScene scene = makeHorizonScene();
   EmbreeScene embree;
@@ -247,7 +247,9 @@ TEST_CASE("the tile list is sized by the resolution and accounted as pass buffer
   const ClassifierComparison r = compareClassifier(fx, scene, cpu, sun({0.6, 0.3, 0.3}));
   const VkDeviceSize expected = rb::TileClassifier::listBytes(view.width, view.height);
   CHECK(expected == 16 + 4 * tileCount(view));
-  // Both passes hold a list (the one without the classifier binds it unread); nothing else was allocated.
-  CHECK(r.passBufferBytes >= 2 * expected);
-  CHECK(r.passBufferBytes < 2 * (expected + 64 * 1024));  // the lists and their allocations' alignment
+  // Both passes hold a list and the converged-tile state, 4 bytes per tile (the one without the classifier binds
+  // the list unread); nothing else was allocated.
+  const VkDeviceSize state = 4 * tileCount(view);
+  CHECK(r.passBufferBytes >= 2 * (expected + state));
+  CHECK(r.passBufferBytes < 2 * (expected + state + 64 * 1024));  // and their allocations' alignment
 }

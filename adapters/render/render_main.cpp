@@ -617,7 +617,12 @@ int main(int argc, char** argv) {
     for (const auto& [name, p] : named) {
       passes[name] = {
           {"gpu_ms", p->gpuMs}, {"rays", p->rays}, {"rays_per_second", p->raysPerSecond()}, {"frame", p->frame}};
-      if (p->tilesTotal()) passes[name]["tiles"] = {{"traced", p->tilesTraced}, {"skipped", p->tilesSkipped}};
+      if (p->tilesTotal()) {
+        passes[name]["tiles"] = {{"traced", p->tilesTraced},
+                                 {"skipped", p->tilesSkipped},
+                                 {"converged", p->tilesConverged},
+                                 {"rays_saved", p->raysSaved}};
+      }
       rays += p->rays;
       std::printf(" %s %.1f ms", name, p->gpuMs);
       if (p->rays) std::printf(" %.2f Mrays (%.1f Mrays/s)", p->rays * 1e-6, p->raysPerSecond() * 1e-6);

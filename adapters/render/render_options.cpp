@@ -354,6 +354,12 @@ void addOptions(CLI::App& app, RenderOptions& o) {
   app.add_flag("--tile-classifier", o.tileClassifier,
                "hybrid shadows: classify 8x8 tiles and trace only those with a pixel that needs\n"
                "a ray (same image; off by default, see docs/performance.md)");
+  app.add_option_function<uint32_t>(
+         "--converged-tiles", [&o](const uint32_t& v) { o.convergedTiles = v; },
+         "soft shadows: skip the 8x8 tiles whose denoised history has converged, each\n"
+         "still traced once in K frames (turns the tile classifier on; e.g. 8, the default)")
+      ->type_name("K")
+      ->check(rbCli::wholeNumber(1, 65535));
   app.add_option_function<std::string>(
          "--adaptive", [&o](const std::string& v) { parseAdaptive(v, &o); },
          "adaptive rays per pixel for soft shadows and AO, planned from the denoiser's history:\n"
@@ -482,6 +488,8 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.shadows.raysPerPixel = shadowRays;
   h.shadows.disableDenoiser = !o.denoise;
   h.shadows.tileClassifier = o.tileClassifier;
+  h.shadows.convergedTiles.enabled = o.convergedTiles.has_value();
+  h.shadows.convergedTiles.refreshPeriod = o.convergedTiles.value_or(0);
   h.shadows.adaptive.enabled = o.adaptiveShadowsMs.has_value();
   h.shadows.adaptive.timeBudgetMs = o.adaptiveShadowsMs.value_or(0.0f);
   h.shadows.adaptive.granularity = o.adaptiveGranularity;
@@ -538,6 +546,10 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
            "punctual lights; AO and reflections need the G-buffer it does not draw, so it takes no effect list";
   if (o.mode == Mode::RayTraced && o.geometricNormals)
     return "--gbuffer-normals: --mode raytraced draws no G-buffer; its hits shade with the mesh normals";
+  if (o.convergedTiles && !o.denoise)
+    return "--converged-tiles: converged tiles are read from the shadow denoiser's history; drop --no-denoise";
+  if (o.convergedTiles && o.mode != Mode::Hybrid)
+    return "--converged-tiles: only --mode hybrid traces the shadow pass whose tiles it skips";
   if ((o.adaptiveShadowsMs || o.adaptiveAoMs) && !o.denoise)
     return "--adaptive: adaptive rays plan from the denoiser's history; drop --no-denoise";
   if ((o.adaptiveShadowsMs || o.adaptiveAoMs) && o.mode != Mode::Hybrid)

@@ -115,6 +115,8 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--adaptive ao,tile=3x4", "--adaptive: '3x4' in 'tile=3x4' is not a tile WxH with sides 1, 2, 4 or 8"},
       {"--adaptive ao,pixel=8x4", "--adaptive: '8x4' in 'pixel=8x4' is not allowed (pixel takes no size)"},
       {"--adaptive pixel", "--adaptive: 'pixel' names no effect with adaptive rays (shadows, ao)"},
+      {"--converged-tiles 0", "--converged-tiles: 0 is outside 1..65535"},
+      {"--converged-tiles 8 --no-denoise", "--converged-tiles: converged tiles are read from the shadow denoiser's"},
       {"--half-res ao,shadows",
        "--half-res: 'shadows' in 'ao,shadows' is not an effect with half-resolution tracing (ao, reflections)"},
   };

@@ -72,6 +72,9 @@ struct Denoiser::Impl {
   // The images hold what a record() wrote, in the layouts it left them in (false from their creation until then:
   // adaptive rays read the history only when it is true).
   bool imagesWritten = false;
+  // The frame whose signal holds kept-history marks (internal::expectKeptMarks); set through a const Denoiser by
+  // the shadow pass that reads its history.
+  mutable uint64_t keptMarksFrame = UINT64_MAX;
   double previousViewProjection[16] = {};
   double previousCamera[3] = {};
   explicit Impl(Context& c) : ctx(c) {}
@@ -451,6 +454,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
     return st;
   }
 
+  if (s.keptMarksFrame == s.ctx.frameIndex()) flags |= RB_DN_KEPT_MARKS;
   Status st = recordScalar(s, cmd, g, signal, settings, pc, flags);
   if (st) {
     std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
@@ -472,9 +476,14 @@ DenoiserHistory latestHistory(const Denoiser& denoiser, const GBufferDesc& g) {
   const uint32_t last = 1 - s.parity;
   h.mean = s.images[last].view;
   h.distance = s.images[2 + last].view;
+  h.noise = s.images[4].view;
   h.sampler = s.sampler;
   h.valid = s.historyValid;
   return h;
+}
+
+void expectKeptMarks(const Denoiser& denoiser, uint64_t frame) {
+  DenoiserAccess::impl(denoiser).keptMarksFrame = frame;
 }
 
 Status historyReprojection(const Denoiser& denoiser, const GBufferDesc& g, const char* who, DenoiseConstants& pc) {

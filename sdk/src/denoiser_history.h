@@ -1,5 +1,6 @@
-// What adaptive rays (adaptive_rays.h) read of a scalar Denoiser: the history its latest record() wrote, and the
-// reprojection from that frame's camera to the G-buffer about to be traced (the temporal pass's own).
+// What adaptive rays (adaptive_rays.h) and converged shadow tiles (converged_tiles.h) read of a scalar Denoiser: the
+// history its latest record() wrote, and the reprojection from that frame's camera to the G-buffer about to be traced
+// (the temporal pass's own).
 #pragma once
 
 #include <raybridge/denoiser.h>
@@ -18,6 +19,7 @@ struct DenoiserHistory {
   // a resize, or for an RGB signal).
   VkImageView mean = VK_NULL_HANDLE;
   VkImageView distance = VK_NULL_HANDLE;
+  VkImageView noise = VK_NULL_HANDLE;  // RG16F: the latest temporal result (value, variance of its noise)
   VkSampler sampler = VK_NULL_HANDLE;  // nearest, clamped: the denoiser's own
   bool valid = false;                  // false = the images hold no usable history (reset, temporal off)
 };
@@ -25,6 +27,9 @@ struct DenoiserHistory {
 DenoiserHistory latestHistory(const Denoiser& denoiser, const GBufferDesc& g);
 // The temporal pass's constants for `g` (camera, layout, reprojection; RB_DN_HISTORY when the history is valid);
 // the settings-dependent fields are left 0. `who` names the caller in G-buffer errors.
+// The signal of `denoiser`'s record() in frame `frame` holds kept-history marks (RB_DN_KEPT_MARKS): the shadow pass
+// skipped converged tiles for it.
+void expectKeptMarks(const Denoiser& denoiser, uint64_t frame);
 Status historyReprojection(const Denoiser& denoiser, const GBufferDesc& g, const char* who, DenoiseConstants& pc);
 
 }  // namespace rb::internal

@@ -45,6 +45,9 @@ Status validate(const HybridEffectsDesc& d) {
   if (Status st = AdaptiveRayPlanner::validate(d.ao.adaptive, "HybridEffects: ao.adaptive", false); !st) return st;
   if (Status st = AdaptiveRayPlanner::validate(d.shadows.adaptive, "HybridEffects: shadows.adaptive", false); !st)
     return st;
+  if (d.shadows.convergedTiles.enabled && d.shadows.disableDenoiser)
+    return invalid("shadows.convergedTiles reads the shadow denoiser's history: enable the denoiser "
+                   "(shadows.disableDenoiser = false) or disable convergedTiles");
   if (d.ao.adaptive.enabled && d.ao.disableDenoiser)
     return invalid("ao.adaptive plans from the AO denoiser's history: enable the denoiser (ao.disableDenoiser = "
                    "false) or disable adaptive rays");
@@ -234,6 +237,10 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   s.adaptive = desc.shadows.adaptive;
   s.adaptive.history = shadowDenoiser.get();
   s.adaptive.enabled = s.adaptive.enabled && s.adaptive.history && plan.soft;
+  // Converged tiles too: only for soft shadows, whose denoiser runs after the pass this frame.
+  s.convergedTiles = desc.shadows.convergedTiles;
+  s.convergedTiles.history = shadowDenoiser.get();
+  s.convergedTiles.enabled = s.convergedTiles.enabled && s.convergedTiles.history && plan.soft;
   if (Status st = shadow->record(cmd, f.gbuffer, tlas, plan.light, s); !st)
     return wrap("ShadowPass::record", st.error());
   const ShadowOutputs& o = shadow->outputs();

@@ -55,8 +55,9 @@ struct ShadowConstants {
   float range;             // point and spot lights; 0 = unlimited
   uint32_t raysPerPixel;
   uint32_t launchOverTiles;  // 1 = the launch covers the tile classifier's list, 0 = the image
+  uint32_t convergedTiles;   // classifier: 1 = skip the tiles the tile state marks converged
 };
-static_assert(sizeof(ShadowConstants) == 224);
+static_assert(sizeof(ShadowConstants) == 228);
 RB_ASSERT_OFFSET(ShadowConstants, gbuffer, 0);
 RB_ASSERT_OFFSET(ShadowConstants, lightDirection, 160);
 RB_ASSERT_OFFSET(ShadowConstants, lightType, 172);
@@ -68,6 +69,7 @@ RB_ASSERT_OFFSET(ShadowConstants, tanAngularRadius, 208);
 RB_ASSERT_OFFSET(ShadowConstants, range, 212);
 RB_ASSERT_OFFSET(ShadowConstants, raysPerPixel, 216);
 RB_ASSERT_OFFSET(ShadowConstants, launchOverTiles, 220);
+RB_ASSERT_OFFSET(ShadowConstants, convergedTiles, 224);
 
 struct AoConstants {
   GBufferConstants gbuffer;
@@ -223,6 +225,21 @@ RB_ASSERT_OFFSET(DenoiseConstants, wAtDepthOne, 212);
 RB_ASSERT_OFFSET(DenoiseConstants, normalPower, 216);
 RB_ASSERT_OFFSET(DenoiseConstants, signalRaysPerPixel, 220);
 RB_ASSERT_OFFSET(DenoiseConstants, convergedNoise, 224);
+
+struct ConvergedTileConstants {
+  DenoiseConstants denoise;
+  uint32_t pad[3];  // std430 rounds the nested struct up to its 16-byte alignment
+  uint32_t minFrames;
+  float maxNoise;
+  uint32_t refreshPeriod;
+  uint32_t frameIndex;
+};
+static_assert(sizeof(ConvergedTileConstants) == 256);
+RB_ASSERT_OFFSET(ConvergedTileConstants, denoise, 0);
+RB_ASSERT_OFFSET(ConvergedTileConstants, minFrames, 240);
+RB_ASSERT_OFFSET(ConvergedTileConstants, maxNoise, 244);
+RB_ASSERT_OFFSET(ConvergedTileConstants, refreshPeriod, 248);
+RB_ASSERT_OFFSET(ConvergedTileConstants, frameIndex, 252);
 
 struct ClusterBoundsConstants {
   uint64_t positions;  // device addresses

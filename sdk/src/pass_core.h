@@ -85,9 +85,15 @@ struct PassCore {
   template <typename Constants>
   void traceIndirectAndEnd(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const Constants& pc,
                            VkDeviceAddress arguments, const RayTracingPipeline* variant = nullptr) {
+    traceIndirect(ctx, cmd, w, pc, arguments, variant);
+    end(ctx, cmd);
+  }
+  // Without the end: for a pass with work after its trace (images.endWrite(), that work, metrics.writeEnd()).
+  template <typename Constants>
+  void traceIndirect(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const Constants& pc,
+                     VkDeviceAddress arguments, const RayTracingPipeline* variant = nullptr) {
     bind(ctx, cmd, w, &pc, sizeof pc, variant);
     (variant ? *variant : pipeline).traceIndirect(ctx, cmd, arguments);
-    end(ctx, cmd);
   }
   // Makes the outputs readable and ends the measurements.
   void end(Context& ctx, VkCommandBuffer cmd);

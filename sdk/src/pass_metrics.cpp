@@ -77,6 +77,8 @@ void PassMetrics::collect(Context& ctx) {
       for (uint32_t i = 0; i < kCounterSlots; ++i) s.anyHitInvocations += counts[kCounterSlots + i];
       s.tilesTraced = counts[2 * kCounterSlots];  // RayCounters::tilesTraced, then tilesSkipped
       s.tilesSkipped = counts[2 * kCounterSlots + 1];
+      s.tilesConverged = counts[2 * kCounterSlots + 2];  // then tilesConverged, raysSaved
+      s.raysSaved = counts[2 * kCounterSlots + 3];
     }
     if (timing_) {
       uint64_t ticks[2] = {0, 0};

@@ -5,6 +5,7 @@
 
 #include "adaptive_rays.h"
 #include "context_impl.h"
+#include "converged_tiles.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
 #include "tile_classifier.h"
@@ -20,6 +21,7 @@ struct ShadowPass::Impl {
   ShadowPassDesc desc;
   PassCore core;
   TileClassifier classifier;
+  ConvergedTiles converged;  // ShadowSettings::convergedTiles, pipelines created on first use
   // Adaptive rays (soft lights), created on first use: shadow_adaptive.rgen and its planner.
   RayTracingPipelineDesc adaptiveDesc;
   RayTracingPipeline adaptivePipeline;
@@ -29,6 +31,7 @@ struct ShadowPass::Impl {
   ~Impl() {  // frames in flight may still trace with it
     core.retire(ctx);
     classifier.retire(ctx);
+    converged.retire(ctx);
     adaptivePipeline.retire(ctx);
     planner.retire(ctx);
   }
@@ -72,6 +75,8 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
     if (b.binding == RB_BINDING_TLAS) continue;
     cb.push_back({b.binding, b.descriptorType, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
   }
+  cb.push_back(
+      {RB_SHADOW_BINDING_TILE_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
   const SpirvModule classify = desc.outputHitDistance ? SpirvModule::of(spirv::shadow_classify_distance_comp)
                                                       : SpirvModule::of(spirv::shadow_classify_comp);
   if (Status s = impl->classifier.init(context, classify, cb, sizeof(ShadowConstants), "shadow tile classifier"); !s) {
@@ -145,6 +150,14 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
     if (!p) return p.error();
     s.adaptivePipeline = p.value();
   }
+  if (Status st = ConvergedTiles::validate(settings.convergedTiles, "ShadowPass: ShadowSettings::convergedTiles");
+      !st) {
+    return st;
+  }
+  if (settings.convergedTiles.enabled && s.desc.outputHitDistance) {
+    return invalid("converged tiles have no occluder distance: create the pass without "
+                   "ShadowPassDesc::outputHitDistance, or disable ShadowSettings::convergedTiles");
+  }
   const PassStats latest = s.core.metrics.latest(s.ctx);
 
   std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16_SFLOAT, "shadow visibility"}};
@@ -170,15 +183,35 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   if (!plan) return plan.error();
   const bool planned = plan.value();
   const RayTracingPipeline* variant = planned ? &s.adaptivePipeline : nullptr;
-  if (!settings.tileClassifier) {
+  if (!settings.tileClassifier && !settings.convergedTiles.enabled) {
     s.core.traceAndEnd(s.ctx, cmd, w, pc, g, variant);
   } else {
+    bool converged = false;
+    if (settings.convergedTiles.enabled) {
+      Result<bool> c = s.converged.record(s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel, s.classifier,
+                                          images[0].view, "ShadowPass");
+      if (!c) {
+        s.core.end(s.ctx, cmd);
+        return c.error();
+      }
+      converged = c.value();
+    }
+    pc.convergedTiles = converged ? 1u : 0u;
     DescriptorWrites cw;
     s.core.writeGBuffer(s.ctx, cw, g);
     writeOutputs(cw);
+    s.classifier.writeState(cw, RB_SHADOW_BINDING_TILE_STATE);
     s.classifier.classify(s.ctx, cmd, cw, &pc, sizeof pc);
     pc.launchOverTiles = 1;
-    s.core.traceIndirectAndEnd(s.ctx, cmd, w, pc, s.classifier.traceArguments(), variant);
+    if (!converged) {
+      s.core.traceIndirectAndEnd(s.ctx, cmd, w, pc, s.classifier.traceArguments(), variant);
+    } else {
+      // The check reads the traced visibility, so it comes after the outputs are readable, inside the pass's time.
+      s.core.traceIndirect(s.ctx, cmd, w, pc, s.classifier.traceArguments(), variant);
+      s.core.images.endWrite(s.ctx, cmd);
+      s.converged.check(s.ctx, cmd, g, s.classifier, images[0].view);
+      s.core.metrics.writeEnd(s.ctx, cmd);
+    }
   }
 
   ShadowOutputs& o = s.outputs;

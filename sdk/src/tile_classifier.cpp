@@ -24,6 +24,7 @@ Status TileClassifier::init(Context& ctx, const SpirvModule& shader,
 void TileClassifier::retire(Context& ctx) {
   pipeline_.retire(ctx);
   retireBuffer(ctx, list_);
+  retireBuffer(ctx, state_);
   width_ = height_ = 0;
 }
 
@@ -33,14 +34,22 @@ VkDeviceSize TileClassifier::listBytes(uint32_t width, uint32_t height) {
 }
 
 Status TileClassifier::ensure(Context& ctx, uint32_t width, uint32_t height) {
-  if (list_.valid() && width == width_ && height == height_) return {};
+  if (list_.valid() && state_.valid() && width == width_ && height == height_) return {};
   retireBuffer(ctx, list_);
+  retireBuffer(ctx, state_);
   Result<GpuBuffer> b = createBuffer(ctx, listBytes(width, height),
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
                                      MemoryLocation::DeviceLocal, MemoryCategory::PassBuffers, "tile list");
   if (!b) return b.error();
   list_ = b.value();
+  const VkDeviceSize tiles = (listBytes(width, height) - kHeaderBytes) / sizeof(uint32_t);
+  Result<GpuBuffer> st = createBuffer(ctx, tiles * sizeof(uint32_t),
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                      MemoryLocation::DeviceLocal, MemoryCategory::PassBuffers, "tile state");
+  if (!st) return st.error();
+  state_ = st.value();
+  stateReset_ = true;
   width_ = width;
   height_ = height;
   return {};
@@ -48,6 +57,10 @@ Status TileClassifier::ensure(Context& ctx, uint32_t width, uint32_t height) {
 
 void TileClassifier::writeList(DescriptorWrites& w, uint32_t binding) const {
   w.storageBuffer(binding, list_.buffer, 0, list_.size);
+}
+
+void TileClassifier::writeState(DescriptorWrites& w, uint32_t binding) const {
+  w.storageBuffer(binding, state_.buffer, 0, state_.size);
 }
 
 void TileClassifier::classify(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w, const void* constants,

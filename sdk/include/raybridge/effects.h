@@ -38,6 +38,10 @@ struct PassStats {
   // pixels all needed no ray (written without tracing). Both 0 when the pass ran without one.
   uint64_t tilesTraced = 0;
   uint64_t tilesSkipped = 0;
+  // Of tilesSkipped, those that needed rays but were skipped because their history had converged
+  // (ShadowSettings::convergedTiles), and the rays their pixels would have traced at the uniform rays per pixel.
+  uint64_t tilesConverged = 0;
+  uint64_t raysSaved = 0;
   uint64_t tilesTotal() const { return tilesTraced + tilesSkipped; }
   double raysPerSecond() const { return gpuMs > 0.0 ? double(rays) / (gpuMs * 1e-3) : 0.0; }
 };

@@ -62,6 +62,10 @@ struct ShadowEffectSettings {
   // Soft shadows: rays per pixel planned from the shadow denoiser's history (adaptive_rays.h); raysPerPixel is the
   // average the budget is made of. `history` is ignored (the effect's denoiser, which must be enabled).
   AdaptiveRaySettings adaptive;
+  // Soft shadows: skip the tiles whose denoised history has converged (ShadowSettings::convergedTiles; the raw
+  // shadow output then holds kept-history marks there, the denoised one is complete). `history` is ignored (the
+  // effect's denoiser, which must be enabled). Off by default.
+  ConvergedTileSettings convergedTiles;
 };
 
 struct AoEffectSettings {

@@ -11,8 +11,19 @@
 // traced (vkCmdTraceRaysIndirectKHR). The outputs are the same bit for bit either way; PassStats counts the tiles
 // traced and skipped. It is off by default: on an NVIDIA H200 the pass was 0.08 ms slower with it at 2560x1440
 // (docs/performance.md), since the pixels it skips already end before their first ray. Its tile list takes 16
-// bytes + 4 bytes per tile (MemoryCategory::PassBuffers, about 130 KB at 1920x1080), allocated with the output
-// images.
+// bytes + 8 bytes per tile (the list and the converged-tile state; MemoryCategory::PassBuffers, about 260 KB at
+// 1920x1080), allocated with the output images.
+//
+// Converged tiles (ShadowSettings::convergedTiles, with the classifier): for denoised shadows, a tile whose every
+// surface pixel has a reprojected history in the shadow denoiser of at least minFrames frames, with the noise the
+// denoiser measured there under maxNoise, traces no ray. Its pixels are not a sample: they hold kept-history marks,
+// -1 - (the reprojected history mean), in [-2, -1], which that denoiser's next record() reads as "no new frame":
+// it carries the history to the pixel's new position unchanged (the reprojection, and its disocclusion test, are
+// the denoiser's own, so a disoccluded pixel is never skipped). Read the denoised output, not the raw visibility,
+// or decode a value v < -0.5 as -1 - v. A converged tile is still traced once in refreshPeriod frames (a rotating
+// subset of the tiles each frame); when its new rays disagree with its history beyond their noise (a moved light or
+// occluder, which the history cannot see) it is traced every frame for the next minFrames frames. Two compute
+// dispatches over the tiles (before the classifier and after the trace), within the pass's GPU time.
 //
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipelines, output images,
 // tile list and measurement objects are handed to the Context's deferred release (see context.h) and freed once
@@ -39,6 +50,25 @@ struct ShadowPassDesc {
 
 inline constexpr uint32_t kDefaultSoftShadowRays = 4;
 
+// Defaults of ConvergedTileSettings: a tile is converged when each of its surface pixels has a history of at least
+// 16 frames (half the denoiser's default 32) whose measured noise has a standard deviation under 0.05 (half
+// kDefaultDenoiseConvergedNoise: 4 rays at visibility 0.5 need 25 frames), and it is still traced once in 8 frames.
+inline constexpr uint32_t kDefaultConvergedMinFrames = 16;
+inline constexpr float kDefaultConvergedMaxNoise = 0.05f;
+inline constexpr uint32_t kDefaultConvergedRefreshPeriod = 8;
+
+// Skipping the tiles whose denoised history has converged (see the top of this file). Zero-initialised = off, and
+// the defaults when enabled.
+struct ConvergedTileSettings {
+  bool enabled = false;  // true = skip converged tiles (turns the tile classifier on); needs `history`
+  // The Denoiser (DenoiseSignal::Scalar) that filters this pass's visibility, recorded after it every frame (the
+  // same frame): its history decides, and its next record() reads the marks. HybridEffects sets it.
+  const Denoiser* history = nullptr;
+  uint32_t minFrames = 0;      // frames of history a pixel needs; 0 = kDefaultConvergedMinFrames; at most 65535
+  float maxNoise = 0.0f;       // std. deviation of the denoiser's measured noise; 0 = kDefaultConvergedMaxNoise
+  uint32_t refreshPeriod = 0;  // a converged tile is traced once in this many frames; 0 = the default, 1 = never skip
+};
+
 struct ShadowSettings {
   // Rays per pixel for a soft light (angular radius or radius > 0); 0 = kDefaultSoftShadowRays. A hard light
   // always uses one.
@@ -53,12 +83,16 @@ struct ShadowSettings {
   // (adaptive_rays.h); raysPerPixel is then the average the budget is made of. A hard light traces one ray per
   // pixel regardless. Not with ShadowPassDesc::outputHitDistance. Disabled by default.
   AdaptiveRaySettings adaptive;
+  // Skip the tiles whose denoised history has converged (soft shadows). Off by default. Not with
+  // ShadowPassDesc::outputHitDistance (a skipped pixel has no occluder distance).
+  ConvergedTileSettings convergedTiles;
 };
 
 // Images owned by the pass, sized to the G-buffer, left in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL after
 // record() with a barrier that makes them readable by fragment and compute shaders.
 struct ShadowOutputs {
-  VkImage visibility = VK_NULL_HANDLE;  // R16_SFLOAT, 1 = lit
+  // R16_SFLOAT, 1 = lit; with ShadowSettings::convergedTiles, skipped pixels hold kept-history marks (see the top).
+  VkImage visibility = VK_NULL_HANDLE;
   VkImageView visibilityView = VK_NULL_HANDLE;
   VkImage hitDistance = VK_NULL_HANDLE;  // R32_SFLOAT, world units; 0 = no occluder; only with outputHitDistance
   VkImageView hitDistanceView = VK_NULL_HANDLE;

@@ -1,0 +1,133 @@
+#include "converged_tiles.h"
+
+#include <cmath>
+#include <string>
+
+#include "context_impl.h"
+#include "denoiser_history.h"
+#include "memory_barrier.h"
+#include "raybridge_shaders.h"
+#include "tile_classifier.h"
+
+namespace rb {
+
+Status ConvergedTiles::validate(const ConvergedTileSettings& s, const char* who) {
+  if (!s.enabled) return {};
+  auto invalid = [&](const std::string& m) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, std::string(who) + ": " + m};
+  };
+  if (!s.history) {
+    return invalid("history is nullptr; converged tiles are read from the history of the Denoiser that filters this "
+                   "pass's visibility: set it, or disable convergedTiles");
+  }
+  if (s.history->signal() != DenoiseSignal::Scalar) {
+    return invalid("history must be a DenoiseSignal::Scalar Denoiser (the one filtering this pass's visibility)");
+  }
+  if (s.minFrames > RB_TILE_HOLD_MASK) {
+    return invalid("minFrames " + std::to_string(s.minFrames) + " exceeds " + std::to_string(RB_TILE_HOLD_MASK));
+  }
+  if (!(s.maxNoise >= 0.0f) || !std::isfinite(s.maxNoise)) {
+    return invalid("maxNoise " + std::to_string(s.maxNoise) + " must be a finite number >= 0 (0 = default)");
+  }
+  return {};
+}
+
+Status ConvergedTiles::init(Context& ctx) {
+  const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+  auto binding = [&](uint32_t b, VkDescriptorType t) { return VkDescriptorSetLayoutBinding{b, t, 1, cs, nullptr}; };
+  const VkDescriptorType sampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  std::vector<VkDescriptorSetLayoutBinding> common = {
+      binding(RB_CONVERGED_BINDING_DEPTH, sampled), binding(RB_CONVERGED_BINDING_MOTION, sampled),
+      binding(RB_CONVERGED_BINDING_HISTORY, sampled), binding(RB_CONVERGED_BINDING_DISTANCE, sampled),
+      binding(RB_CONVERGED_BINDING_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER)};
+  if (!mark_.pipeline) {
+    std::vector<VkDescriptorSetLayoutBinding> b = common;
+    b.push_back(binding(RB_CONVERGED_BINDING_NOISE, sampled));
+    b.push_back(binding(RB_CONVERGED_BINDING_VISIBILITY, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE));
+    Result<ComputePipeline> p = ComputePipeline::create(ctx, SpirvModule::of(spirv::shadow_converged_comp), b,
+                                                        sizeof(ConvergedTileConstants), "shadow converged tiles");
+    if (!p) return p.error();
+    mark_ = p.value();
+  }
+  if (!check_.pipeline) {
+    std::vector<VkDescriptorSetLayoutBinding> b = common;
+    b.push_back(binding(RB_CONVERGED_BINDING_VISIBILITY, sampled));
+    Result<ComputePipeline> p = ComputePipeline::create(ctx, SpirvModule::of(spirv::shadow_converged_check_comp), b,
+                                                        sizeof(ConvergedTileConstants),
+                                                        "shadow converged tiles: check");
+    if (!p) return p.error();
+    check_ = p.value();
+  }
+  return {};
+}
+
+void ConvergedTiles::retire(Context& ctx) {
+  mark_.retire(ctx);
+  check_.retire(ctx);
+}
+
+Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
+                                    const ConvergedTileSettings& s, uint32_t raysPerPixel, TileClassifier& classifier,
+                                    VkImageView visibility, const char* who) {
+  const internal::DenoiserHistory history = internal::latestHistory(*s.history, g);
+  if (!history.mean || !history.valid) return false;
+  ConvergedTileConstants pc{};
+  if (Status st = internal::historyReprojection(*s.history, g, who, pc.denoise); !st) return st.error();
+  if (Status st = init(ctx); !st) return st.error();
+  pc.denoise.signalRaysPerPixel = float(raysPerPixel);
+  pc.minFrames = s.minFrames ? s.minFrames : kDefaultConvergedMinFrames;
+  pc.maxNoise = s.maxNoise > 0.0f ? s.maxNoise : kDefaultConvergedMaxNoise;
+  pc.refreshPeriod = s.refreshPeriod ? s.refreshPeriod : kDefaultConvergedRefreshPeriod;
+  // The pass's own count of recordings, not the context's frame index: every tile refreshes once in refreshPeriod
+  // recordings however the engine's frame index steps.
+  pc.frameIndex = recordings_++;
+  constants_ = pc;
+
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
+  const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  const VkAccessFlags rw = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  if (classifier.takeStateReset()) {
+    // A new state buffer: no tile held. (The previous frame's users of the old one are a different buffer.)
+    vk.vkCmdFillBuffer(cmd, classifier.stateBuffer(), 0, VK_WHOLE_SIZE, 0);
+    recordMemoryBarrier(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, cs, rw);
+  } else {
+    // Last frame's check and classifier are done with the state.
+    recordMemoryBarrier(vk, cmd, cs, rw, cs, rw);
+  }
+  history_ = history;
+  DescriptorWrites w;
+  writeCommon(w, g, classifier);
+  w.sampledImage(RB_CONVERGED_BINDING_NOISE, history.noise, history.sampler, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  w.storageImage(RB_CONVERGED_BINDING_VISIBILITY, visibility);
+  mark_.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
+  // The state and the marks, for the classifier (which may overwrite a tile that needs no ray with its exact values).
+  recordMemoryBarrier(vk, cmd, cs, VK_ACCESS_SHADER_WRITE_BIT, cs, rw);
+  internal::expectKeptMarks(*s.history, ctx.frameIndex());
+  return true;
+}
+
+void ConvergedTiles::writeCommon(DescriptorWrites& w, const GBufferDesc& g, const TileClassifier& classifier) const {
+  const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  w.sampledImage(RB_CONVERGED_BINDING_DEPTH, g.depth.view, history_.sampler, readLayout(g.depth));
+  const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
+  w.sampledImage(RB_CONVERGED_BINDING_MOTION, motion.view, history_.sampler, readLayout(motion));
+  w.sampledImage(RB_CONVERGED_BINDING_HISTORY, history_.mean, history_.sampler, ro);
+  w.sampledImage(RB_CONVERGED_BINDING_DISTANCE, history_.distance, history_.sampler, ro);
+  classifier.writeState(w, RB_CONVERGED_BINDING_STATE);
+}
+
+void ConvergedTiles::check(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const TileClassifier& classifier,
+                           VkImageView visibility) const {
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
+  // The state: written by step 1 and read by the classifier, both compute.
+  recordMemoryBarrier(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  DescriptorWrites w;
+  writeCommon(w, g, classifier);
+  w.sampledImage(RB_CONVERGED_BINDING_VISIBILITY, visibility, history_.sampler,
+                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  check_.dispatch(ctx, cmd, w.writes, &constants_, sizeof constants_, g.width, g.height);
+}
+
+}  // namespace rb
