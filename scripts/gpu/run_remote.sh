@@ -339,7 +339,8 @@ fi
 # speed-vs-error sweep of AO and reflections (full and half resolution rows) at RB_ADAPTIVE_SIZE, then the Ultra
 # preset on the performance and demo scenes with per-effect time targets and half resolution (RB_ADAPTIVE_ULTRA:
 # `uniform` is the thesis's Ultra, AO at full resolution; `preset` is the preset as it is, AO at half resolution).
-# RB_ADAPTIVE_BENCH=0 leaves the two effects-bench sweeps out (the Ultra rows only).
+# RB_ADAPTIVE_BENCH=0 leaves the two effects-bench sweeps out (the Ultra rows only); RB_ADAPTIVE_HALF=0 leaves out
+# the second (half resolution) alone.
 # perf_report.py writes adaptive_perf_gpu.json from the renders. Validation off.
 if want adaptive; then
   : >"$OUT/adaptive_gpu.log"
@@ -351,7 +352,7 @@ if want adaptive; then
   fi
   [ "${RB_ADAPTIVE_BENCH:-1}" = 1 ] && RAYBRIDGE_VALIDATION=0 step "effects adaptive" 200 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-effects-bench" \
     --scenario adaptive --effects shadows,ao --width "$AW" --height "$AH" --out "$OUT/effects_adaptive_gpu.json"
-  [ "${RB_ADAPTIVE_BENCH:-1}" = 1 ] && RAYBRIDGE_VALIDATION=0 step "effects half" 200 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-effects-bench" \
+  [ "${RB_ADAPTIVE_BENCH:-1}" = 1 ] && [ "${RB_ADAPTIVE_HALF:-1}" = 1 ] && RAYBRIDGE_VALIDATION=0 step "effects half" 200 "$OUT/adaptive_gpu.log" "$RT/bin/raybridge-effects-bench" \
     --effects ao,reflections --width "$AW" --height "$AH" --out "$OUT/effects_half_gpu.json"
   AFRAMES="${RB_PERF_FRAMES:-40}"
   for scene in perf demo; do
