@@ -1,9 +1,10 @@
 // tlas: a TLAS over 1k, 10k, 100k (GPU: 1M) instances of a few small meshes. Host time of recordTlasBuild
 // (std::chrono; it writes the instance buffer) and GPU time of the build (the bench's own timestamps, the instance
 // copy included where there is one), both as medians of repeated frames after one warm-up frame per frame slot,
-// and per 1,000 instances. Each size is measured in three variants, one change at a time: the build reading the
-// host-visible instances in place, reading a device-local copy (the default on a discrete GPU), and the copy with a
-// fast-build TLAS.
+// and per 1,000 instances. Each size is measured in four variants, one change at a time: the build reading the
+// host-visible instances in place, reading a device-local copy (the default on a discrete GPU), the copy with a
+// fast-build TLAS, and the copy refitting the previous frame's TLAS (TlasBuildMode::UpdateIfPossible) while every
+// instance moves a little each frame (an engine's frame where the instance list keeps its meshes).
 #include <chrono>
 
 #include "gpu_timer.h"
@@ -48,12 +49,16 @@ nlohmann::json runTlasScenario(BenchEnv& env) {
   struct Variant {
     const char* name;
     rb::TlasBuildOptions options;
+    bool moving = false;  // every instance's translation changes each frame (a refit then has work to do)
   };
-  const Variant variants[] = {{"in place", {.instanceUpload = rb::TlasInstanceUpload::ReadInPlace}},
-                              {"device copy", {.instanceUpload = rb::TlasInstanceUpload::CopyToDevice}},
-                              {"copy+fast build",
-                               {.instanceUpload = rb::TlasInstanceUpload::CopyToDevice,
-                                .preference = rb::TlasBuildPreference::FastBuild}}};
+  const Variant variants[] = {
+      {"in place", {.instanceUpload = rb::TlasInstanceUpload::ReadInPlace}},
+      {"device copy", {.instanceUpload = rb::TlasInstanceUpload::CopyToDevice}},
+      {"copy+fast build",
+       {.instanceUpload = rb::TlasInstanceUpload::CopyToDevice, .preference = rb::TlasBuildPreference::FastBuild}},
+      {"copy+update",
+       {.mode = rb::TlasBuildMode::UpdateIfPossible, .instanceUpload = rb::TlasInstanceUpload::CopyToDevice},
+       true}};
   for (const Variant& variant : variants) {
     freshService();
     for (uint32_t count : z.tlasInstances) {
@@ -68,6 +73,10 @@ nlohmann::json runTlasScenario(BenchEnv& env) {
       std::vector<double> hostMs, gpuMs;
       const uint32_t warmup = env.ctx().framesInFlight();
       for (uint32_t f = 0; f < warmup + z.tlasRepeats; ++f) {
+        if (variant.moving) {
+          // Up to 0.06 units along y, a different phase per instance: every bound moves, none by much.
+          for (uint32_t i = 0; i < count; ++i) instances[i].transform[7] = placement[i][7] + 0.01f * float((f + i) % 7);
+        }
         double host = 0.0;
         uint32_t a = 0, b = 0;
         rb::TlasInfo info;
@@ -81,6 +90,9 @@ nlohmann::json runTlasScenario(BenchEnv& env) {
         });
         timer.resolve();
         if (info.instanceCount != count) throw BenchFailure("tlas: the TLAS holds fewer instances than given");
+        // After the warm-up frames the update variant must refit, or it measures rebuilds.
+        if (variant.options.mode == rb::TlasBuildMode::UpdateIfPossible && f >= warmup && !info.updated)
+          throw BenchFailure("tlas: copy+update rebuilt the TLAS instead of refitting it");
         if (f < warmup) continue;
         hostMs.push_back(host);
         gpuMs.push_back(timer.ms(a, b));
