@@ -23,6 +23,8 @@ const float kKernel[2] = float[2](1.0 / 2.0, 1.0 / 4.0);
 // The colour tolerance in standard deviations (SVGF's luminance one is 4; an RGB distance is larger).
 const float kColourSigma = 2.5;
 const float kLog2e = 1.4426950408889634;
+// A pixel whose taps all carry a deviation under this fraction of its colour skips the filter (below).
+const float kConvergedDeviation = 1e-4;
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -37,6 +39,27 @@ void main() {
     imageStore(signalOut, ip, vec4(centre.rgb, final ? coverage : centre.a));
     return;
   }
+  int step = int(pc.atrousStep);
+  // The taps' values first. Where every one of them (the centre too) is noise-free, the pixel stays as it is
+  // whatever the geometry: each tap's colour tolerance is then at most kColourSigma * 1e-4 plus the floor below
+  // (0.1% of the centre's colour), and a tap at colour distance d moves the centre by at most its weight times
+  // d exp(-d / sigma) <= sigma / e, so all 8 (3/4 of the kernel, against the centre's 1/4) by at most 0.14% of
+  // its colour: the half-float rounding of the output. Skipping them saves the guide reads and the weights; it is
+  // most of a converged signal (mirrors, which the temporal pass gives no noise; a uniform sky reflected).
+  vec4 values[9];
+  bool inside[9];
+  float noisiest = 0.0;
+  for (int k = 0; k < 9; ++k) {
+    ivec2 q = ip + ivec2(k % 3 - 1, k / 3 - 1) * step;
+    inside[k] = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, ivec2(pc.size)));
+    values[k] = k == 4 ? centre : (inside[k] ? texelFetch(signalIn, q, 0) : vec4(0.0));
+    noisiest = max(noisiest, values[k].a);
+  }
+  if (noisiest <= kConvergedDeviation * length(centre.rgb)) {
+    imageStore(signalOut, ip, vec4(centre.rgb, final ? 1.0 : centre.a));
+    return;
+  }
+
   vec3 n = rbDnGuideNormal(g);
   // Camera-relative points at one depth are linear in the pixel coordinates (before the perspective division,
   // which only scales them): the direction towards any pixel from the centre's and two differences.
@@ -45,21 +68,18 @@ void main() {
   vec3 ax = rbDnCameraRelative(pixel + uvec2(1, 0), anyDepth) - a0;
   vec3 ay = rbDnCameraRelative(pixel + uvec2(0, 1), anyDepth) - a0;
   vec3 p = normalize(a0) * dist;
-  int step = int(pc.atrousStep);
   float tolerance = length(p) * pc.depthSigma * float(step) + 1e-6;
 
-  // The taps, with their geometric weights first: the centre's noise level for the colour weight is the mean
-  // variance of the taps on the same surface (a weighted sum here), so a pixel whose few frames happened
-  // to agree still takes its neighbours' noise level, and the other side of an edge lends none.
-  vec4 values[9];
+  // The taps' geometric weights: the centre's noise level for the colour weight is the mean variance of the
+  // taps on the same surface (a weighted sum here), so a pixel whose few frames happened to agree still takes
+  // its neighbours' noise level, and the other side of an edge lends none.
   float geometric[9];
   float tapVariances = 0.0, varianceWeights = 0.0;
   for (int k = 0; k < 9; ++k) {
     ivec2 o = ivec2(k % 3 - 1, k / 3 - 1);
     ivec2 q = ip + o * step;
     geometric[k] = 0.0;
-    values[k] = vec4(0.0);
-    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(pc.size)))) continue;
+    if (!inside[k]) continue;
     uvec2 qg = texelFetch(guide, q, 0).xy;
     float qdist = rbDnGuideDistance(qg);
     if (qdist <= 0.0) continue;
@@ -70,7 +90,6 @@ void main() {
     float w = cosine > 0.0 ? kKernel[abs(o.x)] * kKernel[abs(o.y)] *
                                  exp2(pc.normalPower * log2(cosine) - kLog2e * planeDistance)
                            : 0.0;
-    values[k] = texelFetch(signalIn, q, 0);
     geometric[k] = w;
     tapVariances += w * values[k].a * values[k].a;
     varianceWeights += w;

@@ -267,6 +267,69 @@ TEST_CASE("the denoiser filters a one-ray signal and never raises the error", "[
   }
 }
 
+TEST_CASE("a noise-free RGB signal passes the a-trous steps bit for bit, a noisy one is filtered",
+          "[denoise][adaptive]") {
+  // The a-trous steps skip a pixel whose taps all carry no noise (denoise_rgb_atrous.comp); the filter would move
+  // a curved colour ramp's pixels by up to ~0.1% (the colour floor, 1 ulp here), so an exact pass shows that the
+  // skip happened, and the noisy case that it does not happen where the filter has work to do.
+  GpuFixture fx;
+  AoScene s;
+  const SyntheticView view = viewAt(0.0);
+  const uint32_t w = view.width, h = view.height;
+  const size_t n = s.scene.instances.size();
+  // Quadratic ramps in steps of one half-float ulp (the output's format: passing means equal), restarting every 16
+  // pixels: the neighbours differ by about the floor's tolerance, and unevenly, so the filter would move them.
+  auto colour = [](uint32_t x, uint32_t y) {
+    return glm::vec3(1.0f + float((x % 16) * (x % 16)) / 1024.0f, 0.5f + float((y % 16) * (y % 16)) / 2048.0f, 0.25f);
+  };
+  auto signal = [&](float noise) {
+    std::mt19937 rng(5);
+    std::normal_distribution<float> gauss(0.0f, noise);
+    std::vector<float> out(size_t(w) * h * 4);
+    for (uint32_t y = 0; y < h; ++y) {
+      for (uint32_t x = 0; x < w; ++x) {
+        glm::vec3 c = colour(x, y);
+        float* px = &out[(size_t(y) * w + x) * 4];
+        for (int k = 0; k < 3; ++k) px[k] = noise > 0.0f ? std::max(c[k] + gauss(rng) * c[k], 0.0f) : c[k];
+        px[3] = 1.0f;
+      }
+    }
+    return out;
+  };
+  auto changedPixels = [&](const std::vector<float>& in, const std::vector<float>& out, const CpuGBuffer& g) {
+    size_t changed = 0;
+    for (size_t i = 0; i < size_t(w) * h; ++i) {
+      if (!g.hit[i]) continue;
+      bool same = true;
+      for (int k = 0; k < 3; ++k) same = same && out[i * 4 + k] == in[i * 4 + k];
+      changed += !same;
+    }
+    return changed;
+  };
+  size_t surface = 0;
+  const CpuGBuffer glossy = traceGBuffer(s.embree, view, std::vector<float>(n, 0.5f));
+  for (size_t i = 0; i < size_t(w) * h; ++i) surface += glossy.hit[i];
+  REQUIRE(surface > size_t(w) * h / 4);
+  rb::DenoiseSettings oneFrameRgb;
+  oneFrameRgb.disableTemporal = true;
+  // A mirror (roughness 0): the temporal pass gives it no noise.
+  const CpuGBuffer mirror = traceGBuffer(s.embree, view, std::vector<float>(n, 0.0f));
+  const std::vector<float> clean = signal(0.0f);
+  std::vector<float> out = denoiseOnce(fx, mirror, clean, rb::DenoiseSignal::Reflection, oneFrameRgb);
+  CHECK(changedPixels(clean, out, mirror) == 0);
+  // With the default settings too (the first frame: no history yet).
+  out = denoiseOnce(fx, mirror, clean, rb::DenoiseSignal::Reflection, {});
+  CHECK(changedPixels(clean, out, mirror) == 0);
+  // A glossy reflection and an RGB signal with noise of 30% of the colour: most pixels are filtered.
+  const std::vector<float> noisy = signal(0.3f);
+  for (rb::DenoiseSignal kind : {rb::DenoiseSignal::Rgb, rb::DenoiseSignal::Reflection}) {
+    out = denoiseOnce(fx, glossy, noisy, kind, oneFrameRgb);
+    const size_t changed = changedPixels(noisy, out, glossy);
+    INFO("signal " << uint32_t(kind) << ": " << changed << " of " << surface << " noisy pixels changed");
+    CHECK(changed > surface / 2);
+  }
+}
+
 TEST_CASE("reflections: mirrors keep their edges, glossy noise is filtered, uncovered pixels pass",
           "[denoise][adaptive]") {
   GpuFixture fx;
