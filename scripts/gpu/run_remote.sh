@@ -4,7 +4,8 @@
 #
 #   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, inject, render, effects, animated,
 #                                                          lights, perf, adaptive, soak (default all; inject,
-#                                                          the failure-injection cases, runs only when named)
+#                                                          the failure-injection cases, and tlas, the TLAS
+#                                                          benchmark alone, run only when named)
 #
 # Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
 # tests_gpu.log, effects_gpu.json, effects_gpu.log, render_gpu.tar.gz (render logs, stats.json and final.png
@@ -23,11 +24,13 @@
 #   size, frames per row and along the path, presets (of the current build and of the earlier ones) and benchmark
 #   arguments (smaller ones for a rehearsal on lavapipe)
 #   RB_RUNTIME_DIR=DIR  where .devcarry is unpacked (default /tmp/raybridge-devcarry)
+#   RB_TESTS="NAME ..." the tests mode runs only these executables (tests.txt names); RB_TEST_ARGS="[tag]" gives
+#                       them these arguments instead of their own
 set -u
 
 MODE="${1:-all}"
 for m in ${MODE//,/ }; do
-  case "$m" in all|bench|tests|inject|render|effects|animated|lights|perf|adaptive|soak) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, inject, render, effects, animated, lights, perf, adaptive or soak" >&2; exit 2 ;; esac
+  case "$m" in all|bench|tests|inject|render|effects|animated|lights|perf|adaptive|soak|tlas) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, inject, render, effects, animated, lights, perf, adaptive, soak or tlas" >&2; exit 2 ;; esac
 done
 want() { [ "$MODE" = all ] || [[ ",$MODE," == *",$1,"* ]]; }
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -390,11 +393,20 @@ if want tests; then
   : >"$OUT/tests_gpu.log"
   while IFS='|' read -r name exe args; do
     [ -n "$name" ] || continue
+    # RB_TESTS="NAME ...": only those executables; RB_TEST_ARGS replaces their arguments (a Catch2 tag filter).
+    [ -z "${RB_TESTS:-}" ] || [[ " $RB_TESTS " == *" $name "* ]] || continue
+    [ -z "${RB_TEST_ARGS:-}" ] || args="$RB_TEST_ARGS"
     read -r -a targs <<<"$args"
     [ "$name" = bench_smoke ] && targs+=(--scenes "$SCENES" --out "$(mktemp -d)/bench_smoke_gpu.json")
     RAYBRIDGE_VALIDATION=1 step "test $name" 240 "$OUT/tests_gpu.log" "$RT/bin/$exe" "${targs[@]}"
   done <"$RT/tests.txt"
   grep -E '^(All tests passed|test cases:)|FAILED|validation\]' "$OUT/tests_gpu.log" | head -n 40
+fi
+# ---- tlas: raybridge-bench --scenario tlas --full alone (docs/performance.md's TLAS table), into tlas_gpu.json.
+if [[ ",$MODE," == *,tlas,* ]]; then  # only when named: `bench` runs it with every other scenario
+  RAYBRIDGE_VALIDATION=0 step "tlas bench" 150 "$OUT/tlas_gpu.log" "$RT/bin/raybridge-bench" --scenario tlas --full \
+    --out "$OUT/tlas_gpu.json"
+  grep -E 'variant|in place|device copy|copy\+|gpuMsAt10k' "$OUT/tlas_gpu.log" | head -n 30
 fi
 # ---- inject: raybridge_tests' failure-injection cases ([inject]), left out of `tests`: every SDK allocation site
 # fails in turn, and every pass is recreated after each (minutes of pipeline compilation on the GPU).
