@@ -295,6 +295,29 @@ TEST_CASE("context creation names what is missing", "[context][bad-input]") {
   CHECK(!rb::computeCameraBasis(rb::PrimaryRayCamera{}, 0, 4).ok());
 }
 
+TEST_CASE("invocation reorder is enabled only where the device has it", "[context][invocation_reorder]") {
+  GpuFixture fx;
+  rb::HeadlessDevice& dev = fx.device();
+  const bool supported = rb::supportsInvocationReorder(dev.instance(), dev.physicalDevice(), dev.getInstanceProcAddr());
+  // The headless device enables it wherever it can, and tells the context.
+  CHECK(dev.invocationReorderEnabled() == supported);
+  CHECK(fx.ctx().deviceInfo().invocationReorder == supported);
+  CHECK(!rb::supportsInvocationReorder(VK_NULL_HANDLE, dev.physicalDevice(), dev.getInstanceProcAddr()));
+  rb::ContextDesc d = dev.contextDesc();
+  d.invocationReorderEnabled = true;
+  auto r = rb::Context::create(d);
+  if (supported) {
+    RB_REQUIRE_OK(r);
+    CHECK(r.value()->deviceInfo().invocationReorder);
+    SKIP("the device supports VK_NV_ray_tracing_invocation_reorder: no mismatch to report");
+  }
+  // Claimed on a device without it: a named error, not a pipeline failure later.
+  REQUIRE(!r.ok());
+  CHECK(r.error().code == rb::ErrorCode::MissingExtension);
+  CHECK(mentions(r.error(), "invocationReorderEnabled"));
+  CHECK(mentions(r.error(), "VK_NV_ray_tracing_invocation_reorder"));
+}
+
 TEST_CASE("the headless device picks a ray tracing device and honours the name filter", "[context]") {
   rb::HeadlessDeviceDesc desc;
   desc.deviceNameFilter = "no-such-device-xyz";

@@ -319,12 +319,14 @@ int main(int argc, char** argv) {
     return fail("--animation " + o.animation + ": the scene has no animations");
   }
 
-  // The same device in every mode (Raybridge's extensions enabled), so the modes compare like for like.
+  // The same device in every mode (Raybridge's extensions enabled, the optional ones where the device has them), so
+  // the modes, and --no-reorder, compare like for like.
   rb::RequiredFeatures features;
+  rb::OptionalFeatures optionalFeatures;
   se::EngineConfig config;
   config.enableValidation = o.validation;
   config.deviceNameFilter = o.device;
-  rbAdapter::configureEngine(config, features);
+  rbAdapter::configureEngine(config, features, &optionalFeatures);
   auto created = se::Engine::create(config);
   if (!created) return fail("engine: " + created.error);
   se::Engine& engine = *created.value;
@@ -598,6 +600,12 @@ int main(int argc, char** argv) {
     const rb::DeviceInfo& di = adapter->context().deviceInfo();
     stats["device"]["driver"] = di.driverName;
     stats["device"]["driver_info"] = di.driverInfo;
+    // Shader execution reordering: enabled on the device, whether the driver says it reorders, and whether the
+    // reflections of the reported frame used it (not with --no-reorder).
+    stats["device"]["invocation_reorder"] = di.invocationReorder;
+    stats["device"]["invocation_reorder_reorders"] = di.invocationReorderReorders;
+    const rb::ReflectionPass* reflectionPass = adapter->effects().reflectionPass();
+    stats["effects"]["reflection_invocation_reorder"] = reflectionPass && reflectionPass->reordered();
     const rb::HybridEffects& fxo = adapter->effects();
     const rb::HybridStats es = fxo.stats();
     const rb::AsStats as = adapter->accelerationStructures().stats();

@@ -49,7 +49,11 @@ struct RenderOptions {
   // every preset with AO, presets.h); `--half-res none` traces both at full resolution.
   bool halfResGiven = false;
   bool halfResAo = false, halfResReflections = false;
-  bool denoise = true;          // --no-denoise
+  bool denoise = true;  // --no-denoise
+  // --no-reorder: reflections without shader execution reordering even where the device enabled it
+  // (HybridEffectsDesc::reflections.disableInvocationReorder); the device is the same either way, so a pair of runs
+  // measures it alone. No effect without reflections or outside --mode hybrid.
+  bool invocationReorder = true;
   bool tileClassifier = false;  // --tile-classifier: HybridEffectsDesc::shadows.tileClassifier
   // --converged-tiles K: HybridEffectsDesc::shadows.convergedTiles, each converged tile traced once in K frames.
   std::optional<uint32_t> convergedTiles;

@@ -92,7 +92,10 @@ void convertLights(std::span<const se::FrameLight> lights, std::vector<rb::Light
 
 }  // namespace
 
-void configureEngine(se::EngineConfig& config, rb::RequiredFeatures& features) {
+void configureEngine(se::EngineConfig& config, rb::RequiredFeatures& features, rb::OptionalFeatures* optional) {
+  // Shader execution reordering where the device has it: the engine fills the struct with what is supported.
+  if (optional)
+    config.optionalDeviceExtensions.push_back({rb::kInvocationReorderExtension, &optional->invocationReorder});
   for (const char* name : rb::requiredDeviceExtensions())
     if (std::ranges::find(config.deviceExtensions, name) == config.deviceExtensions.end())
       config.deviceExtensions.emplace_back(name);
@@ -132,8 +135,17 @@ se::Result<std::unique_ptr<Adapter>> Adapter::create(se::Engine& engine, const A
   using R = se::Result<std::unique_ptr<Adapter>>;
   auto impl = std::make_unique<Impl>(engine);
   impl->config = config;
-  auto ctx = rb::Context::create({engine.instance(), engine.physicalDevice(), engine.device(),
-                                  engine.getInstanceProcAddr(), se::kFramesInFlight, nullptr, engine.queueFamily()});
+  rb::ContextDesc cd{engine.instance(),   engine.physicalDevice(),
+                     engine.device(),     engine.getInstanceProcAddr(),
+                     se::kFramesInFlight, nullptr,
+                     engine.queueFamily()};
+  // configureEngine's optional extension: the engine enabled it with every feature the device supports, so the
+  // feature is on exactly where the device has it.
+  cd.invocationReorderEnabled = std::ranges::find(engine.enabledDeviceExtensions(), rb::kInvocationReorderExtension) !=
+                                    engine.enabledDeviceExtensions().end() &&
+                                rb::supportsInvocationReorder(engine.instance(), engine.physicalDevice(),
+                                                              engine.getInstanceProcAddr());
+  auto ctx = rb::Context::create(cd);
   if (!ctx) return R::failure(message("rb::Context::create", ctx.error()));
   impl->ctx = std::move(ctx.value());
   rb::AsServiceDesc asDesc = config.accelerationStructures;

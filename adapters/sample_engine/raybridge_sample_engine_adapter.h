@@ -9,7 +9,8 @@
 // shadow ray, sky ambient, emission, the punctual lights) straight into the engine's HDR target.
 //
 //   rb::RequiredFeatures features;                       // must outlive Engine::create()
-//   rbAdapter::configureEngine(config, features);        // config: the engine's EngineConfig
+//   rb::OptionalFeatures optional;                       // likewise; optional (shader execution reordering)
+//   rbAdapter::configureEngine(config, features, &optional);  // config: the engine's EngineConfig
 //   auto engine = sample_engine::Engine::create(config).value;
 //   auto adapter = rbAdapter::Adapter::create(*engine, {.preset = rb::Preset::High}).value;  // after loadScene
 //   engine->setPrepassHook(adapter->prepassHook());      // then render as before
@@ -48,8 +49,11 @@ struct FrameSettings {  // change them between frames through Adapter::settings(
   bool updateDeformedMeshes = true;  // false = deforming BLASes keep their pose (a paused animation costs nothing)
 };
 
-// Before Engine::create(): Raybridge's device extensions and features (held by `features`) into the config.
-void configureEngine(sample_engine::EngineConfig& config, rb::RequiredFeatures& features);
+// Before Engine::create(): Raybridge's device extensions and features (held by `features`) into the config. With
+// `optional` (which must outlive Engine::create() too), also the optional ones where the chosen device has them
+// (shader execution reordering for reflections); Adapter::create() then tells the context what was enabled.
+void configureEngine(sample_engine::EngineConfig& config, rb::RequiredFeatures& features,
+                     rb::OptionalFeatures* optional = nullptr);
 
 class Adapter {
  public:

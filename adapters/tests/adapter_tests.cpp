@@ -177,6 +177,24 @@ TEST_CASE("raybridge-render --half-res traces AO and reflections at half resolut
   }
 }
 
+TEST_CASE("raybridge-render --no-reorder: stats.json says whether reflections reordered", "[render][reorder]") {
+  auto render = [](const std::string& name, const std::string& extra) {
+    const fs::path dir = tempDir(name);
+    const RunResult r = runRender("--effects reflections --width 64 --height 48 --dump " + extra + " --out " +
+                                  dir.string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    return nlohmann::json::parse(std::ifstream(dir / "stats.json"));
+  };
+  const nlohmann::json byDefault = render("reorder_default", "");
+  const nlohmann::json off = render("reorder_off", "--no-reorder");
+  // Reordered by default exactly where the device enabled it (never on lavapipe); never with --no-reorder.
+  CHECK(byDefault["effects"]["reflection_invocation_reorder"] == byDefault["device"]["invocation_reorder"]);
+  CHECK(off["effects"]["reflection_invocation_reorder"] == false);
+  CHECK(off["device"]["invocation_reorder"] == byDefault["device"]["invocation_reorder"]);  // the same device
+  CHECK(off["validation"]["errors"] == 0);
+}
+
 TEST_CASE("raybridge-render: --preset high --dump writes every effect image and counts rays per pass", "[render]") {
   const fs::path dir = tempDir("dump");
   const int w = 160, h = 96;

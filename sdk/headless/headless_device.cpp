@@ -43,6 +43,7 @@ struct HeadlessDevice::Impl {
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
   bool validation = false;
   uint32_t framesInFlight = 2;
+  bool invocationReorder = false;
   std::string name;
   // The debug messenger calls onMessage on whichever thread made the Vulkan call (registerMesh runs on streaming
   // threads), possibly on several at once and while another thread reads the count: `errors` has its own mutex.
@@ -243,7 +244,16 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
   qci[1].queueFamilyIndex = impl->asyncFamily;
   qci[1].queueCount = 1;
   qci[1].pQueuePriorities = &priority;
-  auto ext = requiredDeviceExtensions();
+  std::vector<const char*> ext(requiredDeviceExtensions().begin(), requiredDeviceExtensions().end());
+  // Optional features last in the chain: the feature struct of an extension is only chained with the extension.
+  OptionalFeatures optional;
+  impl->invocationReorder = !desc.disableInvocationReorder &&
+                            supportsInvocationReorder(impl->instance, impl->physicalDevice, impl->gipa);
+  if (impl->invocationReorder) {
+    ext.push_back(kInvocationReorderExtension);
+    optional.invocationReorder.pNext = features.pNext;
+    features.pNext = &optional.invocationReorder;
+  }
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features};
   dci.queueCreateInfoCount = impl->asyncFamily == UINT32_MAX ? 1 : 2;
   dci.pQueueCreateInfos = qci;
@@ -291,6 +301,7 @@ std::vector<std::string> HeadlessDevice::validationErrors() const {
   return impl_->errors;
 }
 bool HeadlessDevice::validationEnabled() const { return impl_->validation; }
+bool HeadlessDevice::invocationReorderEnabled() const { return impl_->invocationReorder; }
 
 ContextDesc HeadlessDevice::contextDesc() const {
   ContextDesc d;
@@ -300,6 +311,7 @@ ContextDesc HeadlessDevice::contextDesc() const {
   d.getInstanceProcAddr = impl_->gipa;
   d.framesInFlight = impl_->framesInFlight;
   d.mainQueueFamily = impl_->queueFamily;
+  d.invocationReorderEnabled = impl_->invocationReorder;
   return d;
 }
 

@@ -75,7 +75,61 @@ Status checkFeatures(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
   return {};
 }
 
+bool hasExtension(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice, const char* name) {
+  uint32_t count = 0;
+  vk.vkEnumerateDeviceExtensionProperties(physicalDevice, nullptr, &count, nullptr);
+  std::vector<VkExtensionProperties> available(count);
+  vk.vkEnumerateDeviceExtensionProperties(physicalDevice, nullptr, &count, available.data());
+  return std::any_of(available.begin(), available.end(),
+                     [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+}
+
+bool hasInvocationReorderFeature(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice) {
+  VkPhysicalDeviceRayTracingInvocationReorderFeaturesNV ser{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_INVOCATION_REORDER_FEATURES_NV};
+  VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &ser};
+  vk.vkGetPhysicalDeviceFeatures2(physicalDevice, &f2);
+  return ser.rayTracingInvocationReorder == VK_TRUE;
+}
+
+// ContextDesc::invocationReorderEnabled against what the physical device supports: a device that lacks it cannot
+// have enabled it, and a pipeline using it there would fail to build (or crash the driver) much later.
+Status checkInvocationReorder(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
+                              const std::string& deviceName) {
+  if (!hasExtension(vk, physicalDevice, kInvocationReorderExtension)) {
+    return Error{ErrorCode::MissingExtension, VK_SUCCESS,
+                 "ContextDesc::invocationReorderEnabled is true but device '" + deviceName + "' does not support " +
+                     kInvocationReorderExtension + "; set it only where rb::supportsInvocationReorder() is true"};
+  }
+  if (!hasInvocationReorderFeature(vk, physicalDevice)) {
+    return Error{ErrorCode::MissingFeature, VK_SUCCESS,
+                 "ContextDesc::invocationReorderEnabled is true but device '" + deviceName +
+                     "' does not support the feature rayTracingInvocationReorder"};
+  }
+  return {};
+}
+
 }  // namespace
+
+bool supportsInvocationReorder(VkInstance instance, VkPhysicalDevice physicalDevice,
+                               PFN_vkGetInstanceProcAddr getInstanceProcAddr) {
+  if (!instance || !physicalDevice || !getInstanceProcAddr) return false;
+  DeviceFunctions vk;
+  vk.vkGetPhysicalDeviceFeatures2 = reinterpret_cast<PFN_vkGetPhysicalDeviceFeatures2>(
+      getInstanceProcAddr(instance, "vkGetPhysicalDeviceFeatures2"));
+  vk.vkEnumerateDeviceExtensionProperties = reinterpret_cast<PFN_vkEnumerateDeviceExtensionProperties>(
+      getInstanceProcAddr(instance, "vkEnumerateDeviceExtensionProperties"));
+  if (!vk.vkGetPhysicalDeviceFeatures2 || !vk.vkEnumerateDeviceExtensionProperties) return false;
+  // The feature struct is only defined for a device with the extension: ask for it after the extension.
+  return hasExtension(vk, physicalDevice, kInvocationReorderExtension) &&
+         hasInvocationReorderFeature(vk, physicalDevice);
+}
+
+OptionalFeatures::OptionalFeatures() {
+  invocationReorder.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_INVOCATION_REORDER_FEATURES_NV;
+  invocationReorder.pNext = nullptr;
+  invocationReorder.rayTracingInvocationReorder = VK_TRUE;
+}
 
 std::span<const char* const> requiredDeviceExtensions() { return kRequiredExtensions; }
 
@@ -193,6 +247,16 @@ Result<std::unique_ptr<Context>> Context::create(const ContextDesc& desc) {
   }
   if (Status s = checkExtensions(vk, desc.physicalDevice, info.deviceName); !s) return s.error();
   if (Status s = checkFeatures(vk, desc.physicalDevice, info.deviceName); !s) return s.error();
+  if (desc.invocationReorderEnabled) {
+    if (Status s = checkInvocationReorder(vk, desc.physicalDevice, info.deviceName); !s) return s.error();
+    VkPhysicalDeviceRayTracingInvocationReorderPropertiesNV serProps{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_INVOCATION_REORDER_PROPERTIES_NV};
+    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &serProps};
+    vk.vkGetPhysicalDeviceProperties2(desc.physicalDevice, &p2);
+    info.invocationReorder = true;
+    info.invocationReorderReorders = serProps.rayTracingInvocationReorderReorderingHint ==
+                                     VK_RAY_TRACING_INVOCATION_REORDER_MODE_REORDER_NV;
+  }
 
   if (const char* missing = loadDeviceFunctions(vk, desc.getInstanceProcAddr, desc.instance, desc.device)) {
     return Error{ErrorCode::MissingExtension, VK_SUCCESS,

@@ -19,10 +19,14 @@ struct ReflectionPass::Impl {
   // ReflectionSettings::halfResolution: the sample image and the upsample, made on first use.
   HalfResolution half{HalfResolution::Signal::Reflection};
   ReflectionOutputs outputs;
+  // The same pipeline with reflect_reorder.rgen: only on a context with DeviceInfo::invocationReorder.
+  RayTracingPipeline reorderPipeline;
+  bool reordered = false;  // the latest record() traced with reorderPipeline
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still trace with it
     core.retire(ctx);
     half.retire(ctx);
+    reorderPipeline.retire(ctx);
   }
 };
 
@@ -57,7 +61,16 @@ Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context)
   p.bindings.push_back({RB_REFLECTION_BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit, nullptr});
   p.pushConstantBytes = sizeof(ReflectionConstants);
   // Shading records and materials: read by the hits (shading) and the any-hits (alpha).
+  RayTracingPipelineDesc reorder = p;  // init() takes the description
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::reflect_rahit), hit); !s) return s.error();
+  if (c.info.invocationReorder) {
+    reorder.name = "reflection pass (invocation reorder)";
+    reorder.raygen = SpirvModule::of(spirv::reflect_reorder_rgen);
+    Result<RayTracingPipeline> r = impl->core.createVariant(context, std::move(reorder),
+                                                            SpirvModule::of(spirv::reflect_rahit), hit);
+    if (!r) return r.error();
+    impl->reorderPipeline = r.value();
+  }
   // The own table holds one white material until the engine gives its own.
   return std::unique_ptr<ReflectionPass>(new ReflectionPass(std::move(impl)));
 }
@@ -146,10 +159,12 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   // The local lights' list when given, else any valid buffer (never read: lightCount is 0).
   w.storageBuffer(RB_REFLECTION_BINDING_LIGHTS,
                   pc.lightCount ? lights.buffer : internal::materialTableImpl(*table).materials.buffer);
+  s.reordered = s.reorderPipeline.pipeline && !settings.disableInvocationReorder;
+  const RayTracingPipeline* variant = s.reordered ? &s.reorderPipeline : nullptr;
   if (settings.halfResolution) {
-    s.core.traceHalfAndEnd(s.ctx, cmd, w, pc, g, s.half, threshold);
+    s.core.traceHalfAndEnd(s.ctx, cmd, w, pc, g, s.half, threshold, variant);
   } else {
-    s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+    s.core.traceAndEnd(s.ctx, cmd, w, pc, g, variant);
   }
   s.outputs.radiance = s.core.images[0].image;
   s.outputs.radianceView = s.core.images[0].view;
@@ -160,5 +175,6 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
 
 const ReflectionOutputs& ReflectionPass::outputs() const { return impl_->outputs; }
 PassStats ReflectionPass::stats() const { return impl_->core.metrics.latest(impl_->ctx); }
+bool ReflectionPass::reordered() const { return impl_->reordered; }
 
 }  // namespace rb

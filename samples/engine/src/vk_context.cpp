@@ -245,8 +245,29 @@ std::string VulkanContext::create(const EngineConfig& config) {
   bufferDeviceAddressFeature = f12.bufferDeviceAddress;
   info.bufferDeviceAddress = config.enableRayTracingInputs && f12.bufferDeviceAddress;
 
+  // Optional extensions the chosen device has, with their feature structs as supported (an unsupported feature
+  // cannot be enabled, and a struct is only valid with its extension).
+  std::vector<std::string> optionalExts;
+  {
+    std::vector<std::string> have = deviceExtensionNames(physicalDevice);
+    for (const auto& o : config.optionalDeviceExtensions) {
+      if (std::find(have.begin(), have.end(), o.name) == have.end()) continue;
+      optionalExts.push_back(o.name);
+      if (!o.features) continue;
+      auto* s = static_cast<VkBaseOutStructure*>(o.features);
+      s->pNext = nullptr;
+      VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, s, {}};
+      vkGetPhysicalDeviceFeatures2(physicalDevice, &query);
+      s->pNext = static_cast<VkBaseOutStructure*>(f2.pNext);
+      f2.pNext = s;
+    }
+  }
+
   // --- Device ---
   deviceExtensions = requiredExts;
+  for (const auto& e : optionalExts)
+    if (std::find(deviceExtensions.begin(), deviceExtensions.end(), e) == deviceExtensions.end())
+      deviceExtensions.push_back(e);
   swapchainEnabled = config.enableSwapchain;
   accelerationStructureEnabled = std::find(deviceExtensions.begin(), deviceExtensions.end(),
                                            VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) != deviceExtensions.end();

@@ -46,6 +46,12 @@ struct ContextDesc {
   // deforming meshes are recorded into the same command buffers as everything else, unless the engine hands
   // an AccelerationStructureService a compute queue of another family (AsServiceDesc::asyncQueue).
   uint32_t mainQueueFamily = 0;
+  // Whether the engine enabled VK_NV_ray_tracing_invocation_reorder and its feature rayTracingInvocationReorder
+  // (OptionalFeatures::invocationReorder) on `device`; the SDK cannot query what a device enabled, so it takes
+  // the engine's word. false (default) = the SDK never reorders. true = the ReflectionPass reorders its hit
+  // shading (ReflectionSettings::disableInvocationReorder); Context::create fails with MissingExtension or
+  // MissingFeature when the physical device does not support it (check supportsInvocationReorder() first).
+  bool invocationReorderEnabled = false;
 };
 
 // Device extensions the engine must enable on its VkDevice for Raybridge (Vulkan 1.2 or newer).
@@ -72,6 +78,24 @@ struct RequiredFeatures {
   }
 };
 
+// Optional: shader execution reordering (VK_NV_ray_tracing_invocation_reorder). Where the physical device supports
+// it (supportsInvocationReorder), the engine may add kInvocationReorderExtension to its device extensions, chain
+// OptionalFeatures::invocationReorder into VkDeviceCreateInfo::pNext and set ContextDesc::invocationReorderEnabled.
+// The ReflectionPass then sorts its hits by instance before shading them (divergent materials per lane).
+inline constexpr const char* kInvocationReorderExtension = VK_NV_RAY_TRACING_INVOCATION_REORDER_EXTENSION_NAME;
+// Whether `physicalDevice` has the extension and its feature rayTracingInvocationReorder. Instance-level
+// queries only (vkEnumerateDeviceExtensionProperties, vkGetPhysicalDeviceFeatures2 from `getInstanceProcAddr`):
+// call it before creating the device. false when a query function cannot be loaded.
+bool supportsInvocationReorder(VkInstance instance, VkPhysicalDevice physicalDevice,
+                               PFN_vkGetInstanceProcAddr getInstanceProcAddr);
+
+// Feature structures of the optional extensions above, each with its features turned on and pNext null: chain one
+// (set its pNext) only when its extension is enabled too.
+struct OptionalFeatures {
+  VkPhysicalDeviceRayTracingInvocationReorderFeaturesNV invocationReorder{};
+  OptionalFeatures();  // sets sTypes and turns every feature on
+};
+
 // Device properties Raybridge reads once at creation.
 struct DeviceInfo {
   std::string deviceName;
@@ -90,6 +114,12 @@ struct DeviceInfo {
   float timestampPeriodNs = 0.0f;   // nanoseconds per timestamp tick
   uint32_t timestampValidBits = 0;  // of the queue family executing Raybridge's work
   bool timestampsSupported = false;
+  // ContextDesc::invocationReorderEnabled, checked against the device: the ReflectionPass may reorder.
+  bool invocationReorder = false;
+  // With invocationReorder: whether the driver says it actually reorders (VkPhysicalDeviceRayTracingInvocation-
+  // ReorderPropertiesNV::rayTracingInvocationReorderReorderingHint is REORDER); false = the calls are accepted
+  // but threads stay where they are, so reordering costs a little and gains nothing.
+  bool invocationReorderReorders = false;
   // Ticks from `start` to `end`, modulo the counter's valid bits.
   uint64_t timestampTicks(uint64_t start, uint64_t end) const {
     uint64_t mask = timestampValidBits >= 64 ? ~0ull : (1ull << timestampValidBits) - 1;

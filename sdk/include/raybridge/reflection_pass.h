@@ -22,6 +22,13 @@
 // covered one nearby), 0 on the sky and rougher pixels. The output keeps its format, size and layout. stats() then
 // counts the rays actually traced (about a quarter) and its gpuMs covers the trace and the upsample.
 //
+// Shader execution reordering: on a Context with DeviceInfo::invocationReorder (the engine enabled
+// VK_NV_ray_tracing_invocation_reorder, context.h), the pass also builds a second pipeline whose ray generation
+// shader traces each ray into a hit object, regroups the threads by the instance hit (misses apart) and only then
+// runs the closest-hit or miss shader: hit shading (material lookup, textures, a shadow ray) runs with fewer
+// divergent lanes. The rays and the shading are those of the plain pipeline; only the order differs. Elsewhere
+// (lavapipe, say) the plain pipeline runs and the setting is ignored: no error, nothing else built.
+//
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output image,
 // material table, texture set and measurement objects are handed to the Context's deferred release (see
 // context.h) and freed once those frames are done. Destroy it before its Context.
@@ -75,6 +82,10 @@ struct ReflectionSettings {
   uint32_t lightCandidates = 0;  // 0 = kDefaultReflectionLightCandidates; at most 64
   // Trace a quarter of the pixels and upsample (see Half resolution above). false = every pixel traces its rays.
   bool halfResolution = false;
+  // false = reorder the hits before shading them (shader execution reordering) where the Context has it
+  // (DeviceInfo::invocationReorder), else trace as usual; true = never reorder. Same rays and shading either way;
+  // only the order the closest-hit shaders run in differs. ReflectionPass::reordered() says what a record did.
+  bool disableInvocationReorder = false;
 };
 
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
@@ -99,6 +110,9 @@ class ReflectionPass {
                 const ReflectionSettings& settings = {});
   const ReflectionOutputs& outputs() const;
   PassStats stats() const;
+  // Whether the latest record() traced with shader execution reordering (ReflectionSettings::
+  // disableInvocationReorder, DeviceInfo::invocationReorder); false before the first record().
+  bool reordered() const;
 
   struct Impl;
 

@@ -92,6 +92,15 @@ struct EngineConfig {
   std::vector<std::string> instanceExtensions;
   // Extra device extensions an add-on needs; devices lacking one are not chosen.
   std::vector<std::string> deviceExtensions;
+  // Device extensions an add-on uses where present: enabled when the chosen device has them, never a reason to
+  // pass a device over (Engine::enabledDeviceExtensions() tells). `features` (optional, pNext null): that
+  // extension's feature struct, filled with what the device supports and chained only when the extension is
+  // enabled; it must stay alive during Engine::create().
+  struct OptionalDeviceExtension {
+    std::string name;
+    void* features = nullptr;
+  };
+  std::vector<OptionalDeviceExtension> optionalDeviceExtensions;
   // Extra feature structs appended to the engine's VkPhysicalDeviceFeatures2 chain at device creation
   // (e.g. acceleration-structure / ray-query features). It must not contain VkPhysicalDeviceFeatures2 or
   // VkPhysicalDeviceVulkan11/12/13Features: set the core features you need in the fields below, which are

@@ -31,6 +31,10 @@ struct HeadlessDeviceDesc {
   // has one (GPUs usually do; lavapipe does not), for AsServiceDesc::asyncQueue. Then every buffer the device
   // creates is VK_SHARING_MODE_CONCURRENT over both families. false = one queue.
   bool requestAsyncComputeQueue = false;
+  // false = enable VK_NV_ray_tracing_invocation_reorder and its feature where the device supports them
+  // (rb::supportsInvocationReorder), and say so in contextDesc(); true = never (a device like the engine's that
+  // did not enable it).
+  bool disableInvocationReorder = false;
 };
 
 // A buffer made by the headless device for samples and tests (the engine's buffers in a real integration).
@@ -62,7 +66,9 @@ class HeadlessDevice {
   // Instance-level function loaded from the headless instance (handy for tests that call Vulkan directly).
   PFN_vkVoidFunction instanceProc(const char* name) const;
   PFN_vkVoidFunction deviceProc(const char* name) const;
-  // A ContextDesc filled with this device's handles.
+  // Whether the device was created with VK_NV_ray_tracing_invocation_reorder (HeadlessDeviceDesc).
+  bool invocationReorderEnabled() const;
+  // A ContextDesc filled with this device's handles (and invocationReorderEnabled).
   ContextDesc contextDesc() const;
   std::string deviceName() const;
 
