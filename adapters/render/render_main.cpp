@@ -320,7 +320,7 @@ int main(int argc, char** argv) {
   }
 
   // The same device in every mode (Raybridge's extensions enabled, the optional ones where the device has them), so
-  // the modes, and --no-reorder, compare like for like.
+  // the modes, and --reorder, compare like for like.
   rb::RequiredFeatures features;
   rb::OptionalFeatures optionalFeatures;
   se::EngineConfig config;
@@ -601,7 +601,7 @@ int main(int argc, char** argv) {
     stats["device"]["driver"] = di.driverName;
     stats["device"]["driver_info"] = di.driverInfo;
     // Shader execution reordering: enabled on the device, whether the driver says it reorders, and whether the
-    // reflections of the reported frame used it (not with --no-reorder).
+    // reflections of the reported frame used it (only with --reorder).
     stats["device"]["invocation_reorder"] = di.invocationReorder;
     stats["device"]["invocation_reorder_reorders"] = di.invocationReorderReorders;
     const rb::ReflectionPass* reflectionPass = adapter->effects().reflectionPass();

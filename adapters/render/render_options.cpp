@@ -302,9 +302,9 @@ void addOptions(CLI::App& app, RenderOptions& o) {
   app.add_flag_callback(
       "--no-denoise", [&o] { o.denoise = false; }, "use the raw shadow, AO and local-light images (default: denoised)");
   app.add_flag_callback(
-      "--no-reorder", [&o] { o.invocationReorder = false; },
-      "trace reflections without shader execution reordering (default: reordered where\n"
-      "the device has VK_NV_ray_tracing_invocation_reorder; stats.json tells)");
+      "--reorder", [&o] { o.invocationReorder = true; },
+      "reflections with shader execution reordering where the device has\n"
+      "VK_NV_ray_tracing_invocation_reorder (default: off; stats.json tells)");
   app.add_option_function<uint32_t>(
          "--shadow-map-size", [&o](const uint32_t& v) { o.shadowMapSize = v; },
          "raster mode's shadow map, texels squared, 0 = none (default: the preset's)")
@@ -522,7 +522,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.reflections.roughnessThreshold = o.reflectionRoughness ? *o.reflectionRoughness : kDefaultReflectionRoughness;
   h.reflections.raysPerPixel = o.reflectionRays ? *o.reflectionRays : kDefaultReflectionRays;
   h.reflections.halfResolution = o.halfResReflections;
-  h.reflections.disableInvocationReorder = !o.invocationReorder;
+  h.reflections.invocationReorder = o.invocationReorder;
 
   r.raster = p.raster;
   if (o.shadowMapSize) r.raster.mapSize = *o.shadowMapSize;

@@ -50,10 +50,10 @@ struct RenderOptions {
   bool halfResGiven = false;
   bool halfResAo = false, halfResReflections = false;
   bool denoise = true;  // --no-denoise
-  // --no-reorder: reflections without shader execution reordering even where the device enabled it
-  // (HybridEffectsDesc::reflections.disableInvocationReorder); the device is the same either way, so a pair of runs
+  // --reorder: reflections with shader execution reordering where the device enabled it
+  // (HybridEffectsDesc::reflections.invocationReorder); the device is the same either way, so a pair of runs
   // measures it alone. No effect without reflections or outside --mode hybrid.
-  bool invocationReorder = true;
+  bool invocationReorder = false;
   bool tileClassifier = false;  // --tile-classifier: HybridEffectsDesc::shadows.tileClassifier
   // --converged-tiles K: HybridEffectsDesc::shadows.convergedTiles, each converged tile traced once in K frames.
   std::optional<uint32_t> convergedTiles;

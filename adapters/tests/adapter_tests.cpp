@@ -177,7 +177,7 @@ TEST_CASE("raybridge-render --half-res traces AO and reflections at half resolut
   }
 }
 
-TEST_CASE("raybridge-render --no-reorder: stats.json says whether reflections reordered", "[render][reorder]") {
+TEST_CASE("raybridge-render --reorder: stats.json says whether reflections reordered", "[render][reorder]") {
   auto render = [](const std::string& name, const std::string& extra) {
     const fs::path dir = tempDir(name);
     const RunResult r = runRender("--effects reflections --width 64 --height 48 --dump " + extra + " --out " +
@@ -186,13 +186,13 @@ TEST_CASE("raybridge-render --no-reorder: stats.json says whether reflections re
     REQUIRE(r.exitCode == 0);
     return nlohmann::json::parse(std::ifstream(dir / "stats.json"));
   };
+  const nlohmann::json on = render("reorder_on", "--reorder");
   const nlohmann::json byDefault = render("reorder_default", "");
-  const nlohmann::json off = render("reorder_off", "--no-reorder");
-  // Reordered by default exactly where the device enabled it (never on lavapipe); never with --no-reorder.
-  CHECK(byDefault["effects"]["reflection_invocation_reorder"] == byDefault["device"]["invocation_reorder"]);
-  CHECK(off["effects"]["reflection_invocation_reorder"] == false);
-  CHECK(off["device"]["invocation_reorder"] == byDefault["device"]["invocation_reorder"]);  // the same device
-  CHECK(off["validation"]["errors"] == 0);
+  // Reordered with --reorder exactly where the device enabled it (never on lavapipe); never by default.
+  CHECK(on["effects"]["reflection_invocation_reorder"] == on["device"]["invocation_reorder"]);
+  CHECK(byDefault["effects"]["reflection_invocation_reorder"] == false);
+  CHECK(byDefault["device"]["invocation_reorder"] == on["device"]["invocation_reorder"]);  // the same device
+  CHECK(on["validation"]["errors"] == 0);
 }
 
 TEST_CASE("raybridge-render: --preset high --dump writes every effect image and counts rays per pass", "[render]") {

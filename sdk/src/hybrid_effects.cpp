@@ -279,7 +279,7 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.roughnessThreshold = desc.reflections.roughnessThreshold;
   s.raysPerPixel = desc.reflections.raysPerPixel;
   s.halfResolution = desc.reflections.halfResolution;
-  s.disableInvocationReorder = desc.reflections.disableInvocationReorder;
+  s.invocationReorder = desc.reflections.invocationReorder;
   s.flags = (f.flags & kFrameExplicitLighting) ? kReflectionExplicitLighting : 0u;
   for (int i = 0; i < 3; ++i) {
     s.sunRadiance[i] = f.lightRadiance[i];

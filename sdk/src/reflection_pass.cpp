@@ -159,7 +159,7 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   // The local lights' list when given, else any valid buffer (never read: lightCount is 0).
   w.storageBuffer(RB_REFLECTION_BINDING_LIGHTS,
                   pc.lightCount ? lights.buffer : internal::materialTableImpl(*table).materials.buffer);
-  s.reordered = s.reorderPipeline.pipeline && !settings.disableInvocationReorder;
+  s.reordered = s.reorderPipeline.pipeline && settings.invocationReorder;
   const RayTracingPipeline* variant = s.reordered ? &s.reorderPipeline : nullptr;
   if (settings.halfResolution) {
     s.core.traceHalfAndEnd(s.ctx, cmd, w, pc, g, s.half, threshold, variant);

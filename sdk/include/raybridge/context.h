@@ -48,8 +48,8 @@ struct ContextDesc {
   uint32_t mainQueueFamily = 0;
   // Whether the engine enabled VK_NV_ray_tracing_invocation_reorder and its feature rayTracingInvocationReorder
   // (OptionalFeatures::invocationReorder) on `device`; the SDK cannot query what a device enabled, so it takes
-  // the engine's word. false (default) = the SDK never reorders. true = the ReflectionPass reorders its hit
-  // shading (ReflectionSettings::disableInvocationReorder); Context::create fails with MissingExtension or
+  // the engine's word. false (default) = the SDK never reorders. true = the ReflectionPass may reorder its hit
+  // shading (opt-in: ReflectionSettings::invocationReorder); Context::create fails with MissingExtension or
   // MissingFeature when the physical device does not support it (check supportsInvocationReorder() first).
   bool invocationReorderEnabled = false;
 };

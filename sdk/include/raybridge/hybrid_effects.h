@@ -89,9 +89,10 @@ struct ReflectionEffectSettings {
   // false = every pixel traces; true = ReflectionSettings::halfResolution (a quarter of the rays, depth-aware
   // upsample).
   bool halfResolution = false;
-  // false = shader execution reordering where the Context has it; true = never (ReflectionSettings's field of the
-  // same name). reflectionPass()->reordered() says whether the latest frame reordered.
-  bool disableInvocationReorder = false;
+  // false (default) = never reorder; true = shader execution reordering where the Context has it
+  // (ReflectionSettings's field of the same name). reflectionPass()->reordered() says whether the latest frame
+  // reordered.
+  bool invocationReorder = false;
 };
 
 struct LocalLightEffectSettings {

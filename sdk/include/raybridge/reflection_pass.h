@@ -82,10 +82,12 @@ struct ReflectionSettings {
   uint32_t lightCandidates = 0;  // 0 = kDefaultReflectionLightCandidates; at most 64
   // Trace a quarter of the pixels and upsample (see Half resolution above). false = every pixel traces its rays.
   bool halfResolution = false;
-  // false = reorder the hits before shading them (shader execution reordering) where the Context has it
-  // (DeviceInfo::invocationReorder), else trace as usual; true = never reorder. Same rays and shading either way;
-  // only the order the closest-hit shaders run in differs. ReflectionPass::reordered() says what a record did.
-  bool disableInvocationReorder = false;
+  // false (default) = trace as usual; true = reorder the hits before shading them (shader execution reordering)
+  // where the Context has it (DeviceInfo::invocationReorder), else trace as usual. Same rays and shading either
+  // way; only the order the closest-hit shaders run in differs. Opt-in because it did not pay on the one device
+  // measured: on an NVIDIA H200 the pass was 3-4% slower with it (docs/performance.md); measure it on yours.
+  // ReflectionPass::reordered() says what a record did.
+  bool invocationReorder = false;
 };
 
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
@@ -110,8 +112,8 @@ class ReflectionPass {
                 const ReflectionSettings& settings = {});
   const ReflectionOutputs& outputs() const;
   PassStats stats() const;
-  // Whether the latest record() traced with shader execution reordering (ReflectionSettings::
-  // disableInvocationReorder, DeviceInfo::invocationReorder); false before the first record().
+  // Whether the latest record() traced with shader execution reordering (ReflectionSettings::invocationReorder,
+  // DeviceInfo::invocationReorder); false before the first record().
   bool reordered() const;
 
   struct Impl;
