@@ -18,16 +18,24 @@ constexpr const char* kRequiredExtensions[] = {
     VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME,
 };
 
-Status checkExtensions(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice, const std::string& deviceName) {
+std::vector<VkExtensionProperties> deviceExtensions(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice) {
   uint32_t count = 0;
   vk.vkEnumerateDeviceExtensionProperties(physicalDevice, nullptr, &count, nullptr);
   std::vector<VkExtensionProperties> available(count);
   vk.vkEnumerateDeviceExtensionProperties(physicalDevice, nullptr, &count, available.data());
+  return available;
+}
+
+bool hasExtension(const std::vector<VkExtensionProperties>& available, const char* name) {
+  return std::any_of(available.begin(), available.end(),
+                     [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+}
+
+Status checkExtensions(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice, const std::string& deviceName) {
+  const std::vector<VkExtensionProperties> available = deviceExtensions(vk, physicalDevice);
   std::string missing;
   for (const char* name : kRequiredExtensions) {
-    bool found = std::any_of(available.begin(), available.end(),
-                             [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
-    if (!found) missing += std::string(missing.empty() ? "" : ", ") + name;
+    if (!hasExtension(available, name)) missing += std::string(missing.empty() ? "" : ", ") + name;
   }
   if (!missing.empty()) {
     return Error{ErrorCode::MissingExtension, VK_SUCCESS,
@@ -75,15 +83,6 @@ Status checkFeatures(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
   return {};
 }
 
-bool hasExtension(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice, const char* name) {
-  uint32_t count = 0;
-  vk.vkEnumerateDeviceExtensionProperties(physicalDevice, nullptr, &count, nullptr);
-  std::vector<VkExtensionProperties> available(count);
-  vk.vkEnumerateDeviceExtensionProperties(physicalDevice, nullptr, &count, available.data());
-  return std::any_of(available.begin(), available.end(),
-                     [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
-}
-
 bool hasInvocationReorderFeature(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice) {
   VkPhysicalDeviceRayTracingInvocationReorderFeaturesNV ser{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_INVOCATION_REORDER_FEATURES_NV};
@@ -96,7 +95,7 @@ bool hasInvocationReorderFeature(const DeviceFunctions& vk, VkPhysicalDevice phy
 // have enabled it, and a pipeline using it there would fail to build (or crash the driver) much later.
 Status checkInvocationReorder(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
                               const std::string& deviceName) {
-  if (!hasExtension(vk, physicalDevice, kInvocationReorderExtension)) {
+  if (!hasExtension(deviceExtensions(vk, physicalDevice), kInvocationReorderExtension)) {
     return Error{ErrorCode::MissingExtension, VK_SUCCESS,
                  "ContextDesc::invocationReorderEnabled is true but device '" + deviceName + "' does not support " +
                      kInvocationReorderExtension + "; set it only where rb::supportsInvocationReorder() is true"};
@@ -121,7 +120,7 @@ bool supportsInvocationReorder(VkInstance instance, VkPhysicalDevice physicalDev
       getInstanceProcAddr(instance, "vkEnumerateDeviceExtensionProperties"));
   if (!vk.vkGetPhysicalDeviceFeatures2 || !vk.vkEnumerateDeviceExtensionProperties) return false;
   // The feature struct is only defined for a device with the extension: ask for it after the extension.
-  return hasExtension(vk, physicalDevice, kInvocationReorderExtension) &&
+  return hasExtension(deviceExtensions(vk, physicalDevice), kInvocationReorderExtension) &&
          hasInvocationReorderFeature(vk, physicalDevice);
 }
 
