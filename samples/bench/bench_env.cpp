@@ -22,6 +22,8 @@ BenchSizes pickSizes(const BenchOptions& o, bool isCpu) {
     s.fastRepeats = 2;
     s.tlasInstances = {1000, 10000};
     s.tlasRepeats = 3;
+    s.motionInstances = 1000;
+    s.motionFrames = 4;
     s.traceTriangles = 20000;
     s.traceRepeats = 2;
     s.gltfRepeatsOnce = true;
@@ -34,6 +36,8 @@ BenchSizes pickSizes(const BenchOptions& o, bool isCpu) {
     s.fastRepeats = 9;
     s.tlasInstances = {1000, 10000, 100000};
     s.tlasRepeats = 9;
+    s.motionInstances = 4000;
+    s.motionFrames = 128;
     s.traceTriangles = 200000;
     s.traceRepeats = 5;
   } else {  // a GPU, or --full
@@ -47,6 +51,8 @@ BenchSizes pickSizes(const BenchOptions& o, bool isCpu) {
     s.tlasInstances = {1000, 10000, 100000};
     if (!isCpu) s.tlasInstances.push_back(1000000);
     s.tlasRepeats = isCpu ? 3 : 9;
+    s.motionInstances = 10000;
+    s.motionFrames = isCpu ? 128 : 1024;
     s.traceTriangles = 1000000;
     s.traceRepeats = isCpu ? 2 : 10;
   }

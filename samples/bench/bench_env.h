@@ -50,8 +50,10 @@ struct BenchSizes {
   uint32_t fastRepeats = 5;
   std::vector<uint32_t> tlasInstances;
   uint32_t tlasRepeats = 7;
-  uint64_t traceTriangles = 0;  // trace scenario ground
-  uint32_t traceRepeats = 5;    // timed traces per measurement
+  uint32_t motionInstances = 0;  // tlas-motion: instances flying apart
+  uint32_t motionFrames = 0;     // tlas-motion: frames of flight
+  uint64_t traceTriangles = 0;   // trace scenario ground
+  uint32_t traceRepeats = 5;     // timed traces per measurement
   uint32_t width = 0, height = 0;
   bool gltfRepeatsOnce = false;
 };

@@ -97,6 +97,7 @@ int run(const BenchOptions& options) {
       {"fastbuild-vs-fasttrace", [&] { return runFastBuildScenario(env); }},
       {"compaction", [&] { return runCompactionScenario(env, models); }},
       {"tlas", [&] { return runTlasScenario(env); }},
+      {"tlas-motion", [&] { return runTlasMotionScenario(env); }},
       {"trace", [&] { return runTraceScenario(env); }},
       {"gigarays", [&] { return runGigaRaysScenario(env); }},
       {"alpha", [&] { return runAlphaScenario(env); }},

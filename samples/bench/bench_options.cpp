@@ -7,9 +7,9 @@ namespace rbbench {
 
 const std::vector<std::string>& scenarioNames() {
   static const std::vector<std::string> names = {"build",      "duplication", "fastbuild-vs-fasttrace",
-                                                 "compaction", "tlas",        "trace",
-                                                 "gigarays",   "alpha",       "lights",
-                                                 "soak"};
+                                                 "compaction", "tlas",        "tlas-motion",
+                                                 "trace",      "gigarays",    "alpha",
+                                                 "lights",     "soak"};
   return names;
 }
 

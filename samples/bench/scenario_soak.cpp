@@ -496,7 +496,7 @@ void SoakRun::changeLocalLights() {
 void SoakRun::changeTlasPolicy() {
   TlasPolicy p;
   p.byEngine = chance(0.6);
-  p.options.mode = chance(0.6) ? rb::TlasBuildMode::UpdateIfPossible : rb::TlasBuildMode::Rebuild;
+  p.options.mode = chance(0.4) ? rb::TlasBuildMode::Rebuild : rb::TlasBuildMode(1 + pick(2));  // or a refitting mode
   p.options.instanceUpload = rb::TlasInstanceUpload(pick(3));
   p.options.preference = chance(0.5) ? rb::TlasBuildPreference::FastTrace : rb::TlasBuildPreference::FastBuild;
   p.alwaysShadingRecords = chance(0.3);
@@ -740,7 +740,8 @@ void SoakRun::prime() {
   all.effects = rb::kAllEffects;
   setDesc(all, "prime");
   changeLocalLights();
-  for (rb::TlasBuildMode mode : {rb::TlasBuildMode::Rebuild, rb::TlasBuildMode::UpdateIfPossible}) {
+  for (rb::TlasBuildMode mode :
+       {rb::TlasBuildMode::Rebuild, rb::TlasBuildMode::UpdateIfPossible, rb::TlasBuildMode::Adaptive}) {
     for (rb::TlasBuildPreference pref : {rb::TlasBuildPreference::FastTrace, rb::TlasBuildPreference::FastBuild}) {
       for (rb::TlasInstanceUpload upload :
            {rb::TlasInstanceUpload::ReadInPlace, rb::TlasInstanceUpload::CopyToDevice}) {

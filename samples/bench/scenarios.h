@@ -20,6 +20,8 @@ nlohmann::json runFastBuildScenario(BenchEnv& env);
 nlohmann::json runCompactionScenario(BenchEnv& env, const std::vector<GltfModel>& models);
 // TLAS over many instances: recordTlasBuild host time and TLAS build GPU time.
 nlohmann::json runTlasScenario(BenchEnv& env);
+// TLAS refits while instances scatter: trace time over rebuilt, refitted and adaptive TLASes, and build times.
+nlohmann::json runTlasMotionScenario(BenchEnv& env);
 // Raw primary-ray rate on a finely tessellated scene (and on rays that miss everything).
 nlohmann::json runTraceScenario(BenchEnv& env);
 // The thesis's stress (many rays per pixel, all hit) and miss scenarios: the device's raw trace rate.

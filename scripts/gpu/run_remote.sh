@@ -402,11 +402,16 @@ if want tests; then
   done <"$RT/tests.txt"
   grep -E '^(All tests passed|test cases:)|FAILED|validation\]' "$OUT/tests_gpu.log" | head -n 40
 fi
-# ---- tlas: raybridge-bench --scenario tlas --full alone (docs/performance.md's TLAS table), into tlas_gpu.json.
+# ---- tlas: raybridge-bench --scenario tlas --full alone (docs/performance.md's TLAS table), into tlas_gpu.json,
+# and --scenario tlas-motion (its "TLAS refits" table) into tlas_motion_gpu.json.
 if [[ ",$MODE," == *,tlas,* ]]; then  # only when named: `bench` runs it with every other scenario
   RAYBRIDGE_VALIDATION=0 step "tlas bench" 150 "$OUT/tlas_gpu.log" "$RT/bin/raybridge-bench" --scenario tlas --full \
     --out "$OUT/tlas_gpu.json"
   grep -E 'variant|in place|device copy|copy\+|gpuMsAt10k' "$OUT/tlas_gpu.log" | head -n 30
+  # docs/performance.md's "TLAS refits" table: refitted, rebuilt and adaptive TLASes while instances scatter.
+  RAYBRIDGE_VALIDATION=0 step "tlas-motion bench" 150 "$OUT/tlas_motion_gpu.log" "$RT/bin/raybridge-bench" \
+    --scenario tlas-motion --full --out "$OUT/tlas_motion_gpu.json"
+  grep -A40 '^== tlas-motion' "$OUT/tlas_motion_gpu.log" | head -n 40
 fi
 # ---- inject: raybridge_tests' failure-injection cases ([inject]), left out of `tests`: every SDK allocation site
 # fails in turn, and every pass is recreated after each (minutes of pipeline compilation on the GPU).

@@ -19,6 +19,7 @@
 #include "context_impl.h"
 #include "gpu_memory.h"
 #include "mesh_validation.h"
+#include "tlas_motion.h"
 
 namespace rb {
 
@@ -195,6 +196,9 @@ struct AccelerationStructureService::Impl {
   std::vector<TlasSlot> tlasSlots;
   uint64_t tlasSerial = 0;
   uint32_t lastTlasSlot = UINT32_MAX;  // slot of the TLAS recorded last
+  TlasMotionMeasure tlasMotion;        // TlasBuildMode::Adaptive's refit-quality measure
+  std::vector<float> tlasOrigins;      // scratch: the written instances' translations (Adaptive)
+  uint64_t tlasMotionSerial = 0;       // the TLAS (tlasSerial) whose build last updated tlasMotion
   uint64_t releaseCounter = 0;
   VkDeviceSize reservedBytes = 0;  // storage of all live BLASes (aligned), for the budget
   AsStats counters;                // the cumulative counters (registrations, dedupHits, evictions, ...)

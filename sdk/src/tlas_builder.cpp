@@ -42,12 +42,18 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   std::lock_guard<std::mutex> lock(s.mutex);
   s.handOnDeferredRetires();
   if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "recordTlasBuild: cmd is VK_NULL_HANDLE"};
-  if (options.instanceUpload > TlasInstanceUpload::CopyToDevice ||
+  if (options.mode > TlasBuildMode::Adaptive || options.instanceUpload > TlasInstanceUpload::CopyToDevice ||
       options.preference > TlasBuildPreference::FastBuild) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
-                 "recordTlasBuild: options.instanceUpload (" + std::to_string(int(options.instanceUpload)) +
-                     ") or options.preference (" + std::to_string(int(options.preference)) +
-                     ") is not one of its enum's values"};
+                 "recordTlasBuild: options.mode (" + std::to_string(int(options.mode)) + "), options.instanceUpload (" +
+                     std::to_string(int(options.instanceUpload)) + ") or options.preference (" +
+                     std::to_string(int(options.preference)) + ") is not one of its enum's values"};
+  }
+  if (options.maxAreaGrowth != 0.0f && !(options.maxAreaGrowth > 1.0f && std::isfinite(options.maxAreaGrowth))) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "recordTlasBuild: options.maxAreaGrowth is " + std::to_string(options.maxAreaGrowth) +
+                     "; use 0 for kDefaultTlasMaxAreaGrowth or a finite value above 1 (the area multiple that "
+                     "triggers a rebuild)"};
   }
   if (instances.size() > c.info.maxInstanceCount) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
@@ -142,6 +148,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   auto* records = options.writeShadingRecords ? static_cast<ShadingRecord*>(slot.shading.mapped) : nullptr;
   uint32_t written = 0, skipped = 0, stale = 0, nonOpaque = 0;
   uint64_t signature = 0;
+  const bool adaptive = options.mode == TlasBuildMode::Adaptive;
+  if (adaptive) s.tlasOrigins.clear();
   const bool rebase = options.originOffset[0] != 0.0 || options.originOffset[1] != 0.0 ||
                       options.originOffset[2] != 0.0;
   for (uint32_t i = 0; i < count; ++i) {
@@ -173,6 +181,9 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
         inst.transform.matrix[row][3] = static_cast<float>(static_cast<double>(in.transform[row * 4 + 3]) -
                                                            options.originOffset[row]);
       }
+    }
+    if (adaptive) {
+      for (int row = 0; row < 3; ++row) s.tlasOrigins.push_back(inst.transform.matrix[row][3]);
     }
     inst.instanceCustomIndex = in.customIndex;
     inst.mask = in.mask;
@@ -217,7 +228,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   geometry.geometry.instances.data.deviceAddress = copyInstances ? slot.deviceInstances.address
                                                                  : slot.instances.address;
 
-  const bool wantUpdate = options.mode == TlasBuildMode::UpdateIfPossible;
+  // Both refitting modes build with ALLOW_UPDATE, so one can follow the other without a rebuild.
+  const bool wantUpdate = options.mode != TlasBuildMode::Rebuild;
   VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
   info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
   info.flags = (options.preference == TlasBuildPreference::FastBuild
@@ -233,6 +245,16 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
         prev.blasSignature == signature) {
       source = &prev;
     }
+  }
+  // Adaptive: a valid refit still rebuilds when the instances drifted apart or after maxRefits refits.
+  float growth = 0.0f;
+  // The measure describes the chain only if the previous TLAS was built in this mode too.
+  if (adaptive && source && s.tlasMotionSerial + 1 != serial) source = nullptr;
+  if (adaptive && source) {
+    const uint32_t maxRefits = options.maxRefits ? options.maxRefits : kDefaultTlasMaxRefits;
+    const float maxGrowth = options.maxAreaGrowth != 0.0f ? options.maxAreaGrowth : kDefaultTlasMaxAreaGrowth;
+    growth = float(s.tlasMotion.growth(s.tlasOrigins));
+    if (!(growth <= maxGrowth) || s.tlasMotion.refitsSinceRebuild >= maxRefits) source = nullptr;
   }
   info.geometryCount = 1;
   info.pGeometries = &geometry;
@@ -311,6 +333,21 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   recordAsBarrier(
       c.vk, cmd, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR | VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
 
+  if (source) {
+    ++s.counters.tlasRefits;
+  } else {
+    ++s.counters.tlasBuilds;
+  }
+  uint32_t refitsSinceRebuild = 0;
+  if (adaptive) {
+    if (source) {
+      refitsSinceRebuild = ++s.tlasMotion.refitsSinceRebuild;
+    } else {
+      s.tlasMotion.reset(s.tlasOrigins);
+      growth = 1.0f;
+    }
+    s.tlasMotionSerial = serial;
+  }
   slot.builtFlags = info.flags;
   slot.builtInstanceCount = written;
   slot.blasSignature = signature;
@@ -327,6 +364,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   result.skippedInstances = skipped;
   result.nonOpaqueInstances = nonOpaque;
   result.updated = source != nullptr;
+  result.areaGrowth = growth;
+  result.refitsSinceRebuild = refitsSinceRebuild;
   for (int i = 0; i < 3; ++i) result.originOffset[i] = options.originOffset[i];
   if (records) {
     result.shadingRecords = copyInstances ? slot.deviceShading.buffer : slot.shading.buffer;

@@ -183,7 +183,20 @@ enum class TlasBuildMode : uint8_t {
   Rebuild = 0,       // default: a full build every frame (best trace speed after large motion)
   UpdateIfPossible,  // refit the previous frame's TLAS when the instance list has the same meshes and count
                      // (and BLAS copies: see DynamicBuildMode) and it was built with the same preference
+  Adaptive,          // refit as UpdateIfPossible does, and rebuild when the instances drifted apart since the last
+                     // rebuild (TlasBuildOptions::maxAreaGrowth) or after maxRefits refits in a row
 };
+
+// TlasBuildMode::Adaptive rebuilds when the summed surface area of groups of instances that were neighbours at
+// the last rebuild (about 16 per cell of a uniform grid over their origins; each origin padded by half a cell)
+// exceeds this multiple of its value then. A refit keeps the tree's topology, so neighbours that drift apart
+// grow its boxes; a group that moves together does not. Measured on the host from the translations only (the
+// SDK has no mesh bounds there): rotation and scale act through kDefaultTlasMaxRefits.
+// The value and the trace cost of refitted TLASes: docs/performance.md, "TLAS refits".
+constexpr float kDefaultTlasMaxAreaGrowth = 1.5f;
+// TlasBuildMode::Adaptive rebuilds after this many refits in a row even when the measure stays low (one second at
+// 60 frames per second): a rebuild every 60 frames costs a 60th of its time per frame.
+constexpr uint32_t kDefaultTlasMaxRefits = 60;
 
 // Where the TLAS build reads the instance list from. The SDK writes it on the host into host-visible memory; on a
 // discrete GPU that memory sits across the bus, and a build that reads it there pays the bus's latency for every
@@ -207,6 +220,10 @@ struct TlasBuildOptions {
   // Subtracted (in double precision) from every instance's translation, so a camera-relative TLAS keeps full
   // float precision far from the world origin. Default 0: world space.
   double originOffset[3] = {0.0, 0.0, 0.0};
+  // TlasBuildMode::Adaptive only: 0 = kDefaultTlasMaxAreaGrowth, otherwise > 1.
+  float maxAreaGrowth = 0.0f;
+  // TlasBuildMode::Adaptive only: 0 = kDefaultTlasMaxRefits; 1 rebuilds every other frame.
+  uint32_t maxRefits = 0;
   // Also write, per TLAS instance, where its vertex data and material are (TlasInfo::shadingRecords), for
   // passes that shade the surfaces rays hit (reflections) or alpha-test them (any pass, when a mesh is
   // non-opaque). false = no such buffer is allocated.
@@ -221,7 +238,11 @@ struct TlasInfo {
   // Instances written whose geometry runs any-hit shaders (MeshDesc::nonOpaque, or forced by
   // VK_GEOMETRY_INSTANCE_FORCE_NO_OPAQUE_BIT_KHR). 0 = the passes keep the opaque fast path.
   uint32_t nonOpaqueInstances = 0;
-  bool updated = false;                      // true if refit rather than rebuilt
+  bool updated = false;  // true if refit rather than rebuilt
+  // TlasBuildMode::Adaptive: the measure that decided this frame (1 after a rebuild), and the refits since
+  // the last rebuild, this one included (0 after a rebuild). Other modes: 0 and 0.
+  float areaGrowth = 0.0f;
+  uint32_t refitsSinceRebuild = 0;
   double originOffset[3] = {0.0, 0.0, 0.0};  // TlasBuildOptions::originOffset it was built with
   // With TlasBuildOptions::writeShadingRecords: a storage buffer of one record per TLAS instance (indexed by
   // gl_InstanceID), valid for this frame. VK_NULL_HANDLE otherwise.
@@ -302,6 +323,8 @@ struct AsStats {
   VkDeviceSize scratchBytes = 0;       // persistent scratch memory
   VkDeviceSize tlasBytes = 0;          // TLAS storage, scratch and instance buffers over all frame slots
   uint32_t lastTlasInstances = 0;
+  uint64_t tlasBuilds = 0;                // TLAS full builds recorded
+  uint64_t tlasRefits = 0;                // TLAS refits recorded (UpdateIfPossible, Adaptive)
   std::vector<BuildBatchTiming> batches;  // the most recent batches with resolved timings (at most 64); an
                                           // async submission is one batch
   uint64_t batchTimingsDropped = 0;       // older resolved timings no longer in `batches`

@@ -1,0 +1,195 @@
+// TlasBuildMode::Adaptive: the refit-quality measure (TlasMotionMeasure) and the policy that rebuilds on it or on
+// the refit count.
+#include <catch2/catch_test_macros.hpp>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "test_scene.h"
+#include "tlas_motion.h"
+
+using namespace rbtest;
+
+namespace {
+
+// n origins on a jittered grid over [0, size)^2 at y = 0 (a city on a plane: one axis has no extent).
+std::vector<float> planeOrigins(uint32_t side, float size, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> jitter(-0.2f, 0.2f);
+  std::vector<float> o;
+  const float step = size / float(side);
+  for (uint32_t z = 0; z < side; ++z) {
+    for (uint32_t x = 0; x < side; ++x) {
+      o.push_back((float(x) + 0.5f + jitter(rng)) * step);
+      o.push_back(0.0f);
+      o.push_back((float(z) + 0.5f + jitter(rng)) * step);
+    }
+  }
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("the TLAS motion measure grows when neighbours scatter and not when they move together", "[tlas][policy]") {
+  const std::vector<float> base = planeOrigins(100, 1000.0f, 7);  // 10,000 instances 10 units apart
+  rb::TlasMotionMeasure m;
+  m.reset(base);
+  CHECK(m.growth(base) == 1.0);
+
+  // The whole field translated far (a camera-relative origin shift, a convoy): every group keeps its box.
+  std::vector<float> shifted = base;
+  for (size_t i = 0; i < shifted.size(); i += 3) {
+    shifted[i] += 5000.0f;
+    shifted[i + 1] += 40.0f;
+    shifted[i + 2] -= 300.0f;
+  }
+  CHECK(std::abs(m.growth(shifted) - 1.0) < 1e-3);
+
+  // Each instance wanders a little (a tenth of the spacing): the boxes grow a little.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<float> small = base, large = base;
+  for (size_t i = 0; i < base.size(); ++i) {
+    small[i] += 1.0f * unit(rng);
+    large[i] += 60.0f * unit(rng);  // six spacings: neighbours at the rebuild are now far apart
+  }
+  const double smallGrowth = m.growth(small), largeGrowth = m.growth(large);
+  INFO("small " << smallGrowth << ", large " << largeGrowth);
+  CHECK(smallGrowth > 1.0);
+  CHECK(smallGrowth < 1.3);
+  CHECK(largeGrowth > double(rb::kDefaultTlasMaxAreaGrowth));
+
+  // The same scatter on a field that also has height (3D cells) is seen too.
+  std::vector<float> volume = base, volumeScattered;
+  for (size_t i = 1; i < volume.size(); i += 3) volume[i] = float((i / 3) % 37) * 25.0f;
+  m.reset(volume);
+  volumeScattered = volume;
+  for (size_t i = 0; i < volume.size(); ++i) volumeScattered[i] += 60.0f * unit(rng);
+  CHECK(m.growth(volumeScattered) > double(rb::kDefaultTlasMaxAreaGrowth));
+}
+
+TEST_CASE("the TLAS motion measure takes degenerate lists", "[tlas][policy]") {
+  rb::TlasMotionMeasure m;
+  m.reset({});
+  CHECK(m.growth({}) == 1.0);
+  const std::vector<float> one = {3.0f, 4.0f, 5.0f};
+  m.reset(one);
+  CHECK(m.growth(one) == 1.0);
+  const std::vector<float> same = {1, 1, 1, 1, 1, 1, 1, 1, 1};  // three instances in one point
+  m.reset(same);
+  CHECK(m.growth(same) == 1.0);
+  const std::vector<float> apart = {1, 1, 1, 1, 1, 1, 9, 1, 1};
+  CHECK(m.growth(apart) > 1.0);
+  // A list of another length than the one measured at the rebuild is no refit chain: no growth claimed.
+  CHECK(m.growth(one) == 1.0);
+  // A non-finite translation reads as unbounded growth, so the policy rebuilds rather than refits over it.
+  std::vector<float> bad = same;
+  bad[4] = std::numeric_limits<float>::infinity();
+  CHECK(!(m.growth(bad) <= double(rb::kDefaultTlasMaxAreaGrowth)));
+}
+
+TEST_CASE("an adaptive TLAS refits, rebuilds after maxRefits and when instances scatter, and traces right",
+          "[as][tlas][policy]") {
+  GpuFixture fx;
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  auto& s = *service.value();
+  TestScene scene = makeConformanceScene();
+  BuiltScene built = buildScene(fx, s, scene);
+  rb::TlasBuildOptions adaptive;
+  adaptive.mode = rb::TlasBuildMode::Adaptive;
+  adaptive.maxRefits = 3;
+  auto build = [&] {
+    rb::TlasInfo info;
+    fx.runFrame([&](VkCommandBuffer cmd) {
+      auto t = s.recordTlasBuild(cmd, built.instances, adaptive);
+      RB_REQUIRE_OK(t);
+      info = t.value();
+    });
+    return info;
+  };
+  auto moveAll = [&](float dx) {
+    for (size_t i = 0; i < built.instances.size(); ++i) {
+      built.instances[i].transform[3] += dx;
+      scene.instances[i].transform[3] += dx;
+    }
+  };
+  const rb::AsStats before = s.stats();
+  // The scene's first TLAS (buildScene) had no ALLOW_UPDATE: a rebuild, then three refits, then the count rebuilds.
+  rb::TlasInfo t = build();
+  CHECK(!t.updated);
+  CHECK(t.areaGrowth == 1.0f);
+  CHECK(t.refitsSinceRebuild == 0);
+  for (uint32_t k = 1; k <= 3; ++k) {
+    moveAll(0.25f);  // every instance together: the measure stays at 1
+    t = build();
+    CHECK(t.updated);
+    CHECK(t.refitsSinceRebuild == k);
+    CHECK(std::abs(t.areaGrowth - 1.0f) < 1e-4f);
+  }
+  t = build();
+  CHECK(!t.updated);  // maxRefits reached
+  const rb::AsStats after = s.stats();
+  CHECK(after.tlasBuilds - before.tlasBuilds == 2);
+  CHECK(after.tlasRefits - before.tlasRefits == 3);
+
+  // One sphere flies off (the five instances are one group): the group's box more than doubles, so a rebuild.
+  adaptive.maxRefits = 0;
+  built.instances[1].transform[3] += 30.0f;
+  scene.instances[1].transform[3] += 30.0f;
+  t = build();
+  CHECK(!t.updated);
+  // A small step of the same sphere, further out, refits, and the refitted TLAS traces like Embree.
+  built.instances[1].transform[3] += 0.5f;
+  scene.instances[1].transform[3] += 0.5f;
+  t = build();
+  CHECK(t.updated);
+  CHECK(t.areaGrowth > 1.0f);
+  CHECK(t.areaGrowth < rb::kDefaultTlasMaxAreaGrowth);
+  TraceComparison c = compareFirstTrace(fx, scene, t.tlas, conformanceCamera(), 96, 64);
+  CHECK(double(c.hitMissAgree) / c.compared >= 0.999);
+  CHECK(double(c.distanceAgree) / c.hitsCompared >= 0.999);
+
+  // A lower threshold rebuilds on the same kind of step.
+  adaptive.maxAreaGrowth = 1.0001f;
+  built.instances[1].transform[3] += 2.0f;
+  t = build();
+  CHECK(!t.updated);
+
+  // After a frame in another mode the measure no longer describes the chain: Adaptive rebuilds once.
+  rb::TlasBuildOptions update;
+  update.mode = rb::TlasBuildMode::UpdateIfPossible;
+  fx.runFrame([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(s.recordTlasBuild(cmd, built.instances, update)); });
+  adaptive.maxAreaGrowth = 0.0f;
+  CHECK(!build().updated);
+  CHECK(build().updated);
+  destroyScene(fx, built);
+}
+
+TEST_CASE("bad TLAS policy options are named", "[tlas][policy][bad-input]") {
+  GpuFixture fx;
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  TestScene scene = makeConformanceScene();
+  BuiltScene built = buildScene(fx, *service.value(), scene);
+  auto expectError = [&](const rb::TlasBuildOptions& o, const char* word) {
+    fx.runFrame([&](VkCommandBuffer cmd) {
+      auto t = service.value()->recordTlasBuild(cmd, built.instances, o);
+      REQUIRE(!t);
+      CHECK(t.error().code == rb::ErrorCode::InvalidArgument);
+      INFO(t.error().message);
+      CHECK(t.error().message.find(word) != std::string::npos);
+    });
+  };
+  rb::TlasBuildOptions o;
+  o.mode = rb::TlasBuildMode::Adaptive;
+  o.maxAreaGrowth = 0.9f;
+  expectError(o, "maxAreaGrowth");
+  o.maxAreaGrowth = std::numeric_limits<float>::quiet_NaN();
+  expectError(o, "maxAreaGrowth");
+  o.maxAreaGrowth = 0.0f;
+  o.mode = static_cast<rb::TlasBuildMode>(9);
+  expectError(o, "options.mode");
+  destroyScene(fx, built);
+}
