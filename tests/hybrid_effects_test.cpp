@@ -72,6 +72,7 @@ TEST_CASE("the front end rejects bad descriptions and frames by name and keeps i
       {"ao.range", [](rb::HybridEffectsDesc& d) { d.ao.range = std::numeric_limits<float>::infinity(); }},
       {"reflections.roughnessThreshold", [](rb::HybridEffectsDesc& d) { d.reflections.roughnessThreshold = 2.0f; }},
       {"reflections.raysPerPixel", [](rb::HybridEffectsDesc& d) { d.reflections.raysPerPixel = 65; }},
+      {"tlasMode", [](rb::HybridEffectsDesc& d) { d.tlasMode = static_cast<rb::TlasBuildMode>(7); }},
   };
   for (const Case& c : cases) {
     INFO(c.field);

@@ -1,15 +1,21 @@
 // TlasBuildMode::Adaptive: the refit-quality measure (TlasMotionMeasure) and the policy that rebuilds on it or on
-// the refit count.
+// the refit count; HybridEffectsDesc::tlasMode.
 #include <catch2/catch_test_macros.hpp>
 
 #include <cmath>
 #include <limits>
 #include <random>
 
+#include "synthetic_gbuffer.h"
 #include "test_scene.h"
 #include "tlas_motion.h"
 
 using namespace rbtest;
+
+namespace {
+// The first TLAS without ALLOW_UPDATE, so the first refitting build must rebuild.
+const rb::TlasBuildOptions kRebuildTlas{.mode = rb::TlasBuildMode::Rebuild};
+}  // namespace
 
 namespace {
 
@@ -96,7 +102,7 @@ TEST_CASE("an adaptive TLAS refits, rebuilds after maxRefits and when instances 
   RB_REQUIRE_OK(service);
   auto& s = *service.value();
   TestScene scene = makeConformanceScene();
-  BuiltScene built = buildScene(fx, s, scene);
+  BuiltScene built = buildScene(fx, s, scene, kRebuildTlas);
   rb::TlasBuildOptions adaptive;
   adaptive.mode = rb::TlasBuildMode::Adaptive;
   adaptive.maxRefits = 3;
@@ -191,5 +197,43 @@ TEST_CASE("bad TLAS policy options are named", "[tlas][policy][bad-input]") {
   o.maxAreaGrowth = 0.0f;
   o.mode = static_cast<rb::TlasBuildMode>(9);
   expectError(o, "options.mode");
+  destroyScene(fx, built);
+}
+
+TEST_CASE("HybridEffects builds its TLAS as HybridEffectsDesc::tlasMode says: adaptive refits by default",
+          "[tlas][policy][hybrid_effects]") {
+  GpuFixture fx;
+  TestScene scene = makeConformanceScene();
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  CpuGBuffer cpu = traceGBuffer(embree, conformanceView(64, 48));
+  GpuGBuffer gbuffer(fx, cpu);
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  BuiltScene built = buildScene(fx, *service.value(), scene, kRebuildTlas);
+  for (rb::TlasBuildMode mode : {rb::TlasBuildMode::Adaptive, rb::TlasBuildMode::Rebuild}) {
+    INFO("tlasMode " << int(mode));
+    rb::HybridEffectsDesc desc = rb::withPreset({}, rb::Preset::HardShadows);
+    CHECK(desc.tlasMode == rb::TlasBuildMode::Adaptive);  // the default
+    desc.tlasMode = mode;
+    auto effects = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
+    RB_REQUIRE_OK(effects);
+    rb::HybridFrame frame;
+    frame.gbuffer = gbuffer.desc();
+    frame.instances = built.instances;  // the front end builds the TLAS
+    frame.light.direction[1] = 1.0f;
+    const rb::AsStats before = service.value()->stats();
+    std::vector<float> first;
+    for (int f = 0; f < 4; ++f) {
+      fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.value()->record(cmd, frame)); });
+      const std::vector<float> shadow = readR16f(fx, effects.value()->outputs().shadow.image, 64, 48);
+      if (f == 0) first = shadow;
+      CHECK(shadow == first);  // a still scene: a refitted TLAS gives the same hard shadows
+      CHECK(effects.value()->lastTlas().updated == (mode == rb::TlasBuildMode::Adaptive && f > 0));
+    }
+    const rb::AsStats after = service.value()->stats();
+    CHECK(after.tlasRefits - before.tlasRefits == (mode == rb::TlasBuildMode::Adaptive ? 3u : 0u));
+    CHECK(after.tlasBuilds - before.tlasBuilds == (mode == rb::TlasBuildMode::Adaptive ? 1u : 4u));
+  }
   destroyScene(fx, built);
 }

@@ -9,6 +9,11 @@
 
 using namespace rbtest;
 
+namespace {
+// The first TLAS without ALLOW_UPDATE, so the first refitting build must rebuild.
+const rb::TlasBuildOptions kRebuildTlas{.mode = rb::TlasBuildMode::Rebuild};
+}  // namespace
+
 TEST_CASE("a 10,000-instance TLAS builds and traces like Embree", "[as][tlas][embree]") {
   GpuFixture fx;
   auto service = rb::AccelerationStructureService::create(fx.ctx());
@@ -53,7 +58,7 @@ TEST_CASE("TLAS refits when only transforms change and rebuilds when the meshes 
   RB_REQUIRE_OK(service);
   auto& s = *service.value();
   TestScene scene = makeConformanceScene();
-  BuiltScene built = buildScene(fx, s, scene);
+  BuiltScene built = buildScene(fx, s, scene, kRebuildTlas);
   rb::TlasBuildOptions update;
   update.mode = rb::TlasBuildMode::UpdateIfPossible;
 

@@ -652,6 +652,11 @@ int main(int argc, char** argv) {
           {"dedup_hits", as.dedupHits},
           {"tlas_instances", adapter->lastTlas().instanceCount},
           {"tlas_skipped_instances", adapter->lastTlas().skippedInstances},
+          {"tlas_mode", o.tlasMode == rb::TlasBuildMode::Rebuild            ? "rebuild"
+                        : o.tlasMode == rb::TlasBuildMode::UpdateIfPossible ? "refit"
+                                                                            : "adaptive"},
+          {"tlas_builds", as.tlasBuilds},
+          {"tlas_refits", as.tlasRefits},
           {"dynamic_builds", o.dynamicMode == rb::DynamicBuildMode::InFrame          ? "in-frame"
                              : o.dynamicMode == rb::DynamicBuildMode::AsyncSameFrame ? "async"
                                                                                      : "async-late"},

@@ -305,6 +305,18 @@ void addOptions(CLI::App& app, RenderOptions& o) {
       "--reorder", [&o] { o.invocationReorder = true; },
       "reflections with shader execution reordering where the device has\n"
       "VK_NV_ray_tracing_invocation_reorder (default: off; stats.json tells)");
+  app.add_option_function<std::string>(
+         "--tlas-mode",
+         [&o](const std::string& v) {
+           o.tlasMode = v == "rebuild" ? rb::TlasBuildMode::Rebuild
+                        : v == "refit" ? rb::TlasBuildMode::UpdateIfPossible
+                                       : rb::TlasBuildMode::Adaptive;
+         },
+         "how the TLAS is built each frame: adaptive (refit, rebuild when instances drift\n"
+         "apart or every 60 frames), rebuild (every frame) or refit (always when valid)\n"
+         "(default: adaptive)")
+      ->type_name("MODE")
+      ->check(rbCli::oneOf({"adaptive", "rebuild", "refit"}));
   app.add_option_function<uint32_t>(
          "--shadow-map-size", [&o](const uint32_t& v) { o.shadowMapSize = v; },
          "raster mode's shadow map, texels squared, 0 = none (default: the preset's)")
@@ -523,6 +535,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.reflections.raysPerPixel = o.reflectionRays ? *o.reflectionRays : kDefaultReflectionRays;
   h.reflections.halfResolution = o.halfResReflections;
   h.reflections.invocationReorder = o.invocationReorder;
+  h.tlasMode = o.tlasMode;
 
   r.raster = p.raster;
   if (o.shadowMapSize) r.raster.mapSize = *o.shadowMapSize;

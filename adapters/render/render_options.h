@@ -54,6 +54,8 @@ struct RenderOptions {
   // (HybridEffectsDesc::reflections.invocationReorder); the device is the same either way, so a pair of runs
   // measures it alone. No effect without reflections or outside --mode hybrid.
   bool invocationReorder = false;
+  // --tlas-mode: HybridEffectsDesc::tlasMode (adaptive, rebuild or refit = UpdateIfPossible)
+  rb::TlasBuildMode tlasMode = rb::TlasBuildMode::Adaptive;
   bool tileClassifier = false;  // --tile-classifier: HybridEffectsDesc::shadows.tileClassifier
   // --converged-tiles K: HybridEffectsDesc::shadows.convergedTiles, each converged tile traced once in K frames.
   std::optional<uint32_t> convergedTiles;

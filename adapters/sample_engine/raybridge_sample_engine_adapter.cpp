@@ -283,6 +283,7 @@ void Adapter::recordRayTraced(const se::PrepassHookInfo& info) {
     return keepFirst(a.error, message("recordPendingWork", pending.error()));
   // Camera-relative TLAS around the float eye the camera below starts from, so the eye is exactly its origin.
   rb::TlasBuildOptions options;
+  options.mode = a.fx->desc().tlasMode;
   for (int i = 0; i < 3; ++i) options.originOffset[i] = double(info.cameraPosition[i]);
   options.writeShadingRecords = true;  // hits shade with the materials
   auto tlas = a.as->recordTlasBuild(info.commandBuffer, a.instances, options);

@@ -496,7 +496,9 @@ void SoakRun::changeLocalLights() {
 void SoakRun::changeTlasPolicy() {
   TlasPolicy p;
   p.byEngine = chance(0.6);
-  p.options.mode = chance(0.4) ? rb::TlasBuildMode::Rebuild : rb::TlasBuildMode(1 + pick(2));  // or a refitting mode
+  const rb::TlasBuildMode modes[3] = {rb::TlasBuildMode::Adaptive, rb::TlasBuildMode::Rebuild,
+                                      rb::TlasBuildMode::UpdateIfPossible};
+  p.options.mode = modes[pick(3)];
   p.options.instanceUpload = rb::TlasInstanceUpload(pick(3));
   p.options.preference = chance(0.5) ? rb::TlasBuildPreference::FastTrace : rb::TlasBuildPreference::FastBuild;
   p.alwaysShadingRecords = chance(0.3);

@@ -58,6 +58,7 @@ void runMotionCase(BenchEnv& env, const std::vector<UploadedMesh>& meshes, uint3
   const float width = std::cbrt(4.0f * float(count)) * kSpacing, height = width / 4.0f;
   std::vector<MotionVariant> variants(5);
   variants[0].name = "rebuild";
+  variants[0].options.mode = rb::TlasBuildMode::Rebuild;
   variants[1].name = "refit";
   variants[1].options.mode = rb::TlasBuildMode::Adaptive;
   variants[1].options.maxAreaGrowth = 1e30f;

@@ -37,6 +37,9 @@ Status validate(const HybridEffectsDesc& d) {
                    " is outside [0, 1]");
   if (d.localLights.mode != ManyLightMode::Stochastic && d.localLights.mode != ManyLightMode::Exact)
     return invalid("localLights.mode has an unknown value");
+  if (d.tlasMode > TlasBuildMode::UpdateIfPossible)
+    return invalid("tlasMode " + std::to_string(int(d.tlasMode)) +
+                   " is not a TlasBuildMode (Adaptive, Rebuild or UpdateIfPossible)");
   if (d.localLights.raysPerPixel > 64 || d.localLights.candidates > 64)
     return invalid("localLights.raysPerPixel " + std::to_string(d.localLights.raysPerPixel) + " and candidates " +
                    std::to_string(d.localLights.candidates) + " must be at most 64");
@@ -348,6 +351,7 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
           "to create() to build one over HybridFrame::instances");
     if (auto pending = a.service->recordPendingWork(cmd); !pending) return wrap("recordPendingWork", pending.error());
     TlasBuildOptions options;
+    options.mode = a.desc.tlasMode;
     if (!a.desc.worldSpaceTlas) {
       // Camera-relative: precision holds far from the origin (gbuffer.h). The passes read the offset back from
       // TlasInfo, so a G-buffer without cameraPosition (all zero) simply gets a world-space TLAS.

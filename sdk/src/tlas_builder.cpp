@@ -42,7 +42,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   std::lock_guard<std::mutex> lock(s.mutex);
   s.handOnDeferredRetires();
   if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "recordTlasBuild: cmd is VK_NULL_HANDLE"};
-  if (options.mode > TlasBuildMode::Adaptive || options.instanceUpload > TlasInstanceUpload::CopyToDevice ||
+  if (options.mode > TlasBuildMode::UpdateIfPossible || options.instanceUpload > TlasInstanceUpload::CopyToDevice ||
       options.preference > TlasBuildPreference::FastBuild) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
                  "recordTlasBuild: options.mode (" + std::to_string(int(options.mode)) + "), options.instanceUpload (" +

@@ -116,6 +116,9 @@ struct HybridEffectsDesc {
   // Build the TLAS with camera-relative origin (TlasBuildOptions::originOffset = the G-buffer's camera
   // position), so precision holds far from the world origin. Only used when record() builds the TLAS.
   bool worldSpaceTlas = false;  // false = camera-relative (recommended)
+  // How record() builds the TLAS each frame (TlasBuildOptions::mode). Default Adaptive: refits, and rebuilds
+  // when the instances drifted apart or every kDefaultTlasMaxRefits frames. Only used when record() builds the TLAS.
+  TlasBuildMode tlasMode = TlasBuildMode::Adaptive;
 };
 
 // `base` with the preset's effect set, ray counts and AO resolution (every other field is kept).
