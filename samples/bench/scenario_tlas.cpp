@@ -2,9 +2,10 @@
 // (std::chrono; it writes the instance buffer) and GPU time of the build (the bench's own timestamps, the instance
 // copy included where there is one), both as medians of repeated frames after one warm-up frame per frame slot,
 // and per 1,000 instances. Each size is measured in four variants, one change at a time: a rebuild every frame
-// (TlasBuildMode::Rebuild) reading the host-visible instances in place, reading a device-local copy (the default on a discrete GPU), the copy with a
-// fast-build TLAS, and the copy refitting the previous frame's TLAS (TlasBuildMode::UpdateIfPossible) while every
-// instance moves a little each frame (an engine's frame where the instance list keeps its meshes).
+// (TlasBuildMode::Rebuild) reading the host-visible instances in place, reading a device-local copy (the default on a
+// discrete GPU), the copy with a fast-build TLAS, and the copy refitting the previous frame's TLAS
+// (TlasBuildMode::UpdateIfPossible) while every instance moves a little each frame (an engine's frame where the
+// instance list keeps its meshes).
 #include <chrono>
 
 #include "gpu_timer.h"
