@@ -37,6 +37,10 @@ struct BuiltScene {
   std::vector<rb::Instance> instances;
   rb::TlasInfo tlas;
 };
+// Options of a TLAS built without ALLOW_UPDATE (the default mode refits), so a test's first refitting build
+// must rebuild.
+inline const rb::TlasBuildOptions kRebuildTlas{.mode = rb::TlasBuildMode::Rebuild};
+
 // Uploads and registers the meshes, builds them and a TLAS over the instances with `options`.
 BuiltScene buildScene(GpuFixture& fx, rb::AccelerationStructureService& service, const TestScene& scene,
                       const rb::TlasBuildOptions& options = {});

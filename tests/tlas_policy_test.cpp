@@ -13,11 +13,6 @@
 using namespace rbtest;
 
 namespace {
-// The first TLAS without ALLOW_UPDATE, so the first refitting build must rebuild.
-const rb::TlasBuildOptions kRebuildTlas{.mode = rb::TlasBuildMode::Rebuild};
-}  // namespace
-
-namespace {
 
 // n origins on a jittered grid over [0, size)^2 at y = 0 (a city on a plane: one axis has no extent).
 std::vector<float> planeOrigins(uint32_t side, float size, uint32_t seed) {

@@ -9,11 +9,6 @@
 
 using namespace rbtest;
 
-namespace {
-// The first TLAS without ALLOW_UPDATE, so the first refitting build must rebuild.
-const rb::TlasBuildOptions kRebuildTlas{.mode = rb::TlasBuildMode::Rebuild};
-}  // namespace
-
 TEST_CASE("a 10,000-instance TLAS builds and traces like Embree", "[as][tlas][embree]") {
   GpuFixture fx;
   auto service = rb::AccelerationStructureService::create(fx.ctx());
