@@ -305,18 +305,13 @@ void addOptions(CLI::App& app, RenderOptions& o) {
       "--reorder", [&o] { o.invocationReorder = true; },
       "reflections with shader execution reordering where the device has\n"
       "VK_NV_ray_tracing_invocation_reorder (default: off; stats.json tells)");
-  app.add_option_function<std::string>(
-         "--tlas-mode",
-         [&o](const std::string& v) {
-           o.tlasMode = v == "rebuild" ? rb::TlasBuildMode::Rebuild
-                        : v == "refit" ? rb::TlasBuildMode::UpdateIfPossible
-                                       : rb::TlasBuildMode::Adaptive;
-         },
-         "how the TLAS is built each frame: adaptive (refit, rebuild when instances drift\n"
-         "apart or every 60 frames), rebuild (every frame) or refit (always when valid)\n"
-         "(default: adaptive)")
-      ->type_name("MODE")
-      ->check(rbCli::oneOf({"adaptive", "rebuild", "refit"}));
+  rbCli::addEnum(app, "--tlas-mode", o.tlasMode,
+                 {{"adaptive", rb::TlasBuildMode::Adaptive},
+                  {"rebuild", rb::TlasBuildMode::Rebuild},
+                  {"refit", rb::TlasBuildMode::UpdateIfPossible}},
+                 "how the TLAS is built each frame: adaptive (refit, rebuild when instances drift\n"
+                 "apart or every 60 frames), rebuild (every frame) or refit (always when valid)\n"
+                 "(default: adaptive)");
   app.add_option_function<uint32_t>(
          "--shadow-map-size", [&o](const uint32_t& v) { o.shadowMapSize = v; },
          "raster mode's shadow map, texels squared, 0 = none (default: the preset's)")

@@ -77,6 +77,10 @@ void runMotionCase(BenchEnv& env, const std::vector<UploadedMesh>& meshes, uint3
       v.handles.push_back(registerOrThrow(*v.service, meshes[i].desc, "tlas-motion mesh " + std::to_string(i)));
     (void)buildQueued(env, *v.service);
     v.instances.resize(count);
+    for (uint32_t i = 0; i < count; ++i) {
+      v.instances[i].mesh = v.handles[i % v.handles.size()];
+      v.instances[i].customIndex = i & 0xFFFFFFu;
+    }
   }
 
   std::mt19937 rng(env.options().seed);
@@ -95,11 +99,9 @@ void runMotionCase(BenchEnv& env, const std::vector<UploadedMesh>& meshes, uint3
     f.velocity[2] = r * std::sin(phi) * speed;
   }
   const float lo[3] = {-0.5f * width, 0.0f, -0.5f * width}, hi[3] = {0.5f * width, height, 0.5f * width};
-  auto place = [&] {
+  auto place = [&] {  // the transforms; meshes and custom indices stay as set above
     for (MotionVariant& v : variants) {
       for (uint32_t i = 0; i < count; ++i) {
-        v.instances[i].mesh = v.handles[i % v.handles.size()];
-        v.instances[i].customIndex = i & 0xFFFFFFu;
         setTransform(v.instances[i], translation(flyers[i].position[0], flyers[i].position[1], flyers[i].position[2]));
       }
     }

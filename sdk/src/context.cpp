@@ -31,8 +31,7 @@ bool hasExtension(const std::vector<VkExtensionProperties>& available, const cha
                      [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
 }
 
-Status checkExtensions(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice, const std::string& deviceName) {
-  const std::vector<VkExtensionProperties> available = deviceExtensions(vk, physicalDevice);
+Status checkExtensions(const std::vector<VkExtensionProperties>& available, const std::string& deviceName) {
   std::string missing;
   for (const char* name : kRequiredExtensions) {
     if (!hasExtension(available, name)) missing += std::string(missing.empty() ? "" : ", ") + name;
@@ -94,8 +93,8 @@ bool hasInvocationReorderFeature(const DeviceFunctions& vk, VkPhysicalDevice phy
 // ContextDesc::invocationReorderEnabled against what the physical device supports: a device that lacks it cannot
 // have enabled it, and a pipeline using it there would fail to build (or crash the driver) much later.
 Status checkInvocationReorder(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
-                              const std::string& deviceName) {
-  if (!hasExtension(deviceExtensions(vk, physicalDevice), kInvocationReorderExtension)) {
+                              const std::vector<VkExtensionProperties>& available, const std::string& deviceName) {
+  if (!hasExtension(available, kInvocationReorderExtension)) {
     return Error{ErrorCode::MissingExtension, VK_SUCCESS,
                  "ContextDesc::invocationReorderEnabled is true but device '" + deviceName + "' does not support " +
                      kInvocationReorderExtension + "; set it only where rb::supportsInvocationReorder() is true"};
@@ -244,10 +243,12 @@ Result<std::unique_ptr<Context>> Context::create(const ContextDesc& desc) {
                      std::to_string(VK_API_VERSION_MAJOR(info.apiVersion)) + "." +
                      std::to_string(VK_API_VERSION_MINOR(info.apiVersion)) + "; Raybridge needs Vulkan 1.2 or newer"};
   }
-  if (Status s = checkExtensions(vk, desc.physicalDevice, info.deviceName); !s) return s.error();
+  // Enumerated once: the required extensions and the optional reorder extension are checked against the same list.
+  const std::vector<VkExtensionProperties> extensions = deviceExtensions(vk, desc.physicalDevice);
+  if (Status s = checkExtensions(extensions, info.deviceName); !s) return s.error();
   if (Status s = checkFeatures(vk, desc.physicalDevice, info.deviceName); !s) return s.error();
   if (desc.invocationReorderEnabled) {
-    if (Status s = checkInvocationReorder(vk, desc.physicalDevice, info.deviceName); !s) return s.error();
+    if (Status s = checkInvocationReorder(vk, desc.physicalDevice, extensions, info.deviceName); !s) return s.error();
     VkPhysicalDeviceRayTracingInvocationReorderPropertiesNV serProps{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_INVOCATION_REORDER_PROPERTIES_NV};
     VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &serProps};

@@ -83,7 +83,7 @@ double TlasMotionMeasure::growth(std::span<const float> origins) {
 
 double TlasMotionMeasure::summedArea(std::span<const float> origins) {
   constexpr float inf = std::numeric_limits<float>::infinity();
-  boxes_.assign(size_t(groups_) * 6, 0.0f);
+  boxes_.resize(size_t(groups_) * 6);
   for (uint32_t g = 0; g < groups_; ++g) {
     for (int a = 0; a < 3; ++a) {
       boxes_[6 * g + a] = inf;
