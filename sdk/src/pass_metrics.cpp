@@ -39,6 +39,7 @@ Status PassMetrics::init(Context& ctx, const char* passName, bool countsRays) {
     std::memset(readback_.mapped, 0, readback_.size);
   }
   recordedFrame_.assign(slots, UINT64_MAX);
+  hostRays_.assign(slots, 0);
   timing_ = c.info.timestampsSupported;
   if (timing_) {
     VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
@@ -70,6 +71,7 @@ void PassMetrics::collect(Context& ctx) {
     if (f == UINT64_MAX || !c.frameDone(f)) continue;
     PassStats s;
     s.frame = f;
+    s.rays = hostRays_[slot];
     if (readback_.valid()) {
       const uint32_t* counts = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(readback_.mapped) +
                                                                  slot * counterBytes());
@@ -101,6 +103,7 @@ Status PassMetrics::beginRecording(Context& ctx, VkCommandBuffer cmd) {
   Context::Impl& c = internal::contextImpl(ctx);
   const uint32_t slot = static_cast<uint32_t>(c.frame % c.desc.framesInFlight);
   recordedFrame_[slot] = c.frame;
+  hostRays_[slot] = 0;
   if (timing_) c.vk.vkCmdResetQueryPool(cmd, timestamps_, 2 * slot, 2);
   if (!counters_.valid()) return {};
   // After any earlier use of the counters in this command buffer (the pass recorded twice in a frame): clear, then
@@ -114,6 +117,10 @@ Status PassMetrics::beginRecording(Context& ctx, VkCommandBuffer cmd) {
   recordMemoryBarrier(c.vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kCounterShaderStages,
                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   return {};
+}
+
+void PassMetrics::addHostRays(Context& ctx, uint64_t rays) {
+  hostRays_[ctx.frameIndex() % ctx.framesInFlight()] += rays;
 }
 
 void PassMetrics::writeStart(Context& ctx, VkCommandBuffer cmd) {

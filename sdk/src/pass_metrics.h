@@ -33,6 +33,10 @@ class PassMetrics {
   void writeStart(Context& ctx, VkCommandBuffer cmd);
   // The end timestamp, then the copy of this frame's counters to the host-visible readback buffer.
   void writeEnd(Context& ctx, VkCommandBuffer cmd);
+  // Rays the pass knows without counting them on the GPU (a launch of one ray per pixel): added to this frame's
+  // count. A shader atomic per ray costs a measurable share of a one-ray pass (docs/performance.md). Call between
+  // beginRecording() and the frame's end; a later beginRecording() in the same frame starts again from 0.
+  void addHostRays(Context& ctx, uint64_t rays);
   // The counter buffer of this frame's slot, for the shader's ray counters.
   VkBuffer counterBuffer() const { return counters_.buffer; }
   VkDeviceSize counterOffset(Context& ctx) const;
@@ -52,6 +56,7 @@ class PassMetrics {
   GpuBuffer readback_;
   VkQueryPool timestamps_ = VK_NULL_HANDLE;
   std::vector<uint64_t> recordedFrame_;  // per slot; UINT64_MAX = nothing pending
+  std::vector<uint64_t> hostRays_;       // per slot: addHostRays() since the slot's beginRecording()
   PassStats latest_;
   bool timing_ = false;
   const char* name_ = "";  // the pass, for errors

@@ -141,6 +141,8 @@ Status PrimaryRayPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, const P
   s.core.metrics.writeStart(s.ctx, cmd);
   s.core.bind(s.ctx, cmd, w, &pc, sizeof(pc));
   s.core.pipeline.trace(s.ctx, cmd, targets.width, targets.height);
+  // One ray per pixel, counted here: the shader adds none (primary.rgen).
+  s.core.metrics.addHostRays(s.ctx, uint64_t(targets.width) * targets.height);
   s.core.metrics.writeEnd(s.ctx, cmd);
   return {};
 }
