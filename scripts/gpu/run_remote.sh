@@ -4,8 +4,9 @@
 #
 #   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, inject, render, effects, animated,
 #                                                          lights, perf, adaptive, soak (default all; inject,
-#                                                          the failure-injection cases, and tlas, the TLAS
-#                                                          benchmark alone, run only when named)
+#                                                          the failure-injection cases, tlas, the TLAS
+#                                                          benchmark alone, and trace, the primary-ray rate
+#                                                          against the probe, run only when named)
 #
 # Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
 # tests_gpu.log, effects_gpu.json, effects_gpu.log, render_gpu.tar.gz (render logs, stats.json and final.png
@@ -30,7 +31,7 @@ set -u
 
 MODE="${1:-all}"
 for m in ${MODE//,/ }; do
-  case "$m" in all|bench|tests|inject|render|effects|animated|lights|perf|adaptive|soak|tlas) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, inject, render, effects, animated, lights, perf, adaptive, soak or tlas" >&2; exit 2 ;; esac
+  case "$m" in all|bench|tests|inject|render|effects|animated|lights|perf|adaptive|soak|tlas|trace) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, inject, render, effects, animated, lights, perf, adaptive, soak, tlas or trace" >&2; exit 2 ;; esac
 done
 want() { [ "$MODE" = all ] || [[ ",$MODE," == *",$1,"* ]]; }
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -412,6 +413,35 @@ if [[ ",$MODE," == *,tlas,* ]]; then  # only when named: `bench` runs it with ev
   RAYBRIDGE_VALIDATION=0 step "tlas-motion bench" 150 "$OUT/tlas_motion_gpu.log" "$RT/bin/raybridge-bench" \
     --scenario tlas-motion --full --out "$OUT/tlas_motion_gpu.json"
   grep -A40 '^== tlas-motion' "$OUT/tlas_motion_gpu.log" | head -n 40
+fi
+# ---- trace: docs/performance.md's primary-pass rows. The probe (~1M triangles) at 2560x1440 and 1920x1080, then
+# raybridge-bench --scenario trace --full at both sizes (its third view is the probe's own scene and camera), by
+# the current build and by each earlier one carried as bin/raybridge-bench-VARIANT (prepare.sh EXTRA_BINS), in
+# RB_TRACE_ROUNDS rounds (default 2) that rotate their order. Into trace_gpu.log and trace_<size>_<bin>_<round>.json.
+if [[ ",$MODE," == *,trace,* ]]; then
+  : >"$OUT/trace_gpu.log"
+  TDIR="$(mktemp -d)"
+  bins=("$RT/bin/raybridge-bench")
+  for vbin in "$RT"/bin/raybridge-bench-*; do [ -x "$vbin" ] && bins+=("$vbin"); done
+  for size in "2560 1440" "1920 1080"; do
+    read -r tw th <<<"$size"
+    if [ -x "$RT/probe/probe" ]; then
+      RAYBRIDGE_VALIDATION=0 step "probe k32 ${tw}" 60 "$OUT/trace_gpu.log" "$RT/probe/probe" --width "$tw" \
+        --height "$th" --rays 64 --k 32 --ground-tiles 64 --reps 7
+    fi
+    for round in $(seq 1 "${RB_TRACE_ROUNDS:-2}"); do
+      n=${#bins[@]}
+      for ((i = 0; i < n; ++i)); do
+        b="${bins[$(((i + round - 1) % n))]}"
+        tag="${b##*/raybridge-bench}"
+        tag="${tag#-}"
+        RAYBRIDGE_VALIDATION=0 step "trace ${tw} ${tag:-current} r$round" 90 "$OUT/trace_gpu.log" "$b" \
+          --scenario trace --full --width "$tw" --height "$th" --out "$TDIR/trace_${tw}_${tag:-current}_$round.json"
+      done
+    done
+  done
+  tar -C "$TDIR" -czf "$OUT/trace_gpu.tar.gz" . 2>/dev/null
+  grep -E '^== trace [0-9]|^ *(ground|sky|probe scene)|^trace primary|pixels hit' "$OUT/trace_gpu.log" | head -n 80
 fi
 # ---- inject: raybridge_tests' failure-injection cases ([inject]), left out of `tests`: every SDK allocation site
 # fails in turn, and every pass is recreated after each (minutes of pipeline compilation on the GPU).
