@@ -46,14 +46,16 @@ void main() {
   // d exp(-d / sigma) <= sigma / e, so all 8 (3/4 of the kernel, against the centre's 1/4) by at most 0.14% of
   // its colour: the half-float rounding of the output. Skipping them saves the guide reads and the weights; it is
   // most of a converged signal (mirrors, which the temporal pass gives no noise; a uniform sky reflected).
-  vec4 values[9];
-  bool inside[9];
+  // Only the taps' deviations are kept across the loops (9 registers, not 36): their colours are fetched again,
+  // from the cache, where the weights need them. Fewer live registers keep more threads in flight to hide the
+  // fetches' latency.
+  float deviations[9];
   float noisiest = 0.0;
   for (int k = 0; k < 9; ++k) {
     ivec2 q = ip + ivec2(k % 3 - 1, k / 3 - 1) * step;
-    inside[k] = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, ivec2(pc.size)));
-    values[k] = k == 4 ? centre : (inside[k] ? texelFetch(signalIn, q, 0) : vec4(0.0));
-    noisiest = max(noisiest, values[k].a);
+    bool inside = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, ivec2(pc.size)));
+    deviations[k] = k == 4 ? centre.a : (inside ? texelFetch(signalIn, q, 0).a : -1.0);  // -1: outside
+    noisiest = max(noisiest, deviations[k]);
   }
   if (noisiest <= kConvergedDeviation * length(centre.rgb)) {
     imageStore(signalOut, ip, vec4(centre.rgb, final ? 1.0 : centre.a));
@@ -79,7 +81,7 @@ void main() {
     ivec2 o = ivec2(k % 3 - 1, k / 3 - 1);
     ivec2 q = ip + o * step;
     geometric[k] = 0.0;
-    if (!inside[k]) continue;
+    if (deviations[k] < 0.0) continue;
     uvec2 qg = texelFetch(guide, q, 0).xy;
     float qdist = rbDnGuideDistance(qg);
     if (qdist <= 0.0) continue;
@@ -91,7 +93,7 @@ void main() {
                                  exp2(pc.normalPower * log2(cosine) - kLog2e * planeDistance)
                            : 0.0;
     geometric[k] = w;
-    tapVariances += w * values[k].a * values[k].a;
+    tapVariances += w * deviations[k] * deviations[k];
     varianceWeights += w;
   }
   // The floor keeps a noise-free pixel's weight finite: a difference of 0.1% of its colour weighs 1/e.
@@ -100,7 +102,7 @@ void main() {
   float weights = 0.0, varianceSum = 0.0;
   for (int k = 0; k < 9; ++k) {
     if (geometric[k] == 0.0) continue;
-    vec4 qv = values[k];
+    vec4 qv = k == 4 ? centre : texelFetch(signalIn, ip + ivec2(k % 3 - 1, k / 3 - 1) * step, 0);
     // The tolerance is the smaller of the two pixels' noise, the centre's taken without this tap: a pixel
     // mixes with a neighbour only when both are that noisy. A bright, noisy pixel (a light's hot spot, a rare
     // sample) then neither spreads into quiet neighbours nor is averaged away while they take none of it back,
