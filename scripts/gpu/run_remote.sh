@@ -23,7 +23,8 @@
 #   RB_PERF_SIZE="2560 1440", RB_PERF_FRAMES=40, RB_PERF_PATH_FRAMES=240, RB_PERF_PRESETS="hard-shadows low medium
 #   high ultra", RB_PERF_VARIANT_PRESETS="hard-shadows low ultra", RB_PERF_BENCH_ARGS=--full: the perf mode's
 #   size, frames per row and along the path, presets (of the current build and of the earlier ones) and benchmark
-#   arguments (smaller ones for a rehearsal on lavapipe)
+#   arguments (smaller ones for a rehearsal on lavapipe); RB_PERF_EXTRAS=0 leaves out the raster, ray-traced,
+#   classifier and fly-through rows (the presets and their earlier builds only)
 #   RB_RUNTIME_DIR=DIR  where .devcarry is unpacked (default /tmp/raybridge-devcarry)
 #   RB_TESTS="NAME ..." the tests mode runs only these executables (tests.txt names); RB_TEST_ARGS="[tag]" gives
 #                       them these arguments instead of their own
@@ -289,6 +290,7 @@ if want perf; then
         perf_render "${scene}-${variant}__hybrid__$preset" "$vbin" "${sargs[@]}" --preset "$preset" --frames "$PFRAMES"
       done
     done
+    [ "${RB_PERF_EXTRAS:-1}" = 1 ] || continue
     for preset in low ultra; do
       perf_render "${scene}__raster__$preset" "$RT/bin/raybridge-render" "${sargs[@]}" --mode raster \
         --preset "$preset" --frames "$PFRAMES"
@@ -303,6 +305,7 @@ if want perf; then
     done
   done
   for mode in hybrid raster raytraced; do
+    [ "${RB_PERF_EXTRAS:-1}" = 1 ] || break
     for preset in low ultra; do
       [ "$mode" = raytraced ] && [ "$preset" = ultra ] && continue  # the preset does not apply
       perf_render "perf__${mode}__${preset}__path" "$RT/bin/raybridge-render" --perf-scene --models-from "$SCENES" \
