@@ -33,31 +33,23 @@ float squared(vec3 v) { return dot(v, v); }
 // One frame's variance from the neighbourhood: the least of the four 3x3 windows that have this pixel in a
 // corner (Kuwahara's trick). Noise spreads every window, while a noise-free edge leaves at least one window on
 // its own side, so it is not taken for noise. Neighbours on another surface (a depth step) are left out.
+// Each window fetches its own 9 texels (the shared ones again, from the cache) instead of the 5x5 block being
+// held: 25 colours and flags live at once would size every thread of this pass by this rarely taken branch.
 float spatialVariance(ivec2 ip, float dist) {
-  vec3 colours[25];
-  bool same[25];
-  for (int y = -2; y <= 2; ++y) {
-    for (int x = -2; x <= 2; ++x) {
-      int k = (y + 2) * 5 + (x + 2);
-      ivec2 q = clamp(ip + ivec2(x, y), ivec2(0), ivec2(pc.size) - 1);
-      float qd = texelFetch(gDepth, q, 0).r;
-      vec4 qv = texelFetch(signalIn, q, 0);
-      same[k] = !rbDnSky(qd) && abs(length(rbDnCameraRelative(uvec2(q), qd)) - dist) <= 0.05 * dist &&
-                ((pc.flags & RB_DN_RGB_REFLECTION) == 0u || qv.a >= 0.5);
-      colours[k] = qv.rgb;
-    }
-  }
-  float v4[4];
-  int wi = 0;
+  float least = 1e30;
   for (int wy = 0; wy <= 2; wy += 2) {
     for (int wx = 0; wx <= 2; wx += 2) {
       vec3 m1 = vec3(0.0), gx = vec3(0.0), gy = vec3(0.0);
       float m2 = 0.0, count = 0.0;
       for (int y = 0; y < 3; ++y) {
         for (int x = 0; x < 3; ++x) {
-          int k = (wy + y) * 5 + wx + x;
-          if (!same[k]) continue;
-          vec3 c = colours[k];
+          ivec2 q = clamp(ip + ivec2(wx + x - 2, wy + y - 2), ivec2(0), ivec2(pc.size) - 1);
+          float qd = texelFetch(gDepth, q, 0).r;
+          vec4 qv = texelFetch(signalIn, q, 0);
+          bool same = !rbDnSky(qd) && abs(length(rbDnCameraRelative(uvec2(q), qd)) - dist) <= 0.05 * dist &&
+                      ((pc.flags & RB_DN_RGB_REFLECTION) == 0u || qv.a >= 0.5);
+          if (!same) continue;
+          vec3 c = qv.rgb;
           m1 += c;
           m2 += squared(c);
           gx += float(x - 1) * c;
@@ -70,10 +62,10 @@ float spatialVariance(ivec2 ip, float dist) {
       // either; 6 degrees of freedom remain.
       float v = count == 9.0 ? max(m2 - squared(m1) / 9.0 - squared(gx) / 6.0 - squared(gy) / 6.0, 0.0) / 6.0
                              : max(m2 - squared(m1) / count, 0.0) / max(count - 1.0, 1.0);
-      v4[wi++] = v;
+      least = min(least, v);
     }
   }
-  return min(min(v4[0], v4[1]), min(v4[2], v4[3]));
+  return least;
 }
 
 void main() {
