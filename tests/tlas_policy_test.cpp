@@ -2,6 +2,7 @@
 // the refit count; HybridEffectsDesc::tlasMode.
 #include <catch2/catch_test_macros.hpp>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -30,13 +31,26 @@ std::vector<float> planeOrigins(uint32_t side, float size, uint32_t seed) {
   return o;
 }
 
+// TlasMotionMeasure's input: a row-major 3x4 transform per origin, with `linear` (row-major 3x3) as every
+// instance's rotation and scale.
+std::vector<float> placed(const std::vector<float>& origins,
+                          const std::array<float, 9>& linear = {1, 0, 0, 0, 1, 0, 0, 0, 1}) {
+  std::vector<float> t;
+  for (size_t i = 0; i + 2 < origins.size(); i += 3) {
+    for (int row = 0; row < 3; ++row) {
+      t.insert(t.end(), {linear[3 * row], linear[3 * row + 1], linear[3 * row + 2], origins[i + row]});
+    }
+  }
+  return t;
+}
+
 }  // namespace
 
 TEST_CASE("the TLAS motion measure grows when neighbours scatter and not when they move together", "[tlas][policy]") {
   const std::vector<float> base = planeOrigins(100, 1000.0f, 7);  // 10,000 instances 10 units apart
   rb::TlasMotionMeasure m;
-  m.reset(base);
-  CHECK(m.growth(base) == 1.0);
+  m.reset(placed(base));
+  CHECK(m.growth(placed(base)) == 1.0);
 
   // The whole field translated far (a camera-relative origin shift, a convoy): every group keeps its box.
   std::vector<float> shifted = base;
@@ -45,7 +59,7 @@ TEST_CASE("the TLAS motion measure grows when neighbours scatter and not when th
     shifted[i + 1] += 40.0f;
     shifted[i + 2] -= 300.0f;
   }
-  CHECK(std::abs(m.growth(shifted) - 1.0) < 1e-3);
+  CHECK(std::abs(m.growth(placed(shifted)) - 1.0) < 1e-3);
 
   // Each instance wanders a little (a tenth of the spacing): the boxes grow a little.
   std::mt19937 rng(11);
@@ -55,7 +69,7 @@ TEST_CASE("the TLAS motion measure grows when neighbours scatter and not when th
     small[i] += 1.0f * unit(rng);
     large[i] += 60.0f * unit(rng);  // six spacings: neighbours at the rebuild are now far apart
   }
-  const double smallGrowth = m.growth(small), largeGrowth = m.growth(large);
+  const double smallGrowth = m.growth(placed(small)), largeGrowth = m.growth(placed(large));
   INFO("small " << smallGrowth << ", large " << largeGrowth);
   CHECK(smallGrowth > 1.0);
   CHECK(smallGrowth < 1.3);
@@ -64,29 +78,47 @@ TEST_CASE("the TLAS motion measure grows when neighbours scatter and not when th
   // The same scatter on a field that also has height (3D cells) is seen too.
   std::vector<float> volume = base, volumeScattered;
   for (size_t i = 1; i < volume.size(); i += 3) volume[i] = float((i / 3) % 37) * 25.0f;
-  m.reset(volume);
+  m.reset(placed(volume));
   volumeScattered = volume;
   for (size_t i = 0; i < volume.size(); ++i) volumeScattered[i] += 60.0f * unit(rng);
-  CHECK(m.growth(volumeScattered) > double(rb::kDefaultTlasMaxAreaGrowth));
+  CHECK(m.growth(placed(volumeScattered)) > double(rb::kDefaultTlasMaxAreaGrowth));
+}
+
+TEST_CASE("the TLAS motion measure sees instances spin and grow in place", "[tlas][policy]") {
+  const std::vector<float> base = planeOrigins(100, 1000.0f, 7);
+  rb::TlasMotionMeasure m;
+  m.reset(placed(base));
+  // A quarter turn about y permutes the axes of each instance's box: the same bounds, the same area.
+  CHECK(std::abs(m.growth(placed(base, {0, 0, 1, 0, 1, 0, -1, 0, 0})) - 1.0) < 1e-9);
+  // An eighth of a turn widens each box by sqrt(2) in x and z: the groups' boxes grow, by less than a scatter.
+  const float c = std::sqrt(0.5f);
+  const double turned = m.growth(placed(base, {c, 0, c, 0, 1, 0, -c, 0, c}));
+  INFO("eighth turn " << turned);
+  CHECK(turned > 1.05);
+  CHECK(turned < double(rb::kDefaultTlasMaxAreaGrowth));
+  // Every instance three times its size where it stands: the refitted boxes would overlap their neighbours'.
+  CHECK(m.growth(placed(base, {3, 0, 0, 0, 3, 0, 0, 0, 3})) > double(rb::kDefaultTlasMaxAreaGrowth));
+  // A field built rotated and scaled is its own baseline.
+  const std::array<float, 9> rotated = {c, 0, c, 0, 2, 0, -c, 0, c};
+  m.reset(placed(base, rotated));
+  CHECK(m.growth(placed(base, rotated)) == 1.0);
 }
 
 TEST_CASE("the TLAS motion measure takes degenerate lists", "[tlas][policy]") {
   rb::TlasMotionMeasure m;
   m.reset({});
   CHECK(m.growth({}) == 1.0);
-  const std::vector<float> one = {3.0f, 4.0f, 5.0f};
+  const std::vector<float> one = placed({3.0f, 4.0f, 5.0f});
   m.reset(one);
   CHECK(m.growth(one) == 1.0);
-  const std::vector<float> same = {1, 1, 1, 1, 1, 1, 1, 1, 1};  // three instances in one point
+  const std::vector<float> same = placed({1, 1, 1, 1, 1, 1, 1, 1, 1});  // three instances in one point
   m.reset(same);
   CHECK(m.growth(same) == 1.0);
-  const std::vector<float> apart = {1, 1, 1, 1, 1, 1, 9, 1, 1};
-  CHECK(m.growth(apart) > 1.0);
+  CHECK(m.growth(placed({1, 1, 1, 1, 1, 1, 9, 1, 1})) > 1.0);
   // A list of another length than the one measured at the rebuild is no refit chain: no growth claimed.
   CHECK(m.growth(one) == 1.0);
   // A non-finite translation reads as unbounded growth, so the policy rebuilds rather than refits over it.
-  std::vector<float> bad = same;
-  bad[4] = std::numeric_limits<float>::infinity();
+  std::vector<float> bad = placed({1, 1, 1, 1, std::numeric_limits<float>::infinity(), 1, 1, 1, 1});
   CHECK(!(m.growth(bad) <= double(rb::kDefaultTlasMaxAreaGrowth)));
 }
 

@@ -197,7 +197,7 @@ struct AccelerationStructureService::Impl {
   uint64_t tlasSerial = 0;
   uint32_t lastTlasSlot = UINT32_MAX;  // slot of the TLAS recorded last
   TlasMotionMeasure tlasMotion;        // TlasBuildMode::Adaptive's refit-quality measure
-  std::vector<float> tlasOrigins;      // scratch: the written instances' translations (Adaptive)
+  std::vector<float> tlasTransforms;   // scratch: the written instances' transforms, 12 floats each (Adaptive)
   uint64_t tlasMotionSerial = 0;       // the TLAS (tlasSerial) whose build last updated tlasMotion
   uint64_t releaseCounter = 0;
   VkDeviceSize reservedBytes = 0;  // storage of all live BLASes (aligned), for the budget

@@ -149,7 +149,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   uint32_t written = 0, skipped = 0, stale = 0, nonOpaque = 0;
   uint64_t signature = 0;
   const bool adaptive = options.mode == TlasBuildMode::Adaptive;
-  if (adaptive) s.tlasOrigins.clear();
+  if (adaptive) s.tlasTransforms.clear();
   const bool rebase = options.originOffset[0] != 0.0 || options.originOffset[1] != 0.0 ||
                       options.originOffset[2] != 0.0;
   for (uint32_t i = 0; i < count; ++i) {
@@ -183,7 +183,9 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
       }
     }
     if (adaptive) {
-      for (int row = 0; row < 3; ++row) s.tlasOrigins.push_back(inst.transform.matrix[row][3]);
+      for (int row = 0; row < 3; ++row) {
+        for (int col = 0; col < 4; ++col) s.tlasTransforms.push_back(inst.transform.matrix[row][col]);
+      }
     }
     inst.instanceCustomIndex = in.customIndex;
     inst.mask = in.mask;
@@ -253,7 +255,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   if (adaptive && source) {
     const uint32_t maxRefits = options.maxRefits ? options.maxRefits : kDefaultTlasMaxRefits;
     const float maxGrowth = options.maxAreaGrowth != 0.0f ? options.maxAreaGrowth : kDefaultTlasMaxAreaGrowth;
-    growth = float(s.tlasMotion.growth(s.tlasOrigins));
+    growth = float(s.tlasMotion.growth(s.tlasTransforms));
     if (!(growth <= maxGrowth) || s.tlasMotion.refitsSinceRebuild >= maxRefits) source = nullptr;
   }
   info.geometryCount = 1;
@@ -343,7 +345,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
     if (source) {
       refitsSinceRebuild = ++s.tlasMotion.refitsSinceRebuild;
     } else {
-      s.tlasMotion.reset(s.tlasOrigins);
+      s.tlasMotion.reset(s.tlasTransforms);
       growth = 1.0f;
     }
     s.tlasMotionSerial = serial;

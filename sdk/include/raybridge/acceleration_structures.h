@@ -191,10 +191,11 @@ enum class TlasBuildMode : uint8_t {
 };
 
 // TlasBuildMode::Adaptive rebuilds when the summed surface area of groups of instances that were neighbours at
-// the last rebuild (about 16 per cell of a uniform grid over their origins; each origin padded by half a cell)
-// exceeds this multiple of its value then. A refit keeps the tree's topology, so neighbours that drift apart
-// grow its boxes; a group that moves together does not. Measured on the host from the translations only (the
-// SDK has no mesh bounds there): rotation and scale act through kDefaultTlasMaxRefits.
+// the last rebuild (about 16 per cell of a uniform grid over their origins; each instance a cube of half a cell
+// around its origin under its rotation and scale) exceeds this multiple of its value then. A refit keeps the
+// tree's topology, so neighbours that drift apart, spin or grow enlarge its boxes; a group that moves together
+// does not. Measured on the host from the instance transforms (the SDK has no mesh bounds there: the cell stands
+// for an instance's size).
 // The value and the trace cost of refitted TLASes: docs/performance.md, "TLAS refits".
 constexpr float kDefaultTlasMaxAreaGrowth = 1.5f;
 // TlasBuildMode::Adaptive rebuilds after this many refits in a row even when the measure stays low (one second at
