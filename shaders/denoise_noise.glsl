@@ -16,9 +16,10 @@ const float kRbDnPriorRays = 1.0;
 // With the rays per pixel known (a fraction of binary rays) an estimate is binomial, p (1 - p) / (rays * frames),
 // at a probability p from the pixel's own rays plus the window's mean; else the window's variance divided by the
 // frames averaged.
-// Each window fetches its own 9 texels (the shared ones again, from the cache): the 5x5 block held at once would
-// keep 25 registers live in every thread of the pass.
 float rbDnNoiseVariance(sampler2D signal, ivec2 ip, float mean, float frames) {
+  float v[25];
+  for (int y = -2; y <= 2; ++y)
+    for (int x = -2; x <= 2; ++x) v[(y + 2) * 5 + x + 2] = rbDnSignalValue(texelFetch(signal, clamp(ip + ivec2(x, y), ivec2(0), ivec2(pc.size) - 1), 0).r);
   const float rays = pc.signalRaysPerPixel * frames;
   const float c = clamp(mean, 0.0, 1.0);
   float least = 1e30;
@@ -27,8 +28,7 @@ float rbDnNoiseVariance(sampler2D signal, ivec2 ip, float mean, float frames) {
       float m1 = 0.0, m2 = 0.0;
       for (int y = 0; y < 3; ++y) {
         for (int x = 0; x < 3; ++x) {
-          ivec2 t = clamp(ip + ivec2(wx + x - 2, wy + y - 2), ivec2(0), ivec2(pc.size) - 1);
-          float q = rbDnSignalValue(texelFetch(signal, t, 0).r);
+          float q = v[(wy + y) * 5 + wx + x];
           m1 += q;
           m2 += q * q;
         }

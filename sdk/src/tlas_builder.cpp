@@ -183,9 +183,8 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
       }
     }
     if (adaptive) {
-      for (int row = 0; row < 3; ++row) {
-        for (int col = 0; col < 4; ++col) s.tlasTransforms.push_back(inst.transform.matrix[row][col]);
-      }
+      const float* m = &inst.transform.matrix[0][0];  // row-major 3x4, contiguous
+      s.tlasTransforms.insert(s.tlasTransforms.end(), m, m + TlasMotionMeasure::kFloatsPerInstance);
     }
     inst.instanceCustomIndex = in.customIndex;
     inst.mask = in.mask;
