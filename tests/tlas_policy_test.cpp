@@ -122,6 +122,79 @@ TEST_CASE("the TLAS motion measure takes degenerate lists", "[tlas][policy]") {
   CHECK(!(m.growth(bad) <= double(rb::kDefaultTlasMaxAreaGrowth)));
 }
 
+TEST_CASE("the TLAS motion measure survives NaN, outliers, zero scale and far origins", "[tlas][policy]") {
+  constexpr float nan = std::numeric_limits<float>::quiet_NaN();
+  const double maxGrowth = double(rb::kDefaultTlasMaxAreaGrowth);
+  const std::vector<float> base = planeOrigins(100, 1000.0f, 7);
+  rb::TlasMotionMeasure m;
+
+  // A NaN in the first instance at the rebuild: the measure must not size its grid from it. Until a finite
+  // list is measured again, every frame reads as unbounded growth, so the policy rebuilds.
+  std::vector<float> firstNaN = base;
+  firstNaN[0] = nan;
+  m.reset(placed(firstNaN));
+  CHECK(!(m.growth(placed(firstNaN)) <= maxGrowth));
+  CHECK(!(m.growth(placed(base)) <= maxGrowth));
+  // A NaN in a later instance, in a frame after a finite rebuild, is no refit either (min and max skip NaN).
+  m.reset(placed(base));
+  std::vector<float> laterNaN = base;
+  laterNaN[3 * 4321 + 2] = nan;
+  CHECK(!(m.growth(placed(laterNaN)) <= maxGrowth));
+  std::vector<float> nanScale = placed(base);
+  nanScale[12 * 77 + 5] = nan;  // instance 77's linear part
+  CHECK(!(m.growth(nanScale) <= maxGrowth));
+  CHECK(m.growth(placed(base)) == 1.0);
+
+  // One instance far away (a skybox anchor, a parked vehicle at the origin of a streamed world) must not stretch
+  // the grid so that the whole field is one group: the same scatter as above is still seen.
+  std::vector<float> withOutlier = base;
+  withOutlier.insert(withOutlier.end(), {1.0e6f, 0.0f, 1.0e6f});
+  m.reset(placed(withOutlier));
+  CHECK(m.growth(placed(withOutlier)) == 1.0);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<float> scattered = withOutlier, wandered = withOutlier;
+  for (size_t i = 0; i < base.size(); ++i) {
+    scattered[i] += 60.0f * unit(rng);
+    wandered[i] += 1.0f * unit(rng);
+  }
+  const double scatterGrowth = m.growth(placed(scattered)), wanderGrowth = m.growth(placed(wandered));
+  INFO("with an outlier: scatter " << scatterGrowth << ", wander " << wanderGrowth);
+  CHECK(scatterGrowth > maxGrowth);
+  CHECK(wanderGrowth < 1.3);
+  // The outlier moving on its own (it is its own group) changes nothing the tree would notice.
+  std::vector<float> outlierMoved = withOutlier;
+  outlierMoved[outlierMoved.size() - 3] += 5000.0f;
+  CHECK(std::abs(m.growth(placed(outlierMoved)) - 1.0) < 1e-6);
+
+  // Instances hidden by a zero scale, on one line: the baseline area is 0. Growing back is growth, not "1".
+  std::vector<float> line;
+  for (int i = 0; i < 40; ++i) line.insert(line.end(), {float(i) * 10.0f, 0.0f, 0.0f});
+  m.reset(placed(line, {0, 0, 0, 0, 0, 0, 0, 0, 0}));
+  CHECK(m.growth(placed(line, {0, 0, 0, 0, 0, 0, 0, 0, 0})) == 1.0);
+  CHECK(!(m.growth(placed(line)) <= maxGrowth));
+
+  // A field ten thousand kilometres from the origin (integer origins, exact in float there) measures as it does
+  // at the origin: the boxes are summed in double, not rounded to the inputs' 1-unit spacing out there.
+  std::vector<float> near, far;
+  for (int z = 0; z < 60; ++z) {
+    for (int x = 0; x < 60; ++x) {
+      const float px = float(10 * x + (x * 7 + z) % 3), pz = float(10 * z + (z * 5 + x) % 4);
+      near.insert(near.end(), {px, 0.0f, pz});
+      far.insert(far.end(), {px + 1.0e7f, 0.0f, pz - 1.0e7f});
+    }
+  }
+  const float c = std::sqrt(0.5f);
+  const std::array<float, 9> eighthTurn = {c, 0, c, 0, 1, 0, -c, 0, c};
+  m.reset(placed(near));
+  const double nearTurned = m.growth(placed(near, eighthTurn));
+  m.reset(placed(far));
+  const double farTurned = m.growth(placed(far, eighthTurn));
+  INFO("an eighth turn near the origin " << nearTurned << ", 10,000 km away " << farTurned);
+  CHECK(nearTurned > 1.05);
+  CHECK(std::abs(farTurned - nearTurned) < 1e-6);
+}
+
 TEST_CASE("an adaptive TLAS refits, rebuilds after maxRefits and when instances scatter, and traces right",
           "[as][tlas][policy]") {
   GpuFixture fx;

@@ -32,6 +32,10 @@ T check(rb::Result<T> r, const std::string& what) {
 }
 void check(const rb::Status& s, const std::string& what);
 
+// The TLAS of the benchmarks that trace a static instance list built once: a plain rebuild, without the
+// ALLOW_UPDATE flag that the default (TlasBuildMode::Adaptive) builds with, as their published rates were measured.
+inline constexpr rb::TlasBuildOptions kStaticTlas{.mode = rb::TlasBuildMode::Rebuild};
+
 // A mesh uploaded into device-local buffers the way an engine would hold it.
 struct UploadedMesh {
   rb::HeadlessBuffer vertices;

@@ -205,7 +205,7 @@ nlohmann::json runAlphaScenario(BenchEnv& env) {
   const size_t variantCount = std::size(kVariants);
   struct Setup {
     std::vector<rb::Instance> instances;
-    rb::TlasBuildOptions tlas;
+    rb::TlasBuildOptions tlas = kStaticTlas;
     rb::ShadowSettings settings[2];
   };
   std::vector<Setup> setups(variantCount);

@@ -42,7 +42,7 @@ nlohmann::json measure(BenchEnv& env, rb::PrimaryRayPass& pass, const UploadedMe
   env.runFrame([&](VkCommandBuffer cmd) {
     timer.reset(cmd);
     a = timer.mark(cmd);
-    tlas = check(service->recordTlasBuild(cmd, instances), "recordTlasBuild");
+    tlas = check(service->recordTlasBuild(cmd, instances, kStaticTlas), "recordTlasBuild");
     b = timer.mark(cmd);
   });
   timer.resolve();

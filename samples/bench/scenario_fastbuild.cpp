@@ -29,7 +29,9 @@ nlohmann::json measure(BenchEnv& env, rb::PrimaryRayPass& pass, const UploadedMe
     ms.push_back(buildQueued(env, *service).gpuMs);
   }
   rb::TlasInfo tlas;
-  env.runFrame([&](VkCommandBuffer cmd) { tlas = check(service->recordTlasBuild(cmd, {&instance, 1}), "TLAS"); });
+  env.runFrame([&](VkCommandBuffer cmd) {
+    tlas = check(service->recordTlasBuild(cmd, {&instance, 1}, kStaticTlas), "TLAS");
+  });
   env.settle();
   TraceTiming trace = timeTraces(env, pass, tlas.tlas, cameraOverGround(kGroundSize), env.sizes().traceRepeats);
   rb::AsStats st = service->stats();

@@ -65,8 +65,9 @@ nlohmann::json runGigaRaysScenario(BenchEnv& env) {
   instance.mesh = registerOrThrow(*service, mesh.desc, "stress ground");
   (void)buildQueued(env, *service);
   rb::TlasInfo tlas;
-  env.runFrame(
-      [&](VkCommandBuffer cmd) { tlas = check(service->recordTlasBuild(cmd, std::span(&instance, 1)), "TLAS"); });
+  env.runFrame([&](VkCommandBuffer cmd) {
+    tlas = check(service->recordTlasBuild(cmd, std::span(&instance, 1), kStaticTlas), "TLAS");
+  });
   env.settle();
 
   rb::RayTracingPipelineDesc desc;

@@ -166,7 +166,7 @@ nlohmann::json runLightsScenario(BenchEnv& env) {
     std::memcpy(instances[i].transform, scene.instanceTransforms[i].data(), sizeof instances[i].transform);
     instances[i].customIndex = uint32_t(i);
   }
-  rb::TlasBuildOptions tlasOptions;
+  rb::TlasBuildOptions tlasOptions = kStaticTlas;
   for (int i = 0; i < 3; ++i) tlasOptions.originOffset[i] = camera.eye[i];
   auto buildTlas = [&](VkCommandBuffer cmd) {
     rb::TlasInfo tlas = check(service->recordTlasBuild(cmd, instances, tlasOptions), "TLAS");

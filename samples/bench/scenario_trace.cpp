@@ -74,7 +74,8 @@ TracedScene buildScene(BenchEnv& env, const std::vector<rbsamples::CpuMesh>& cpu
   (void)buildQueued(env, *s.service);
   env.runFrame([&](VkCommandBuffer cmd) { (void)check(s.service->recordPendingWork(cmd), "compaction frame"); });
   env.settle();
-  env.runFrame([&](VkCommandBuffer cmd) { s.tlas = check(s.service->recordTlasBuild(cmd, instances), "TLAS"); });
+  env.runFrame(
+      [&](VkCommandBuffer cmd) { s.tlas = check(s.service->recordTlasBuild(cmd, instances, kStaticTlas), "TLAS"); });
   env.settle();
   return s;
 }

@@ -10,6 +10,10 @@
 // scale of its neighbourhood), so a group that moves together (a vehicle, a crowd walking one way, a
 // camera-relative origin shift) keeps its area, while members that scatter, spin (a rotated box's bounds are up to
 // sqrt(3) times wider) or grow enlarge it, as they enlarge the refitted tree's boxes.
+// The grid spans the origins within the kOutlierFraction quantiles per axis; an instance more than a cell outside
+// is a group of its own, so one far instance does not make the cells so large that the whole field is one group. A
+// non-finite transform (at the rebuild or since) reads as unbounded growth, and so does any growth over a zero baseline
+// (instances hidden by a zero scale): the policy rebuilds rather than refit over what it cannot measure.
 //
 // Thread safety: none; owned by one service, used under its mutex.
 #pragma once
@@ -29,19 +33,28 @@ class TlasMotionMeasure {
   static constexpr size_t kFloatsPerInstance = 12;
   // Groups the instances at a rebuild and records the baseline area.
   void reset(std::span<const float> transforms);
-  // The summed group area now over the one at the last reset(); 1 when no group grew. The instance count must
-  // be the one of reset() (a refit's instance list keeps its count).
+  // The summed group area now over the one at the last reset(); 1 when no group grew; +inf when a transform
+  // now or at reset() is not finite, or when the area grew from 0. A list of another instance count than
+  // reset()'s gives 1 (no refit chain: a refit's instance list keeps its count).
   double growth(std::span<const float> transforms);
   uint32_t refitsSinceRebuild = 0;
 
  private:
   double summedArea(std::span<const float> transforms);
 
+  // Per axis, the fraction of origins below the grid's low end and above its high end (1% each: for lists of
+  // under 100 instances, none).
+  static constexpr double kOutlierFraction = 0.01;
+  // Origins per axis that the quantiles are taken from (an even stride over longer lists).
+  static constexpr size_t kQuantileSamples = 1024;
+
   std::vector<uint32_t> groupOf_;  // per instance
   uint32_t groups_ = 0;
-  float pad_ = 0.0f;  // half a cell edge
+  double pad_ = 0.5;  // half a cell edge
   double baseline_ = 0.0;
-  std::vector<float> boxes_;  // per group: min xyz, max xyz (scratch of summedArea)
+  float ref_[3] = {0.0f, 0.0f, 0.0f};  // the grid's low corner: summedArea()'s boxes are relative to it
+  bool finite_ = true;                 // every float of reset()'s list was finite
+  std::vector<float> boxes_;           // per group: min xyz, max xyz relative to ref_ (scratch of summedArea)
 };
 
 }  // namespace rb

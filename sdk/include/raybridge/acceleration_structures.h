@@ -218,7 +218,7 @@ enum class TlasBuildPreference : uint8_t {
 };
 
 struct TlasBuildOptions {
-  TlasBuildMode mode = TlasBuildMode::Rebuild;
+  TlasBuildMode mode = TlasBuildMode::Adaptive;  // the zero value, as HybridEffectsDesc::tlasMode's default
   TlasInstanceUpload instanceUpload = TlasInstanceUpload::Auto;
   TlasBuildPreference preference = TlasBuildPreference::FastTrace;
   // Subtracted (in double precision) from every instance's translation, so a camera-relative TLAS keeps full
