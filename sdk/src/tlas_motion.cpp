@@ -16,13 +16,15 @@ float originOf(std::span<const float> transforms, size_t i, int a) { return tran
 
 // Whether every float is finite: its exponent bits not all set. Written on the bits so that it vectorises
 // (std::isfinite per float does not), as it runs over twelve floats per instance every frame.
+uint32_t nonFiniteBit(float v) {
+  uint32_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return uint32_t((bits & 0x7f800000u) == 0x7f800000u);
+}
+
 bool allFinite(std::span<const float> transforms) {
   uint32_t nonFinite = 0;
-  for (float v : transforms) {
-    uint32_t bits;
-    std::memcpy(&bits, &v, sizeof bits);
-    nonFinite |= uint32_t((bits & 0x7f800000u) == 0x7f800000u);
-  }
+  for (float v : transforms) nonFinite |= nonFiniteBit(v);
   return nonFinite == 0;
 }
 
@@ -127,14 +129,17 @@ double TlasMotionMeasure::growth(std::span<const float> transforms) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   // A list of another length is no refit chain (the caller rebuilds on the count anyway): no growth claimed.
   if (transforms.size() / kStride != groupOf_.size()) return 1.0;
-  // min and max skip NaN, so a non-finite transform would vanish from the boxes: it reads as unbounded growth.
-  if (!finite_ || !allFinite(transforms)) return inf;
+  // min and max skip NaN, so a non-finite transform would vanish from the boxes: summedArea() says NaN
+  // instead, and it reads as unbounded growth.
+  if (!finite_) return inf;
   const double now = summedArea(transforms);
+  if (std::isnan(now)) return inf;
   // A zero baseline (every instance scaled to nothing, on one line or in one point) grows from nothing.
   if (!(baseline_ > 0.0)) return now > 0.0 ? inf : 1.0;
   return std::isfinite(now) ? now / baseline_ : inf;
 }
 
+// NaN when an input float is not finite.
 double TlasMotionMeasure::summedArea(std::span<const float> transforms) {
   // The boxes are float (half the memory of double: at a million instances they outgrow the caches), in
   // coordinates relative to ref_, a grid corner of reset(): an origin near the field minus ref_ is exact
@@ -149,17 +154,28 @@ double TlasMotionMeasure::summedArea(std::span<const float> transforms) {
     }
   }
   const float pad = float(pad_);
+  // Any non-finite input float makes a bound below non-finite (pad is finite and positive): one test per bound
+  // instead of another pass over the twelve floats of each instance.
+  uint32_t nonFinite = 0;
+  const float ref[3] = {ref_[0], ref_[1], ref_[2]};  // locals: the box stores below may not alias them
   for (size_t i = 0; i < groupOf_.size(); ++i) {
-    float* box = &boxes_[6 * size_t(groupOf_[i])];
     const float* m = &transforms[kStride * i];
+    float lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
       // The bounds of the cube [-pad, pad]^3 under the instance's linear part: pad times the row's absolute sum.
       const float half = pad * (std::abs(m[4 * a]) + std::abs(m[4 * a + 1]) + std::abs(m[4 * a + 2]));
-      const float origin = m[4 * a + 3] - ref_[a];
-      box[a] = std::min(box[a], origin - half);
-      box[3 + a] = std::max(box[3 + a], origin + half);
+      const float origin = m[4 * a + 3] - ref[a];
+      lo[a] = origin - half;
+      hi[a] = origin + half;
+      nonFinite |= nonFiniteBit(lo[a]) | nonFiniteBit(hi[a]);
+    }
+    float* box = &boxes_[6 * size_t(groupOf_[i])];
+    for (int a = 0; a < 3; ++a) {
+      box[a] = std::min(box[a], lo[a]);
+      box[3 + a] = std::max(box[3 + a], hi[a]);
     }
   }
+  if (nonFinite) return std::numeric_limits<double>::quiet_NaN();
   double sum = 0.0;
   for (uint32_t g = 0; g < groups_; ++g) {
     const float* box = &boxes_[6 * g];
