@@ -5,8 +5,10 @@
 #   bash scripts/gpu/run_remote.sh [all|MODE[,MODE...]]   MODE: bench, tests, inject, render, effects, animated,
 #                                                          lights, perf, adaptive, soak (default all; inject,
 #                                                          the failure-injection cases, tlas, the TLAS
-#                                                          benchmark alone, and trace, the primary-ray rate
-#                                                          against the probe, run only when named)
+#                                                          benchmarks alone (with the tlas-motion runs of
+#                                                          earlier builds carried as bin/raybridge-bench-X),
+#                                                          and trace, the primary-ray rate against the probe,
+#                                                          run only when named)
 #
 # Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
 # tests_gpu.log, effects_gpu.json, effects_gpu.log, render_gpu.tar.gz (render logs, stats.json and final.png
@@ -416,6 +418,22 @@ if [[ ",$MODE," == *,tlas,* ]]; then  # only when named: `bench` runs it with ev
   RAYBRIDGE_VALIDATION=0 step "tlas-motion bench" 150 "$OUT/tlas_motion_gpu.log" "$RT/bin/raybridge-bench" \
     --scenario tlas-motion --full --out "$OUT/tlas_motion_gpu.json"
   grep -A40 '^== tlas-motion' "$OUT/tlas_motion_gpu.log" | head -n 40
+  # Earlier builds carried as bin/raybridge-bench-VARIANT (prepare.sh EXTRA_BINS): their tlas-motion runs in the
+  # same session, then the current build's once more, so a change of the policy's measure is compared in one run
+  # (host times included). Into tlas_motion_gpu_VARIANT.json and tlas_motion_gpu_again.json, logs appended.
+  shopt -s nullglob
+  earlier=("$RT"/bin/raybridge-bench-*)
+  shopt -u nullglob
+  if [ "${#earlier[@]}" -gt 0 ]; then
+    for bin in "${earlier[@]}"; do
+      variant="${bin##*/raybridge-bench-}"
+      RAYBRIDGE_VALIDATION=0 step "tlas-motion bench ($variant)" 150 "$OUT/tlas_motion_gpu.log" "$bin" \
+        --scenario tlas-motion --full --out "$OUT/tlas_motion_gpu_$variant.json"
+    done
+    RAYBRIDGE_VALIDATION=0 step "tlas-motion bench (again)" 150 "$OUT/tlas_motion_gpu.log" "$RT/bin/raybridge-bench" \
+      --scenario tlas-motion --full --out "$OUT/tlas_motion_gpu_again.json"
+    grep -A12 '^== tlas-motion: TLAS per frame' "$OUT/tlas_motion_gpu.log" | grep -E 'variant|adaptive|rebuild|refit'
+  fi
 fi
 # ---- trace: docs/performance.md's primary-pass rows. The probe (~1M triangles) at 2560x1440 and 1920x1080, then
 # raybridge-bench --scenario trace --full at both sizes (its third view is the probe's own scene and camera), by
