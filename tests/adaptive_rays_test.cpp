@@ -133,6 +133,27 @@ TEST_CASE("the ray budget controller settles on its time target despite a fixed 
   // One measurement is taken in once: asking again without a new frame keeps the budget.
   const uint64_t again = c.next(41, latest, target, 2e7, 1e3, 1e9);
   CHECK(again == planned.back());
+  // One wild measurement (a near-zero reading, a wrapped tick count) moves the budget by at most kMaxBudgetStep,
+  // and the controller walks back to the target.
+  for (double wild : {1e-6, 1.8e13}) {
+    INFO("wild gpuMs " << wild);
+    rb::RayBudgetController w = c;
+    rb::PassStats odd = latest;
+    odd.frame = 39;
+    odd.gpuMs = wild;
+    const uint64_t afterWild = w.next(42, odd, target, 2e7, 1e3, 1e9);
+    CHECK(double(afterWild) <= rb::kMaxBudgetStep * 1.001 * double(again));
+    CHECK(double(afterWild) >= double(again) / (rb::kMaxBudgetStep * 1.001));
+    std::vector<uint64_t> plan(43, afterWild);
+    for (uint64_t frame = 43; frame <= 60; ++frame) {
+      rb::PassStats m;
+      m.frame = frame - 2;
+      m.rays = plan[frame - 2];
+      m.gpuMs = cost(double(m.rays));
+      plan.push_back(w.next(frame, m, target, 2e7, 1e3, 1e9));
+    }
+    CHECK(std::abs(double(plan.back()) - 6e6) < 0.03 * 6e6);
+  }
   // Only a quarter of the plan traced (half resolution): the controller scales the planned budget, not the rays
   // counted, so it still settles where the pass takes the target time (traced = budget / 4).
   rb::RayBudgetController quarter;
@@ -164,6 +185,36 @@ TEST_CASE("the ray budget controller settles on its time target despite a fixed 
     low = slow.next(uint64_t(i + 2), dear, target, 5e5, 1e3, 1e6);
   }
   CHECK(low == 1000);
+}
+
+TEST_CASE("a per-tile cap under one tile's rays still traces one tile a frame", "[adaptive][ao]") {
+  GpuFixture fx;
+  const uint32_t w = 64, h = 48;
+  AdaptiveScene s(fx, w, h);
+  rb::HybridEffectsDesc desc;
+  desc.effects = rb::kEffectAo;
+  desc.ao.raysPerPixel = 4;
+  desc.ao.range = 2.0f;
+  desc.ao.adaptive.enabled = true;
+  desc.ao.adaptive.granularity = rb::AdaptiveRayGranularity::Tile;
+  desc.ao.adaptive.maxRaysPerFrame = 16;  // a quarter of the default 8x8 tile
+  auto fxr = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
+  RB_REQUIRE_OK(fxr);
+  rb::HybridEffects& effects = *fxr.value();
+  const rb::HybridFrame frame = s.frame();
+  fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });  // uniform: no history
+  const uint64_t tileRays = uint64_t(rb::kDefaultAdaptiveTileWidth) * rb::kDefaultAdaptiveTileHeight;
+  // Each tile rounds its share (budget / surface pixels, here 1/32 of a ray) up to one ray a pixel with that
+  // probability, so a frame may trace nothing; over frames some tile must, and never more than one tile's rays.
+  uint64_t total = 0;
+  for (int i = 0; i < 8; ++i) {
+    fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });
+    const uint64_t rays = effects.stats().ao.rays;
+    INFO("frame " << i << ": " << rays << " rays");
+    CHECK(rays <= tileRays);
+    total += rays;
+  }
+  CHECK(total > 0);
 }
 
 TEST_CASE("adaptive AO traces no more rays than its budget, the plan matches the counters, and rays go where the "

@@ -15,8 +15,13 @@ uint64_t RayBudgetController::next(uint64_t frame, const PassStats& latest, doub
     }
     if (measured > 0.0) {
       lastFrame = latest.frame;
-      const double ideal = measured * targetMs / latest.gpuMs;
-      budget = std::sqrt(std::max(budget, 1.0) * std::max(ideal, 1.0));
+      // One measurement moves the budget by at most kMaxBudgetStep (after the half log-step): a single bad
+      // timestamp (a hitch, a wrapped tick count, a near-zero reading) must not plan a frame a hundred times too
+      // dear or too cheap, and the budget walks back from it in a few frames.
+      const double current = std::max(budget, 1.0);
+      const double ideal = std::clamp(measured * targetMs / latest.gpuMs, current / (kMaxBudgetStep * kMaxBudgetStep),
+                                      current * kMaxBudgetStep * kMaxBudgetStep);
+      budget = std::sqrt(current * std::max(ideal, 1.0));
     }
   }
   budget = std::clamp(budget, minRays, std::max(minRays, maxRays));

@@ -3,7 +3,8 @@
 // scaled by target / ms: the budget, not the rays counted, because not every planned ray is traced: at half
 // resolution a quarter of the plan is, and shadow pixels facing away from the light trace none),
 // approached geometrically (half the log-distance per new measurement) so that one noisy timestamp or the frames
-// in flight between planning and measuring do not make it oscillate. A fixed cost per frame (the planning
+// in flight between planning and measuring do not make it oscillate, and by at most kMaxBudgetStep per measurement,
+// so that one wild timestamp cannot plan a frame many times over its target. A fixed cost per frame (the planning
 // dispatches, the launch) is no obstacle: at the fixed point rays * target / ms = rays, i.e. ms = target.
 // Pure host logic, tested on a simulated cost model (tests/adaptive_rays_test.cpp).
 //
@@ -16,6 +17,9 @@
 #include <cstdint>
 
 namespace rb {
+
+// The most one measurement may multiply or divide the budget by.
+inline constexpr double kMaxBudgetStep = 2.0;
 
 struct RayBudgetController {
   double budget = 0.0;     // rays of the frame being planned; 0 = not started

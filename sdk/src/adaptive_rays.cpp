@@ -145,7 +145,7 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
   // target's, under the cap.
   const uint32_t maxRays = adaptiveMaxRays(s, raysPerPixel);
   const double pixels = double(g.width) * g.height;
-  const double cap = std::min<double>(s.maxRaysPerFrame ? double(s.maxRaysPerFrame) : 1e300, double(UINT32_MAX));
+  double cap = std::min<double>(s.maxRaysPerFrame ? double(s.maxRaysPerFrame) : 1e300, double(UINT32_MAX));
   AdaptivePlanConstants pc{};
   pc.size[0] = g.width;
   pc.size[1] = g.height;
@@ -156,6 +156,8 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
   // A tile of launch cells, in pixels: at half resolution a warp's cells stand for twice the pixels per side.
   pc.tileSize[0] = adaptiveTileWidth(s) * cellPixels;
   pc.tileSize[1] = adaptiveTileHeight(s) * cellPixels;
+  // The claim takes whole tiles: a cap under one tile's rays would trace nothing, frame after frame.
+  if (tiles) cap = std::max(cap, double(pc.tileSize[0]) * pc.tileSize[1]);
   if (s.timeBudgetMs > 0.0f) {
     // Start from the uniform rays over the whole image; never below one ray per 64 pixels, so a measurement
     // (which needs rays) always comes back, nor per tile below one ray in every pixel of a tile: the claim takes

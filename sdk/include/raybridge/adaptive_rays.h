@@ -75,7 +75,8 @@ struct AdaptiveRaySettings {
   const Denoiser* history = nullptr;
   // The pass's GPU time to aim for, in ms (planning and tracing). 0 = no time target.
   float timeBudgetMs = 0.0f;
-  // Most rays per frame, whatever the time target asks. 0 = no cap but maxRaysPerPixel per pixel.
+  // Most rays per frame, whatever the time target asks. 0 = no cap but maxRaysPerPixel per pixel. Per tile, at
+  // least one ray in every pixel of one tile (the claim takes whole tiles: less would trace nothing).
   uint64_t maxRaysPerFrame = 0;
   uint32_t minRaysPerPixel = 0;  // 0 = kDefaultAdaptiveMinRays
   uint32_t maxRaysPerPixel = 0;  // 0 = kDefaultAdaptiveMaxRaysFactor x raysPerPixel; at most kMaxAdaptiveRays
