@@ -75,7 +75,7 @@ void main() {
     barrier();
   }
   if (lane == 0u) {
-    atomicAdd(counters.weightSum, uint(round(groupWeight[0] * RB_ADAPTIVE_WEIGHT_SCALE)));
+    atomicAdd(counters.weightSum, uint(round(groupWeight[0] * float(rbAdaptiveWeightScale(pc.size)))));
     atomicAdd(counters.surfacePixels, groupSurface[0]);
   }
 }

@@ -7,11 +7,22 @@
 
 // Filled with zeros before the first dispatch of each frame.
 struct RbPlanCounters {
-  uint weightSum;      // sum of the pixels' weights, in units of 1 / RB_ADAPTIVE_WEIGHT_SCALE
+  uint weightSum;      // sum of the pixels' weights, in units of 1 / rbAdaptiveWeightScale(size)
   uint surfacePixels;  // pixels that are not sky
   uint raysGranted;    // rays handed out so far by the allocation dispatch (never more than the budget)
   uint budget;         // the frame's ray budget, as the allocation dispatch resolved it
 };
+
+// The fixed point of RbPlanCounters::weightSum for an image of `size` pixels: as fine as 32 bits allow. A pixel
+// weighs at most 0.52 (adaptive_estimate.comp) and each 8x8 workgroup adds its sum rounded, at most
+// 64 x 0.52 + 0.5 < 35 units of 1 / scale, so the whole sum stays under 4e9 < 2^32 at any size: 221 at 8K,
+// 1,984 at 2560x1440, 2^16 (the cap) on small images. A fixed 256 overflowed at 8K, and was coarse where
+// converged pixels weigh 1e-4: one workgroup's rounding was then 20% of its weight. Integer arithmetic: the
+// estimate and the allocation dispatches must agree on it exactly.
+uint rbAdaptiveWeightScale(uvec2 size) {
+  const uint groups = ((size.x + 7u) / 8u) * ((size.y + 7u) / 8u);
+  return clamp(4000000000u / max(groups * 35u, 1u), 1u, 65536u);
+}
 
 #ifdef RB_ADAPTIVE_RAYS
 // The plan in a ray generation shader: .x = the pixel's rays this frame, .y = the reprojected history mean, what

@@ -79,8 +79,6 @@
 #define RB_ADAPTIVE_BINDING_WEIGHTS 4   // rg16f: reprojected mean, weight
 #define RB_ADAPTIVE_BINDING_COUNTERS 5  // RbPlanCounters
 #define RB_ADAPTIVE_BINDING_PLAN 6      // rg16f: rays, reprojected mean
-// Fixed point of RbPlanCounters::weightSum: a pixel weighs at most 0.52, so 2^32 holds 8K x 4K pixels.
-#define RB_ADAPTIVE_WEIGHT_SCALE 256.0
 
 // GBufferConstants::flags: what the G-buffer description says.
 #define RB_GB_REVERSED_Z 1u

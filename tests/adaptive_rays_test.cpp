@@ -217,6 +217,65 @@ TEST_CASE("a per-tile cap under one tile's rays still traces one tile a frame", 
   CHECK(total > 0);
 }
 
+TEST_CASE("adaptive AO at 8K (7680x4320) without history shares its budget evenly: the weight sum does not overflow",
+          "[adaptive][ao][large]") {
+  // Every pixel without history weighs the most a pixel can (0.52), and 33 million of them summed in the fixed
+  // point of RbPlanCounters::weightSum once exceeded 32 bits at 8K: the wrapped sum made every share 36 times too
+  // large, the first tiles took the whole budget at maxRaysPerPixel and three quarters of the image got no ray.
+  GpuFixture fx;
+  const uint32_t w = 7680, h = 4320;
+  TestScene scene = makeConformanceScene();
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  // Straight down onto the 40 x 40 ground from 3 units: every pixel is a surface.
+  SyntheticView view;
+  view.eye = {0.0, 3.0, 5.0};
+  view.target = {0.0, 0.0, 5.0};
+  view.up = {0.0, 0.0, -1.0};
+  view.width = w;
+  view.height = h;
+  const CpuGBuffer cpu = traceGBuffer(embree, view);
+  uint64_t surface = 0;
+  for (uint8_t hit : cpu.hit) surface += hit;
+  REQUIRE(surface == uint64_t(w) * h);
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  BuiltScene built = buildScene(fx, *service.value(), scene);
+  {
+    GpuGBuffer gbuffer(fx, cpu);
+    rb::HybridEffectsDesc desc;
+    desc.effects = rb::kEffectAo;
+    desc.ao.raysPerPixel = 2;  // the budget: one ray everywhere (the minimum) and one more shared by weight
+    desc.ao.range = 0.25f;
+    desc.ao.adaptive.enabled = true;
+    auto fxr = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
+    RB_REQUIRE_OK(fxr);
+    rb::HybridEffects& effects = *fxr.value();
+    rb::HybridFrame frame;
+    frame.gbuffer = gbuffer.desc();
+    frame.tlas = &built.tlas;
+    fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });  // uniform: no history
+    effects.resetHistory();  // the history exists but is void: every pixel counts as without history
+    fx.runAndSettle([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });
+    const rb::AoOutputs& o = effects.aoPass()->outputs();
+    REQUIRE(o.rayPlan != VK_NULL_HANDLE);
+    const std::vector<float> plan = readPlan(fx, o.rayPlan, w, h);
+    uint64_t none = 0, near = 0;  // pixels planned no ray; pixels planned 1 to 3 rays (2 on average)
+    for (size_t p = 0; p < size_t(w) * h; ++p) {
+      none += plan[2 * p] == 0.0f;
+      near += plan[2 * p] >= 1.0f && plan[2 * p] <= 3.0f;
+    }
+    const uint64_t rays = effects.stats().ao.rays;
+    INFO(rays << " rays traced for a budget of " << 2 * surface << "; " << none << " pixels planned none, " << near
+              << " planned 1 to 3 of " << surface);
+    CHECK(rays <= 2 * surface);
+    CHECK(rays >= 2 * surface * 9 / 10);
+    CHECK(none <= surface / 100);
+    CHECK(near >= surface * 99 / 100);
+  }
+  destroyScene(fx, built);
+}
+
 TEST_CASE("adaptive AO traces no more rays than its budget, the plan matches the counters, and rays go where the "
           "history is uncertain (per pixel and per tile)",
           "[adaptive][ao]") {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "cluster_bounds.h"
 #include "dynamic_scene.h"
 
 using namespace rbtest;
@@ -138,6 +139,42 @@ TEST_CASE("the adaptive policy rebuilds once the cluster measure passes its thre
   }
   CHECK(service->stats().rebuilds == 1);
   CHECK(service->stats().refits == st.refits + 4);
+}
+
+TEST_CASE("the refit measure declines meshes its 32-bit indexing cannot reach", "[dynamic][policy]") {
+  // The measure's shader indexes words as triangle * 3 + corner and vertex * stride / 4 in 32 bits, which SPIR-V
+  // takes as signed: a mesh past INT32_MAX would read the wrong words (or out of bounds) and decide rebuilds from
+  // garbage; it rebuilds by refit count instead.
+  rb::MeshDesc m;
+  m.vertexAddress = 1 << 16;
+  m.indexAddress = 1 << 20;
+  m.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+  m.vertexStride = 12;
+  m.indexType = rb::IndexType::Uint32;
+  m.vertexCount = 1000000;
+  m.triangleCount = 1000000;
+  m.indexBufferBytes = uint64_t(m.triangleCount) * 12;
+  CHECK(rb::ClusterBoundsPass::canMeasure(m));
+  SECTION("715,827,882 triangles are the most") {
+    m.triangleCount = 715827882u;  // the last index word: 2,147,483,645
+    m.indexBufferBytes = uint64_t(m.triangleCount) * 12;
+    CHECK(rb::ClusterBoundsPass::canMeasure(m));
+    m.triangleCount = 715827883u;
+    m.indexBufferBytes = uint64_t(m.triangleCount) * 12;
+    CHECK_FALSE(rb::ClusterBoundsPass::canMeasure(m));
+  }
+  SECTION("positions past 8 GiB") {
+    m.vertexCount = 715827882u;  // 12 bytes each: the last word read is 2,147,483,645
+    CHECK(rb::ClusterBoundsPass::canMeasure(m));
+    m.vertexStride = 16;  // 4 words each: the last at 2,863,311,526
+    CHECK_FALSE(rb::ClusterBoundsPass::canMeasure(m));
+  }
+  SECTION("without indices") {
+    m.indexType = rb::IndexType::None;
+    m.vertexCount = 3 * 715827883u;
+    m.triangleCount = 715827883u;
+    CHECK_FALSE(rb::ClusterBoundsPass::canMeasure(m));
+  }
 }
 
 TEST_CASE("refit counts and the fixed policies decide rebuilds exactly", "[dynamic][policy]") {

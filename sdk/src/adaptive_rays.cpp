@@ -129,6 +129,14 @@ void AdaptiveRayPlanner::retire(Context& ctx) {
 Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
                                         const AdaptiveRaySettings& s, uint32_t raysPerPixel, const PassStats& latest,
                                         const char* who, uint32_t cellPixels) {
+  if (s.timeBudgetMs > 0.0f && !ctx.deviceInfo().timestampsSupported) {
+    // Without a measurement the budget would stay where it started, frame after frame, whatever the target.
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 std::string(who) + ": timeBudgetMs " + std::to_string(s.timeBudgetMs) +
+                     " needs GPU timestamps, which the Context's queue family does not have (timestampValidBits " +
+                     std::to_string(ctx.deviceInfo().timestampValidBits) +
+                     "): set timeBudgetMs = 0 and cap the rays with maxRaysPerFrame"};
+  }
   const internal::DenoiserHistory history = internal::latestHistory(*s.history, g);
   if (!history.mean) return false;
   DenoiseConstants dn{};
@@ -145,7 +153,8 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
   // target's, under the cap.
   const uint32_t maxRays = adaptiveMaxRays(s, raysPerPixel);
   const double pixels = double(g.width) * g.height;
-  double cap = std::min<double>(s.maxRaysPerFrame ? double(s.maxRaysPerFrame) : 1e300, double(UINT32_MAX));
+  double cap = std::min<double>(s.maxRaysPerFrame ? double(s.maxRaysPerFrame) : 1e300,
+                                double(kMaxAdaptiveRaysPerFrame));
   AdaptivePlanConstants pc{};
   pc.size[0] = g.width;
   pc.size[1] = g.height;
@@ -167,7 +176,7 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
     const uint64_t r = controller_.next(ctx.frameIndex(), latest, s.timeBudgetMs, initial,
                                         std::max(1.0, std::min(std::max(pixels / 64.0, tilePixels), cap)),
                                         std::min(double(maxRays) * pixels, cap));
-    pc.budget = uint32_t(std::min<uint64_t>(r, UINT32_MAX));
+    pc.budget = uint32_t(std::min<uint64_t>(r, kMaxAdaptiveRaysPerFrame));
     pc.uniformRays = 0.0f;
   } else {
     controller_.reset();

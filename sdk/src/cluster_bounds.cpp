@@ -54,6 +54,10 @@ void ClusterBoundsPass::destroy(Context& ctx) { pipeline_.destroy(ctx); }
 bool ClusterBoundsPass::canMeasure(const MeshDesc& m) {
   if (positionFormat(m.vertexFormat) == kPositionUnknown) return false;
   if (m.vertexAddress % 4 != 0 || m.vertexStride % 4 != 0) return false;
+  // The shader indexes words in 32 bits, which SPIR-V's access chains take as signed: corner k of triangle t is
+  // index t * 3 + k, and a position is read from words vertex * stride / 4 to 2 past it. Both stay <= INT32_MAX.
+  if (uint64_t(m.triangleCount) * 3 > uint64_t(INT32_MAX) + 1) return false;
+  if (uint64_t(std::max(m.vertexCount, 1u) - 1) * (m.vertexStride / 4) + 2 > uint64_t(INT32_MAX)) return false;
   if (m.indexType == IndexType::None) return true;
   if (m.indexAddress % 4 != 0) return false;
   // 16-bit indices are read a 32-bit word at a time.

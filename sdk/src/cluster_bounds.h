@@ -16,7 +16,8 @@ class ClusterBoundsPass {
   Status create(Context& ctx);
   void destroy(Context& ctx);
   // False when the shader cannot read the mesh (a position or index address that is not 4-byte aligned, or a
-  // 16-bit index buffer whose last word would be read past its end): such a mesh is rebuilt by refit count only.
+  // 16-bit index buffer whose last word would be read past its end, or a mesh too large for the shader's 32-bit
+  // indexing: over 715,827,882 triangles or 8 GiB of positions): such a mesh is rebuilt by refit count only.
   static bool canMeasure(const MeshDesc& mesh);
   static uint32_t clusterCount(uint32_t triangleCount);
   // Writes clusterCount(triangleCount) floats at `clusterAreas` (4-byte aligned device address).

@@ -106,7 +106,8 @@ enum class RefitPolicyKind : uint8_t {
 // for 523k triangles). Uniform growth of the mesh (an inflating morph) counts as well; scale that belongs to the
 // whole mesh should stay in the instance transform. The clusters follow the index order, which meshes optimised
 // for the vertex cache keep spatially coherent; a mesh whose buffers the measure cannot read (not 4-byte
-// aligned) rebuilds by refit count only.
+// aligned, or past its 32-bit indexing: over 715,827,882 triangles or 8 GiB of positions) rebuilds by refit count
+// only.
 constexpr float kDefaultMaxAreaGrowth = 1.5f;
 // Rebuild after this many refits in a row even when the measure stays low (two seconds at 60 frames per second):
 // clusters of consecutive triangles only approximate the tree's leaves, so drift they do not see is bounded too.

@@ -54,6 +54,10 @@ inline constexpr uint32_t kDefaultAdaptiveMinRays = 1;
 // AdaptiveRaySettings::maxRaysPerPixel when 0: four times the pass's raysPerPixel, at most kMaxAdaptiveRays.
 inline constexpr uint32_t kDefaultAdaptiveMaxRaysFactor = 4;
 inline constexpr uint32_t kMaxAdaptiveRays = 256;
+// The most rays one adaptive frame plans, whatever maxRaysPerFrame, the time target or the uniform rays ask: 2^31,
+// a third of a second of an H200's peak trace rate (64 rays per pixel at 8K). The GPU claims rays with a 32-bit
+// counter; under 2^31 it cannot wrap (a wrapped counter handed out rays again).
+inline constexpr uint64_t kMaxAdaptiveRaysPerFrame = uint64_t(1) << 31;
 
 // How finely the plan varies the rays (AdaptiveRaySettings::granularity).
 enum class AdaptiveRayGranularity : uint32_t {
@@ -73,10 +77,13 @@ struct AdaptiveRaySettings {
   // The Denoiser (DenoiseSignal::Scalar) that filters this pass's output, recorded after it each frame: its
   // history is the variance estimate. Required when enabled. HybridEffects sets it.
   const Denoiser* history = nullptr;
-  // The pass's GPU time to aim for, in ms (planning and tracing). 0 = no time target.
+  // The pass's GPU time to aim for, in ms (planning and tracing). 0 = no time target. Needs timestamps on the
+  // Context's queue family (DeviceInfo::timestampsSupported); the pass's record() fails with a named error
+  // without them.
   float timeBudgetMs = 0.0f;
-  // Most rays per frame, whatever the time target asks. 0 = no cap but maxRaysPerPixel per pixel. Per tile, at
-  // least one ray in every pixel of one tile (the claim takes whole tiles: less would trace nothing).
+  // Most rays per frame, whatever the time target asks. 0 = no cap but maxRaysPerPixel per pixel and
+  // kMaxAdaptiveRaysPerFrame (as is any larger value). Per tile, at least one ray in every pixel of one tile (the
+  // claim takes whole tiles: less would trace nothing).
   uint64_t maxRaysPerFrame = 0;
   uint32_t minRaysPerPixel = 0;  // 0 = kDefaultAdaptiveMinRays
   uint32_t maxRaysPerPixel = 0;  // 0 = kDefaultAdaptiveMaxRaysFactor x raysPerPixel; at most kMaxAdaptiveRays
