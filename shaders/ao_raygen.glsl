@@ -6,13 +6,18 @@
 // At half resolution (pc.halfResolution) the launch is one invocation per 2x2 block, each tracing for the pixel of
 // its block that half_resolution.glsl picks this frame and writing the half-resolution image at its own index.
 // Included by ao.rgen (pc.raysPerPixel rays everywhere) and ao_adaptive.rgen (RB_ADAPTIVE_RAYS: each pixel's rays
-// come from the plan of adaptive_rays.glsl; a pixel given none keeps its reprojected history mean).
+// come from the plan of adaptive_rays.glsl; a pixel given none keeps its reprojected history mean), and by
+// ao_tiles.rgen and ao_adaptive_tiles.rgen (RB_AO_TILE_LIST, converged tiles, full resolution only): the launch
+// covers the tile classifier's list (ao_classify.comp); the tiles it left out already hold their outputs.
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform AoPushConstants { AoConstants pc; };
 #include "half_resolution.glsl"
 #include "pass_inputs.glsl"
 #include "adaptive_rays.glsl"
 #include "ray_counters.glsl"
+#ifdef RB_AO_TILE_LIST
+#include "shadow_tiles.glsl"
+#endif
 
 layout(set = 0, binding = RB_BINDING_TLAS) uniform accelerationStructureEXT tlas;
 layout(set = 0, binding = RB_BINDING_DEPTH) uniform sampler2D gDepth;
@@ -25,7 +30,11 @@ layout(location = 0) rayPayloadEXT float hitT;
 
 void main() {
   const bool halfRes = pc.halfResolution != 0u;
+#ifdef RB_AO_TILE_LIST
+  uvec2 launch = rbShadowListedPixel(gl_LaunchIDEXT.xy);
+#else
   uvec2 launch = gl_LaunchIDEXT.xy;
+#endif
   if (any(greaterThanEqual(launch, halfRes ? rbHalfResSize(pc.gbuffer.size) : pc.gbuffer.size))) return;
   uvec2 pixel = halfRes ? rbHalfResTracedPixel(launch, pc.gbuffer.frameIndex, pc.gbuffer.size) : launch;
   ivec2 ip = ivec2(pixel);

@@ -16,6 +16,10 @@
 #define RB_SHADOW_BINDING_TILES 9         // the tile classifier's list and trace arguments (shadow_tiles.glsl)
 #define RB_SHADOW_BINDING_TILE_STATE 12   // classifier only: per tile, the converged-tile state (shadow_converged.glsl)
 #define RB_AO_BINDING_OUTPUT 5
+// AoSettings::convergedTiles: the AO pass's tile list and tile state, at the shadow pass's bindings (the same
+// layouts: shadow_tiles.glsl, shadow_converged.glsl).
+#define RB_AO_BINDING_TILES RB_SHADOW_BINDING_TILES
+#define RB_AO_BINDING_TILE_STATE RB_SHADOW_BINDING_TILE_STATE
 #define RB_REFLECTION_BINDING_ROUGHNESS_METALNESS 5  // the normal image again when roughness is in normal.w
 #define RB_REFLECTION_BINDING_RADIANCE 6
 #define RB_REFLECTION_BINDING_LIGHTS 10  // the ManyLightPass's light list (GpuLight[]), read by the hits

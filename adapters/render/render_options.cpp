@@ -371,6 +371,12 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "still traced once in K frames (turns the tile classifier on; e.g. 8, the default)")
       ->type_name("K")
       ->check(rbCli::wholeNumber(1, 65535));
+  app.add_option_function<uint32_t>(
+         "--converged-ao", [&o](const uint32_t& v) { o.convergedAo = v; },
+         "AO: skip the 8x8 tiles whose denoised history has converged, each still traced\n"
+         "once in K frames (AO at full resolution: --half-res reflections or none)")
+      ->type_name("K")
+      ->check(rbCli::wholeNumber(1, 65535));
   app.add_option_function<std::string>(
          "--adaptive", [&o](const std::string& v) { parseAdaptive(v, &o); },
          "adaptive rays per pixel for soft shadows and AO, planned from the denoiser's history:\n"
@@ -520,6 +526,8 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.adaptive.tileWidth = o.adaptiveTileWidth;
   h.ao.adaptive.tileHeight = o.adaptiveTileHeight;
   h.ao.halfResolution = o.halfResGiven ? o.halfResAo : p.aoHalfResolution;
+  h.ao.convergedTiles.enabled = o.convergedAo.has_value();
+  h.ao.convergedTiles.refreshPeriod = o.convergedAo.value_or(0);
 
   const uint32_t lightRays = o.lightRays ? *o.lightRays : kDefaultLightRays;
   h.localLights.mode = lightRays ? rb::ManyLightMode::Stochastic : rb::ManyLightMode::Exact;
@@ -563,6 +571,13 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
     return "--converged-tiles: converged tiles are read from the shadow denoiser's history; drop --no-denoise";
   if (o.convergedTiles && o.mode != Mode::Hybrid)
     return "--converged-tiles: only --mode hybrid traces the shadow pass whose tiles it skips";
+  if (o.convergedAo && !o.denoise)
+    return "--converged-ao: converged tiles are read from the AO denoiser's history; drop --no-denoise";
+  if (o.convergedAo && o.mode != Mode::Hybrid)
+    return "--converged-ao: only --mode hybrid traces the AO pass whose tiles it skips";
+  if (o.convergedAo && !(o.halfResGiven && !o.halfResAo))
+    return "--converged-ao: it skips tiles of full-resolution AO, and every preset traces AO at half resolution: add "
+           "--half-res reflections (or --half-res none)";
   if ((o.adaptiveShadowsMs || o.adaptiveAoMs) && !o.denoise)
     return "--adaptive: adaptive rays plan from the denoiser's history; drop --no-denoise";
   if ((o.adaptiveShadowsMs || o.adaptiveAoMs) && o.mode != Mode::Hybrid)

@@ -59,6 +59,8 @@ struct RenderOptions {
   bool tileClassifier = false;  // --tile-classifier: HybridEffectsDesc::shadows.tileClassifier
   // --converged-tiles K: HybridEffectsDesc::shadows.convergedTiles, each converged tile traced once in K frames.
   std::optional<uint32_t> convergedTiles;
+  // --converged-ao K: HybridEffectsDesc::ao.convergedTiles, likewise (AO at full resolution: --half-res without ao).
+  std::optional<uint32_t> convergedAo;
   // --adaptive EFFECT[=MS],...: adaptive rays per pixel for shadows and ao (AdaptiveRaySettings), with a GPU time
   // target in ms (0 = the uniform rays, redistributed). Unset = uniform rays.
   std::optional<float> adaptiveShadowsMs, adaptiveAoMs;

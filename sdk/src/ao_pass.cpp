@@ -5,25 +5,44 @@
 
 #include "adaptive_rays.h"
 #include "context_impl.h"
+#include "converged_tiles.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
+#include "tile_classifier.h"
 
 namespace rb {
 
 namespace {
-// The pipeline of the pass: ao.rgen, or ao_adaptive.rgen (which adds the plan's binding).
-RayTracingPipelineDesc aoPipelineDesc(bool adaptive) {
+// The pipelines of the pass: ao.rgen, ao_adaptive.rgen (which adds the plan's binding), and both over the tile
+// classifier's list (ao_tiles.rgen, ao_adaptive_tiles.rgen: which add the list's binding).
+RayTracingPipelineDesc aoPipelineDesc(bool adaptive, bool tiles = false) {
   RayTracingPipelineDesc p;
-  p.name = adaptive ? "AO pass (adaptive rays)" : "AO pass";
-  p.raygen = adaptive ? SpirvModule::of(spirv::ao_adaptive_rgen) : SpirvModule::of(spirv::ao_rgen);
+  p.name = adaptive ? (tiles ? "AO pass (adaptive rays, converged tiles)" : "AO pass (adaptive rays)")
+                    : (tiles ? "AO pass (converged tiles)" : "AO pass");
+  p.raygen = adaptive
+                 ? (tiles ? SpirvModule::of(spirv::ao_adaptive_tiles_rgen) : SpirvModule::of(spirv::ao_adaptive_rgen))
+                 : (tiles ? SpirvModule::of(spirv::ao_tiles_rgen) : SpirvModule::of(spirv::ao_rgen));
   p.misses = {SpirvModule::of(spirv::occlusion_rmiss)};
   p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::occlusion_rchit), {}}};
   const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
   p.bindings = PassCore::commonBindings();
   p.bindings.push_back({RB_AO_BINDING_OUTPUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
   if (adaptive) p.bindings.push_back({RB_BINDING_RAY_PLAN, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
+  if (tiles) p.bindings.push_back({RB_AO_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr});
   p.pushConstantBytes = sizeof(AoConstants);
   return p;
+}
+
+// The classifier's bindings (ao_classify.comp): the G-buffer, counters, output and tile list of the ray generation
+// shader, and the tile state, in a compute stage.
+std::vector<VkDescriptorSetLayoutBinding> aoClassifierBindings() {
+  std::vector<VkDescriptorSetLayoutBinding> b;
+  for (const VkDescriptorSetLayoutBinding& c : aoPipelineDesc(false, true).bindings) {
+    if (c.binding == RB_BINDING_TLAS) continue;
+    b.push_back({c.binding, c.descriptorType, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  }
+  b.push_back({RB_AO_BINDING_TILE_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  return b;
 }
 }  // namespace
 
@@ -33,6 +52,12 @@ struct AoPass::Impl {
   // Adaptive rays, created on first use.
   RayTracingPipeline adaptivePipeline;
   AdaptiveRayPlanner planner;
+  // AoSettings::convergedTiles, created on first use: the launches over the tile list (uniform, adaptive), the
+  // classifier with its list and tile state, and the converged-tile dispatches.
+  RayTracingPipeline tilesPipeline, adaptiveTilesPipeline;
+  TileClassifier classifier;
+  bool classifierReady = false;
+  ConvergedTiles converged;
   // AoSettings::halfResolution: the sample image and the upsample, made on first use.
   HalfResolution half{HalfResolution::Signal::Ao};
   AoOutputs outputs;
@@ -42,6 +67,35 @@ struct AoPass::Impl {
     adaptivePipeline.retire(ctx);
     planner.retire(ctx);
     half.retire(ctx);
+    retireTiles();
+  }
+  void retireTiles() {
+    tilesPipeline.retire(ctx);
+    adaptiveTilesPipeline.retire(ctx);
+    classifier.retire(ctx);
+    converged.retire(ctx);
+    classifierReady = false;
+  }
+  // What converged tiles need, before the pass's recording begins (so that a failure records nothing).
+  // The uniform launch always (a frame without history to plan from traces uniformly), the adaptive one with
+  // adaptive rays.
+  Status ensureTiles(const GBufferDesc& g, bool adaptive) {
+    for (bool a : {false, true}) {
+      RayTracingPipeline& p = a ? adaptiveTilesPipeline : tilesPipeline;
+      if (p.pipeline || (a && !adaptive)) continue;
+      Result<RayTracingPipeline> r = core.createVariant(ctx, aoPipelineDesc(a, true), SpirvModule::of(spirv::ao_rahit));
+      if (!r) return r.error();
+      p = r.value();
+    }
+    if (!classifierReady) {
+      if (Status st = classifier.init(ctx, SpirvModule::of(spirv::ao_classify_comp), aoClassifierBindings(),
+                                      sizeof(AoConstants), "AO tile classifier");
+          !st) {
+        return st;
+      }
+      classifierReady = true;
+    }
+    return classifier.ensure(ctx, g.width, g.height);
   }
 };
 
@@ -71,6 +125,13 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
     return invalid("AoSettings::estimator has an unknown value");
   }
   if (Status st = AdaptiveRayPlanner::validate(settings.adaptive, "AoPass: AoSettings::adaptive"); !st) return st;
+  if (Status st = ConvergedTiles::validate(settings.convergedTiles, "AoPass: AoSettings::convergedTiles"); !st) {
+    return st;
+  }
+  if (settings.convergedTiles.enabled && settings.halfResolution) {
+    return invalid("AoSettings::convergedTiles skips tiles of full-resolution pixels: disable halfResolution or "
+                   "convergedTiles");
+  }
   AoConstants pc{};
   if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "AoPass", pc.gbuffer); !st) return st;
   pc.range = range;
@@ -90,6 +151,11 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   } else {
     s.half.releaseImage(s.ctx);  // full resolution holds no sample image
   }
+  if (settings.convergedTiles.enabled) {
+    if (Status st = s.ensureTiles(g, settings.adaptive.enabled); !st) return st;
+  } else if (s.classifierReady) {
+    s.retireTiles();  // no tile list nor state while converged tiles are off
+  }
   const PassStats latest = s.core.metrics.latest(s.ctx);
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}}); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
@@ -101,7 +167,33 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   if (!plan) return plan.error();
   const bool planned = plan.value();
   const RayTracingPipeline* variant = planned ? &s.adaptivePipeline : nullptr;
-  if (settings.halfResolution) {
+  bool converged = false;
+  if (settings.convergedTiles.enabled) {
+    Result<bool> c = s.converged.record(s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel, s.classifier,
+                                        s.core.images[0].view, "AoPass");
+    if (!c) {
+      s.core.end(s.ctx, cmd);
+      return c.error();
+    }
+    converged = c.value();
+  }
+  if (converged) {
+    // The classifier lists the tiles with a surface pixel that did not converge; the launch covers them alone.
+    DescriptorWrites cw;
+    s.core.writeGBuffer(s.ctx, cw, g);
+    cw.storageImage(RB_AO_BINDING_OUTPUT, s.core.images[0].view);
+    s.classifier.writeList(cw, RB_AO_BINDING_TILES);
+    s.classifier.writeState(cw, RB_AO_BINDING_TILE_STATE);
+    s.classifier.classify(s.ctx, cmd, cw, &pc, sizeof pc);
+    w.storageImage(RB_AO_BINDING_OUTPUT, s.core.images[0].view);
+    s.classifier.writeList(w, RB_AO_BINDING_TILES);
+    s.core.traceIndirect(s.ctx, cmd, w, pc, s.classifier.traceArguments(),
+                         planned ? &s.adaptiveTilesPipeline : &s.tilesPipeline);
+    // The check reads the traced output, so it comes after the output is readable, inside the pass's time.
+    s.core.images.endWrite(s.ctx, cmd);
+    s.converged.check(s.ctx, cmd, g, s.classifier, s.core.images[0].view);
+    s.core.metrics.writeEnd(s.ctx, cmd);
+  } else if (settings.halfResolution) {
     w.storageImage(RB_AO_BINDING_OUTPUT, s.half.samplesView());
     s.core.traceHalfAndEnd(s.ctx, cmd, w, pc, g, s.half, 0.0f, variant);
   } else {

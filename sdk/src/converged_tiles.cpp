@@ -18,10 +18,10 @@ Status ConvergedTiles::validate(const ConvergedTileSettings& s, const char* who)
   };
   if (!s.history) {
     return invalid("history is nullptr; converged tiles are read from the history of the Denoiser that filters this "
-                   "pass's visibility: set it, or disable convergedTiles");
+                   "pass's output: set it, or disable convergedTiles");
   }
   if (s.history->signal() != DenoiseSignal::Scalar) {
-    return invalid("history must be a DenoiseSignal::Scalar Denoiser (the one filtering this pass's visibility)");
+    return invalid("history must be a DenoiseSignal::Scalar Denoiser (the one filtering this pass's output)");
   }
   if (s.minFrames > RB_TILE_HOLD_MASK) {
     return invalid("minFrames " + std::to_string(s.minFrames) + " exceeds " + std::to_string(RB_TILE_HOLD_MASK));
@@ -32,7 +32,7 @@ Status ConvergedTiles::validate(const ConvergedTileSettings& s, const char* who)
   return {};
 }
 
-Status ConvergedTiles::init(Context& ctx) {
+Status ConvergedTiles::init(Context& ctx, const char* who) {
   const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
   auto binding = [&](uint32_t b, VkDescriptorType t) { return VkDescriptorSetLayoutBinding{b, t, 1, cs, nullptr}; };
   const VkDescriptorType sampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
@@ -45,7 +45,8 @@ Status ConvergedTiles::init(Context& ctx) {
     b.push_back(binding(RB_CONVERGED_BINDING_NOISE, sampled));
     b.push_back(binding(RB_CONVERGED_BINDING_VISIBILITY, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE));
     Result<ComputePipeline> p = ComputePipeline::create(ctx, SpirvModule::of(spirv::shadow_converged_comp), b,
-                                                        sizeof(ConvergedTileConstants), "shadow converged tiles");
+                                                        sizeof(ConvergedTileConstants),
+                                                        (std::string(who) + ": converged tiles").c_str());
     if (!p) return p.error();
     mark_ = p.value();
   }
@@ -54,7 +55,7 @@ Status ConvergedTiles::init(Context& ctx) {
     b.push_back(binding(RB_CONVERGED_BINDING_VISIBILITY, sampled));
     Result<ComputePipeline> p = ComputePipeline::create(ctx, SpirvModule::of(spirv::shadow_converged_check_comp), b,
                                                         sizeof(ConvergedTileConstants),
-                                                        "shadow converged tiles: check");
+                                                        (std::string(who) + ": converged tiles, check").c_str());
     if (!p) return p.error();
     check_ = p.value();
   }
@@ -73,7 +74,7 @@ Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBu
   if (!history.mean || !history.valid) return false;
   ConvergedTileConstants pc{};
   if (Status st = internal::historyReprojection(*s.history, g, who, pc.denoise); !st) return st.error();
-  if (Status st = init(ctx); !st) return st.error();
+  if (Status st = init(ctx, who); !st) return st.error();
   pc.denoise.signalRaysPerPixel = float(raysPerPixel);
   pc.minFrames = s.minFrames ? s.minFrames : kDefaultConvergedMinFrames;
   pc.maxNoise = s.maxNoise > 0.0f ? s.maxNoise : kDefaultConvergedMaxNoise;

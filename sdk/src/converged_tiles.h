@@ -1,11 +1,13 @@
-// Converged-tile skipping for the shadow pass (ShadowSettings::convergedTiles): the two compute dispatches around
-// its tile classifier that decide, from the shadow denoiser's history, which tiles have converged and write their
-// kept-history marks (shadow_converged.comp), and after the trace check the refreshed tiles for a change the history
-// could not see (shadow_converged_check.comp). The tile state they share lives in the TileClassifier. Owns the two
-// pipelines, created on first use.
+// Converged-tile skipping (raybridge/converged_tiles.h) for the shadow pass (ShadowSettings::convergedTiles) and the
+// AO pass (AoSettings::convergedTiles): the two compute dispatches around the pass's tile classifier that decide,
+// from its denoiser's history, which tiles have converged and write their kept-history marks into the pass's R16F
+// output (shadow_converged.comp), and after the trace check the refreshed tiles for a change the history could not
+// see (shadow_converged_check.comp). Both signals are in [0, 1] with sky at 1, so the shaders serve both. The tile
+// state they share lives in the TileClassifier. Owns the two pipelines, created on first use.
 #pragma once
 
-#include <raybridge/shadow_pass.h>
+#include <raybridge/converged_tiles.h>
+#include <raybridge/gbuffer.h>
 
 #include "compute_pipeline.h"
 #include "denoiser_history.h"
@@ -33,7 +35,7 @@ class ConvergedTiles {
              VkImageView visibility) const;
 
  private:
-  Status init(Context& ctx);
+  Status init(Context& ctx, const char* who);
   // The bindings both dispatches share, from the latest record().
   void writeCommon(DescriptorWrites& w, const GBufferDesc& g, const TileClassifier& classifier) const;
   ComputePipeline mark_, check_;

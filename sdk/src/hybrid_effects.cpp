@@ -51,6 +51,12 @@ Status validate(const HybridEffectsDesc& d) {
   if (d.shadows.convergedTiles.enabled && d.shadows.disableDenoiser)
     return invalid("shadows.convergedTiles reads the shadow denoiser's history: enable the denoiser "
                    "(shadows.disableDenoiser = false) or disable convergedTiles");
+  if (d.ao.convergedTiles.enabled && d.ao.disableDenoiser)
+    return invalid("ao.convergedTiles reads the AO denoiser's history: enable the denoiser (ao.disableDenoiser = "
+                   "false) or disable convergedTiles");
+  if (d.ao.convergedTiles.enabled && d.ao.halfResolution)
+    return invalid("ao.convergedTiles skips tiles of full-resolution pixels: disable ao.halfResolution or "
+                   "convergedTiles");
   if (d.ao.adaptive.enabled && d.ao.disableDenoiser)
     return invalid("ao.adaptive plans from the AO denoiser's history: enable the denoiser (ao.disableDenoiser = "
                    "false) or disable adaptive rays");
@@ -265,6 +271,9 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   s.adaptive.history = aoDenoiser.get();  // none before the denoiser's first frame: uniform rays then
   s.adaptive.enabled = s.adaptive.enabled && s.adaptive.history;
   s.halfResolution = desc.ao.halfResolution;
+  s.convergedTiles = desc.ao.convergedTiles;
+  s.convergedTiles.history = aoDenoiser.get();
+  s.convergedTiles.enabled = s.convergedTiles.enabled && s.convergedTiles.history;
   if (Status st = ao->record(cmd, f.gbuffer, tlas, s); !st) return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
   outputs.aoRaw = outputs.ao = image(o.ao, o.aoView, VK_FORMAT_R16_SFLOAT, o.layout, o.width, o.height);

@@ -13,6 +13,13 @@
 // creases; a pixel whose sample it is gets that sample exactly. The output keeps its format, size and layout.
 // stats() then counts the rays actually traced (about a quarter) and its gpuMs covers the trace and the upsample.
 //
+// Converged tiles (AoSettings::convergedTiles, full resolution): as for soft shadows (raybridge/converged_tiles.h),
+// tiles whose denoised AO history has converged trace no ray, and hold kept-history marks for the AO denoiser. A
+// compute classifier over 8x8 tiles then lists the tiles that still need rays (any surface pixel, not converged)
+// and the launch covers those alone (vkCmdTraceRaysIndirectKHR); all-sky tiles get their 1 from it. PassStats
+// counts the tiles traced, skipped and converged, and the rays saved. The tile list and state take 16 bytes + 8
+// bytes per tile (MemoryCategory::PassBuffers), held only while the setting is on.
+//
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output image and
 // measurement objects are handed to the Context's deferred release (see context.h) and freed once those
 // frames are done. Destroy it before its Context.
@@ -22,6 +29,7 @@
 
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/adaptive_rays.h>
+#include <raybridge/converged_tiles.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/material_table.h>
@@ -50,6 +58,9 @@ struct AoSettings {
   AdaptiveRaySettings adaptive;
   // Trace a quarter of the pixels and upsample (see Half resolution above). false = every pixel traces its rays.
   bool halfResolution = false;
+  // Skip the 8x8-pixel tiles whose denoised history has converged (raybridge/converged_tiles.h): their pixels hold
+  // kept-history marks instead of AO, which the denoiser named in it reads. Full resolution only. Off by default.
+  ConvergedTileSettings convergedTiles;
 };
 
 // Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record().

@@ -78,6 +78,10 @@ struct AoEffectSettings {
   AdaptiveRaySettings adaptive;
   // false = every pixel traces; true = AoSettings::halfResolution (a quarter of the rays, depth-aware upsample).
   bool halfResolution = false;
+  // Skip the tiles whose denoised AO history has converged (AoSettings::convergedTiles; the raw AO output then
+  // holds kept-history marks there, the denoised one is complete). Full resolution only. `history` is ignored
+  // (the effect's denoiser, which must be enabled). Off by default.
+  ConvergedTileSettings convergedTiles;
 };
 
 struct ReflectionEffectSettings {

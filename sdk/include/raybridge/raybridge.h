@@ -6,6 +6,7 @@
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/ao_pass.h>
 #include <raybridge/context.h>
+#include <raybridge/converged_tiles.h>
 #include <raybridge/denoiser.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>

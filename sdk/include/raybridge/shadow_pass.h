@@ -34,6 +34,7 @@
 
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/adaptive_rays.h>
+#include <raybridge/converged_tiles.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/material_table.h>
@@ -49,25 +50,6 @@ struct ShadowPassDesc {
 };
 
 inline constexpr uint32_t kDefaultSoftShadowRays = 4;
-
-// Defaults of ConvergedTileSettings: a tile is converged when each of its surface pixels has a history of at least
-// 16 frames (half the denoiser's default 32) whose measured noise has a standard deviation under 0.05 (half
-// kDefaultDenoiseConvergedNoise: 4 rays at visibility 0.5 need 25 frames), and it is still traced once in 8 frames.
-inline constexpr uint32_t kDefaultConvergedMinFrames = 16;
-inline constexpr float kDefaultConvergedMaxNoise = 0.05f;
-inline constexpr uint32_t kDefaultConvergedRefreshPeriod = 8;
-
-// Skipping the tiles whose denoised history has converged (see the top of this file). Zero-initialised = off, and
-// the defaults when enabled.
-struct ConvergedTileSettings {
-  bool enabled = false;  // true = skip converged tiles (turns the tile classifier on); needs `history`
-  // The Denoiser (DenoiseSignal::Scalar) that filters this pass's visibility, recorded after it every frame (the
-  // same frame): its history decides, and its next record() reads the marks. HybridEffects sets it.
-  const Denoiser* history = nullptr;
-  uint32_t minFrames = 0;      // frames of history a pixel needs; 0 = kDefaultConvergedMinFrames; at most 65535
-  float maxNoise = 0.0f;       // std. deviation of the denoiser's measured noise; 0 = kDefaultConvergedMaxNoise
-  uint32_t refreshPeriod = 0;  // a converged tile is traced once in this many frames; 0 = the default, 1 = never skip
-};
 
 struct ShadowSettings {
   // Rays per pixel for a soft light (angular radius or radius > 0); 0 = kDefaultSoftShadowRays. A hard light
