@@ -8,6 +8,10 @@
 //   adaptive_G_equal_time  a GPU time target equal to the uniform row's pass time (planning included);
 //   adaptive_G_budget      (pixel and tile) fractions of the uniform rays (AdaptiveRaySettings::maxRaysPerFrame),
 //                          from which the summary interpolates the rays saved at the uniform row's error.
+// Then converged tiles (raybridge/converged_tiles.h, default settings), over kConvergedFrames frames, long enough
+// for tiles to converge (kDefaultConvergedMinFrames) and then skip:
+//   uniform_long           n rays in every pixel;
+//   converged_tiles        the same with converged tiles skipped: the rays saved, the time, and the error.
 // Per tile against per pixel at equal time is the divergence measurement: a warp traces as long as its busiest
 // pixel, so per-pixel counts cost more GPU time than their rays; the 8x4 and 4x8 rows tell which warp shape the
 // device's ray generation launch uses (the shape that matches it is as fast as 8x8 and plans more finely).
@@ -28,6 +32,8 @@ namespace {
 // Frames accumulated before the error is measured: the denoiser's history then holds that many frames, which the
 // adaptive plan had to work with (the first frame of every run is uniform: no history yet).
 constexpr uint32_t kAccumulatedFrames = 8;
+// The converged-tile rows: 16 frames to converge, 16 more with tiles skipped (and refreshed once in 8 frames).
+constexpr uint32_t kConvergedFrames = 2 * rb::kDefaultConvergedMinFrames;
 const double kBudgetFractions[] = {0.25, 0.375, 0.5, 0.625, 0.75, 1.0};
 
 struct Effect {
@@ -137,18 +143,19 @@ se::Result<EffectResult> runAdaptiveSweep(FrameDriver& driver, const SweepPlan& 
   if (!ref) return R::failure(fx.name + " reference: " + ref.error);
   result.surfacePixels = countSet(ref.value.mask);
 
-  // One run: history reset, kAccumulatedFrames timed frames, then the capture frame's denoised image.
-  auto runOnce = [&](const rb::HybridEffectsDesc& d, Row& row) -> std::string {
+  // One run: history reset, `frames` timed frames, then the capture frame's denoised image.
+  auto runOnce = [&](const rb::HybridEffectsDesc& d, Row& row, uint32_t frames = kAccumulatedFrames) -> std::string {
     if (se::Status st = apply(d); !st) return st.error;
     adapter.effects().resetHistory();
-    auto samples = driver.run(fx.params, 0, kAccumulatedFrames);
+    auto samples = driver.run(fx.params, 0, frames);
     if (!samples) return samples.error;
     auto cap = driver.capture(fx.params);
     if (!cap) return cap.error;
     auto it = cap.value.images.find(fx.denoisedImage);
     if (it == cap.value.images.end()) return std::string("no denoised image captured");
-    // Skip the first frames, where the budget controller (with a time target) has not settled yet.
-    std::vector<FrameSample> settled(samples.value.begin() + kAccumulatedFrames / 2, samples.value.end());
+    // Skip the first frames, where the budget controller (with a time target) has not settled yet, or (converged
+    // tiles) no tile has converged yet.
+    std::vector<FrameSample> settled(samples.value.begin() + frames / 2, samples.value.end());
     const PassResult pass = passMedian(settled, fx.passName, fx.pass);
     const PassResult denoise = passMedian(settled, fx.denoiseName, fx.denoise);
     row.passes = {pass, denoise};
@@ -162,7 +169,7 @@ se::Result<EffectResult> runAdaptiveSweep(FrameDriver& driver, const SweepPlan& 
     row.params["rays_per_frame"] = pass.rays;
     row.params["rays_per_surface_pixel"] = result.surfacePixels ? double(pass.rays) / double(result.surfacePixels)
                                                                 : 0.0;
-    row.params["frames"] = kAccumulatedFrames;
+    row.params["frames"] = frames;
     progress("%s: %-28s %-28s effect %7.3f ms  rays/frame %10llu  RMSE %.5f", fx.name.c_str(), row.method.c_str(),
              row.setting.c_str(), row.effectMs, static_cast<unsigned long long>(pass.rays), row.rmse);
     result.rows.push_back(row);
@@ -257,6 +264,38 @@ se::Result<EffectResult> runAdaptiveSweep(FrameDriver& driver, const SweepPlan& 
                         std::to_string(int(std::lround((1.0 - fractionAtEqualError) * 100))) + "%"
                   : ", no budget reaches uniform's error";
     }
+    a = rb::AdaptiveRaySettings{};
+
+    // Converged tiles against uniform rays over the same kConvergedFrames frames.
+    Row longUniform;
+    longUniform.method = "uniform_long";
+    longUniform.setting = std::to_string(n) + " rays, " + std::to_string(kConvergedFrames) + " frames";
+    longUniform.id = "uniform_long_r" + std::to_string(n);
+    longUniform.params = {{"rays_per_pixel", n}, {"adaptive", false}};
+    if (std::string err = runOnce(d, longUniform, kConvergedFrames); !err.empty()) return R::failure(err);
+    const Row lu = result.rows.back();
+    rb::ConvergedTileSettings& c = fx.flag == rb::kEffectAo ? d.ao.convergedTiles : d.shadows.convergedTiles;
+    c.enabled = true;
+    Row converged;
+    converged.method = "converged_tiles";
+    converged.setting = longUniform.setting;
+    converged.id = "converged_tiles_r" + std::to_string(n);
+    converged.params = {{"rays_per_pixel", n}, {"adaptive", false}, {"converged_tiles", true}};
+    if (std::string err = runOnce(d, converged, kConvergedFrames); !err.empty()) return R::failure(err);
+    const Row ct = result.rows.back();
+    c.enabled = false;
+    const double raysSaved = lu.passes[0].rays ? 1.0 - double(ct.passes[0].rays) / double(lu.passes[0].rays) : 0.0;
+    s["converged_frames"] = kConvergedFrames;
+    s["converged_uniform_rmse"] = lu.rmse;
+    s["converged_uniform_effect_ms"] = lu.effectMs;
+    s["converged_tiles_rmse"] = ct.rmse;
+    s["converged_tiles_effect_ms"] = ct.effectMs;
+    s["converged_tiles_rays_saved"] = raysSaved;
+    char part[200];
+    std::snprintf(part, sizeof part,
+                  "; over %u frames uniform %.5f (%.3f ms), converged tiles %.5f (%.3f ms, %d%% of the rays saved)",
+                  kConvergedFrames, lu.rmse, lu.effectMs, ct.rmse, ct.effectMs, int(std::lround(raysSaved * 100)));
+    line += part;
     summary.push_back(s);
     progress("%s: %u rays: uniform RMSE %.5f (%.3f ms)%s", fx.name.c_str(), n, u.rmse, u.effectMs, line.c_str());
   }
