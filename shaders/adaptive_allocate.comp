@@ -6,6 +6,7 @@
 // Then each workgroup claims its rays from the frame's counter with one atomic, and a pixel gets only what is
 // left under R: the rays traced never exceed the budget, whatever the rounding did. Writes the plan
 // (rays, history mean) the ray generation shader reads.
+#define RB_ADAPTIVE_PLANNING
 #include "adaptive_rays.glsl"
 #include "raybridge_pass_constants.glsl"
 #include "raybridge_sampling.glsl"
@@ -13,8 +14,6 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant) uniform AdaptivePushConstants { AdaptivePlanConstants pc; };
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_WEIGHTS, rg16f) uniform readonly image2D weightsIn;
-// Coherent: the claim reads raysGranted as other workgroups move it.
-layout(set = 0, binding = RB_ADAPTIVE_BINDING_COUNTERS) coherent buffer PlanCountersBlock { RbPlanCounters counters; };
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_PLAN, rg16f) uniform writeonly image2D planOut;
 
 shared uint scan[64];
@@ -33,7 +32,7 @@ void main() {
     float floorRays = float(min(pc.minRays, pc.maxRays));
     float share;
     if (budget >= floorRays * surface) {
-      float total = float(counters.weightSum) / float(rbAdaptiveWeightScale(pc.size));
+      float total = rbAdaptiveWeightTotal(pc.size);
       float extra = budget - floorRays * surface;
       share = floorRays + (total > 0.0 ? extra * wv.y / total : 0.0);
     } else {
@@ -52,12 +51,7 @@ void main() {
   }
   // In integers, under the cap exactly (a float above 2^24 is rounded, above 2^32 out of range).
   const uint budgetRays = min(uint(min(budget, 4294967040.0)), pc.budget);
-  // A workgroup that finds the budget spent claims nothing, so the counter passes the budget by at most the claims
-  // of the workgroups in flight, and the host keeps the budget under 2^31 (kMaxAdaptiveRaysPerFrame): it cannot
-  // wrap, however far the rounded shares overshoot (a wrapped counter would hand rays out again).
-  if (lane == 63u) {
-    groupBase = counters.raysGranted >= budgetRays ? budgetRays : atomicAdd(counters.raysGranted, scan[63]);
-  }
+  if (lane == 63u) groupBase = rbAdaptiveClaim(scan[63], budgetRays);
   if (gl_WorkGroupID.xy == uvec2(0u) && lane == 0u) counters.budget = budgetRays;
   barrier();
   const uint before = groupBase + scan[lane] - rays;  // rays claimed ahead of this pixel

@@ -9,6 +9,7 @@
 // one random number per tile and capped at pc.maxRays. Each workgroup of 16x16 pixels claims its tiles' rays with
 // one atomic; a tile whose rays do not all fit under R gets the most per pixel that does (floor(left / n)), so the
 // budget holds and the tile stays uniform. Sky pixels get 0.
+#define RB_ADAPTIVE_PLANNING
 #include "adaptive_rays.glsl"
 #include "raybridge_pass_constants.glsl"
 #include "raybridge_sampling.glsl"
@@ -16,8 +17,6 @@
 layout(local_size_x = 16, local_size_y = 16) in;
 layout(push_constant) uniform AdaptivePushConstants { AdaptivePlanConstants pc; };
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_WEIGHTS, rg16f) uniform readonly image2D weightsIn;
-// Coherent: the claim reads raysGranted as other workgroups move it.
-layout(set = 0, binding = RB_ADAPTIVE_BINDING_COUNTERS) coherent buffer PlanCountersBlock { RbPlanCounters counters; };
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_PLAN, rg16f) uniform writeonly image2D planOut;
 
 const uint kGroupSide = 16u;
@@ -69,7 +68,7 @@ void main() {
     float floorRays = float(min(pc.minRays, pc.maxRays));
     float share;
     if (budget >= floorRays * surface) {
-      float total = float(counters.weightSum) / float(rbAdaptiveWeightScale(pc.size));
+      float total = rbAdaptiveWeightTotal(pc.size);
       float extra = budget - floorRays * surface;
       share = floorRays + (total > 0.0 ? extra * tileWeight[lane] / (total * float(n)) : 0.0);
     } else {
@@ -90,12 +89,7 @@ void main() {
   }
   // In integers, under the cap exactly (a float above 2^24 is rounded, above 2^32 out of range).
   const uint budgetRays = min(uint(min(budget, 4294967040.0)), pc.budget);
-  // A workgroup that finds the budget spent claims nothing, so the counter passes the budget by at most the claims
-  // of the workgroups in flight, and the host keeps the budget under 2^31 (kMaxAdaptiveRaysPerFrame): it cannot
-  // wrap, however far the rounded shares overshoot (a wrapped counter would hand rays out again).
-  if (lane == kGroupLanes - 1u) {
-    groupBase = counters.raysGranted >= budgetRays ? budgetRays : atomicAdd(counters.raysGranted, scan[kGroupLanes - 1u]);
-  }
+  if (lane == kGroupLanes - 1u) groupBase = rbAdaptiveClaim(scan[kGroupLanes - 1u], budgetRays);
   if (gl_WorkGroupID.xy == uvec2(0u) && lane == 0u) counters.budget = budgetRays;
   barrier();
   if (first) {

@@ -6,6 +6,7 @@
 // for any [0, 1] estimator) shared by the frames already accumulated. A pixel without history (disoccluded, new)
 // counts as kNoHistoryFrames frames of p = 0.5, the most uncertain. Writes (p, weight) per pixel and adds the
 // weights and the surface pixels into the plan's counters (adaptive_rays.glsl); sky pixels weigh nothing.
+#define RB_ADAPTIVE_PLANNING
 #include "adaptive_rays.glsl"
 #include "denoise_common.glsl"
 
@@ -15,7 +16,6 @@ layout(set = 0, binding = RB_ADAPTIVE_BINDING_MOTION) uniform sampler2D gMotion;
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_HISTORY) uniform sampler2D historyIn;    // x: mean, y: frames
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_DISTANCE) uniform sampler2D distanceIn;  // last frame's distance
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_WEIGHTS, rg16f) uniform writeonly image2D weightsOut;
-layout(set = 0, binding = RB_ADAPTIVE_BINDING_COUNTERS) buffer PlanCountersBlock { RbPlanCounters counters; };
 
 // Variance floor: a converged pixel still draws a few rays, so that a change the history has not seen yet
 // (a moving light, a new occluder) is found.
