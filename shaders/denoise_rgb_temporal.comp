@@ -8,7 +8,9 @@
 // history is short) divided by the frames averaged, so the spatial filter knows how noisy the mean still is.
 // It also writes the guide image of the a-trous steps. Reflections (RB_DN_RGB_REFLECTION): a pixel without
 // coverage is handled like the sky, and the deviation shrinks with the roughness below kRbDnGlossyRoughness, so
-// the a-trous steps leave a mirror's sharp reflection as it is.
+// the a-trous steps leave a mirror's sharp reflection as it is. A kept-history mark (RB_DN_KEPT_MARKS: converged
+// reflection tiles) adds no frame: the pixel's history is carried to its new position unchanged; a stale mark (a = 2)
+// drops the pixel's history.
 #include "denoise_rgb_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -47,7 +49,7 @@ float spatialVariance(ivec2 ip, float dist) {
           float qd = texelFetch(gDepth, q, 0).r;
           vec4 qv = texelFetch(signalIn, q, 0);
           bool same = !rbDnSky(qd) && abs(length(rbDnCameraRelative(uvec2(q), qd)) - dist) <= 0.05 * dist &&
-                      ((pc.flags & RB_DN_RGB_REFLECTION) == 0u || qv.a >= 0.5);
+                      ((pc.flags & RB_DN_RGB_REFLECTION) == 0u || qv.a >= 0.5 || rbDnRgbKeptMark(qv.a));
           if (!same) continue;
           vec3 c = qv.rgb;
           m1 += c;
@@ -76,8 +78,9 @@ void main() {
   const bool reflection = (pc.flags & RB_DN_RGB_REFLECTION) != 0u;
   vec4 texel = texelFetch(signalIn, ip, 0);
   vec3 value = texel.rgb;
+  const bool kept = rbDnRgbKeptMark(texel.a);
   float depth = texelFetch(gDepth, ip, 0).r;
-  if (rbDnSky(depth) || (reflection && texel.a < 0.5)) {
+  if (rbDnSky(depth) || (reflection && texel.a < 0.5 && !kept)) {
     imageStore(historyOut, ip, vec4(value, 0.0));
     imageStore(surfaceOut, ip, vec4(0.0));
     imageStore(valueOut, ip, vec4(value, final ? (reflection ? 0.0 : 1.0) : 0.0));
@@ -87,41 +90,18 @@ void main() {
   vec3 rel = rbDnCameraRelative(pixel, depth);
   float dist = length(rel);
   imageStore(guideOut, ip, uvec4(rbDnPackGuide(dist, rbDnNormal(texelFetch(gNormal, ip, 0))), 0u, 0u));
-  vec2 prevPixel;
-  vec3 prevRel = rel + pc.cameraDelta;
-  if ((pc.flags & RB_DN_MOTION) != 0u) {
-    prevPixel = vec2(pixel) + 0.5 - texelFetch(gMotion, ip, 0).xy;
-  } else {
-    vec4 clip = pc.previousViewProjection * vec4(prevRel, 1.0);
-    prevPixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
-  }
   vec3 accumulated = value;
   float variance = 0.0;  // of one frame's colour, over the frames accumulated
   float frames = 1.0;
-  if ((pc.flags & RB_DN_HISTORY) != 0u) {
-    // Bilinear over the four history texels around the reprojected point, each kept only where it holds the
-    // same surface (its distance from last frame's camera matches); nearest-texel reprojection would drift and
-    // blur the history by up to half a pixel every frame the camera moves.
-    vec2 f = prevPixel - 0.5;
-    ivec2 base = ivec2(floor(f));
-    vec2 t = f - vec2(base);
-    float expected = length(prevRel);
-    vec4 h = vec4(0.0);
-    float v = 0.0, weights = 0.0;
-    for (int k = 0; k < 4; ++k) {
-      ivec2 o = ivec2(k & 1, k >> 1);
-      ivec2 pp = base + o;
-      if (any(lessThan(pp, ivec2(0))) || any(greaterThanEqual(pp, ivec2(pc.size)))) continue;
-      vec2 prevSurface = texelFetch(surfaceIn, pp, 0).xy;
-      if (!(prevSurface.x > 0.0 && abs(prevSurface.x - expected) <= 0.02 * expected + 1e-3)) continue;
-      float w = (o.x == 1 ? t.x : 1.0 - t.x) * (o.y == 1 ? t.y : 1.0 - t.y);
-      h += w * texelFetch(historyIn, pp, 0);
-      v += w * prevSurface.y;
-      weights += w;
-    }
-    if (weights > 1e-3) {
-      h /= weights;
-      v /= weights;
+  vec4 h;
+  float v;
+  if (!rbDnRgbStaleMark(texel.a) && rbDnRgbFindHistory(pixel, rel, gMotion, historyIn, surfaceIn, h, v)) {
+    if (kept) {
+      // Not traced this frame: the history as it was, no frame added (the mark's rgb is this same mean).
+      frames = clamp(floor(h.a + 0.5), 1.0, float(pc.maxHistoryFrames));
+      accumulated = h.rgb;
+      variance = v;
+    } else {
       frames = min(floor(h.a + 0.5) + 1.0, float(pc.maxHistoryFrames));
       float alpha = 1.0 / frames;
       accumulated = mix(h.rgb, value, alpha);

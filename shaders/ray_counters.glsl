@@ -6,7 +6,11 @@
 
 #include "raybridge_shader_interface.glsl"
 
-layout(set = 0, binding = RB_BINDING_RAY_COUNTERS) buffer RayCounters {
+// A shader whose set 0 numbers its bindings otherwise (reflection_converged.comp) defines RB_RAY_COUNTERS_BINDING.
+#ifndef RB_RAY_COUNTERS_BINDING
+#define RB_RAY_COUNTERS_BINDING RB_BINDING_RAY_COUNTERS
+#endif
+layout(set = 0, binding = RB_RAY_COUNTERS_BINDING) buffer RayCounters {
   uint rayCount[RB_RAY_COUNTER_SLOTS];
   uint anyHitCount[RB_RAY_COUNTER_SLOTS];
   uint tilesTraced;

@@ -127,9 +127,11 @@ struct DenoiseConstants {
   float normalPower;            // 216
   float signalRaysPerPixel;     // 220: rays per pixel of the noisy signal; 0 = unknown
   float convergedNoise;         // 224: scalar: noise standard deviation under which the value passes unfiltered
+  float roughnessThreshold;     // 228: converged reflection tiles: the reflection pass's (rougher = no reflection)
 };
 
-// The shadow pass's converged-tile dispatches (shadow_converged.glsl): the denoiser's reprojection, then the test.
+// The converged-tile dispatches (shadow_converged.glsl, reflection_converged.glsl): the denoiser's reprojection, then
+// the test.
 // 256 bytes.
 struct ConvergedTileConstants {
   DenoiseConstants denoise;  //   0: historyReprojection(); signalRaysPerPixel = the shadow rays per pixel

@@ -5,6 +5,11 @@
 // reflected direction. Everything rougher, and the sky, traces nothing.
 // At half resolution (pc.halfResolution) the launch is one invocation per 2x2 block, each tracing for the pixel of
 // its block that half_resolution.glsl picks this frame and writing the half-resolution image at its own index.
+// With RB_REFLECTION_CONVERGED_TILES (full resolution only) the pixels of the tiles that reflection_converged.comp
+// marked converged return at once: they already hold their outputs. The launch stays one invocation per pixel
+// rather than covering a classifier's list of the tiles left, as the shadow and AO passes do: along the perf
+// scene's fly-through, where every tile is traced, the list took the pass from 3.57 to 4.33 ms and this launch to
+// 3.70 ms (NVIDIA H200, docs/performance.md), the same rays.
 #ifndef RAYBRIDGE_REFLECTION_RAYGEN_GLSL
 #define RAYBRIDGE_REFLECTION_RAYGEN_GLSL
 
@@ -14,6 +19,9 @@ layout(push_constant) uniform ReflectionPushConstants { ReflectionConstants pc; 
 #include "pass_inputs.glsl"
 #include "ray_counters.glsl"
 #include "reflection_common.glsl"
+#ifdef RB_REFLECTION_CONVERGED_TILES
+layout(set = 0, binding = RB_REFLECTION_BINDING_TILE_STATE, std430) readonly buffer TileState { uint tileState[]; };
+#endif
 
 layout(set = 0, binding = RB_BINDING_TLAS) uniform accelerationStructureEXT tlas;
 layout(set = 0, binding = RB_BINDING_DEPTH) uniform sampler2D gDepth;
@@ -55,6 +63,12 @@ void main() {
   const bool halfRes = pc.halfResolution != 0u;
   uvec2 launch = gl_LaunchIDEXT.xy;
   if (any(greaterThanEqual(launch, halfRes ? rbHalfResSize(pc.gbuffer.size) : pc.gbuffer.size))) return;
+#ifdef RB_REFLECTION_CONVERGED_TILES
+  // The tile's index in the state buffer: as the converged-tile dispatches number their workgroups, row by row.
+  const uint tilesPerRow = (pc.gbuffer.size.x + RB_SHADOW_TILE_SIZE - 1u) / RB_SHADOW_TILE_SIZE;
+  const uvec2 tile = launch / RB_SHADOW_TILE_SIZE;
+  if ((tileState[tile.x + tile.y * tilesPerRow] & RB_TILE_SKIP_CONVERGED) != 0u) return;
+#endif
   uvec2 pixel = halfRes ? rbHalfResTracedPixel(launch, pc.gbuffer.frameIndex, pc.gbuffer.size) : launch;
   ivec2 ip = ivec2(pixel);
   ivec2 target = ivec2(launch);  // the output texel: the pixel, or at half resolution its sample

@@ -1,6 +1,10 @@
 // Reflections: compared on the final HDR image, because the raster counterparts (constant sky, reflection probe)
 // only exist inside the lighting pass. Shadows come from the engine's shadow map in every row (the same map),
-// AO is off, so the reflected term is the only difference between rows.
+// AO is off, so the reflected term is the only difference between rows. Then converged tiles
+// (ReflectionSettings::convergedTiles, default settings) against uniform rays, denoised, over kConvergedFrames
+// frames of the still camera at the most rays of the plan:
+//   uniform_long           n rays in every pixel;
+//   converged_tiles        the same with converged tiles skipped: the rays saved, the time, and the error.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -12,6 +16,10 @@ namespace rbEffects {
 namespace se = sample_engine;
 
 namespace {
+
+// The converged-tile rows: 16 frames to converge, 16 more with tiles skipped (and refreshed once in 8 frames), as
+// the shadow and AO rows of --scenario adaptive.
+constexpr uint32_t kConvergedFrames = 2 * rb::kDefaultConvergedMinFrames;
 
 se::Result<std::vector<float>> hdrRgb(se::Engine& engine) {
   auto hdr = engine.readbackHdr();
@@ -123,6 +131,37 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
       }
     }
   }
+
+  // Converged tiles against uniform rays: history reset, kConvergedFrames frames, then the capture frame (with its
+  // history); times are the medians of the second half, where tiles have converged.
+  const uint32_t n = plan.reflectionRays.back();
+  for (bool converged : {false, true}) {
+    desc.reflections.convergedTiles.enabled = converged;
+    if (se::Status st = apply(n, true); !st) return R::failure(st.error);
+    adapter.effects().resetHistory();
+    auto samples = driver.run(base, 0, kConvergedFrames);
+    if (!samples) return R::failure(samples.error);
+    if (auto cap = driver.capture(base); !cap) return R::failure(cap.error);
+    auto rgb = hdrRgb(driver.engine());
+    if (!rgb) return R::failure(rgb.error);
+    const std::vector<FrameSample> settled(samples.value.begin() + kConvergedFrames / 2, samples.value.end());
+    Row row;
+    row.method = converged ? "converged_tiles" : "uniform_long";
+    row.setting = std::to_string(n) + " rays, " + std::to_string(kConvergedFrames) + " frames";
+    row.id = row.method + "_r" + std::to_string(n);
+    row.params = {{"rays_per_pixel", n},
+                  {"roughness_threshold", plan.reflectionRoughness},
+                  {"denoised", true},
+                  {"frames", kConvergedFrames},
+                  {"converged_tiles", converged}};
+    const PassResult pass = passMedian(settled, "reflection", &rb::HybridStats::reflection);
+    const PassResult dn = passMedian(settled, "reflection_denoise", &rb::HybridStats::reflectionDenoise);
+    row.passes = {pass, dn};
+    row.effectMs = pass.gpuMs + dn.gpuMs;
+    row.effectMsOf = "reflection + reflection_denoise";
+    if (se::Status st = finish(std::move(row), settled, rgb.value); !st) return R::failure(st.error);
+  }
+  desc.reflections.convergedTiles.enabled = false;
 
   // Raster rows: constant sky (probe off) and the probe at each resolution.
   s.enabled = false;

@@ -377,6 +377,12 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "once in K frames (AO at full resolution: --half-res reflections or none)")
       ->type_name("K")
       ->check(rbCli::wholeNumber(1, 65535));
+  app.add_option_function<uint32_t>(
+         "--converged-reflections", [&o](const uint32_t& v) { o.convergedReflections = v; },
+         "reflections: skip the 8x8 tiles whose denoised history has converged and whose view\n"
+         "has not turned, each still traced once in K frames (full resolution: --half-res ao or none)")
+      ->type_name("K")
+      ->check(rbCli::wholeNumber(1, 65535));
   app.add_option_function<std::string>(
          "--adaptive", [&o](const std::string& v) { parseAdaptive(v, &o); },
          "adaptive rays per pixel for soft shadows and AO, planned from the denoiser's history:\n"
@@ -537,6 +543,8 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.reflections.roughnessThreshold = o.reflectionRoughness ? *o.reflectionRoughness : kDefaultReflectionRoughness;
   h.reflections.raysPerPixel = o.reflectionRays ? *o.reflectionRays : kDefaultReflectionRays;
   h.reflections.halfResolution = o.halfResReflections;
+  h.reflections.convergedTiles.enabled = o.convergedReflections.has_value();
+  h.reflections.convergedTiles.refreshPeriod = o.convergedReflections.value_or(0);
   h.reflections.invocationReorder = o.invocationReorder;
   h.tlasMode = o.tlasMode;
 
@@ -578,6 +586,13 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
   if (o.convergedAo && !(o.halfResGiven && !o.halfResAo))
     return "--converged-ao: it skips tiles of full-resolution AO, and every preset traces AO at half resolution: add "
            "--half-res reflections (or --half-res none)";
+  if (o.convergedReflections && !o.denoise)
+    return "--converged-reflections: converged tiles are read from the reflection denoiser's history; drop "
+           "--no-denoise";
+  if (o.convergedReflections && o.mode != Mode::Hybrid)
+    return "--converged-reflections: only --mode hybrid traces the reflection pass whose tiles it skips";
+  if (o.convergedReflections && o.halfResReflections)
+    return "--converged-reflections: it skips tiles of full-resolution reflections: drop reflections from --half-res";
   if ((o.adaptiveShadowsMs || o.adaptiveAoMs) && !o.denoise)
     return "--adaptive: adaptive rays plan from the denoiser's history; drop --no-denoise";
   if ((o.adaptiveShadowsMs || o.adaptiveAoMs) && o.mode != Mode::Hybrid)

@@ -61,6 +61,9 @@ struct RenderOptions {
   std::optional<uint32_t> convergedTiles;
   // --converged-ao K: HybridEffectsDesc::ao.convergedTiles, likewise (AO at full resolution: --half-res without ao).
   std::optional<uint32_t> convergedAo;
+  // --converged-reflections K: HybridEffectsDesc::reflections.convergedTiles, likewise (reflections at full resolution:
+  // --half-res without reflections).
+  std::optional<uint32_t> convergedReflections;
   // --adaptive EFFECT[=MS],...: adaptive rays per pixel for shadows and ao (AdaptiveRaySettings), with a GPU time
   // target in ms (0 = the uniform rays, redistributed). Unset = uniform rays.
   std::optional<float> adaptiveShadowsMs, adaptiveAoMs;

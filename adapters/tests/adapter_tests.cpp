@@ -117,6 +117,11 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--adaptive pixel", "--adaptive: 'pixel' names no effect with adaptive rays (shadows, ao)"},
       {"--converged-tiles 0", "--converged-tiles: 0 is outside 1..65535"},
       {"--converged-tiles 8 --no-denoise", "--converged-tiles: converged tiles are read from the shadow denoiser's"},
+      {"--converged-reflections 0", "--converged-reflections: 0 is outside 1..65535"},
+      {"--converged-reflections 8 --no-denoise",
+       "--converged-reflections: converged tiles are read from the reflection"},
+      {"--converged-reflections 8 --half-res ao,reflections",
+       "--converged-reflections: it skips tiles of full-resolution reflections: drop reflections from --half-res"},
       {"--half-res ao,shadows",
        "--half-res: 'shadows' in 'ao,shadows' is not an effect with half-resolution tracing (ao, reflections)"},
   };

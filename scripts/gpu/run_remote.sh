@@ -202,8 +202,11 @@ if want effects; then
   EIMG="$(mktemp -d)"
   RAW=()
   [ -f "$OUT/bench_gpu.json" ] && RAW=(--raw-rate-json "$OUT/bench_gpu.json")
+  # RB_EFFECTS_ONLY=LIST: those effects alone (raybridge-effects-bench --effects LIST), e.g. reflections.
+  ONLY=()
+  [ -n "${RB_EFFECTS_ONLY:-}" ] && ONLY=(--effects "$RB_EFFECTS_ONLY")
   RAYBRIDGE_VALIDATION=0 step effects 240 "$OUT/effects_gpu.log" "$RT/bin/raybridge-effects-bench" \
-    --width 1920 --height 1080 "${RAW[@]}" --images "$EIMG" --out "$OUT/effects_gpu.json"
+    --width 1920 --height 1080 "${RAW[@]}" "${ONLY[@]}" --images "$EIMG" --out "$OUT/effects_gpu.json"
   # FLIP needs the 1080p images, too large to bring back: computed on the machine from the carried wheel.
   if ls "$ROOT"/.whl/flip_evaluator-*.whl >/dev/null 2>&1; then
     python3 -m pip install -q --no-index --no-deps --no-compile --target /tmp/flipsite "$ROOT"/.whl/flip_evaluator-*.whl \

@@ -125,7 +125,7 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
     return invalid("AoSettings::estimator has an unknown value");
   }
   if (Status st = AdaptiveRayPlanner::validate(settings.adaptive, "AoPass: AoSettings::adaptive"); !st) return st;
-  if (Status st = ConvergedTiles::validate(settings.convergedTiles, "AoPass: AoSettings::convergedTiles"); !st) {
+  if (Status st = s.converged.validate(settings.convergedTiles, "AoPass: AoSettings::convergedTiles"); !st) {
     return st;
   }
   if (settings.convergedTiles.enabled && settings.halfResolution) {

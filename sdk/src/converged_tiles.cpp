@@ -4,6 +4,7 @@
 #include <string>
 
 #include "context_impl.h"
+#include "denoise_rgb_interface.glsl"
 #include "denoiser_history.h"
 #include "memory_barrier.h"
 #include "raybridge_shaders.h"
@@ -11,7 +12,7 @@
 
 namespace rb {
 
-Status ConvergedTiles::validate(const ConvergedTileSettings& s, const char* who) {
+Status ConvergedTiles::validate(const ConvergedTileSettings& s, const char* who) const {
   if (!s.enabled) return {};
   auto invalid = [&](const std::string& m) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS, std::string(who) + ": " + m};
@@ -20,8 +21,10 @@ Status ConvergedTiles::validate(const ConvergedTileSettings& s, const char* who)
     return invalid("history is nullptr; converged tiles are read from the history of the Denoiser that filters this "
                    "pass's output: set it, or disable convergedTiles");
   }
-  if (s.history->signal() != DenoiseSignal::Scalar) {
-    return invalid("history must be a DenoiseSignal::Scalar Denoiser (the one filtering this pass's output)");
+  if (s.history->signal() != signal_) {
+    return invalid(std::string("history must be a DenoiseSignal::") +
+                   (signal_ == DenoiseSignal::Reflection ? "Reflection" : "Scalar") +
+                   " Denoiser (the one filtering this pass's output)");
   }
   if (s.minFrames > RB_TILE_HOLD_MASK) {
     return invalid("minFrames " + std::to_string(s.minFrames) + " exceeds " + std::to_string(RB_TILE_HOLD_MASK));
@@ -40,21 +43,27 @@ Status ConvergedTiles::init(Context& ctx, const char* who) {
       binding(RB_CONVERGED_BINDING_DEPTH, sampled), binding(RB_CONVERGED_BINDING_MOTION, sampled),
       binding(RB_CONVERGED_BINDING_HISTORY, sampled), binding(RB_CONVERGED_BINDING_DISTANCE, sampled),
       binding(RB_CONVERGED_BINDING_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER)};
+  const bool reflection = signal_ == DenoiseSignal::Reflection;
+  if (reflection) common.push_back(binding(RB_CONVERGED_BINDING_ROUGHNESS, sampled));
   if (!mark_.pipeline) {
     std::vector<VkDescriptorSetLayoutBinding> b = common;
-    b.push_back(binding(RB_CONVERGED_BINDING_NOISE, sampled));
+    if (!reflection) b.push_back(binding(RB_CONVERGED_BINDING_NOISE, sampled));
+    if (reflection) b.push_back(binding(RB_CONVERGED_BINDING_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER));
     b.push_back(binding(RB_CONVERGED_BINDING_VISIBILITY, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE));
-    Result<ComputePipeline> p = ComputePipeline::create(ctx, SpirvModule::of(spirv::shadow_converged_comp), b,
-                                                        sizeof(ConvergedTileConstants),
+    const SpirvModule shader = reflection ? SpirvModule::of(spirv::reflection_converged_comp)
+                                          : SpirvModule::of(spirv::shadow_converged_comp);
+    Result<ComputePipeline> p = ComputePipeline::create(ctx, shader, b, sizeof(ConvergedTileConstants),
                                                         (std::string(who) + ": converged tiles").c_str());
     if (!p) return p.error();
     mark_ = p.value();
   }
   if (!check_.pipeline) {
     std::vector<VkDescriptorSetLayoutBinding> b = common;
-    b.push_back(binding(RB_CONVERGED_BINDING_VISIBILITY, sampled));
-    Result<ComputePipeline> p = ComputePipeline::create(ctx, SpirvModule::of(spirv::shadow_converged_check_comp), b,
-                                                        sizeof(ConvergedTileConstants),
+    // Reflections: the radiance in GENERAL, read and marked where a tile is held (before the pass's endWrite()).
+    b.push_back(binding(RB_CONVERGED_BINDING_VISIBILITY, reflection ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : sampled));
+    const SpirvModule shader = reflection ? SpirvModule::of(spirv::reflection_converged_check_comp)
+                                          : SpirvModule::of(spirv::shadow_converged_check_comp);
+    Result<ComputePipeline> p = ComputePipeline::create(ctx, shader, b, sizeof(ConvergedTileConstants),
                                                         (std::string(who) + ": converged tiles, check").c_str());
     if (!p) return p.error();
     check_ = p.value();
@@ -69,13 +78,18 @@ void ConvergedTiles::retire(Context& ctx) {
 
 Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
                                     const ConvergedTileSettings& s, uint32_t raysPerPixel, TileClassifier& classifier,
-                                    VkImageView visibility, const char* who) {
+                                    VkImageView visibility, const char* who, float roughnessThreshold,
+                                    VkDescriptorBufferInfo counters) {
   const internal::DenoiserHistory history = internal::latestHistory(*s.history, g);
   if (!history.mean || !history.valid) return false;
   ConvergedTileConstants pc{};
   if (Status st = internal::historyReprojection(*s.history, g, who, pc.denoise); !st) return st.error();
   if (Status st = init(ctx, who); !st) return st.error();
   pc.denoise.signalRaysPerPixel = float(raysPerPixel);
+  if (signal_ == DenoiseSignal::Reflection) {
+    pc.denoise.roughnessThreshold = roughnessThreshold;
+    if (g.roughnessMetalness.view) pc.denoise.flags |= RB_DN_RGB_ROUGHNESS_IMAGE;
+  }
   pc.minFrames = s.minFrames ? s.minFrames : kDefaultConvergedMinFrames;
   pc.maxNoise = s.maxNoise > 0.0f ? s.maxNoise : kDefaultConvergedMaxNoise;
   pc.refreshPeriod = s.refreshPeriod ? s.refreshPeriod : kDefaultConvergedRefreshPeriod;
@@ -98,11 +112,19 @@ Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBu
   history_ = history;
   DescriptorWrites w;
   writeCommon(w, g, classifier);
-  w.sampledImage(RB_CONVERGED_BINDING_NOISE, history.noise, history.sampler, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  if (signal_ != DenoiseSignal::Reflection) {
+    w.sampledImage(RB_CONVERGED_BINDING_NOISE, history.noise, history.sampler,
+                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  } else {
+    w.storageBuffer(RB_CONVERGED_BINDING_COUNTERS, counters.buffer, counters.offset, counters.range);
+  }
   w.storageImage(RB_CONVERGED_BINDING_VISIBILITY, visibility);
   mark_.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
-  // The state and the marks, for the classifier (which may overwrite a tile that needs no ray with its exact values).
-  recordMemoryBarrier(vk, cmd, cs, VK_ACCESS_SHADER_WRITE_BIT, cs, rw);
+  // The state and the marks, for the classifier (which may overwrite a tile that needs no ray with its exact values),
+  // or for reflections the ray generation shader (which reads the state and writes the traced tiles).
+  recordMemoryBarrier(vk, cmd, cs, VK_ACCESS_SHADER_WRITE_BIT,
+                      signal_ == DenoiseSignal::Reflection ? cs | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR : cs,
+                      rw);
   internal::expectKeptMarks(*s.history, ctx.frameIndex());
   return true;
 }
@@ -115,6 +137,11 @@ void ConvergedTiles::writeCommon(DescriptorWrites& w, const GBufferDesc& g, cons
   w.sampledImage(RB_CONVERGED_BINDING_HISTORY, history_.mean, history_.sampler, ro);
   w.sampledImage(RB_CONVERGED_BINDING_DISTANCE, history_.distance, history_.sampler, ro);
   classifier.writeState(w, RB_CONVERGED_BINDING_STATE);
+  if (signal_ == DenoiseSignal::Reflection) {
+    // The roughness image, else the normal image (roughness in .w): as the RGB denoiser reads it.
+    const GBufferImage& roughness = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
+    w.sampledImage(RB_CONVERGED_BINDING_ROUGHNESS, roughness.view, history_.sampler, readLayout(roughness));
+  }
 }
 
 void ConvergedTiles::check(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const TileClassifier& classifier,
@@ -126,8 +153,15 @@ void ConvergedTiles::check(Context& ctx, VkCommandBuffer cmd, const GBufferDesc&
                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   DescriptorWrites w;
   writeCommon(w, g, classifier);
-  w.sampledImage(RB_CONVERGED_BINDING_VISIBILITY, visibility, history_.sampler,
-                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  if (signal_ == DenoiseSignal::Reflection) {
+    // The trace's radiance, still in GENERAL: read and written here.
+    recordMemoryBarrier(vk, cmd, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, VK_ACCESS_SHADER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    w.storageImage(RB_CONVERGED_BINDING_VISIBILITY, visibility);
+  } else {
+    w.sampledImage(RB_CONVERGED_BINDING_VISIBILITY, visibility, history_.sampler,
+                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  }
   check_.dispatch(ctx, cmd, w.writes, &constants_, sizeof constants_, g.width, g.height);
 }
 

@@ -445,6 +445,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
     }
     flags |= RB_DN_RGB_REFLECTION | (g.roughnessMetalness.view ? RB_DN_RGB_ROUGHNESS_IMAGE : 0u);
   }
+  if (s.keptMarksFrame == s.ctx.frameIndex()) flags |= RB_DN_KEPT_MARKS;
   if (s.signal != DenoiseSignal::Scalar) {
     Status st = recordRgb(s, cmd, g, signal, settings, pc, flags);
     if (st) {
@@ -454,7 +455,6 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
     return st;
   }
 
-  if (s.keptMarksFrame == s.ctx.frameIndex()) flags |= RB_DN_KEPT_MARKS;
   Status st = recordScalar(s, cmd, g, signal, settings, pc, flags);
   if (st) {
     std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
@@ -468,15 +468,15 @@ namespace internal {
 DenoiserHistory latestHistory(const Denoiser& denoiser, const GBufferDesc& g) {
   const Denoiser::Impl& s = DenoiserAccess::impl(denoiser);
   DenoiserHistory h;
-  // Scalar images: 0,1 the history ping-pong, 2,3 the distances; the latest record() wrote 1 - parity.
-  if (s.signal != DenoiseSignal::Scalar || !s.imagesWritten || s.images.size() < 4 || s.images[0].width != g.width ||
-      s.images[0].height != g.height) {
+  // Scalar images: 0,1 the history ping-pong, 2,3 the distances; RGB: 0,1 the colour history, 2,3 the surface
+  // (distance, variance). The latest record() wrote 1 - parity.
+  if (!s.imagesWritten || s.images.size() < 5 || s.images[0].width != g.width || s.images[0].height != g.height) {
     return h;
   }
   const uint32_t last = 1 - s.parity;
   h.mean = s.images[last].view;
   h.distance = s.images[2 + last].view;
-  h.noise = s.images[4].view;
+  h.noise = s.signal == DenoiseSignal::Scalar ? s.images[4].view : VK_NULL_HANDLE;
   h.sampler = s.sampler;
   h.valid = s.historyValid;
   return h;

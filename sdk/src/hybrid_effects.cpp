@@ -57,6 +57,12 @@ Status validate(const HybridEffectsDesc& d) {
   if (d.ao.convergedTiles.enabled && d.ao.halfResolution)
     return invalid("ao.convergedTiles skips tiles of full-resolution pixels: disable ao.halfResolution or "
                    "convergedTiles");
+  if (d.reflections.convergedTiles.enabled && d.reflections.disableDenoiser)
+    return invalid("reflections.convergedTiles reads the reflection denoiser's history: enable the denoiser "
+                   "(reflections.disableDenoiser = false) or disable convergedTiles");
+  if (d.reflections.convergedTiles.enabled && d.reflections.halfResolution)
+    return invalid("reflections.convergedTiles skips tiles of full-resolution pixels: disable "
+                   "reflections.halfResolution or convergedTiles");
   if (d.ao.adaptive.enabled && d.ao.disableDenoiser)
     return invalid("ao.adaptive plans from the AO denoiser's history: enable the denoiser (ao.disableDenoiser = "
                    "false) or disable adaptive rays");
@@ -292,6 +298,9 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.raysPerPixel = desc.reflections.raysPerPixel;
   s.halfResolution = desc.reflections.halfResolution;
   s.invocationReorder = desc.reflections.invocationReorder;
+  s.convergedTiles = desc.reflections.convergedTiles;
+  s.convergedTiles.history = reflectionDenoiser.get();
+  s.convergedTiles.enabled = s.convergedTiles.enabled && s.convergedTiles.history;
   s.flags = (f.flags & kFrameExplicitLighting) ? kReflectionExplicitLighting : 0u;
   for (int i = 0; i < 3; ++i) {
     s.sunRadiance[i] = f.lightRadiance[i];

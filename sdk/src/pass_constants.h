@@ -210,8 +210,9 @@ struct DenoiseConstants {
   float normalPower;
   float signalRaysPerPixel;  // 0 = unknown
   float convergedNoise;      // scalar: DenoiseSettings::convergedNoise
+  float roughnessThreshold;  // converged reflection tiles: ReflectionSettings::roughnessThreshold
 };
-static_assert(sizeof(DenoiseConstants) == 228);
+static_assert(sizeof(DenoiseConstants) == 232);
 RB_ASSERT_OFFSET(DenoiseConstants, inverseProjection, 0);
 RB_ASSERT_OFFSET(DenoiseConstants, viewToWorld, 64);
 RB_ASSERT_OFFSET(DenoiseConstants, previousViewProjection, 112);
@@ -225,10 +226,11 @@ RB_ASSERT_OFFSET(DenoiseConstants, wAtDepthOne, 212);
 RB_ASSERT_OFFSET(DenoiseConstants, normalPower, 216);
 RB_ASSERT_OFFSET(DenoiseConstants, signalRaysPerPixel, 220);
 RB_ASSERT_OFFSET(DenoiseConstants, convergedNoise, 224);
+RB_ASSERT_OFFSET(DenoiseConstants, roughnessThreshold, 228);
 
 struct ConvergedTileConstants {
   DenoiseConstants denoise;
-  uint32_t pad[3];  // std430 rounds the nested struct up to its 16-byte alignment
+  uint32_t pad[2];  // std430 rounds the nested struct up to its 16-byte alignment
   uint32_t minFrames;
   float maxNoise;
   uint32_t refreshPeriod;

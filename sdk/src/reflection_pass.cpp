@@ -5,12 +5,47 @@
 #include <string>
 
 #include "context_impl.h"
+#include "converged_tiles.h"
 #include "many_light_pass_impl.h"
 #include "material_table_impl.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
+#include "tile_classifier.h"  // the tile state
 
 namespace rb {
+
+namespace {
+const VkShaderStageFlags kRaygen = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
+const VkShaderStageFlags kHit = VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR;
+
+// The pipelines of the pass: reflect.rgen, reflect_reorder.rgen (shader execution reordering), and both skipping
+// the converged tiles (reflect_converged.rgen, reflect_reorder_converged.rgen: which add the tile state's binding).
+RayTracingPipelineDesc reflectionPipelineDesc(bool reorder, bool tiles = false) {
+  RayTracingPipelineDesc p;
+  p.name = reorder ? (tiles ? "reflection pass (invocation reorder, converged tiles)"
+                            : "reflection pass (invocation reorder)")
+                   : (tiles ? "reflection pass (converged tiles)" : "reflection pass");
+  p.raygen = reorder ? (tiles ? SpirvModule::of(spirv::reflect_reorder_converged_rgen)
+                              : SpirvModule::of(spirv::reflect_reorder_rgen))
+                     : (tiles ? SpirvModule::of(spirv::reflect_converged_rgen) : SpirvModule::of(spirv::reflect_rgen));
+  p.misses = {SpirvModule::of(spirv::reflect_rmiss), SpirvModule::of(spirv::occlusion_rmiss)};
+  p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::reflect_rchit), {}}};
+  p.maxRecursionDepth = 2;
+  p.bindings = PassCore::commonBindings();
+  p.bindings[RB_BINDING_TLAS].stageFlags |= kHit;          // shadow rays from hits
+  p.bindings[RB_BINDING_RAY_COUNTERS].stageFlags |= kHit;  // and their count
+  p.bindings.push_back(
+      {RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, kRaygen, nullptr});
+  p.bindings.push_back({RB_REFLECTION_BINDING_RADIANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kRaygen, nullptr});
+  p.bindings.push_back({RB_REFLECTION_BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kHit, nullptr});
+  if (tiles) {
+    p.bindings.push_back({RB_REFLECTION_BINDING_TILE_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kRaygen, nullptr});
+  }
+  p.pushConstantBytes = sizeof(ReflectionConstants);
+  return p;
+}
+
+}  // namespace
 
 struct ReflectionPass::Impl {
   Context& ctx;
@@ -22,11 +57,40 @@ struct ReflectionPass::Impl {
   // The same pipeline with reflect_reorder.rgen: only on a context with DeviceInfo::invocationReorder.
   RayTracingPipeline reorderPipeline;
   bool reordered = false;  // the latest record() traced with reorderPipeline
+  // ReflectionSettings::convergedTiles, created on first use: the launches that skip converged tiles (plain, and
+  // with reordering where the context has it), the tile state (a TileClassifier without list nor pipeline: the
+  // launch stays one invocation per pixel, see reflection_raygen.glsl), and the converged-tile dispatches.
+  RayTracingPipeline tilesPipeline, reorderTilesPipeline;
+  TileClassifier tileState;
+  ConvergedTiles converged{DenoiseSignal::Reflection};
+  bool tilesReady = false;
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still trace with it
     core.retire(ctx);
     half.retire(ctx);
     reorderPipeline.retire(ctx);
+    retireTiles();
+  }
+  void retireTiles() {
+    tilesPipeline.retire(ctx);
+    reorderTilesPipeline.retire(ctx);
+    tileState.retire(ctx);
+    converged.retire(ctx);
+    tilesReady = false;
+  }
+  // What converged tiles need, before the pass's recording begins (so that a failure records nothing): the launch
+  // that skips them (reordered too when `reorder`), and the tile state for this size.
+  Status ensureTiles(const GBufferDesc& g, bool reorder) {
+    for (bool r : {false, true}) {
+      RayTracingPipeline& p = r ? reorderTilesPipeline : tilesPipeline;
+      if (p.pipeline || (r && !reorder)) continue;
+      Result<RayTracingPipeline> v = core.createVariant(ctx, reflectionPipelineDesc(r, true),
+                                                        SpirvModule::of(spirv::reflect_rahit), kHit);
+      if (!v) return v.error();
+      p = v.value();
+    }
+    tilesReady = true;
+    return tileState.ensure(ctx, g.width, g.height, false);
   }
 };
 
@@ -44,30 +108,12 @@ Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context)
   Result<std::unique_ptr<MaterialTable>> table = MaterialTable::create(context);
   if (!table) return table.error();
   impl->ownMaterials = std::move(table.value());
-  RayTracingPipelineDesc p;
-  p.name = "reflection pass";
-  p.raygen = SpirvModule::of(spirv::reflect_rgen);
-  p.misses = {SpirvModule::of(spirv::reflect_rmiss), SpirvModule::of(spirv::occlusion_rmiss)};
-  p.hitGroups = {HitGroupDesc{SpirvModule::of(spirv::reflect_rchit), {}}};
-  p.maxRecursionDepth = 2;
-  const VkShaderStageFlags rg = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
-  const VkShaderStageFlags hit = VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR;
-  p.bindings = PassCore::commonBindings();
-  p.bindings[RB_BINDING_TLAS].stageFlags |= hit;          // shadow rays from hits
-  p.bindings[RB_BINDING_RAY_COUNTERS].stageFlags |= hit;  // and their count
-  p.bindings.push_back(
-      {RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
-  p.bindings.push_back({RB_REFLECTION_BINDING_RADIANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
-  p.bindings.push_back({RB_REFLECTION_BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit, nullptr});
-  p.pushConstantBytes = sizeof(ReflectionConstants);
+  RayTracingPipelineDesc p = reflectionPipelineDesc(false);
   // Shading records and materials: read by the hits (shading) and the any-hits (alpha).
-  RayTracingPipelineDesc reorder = p;  // init() takes the description
-  if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::reflect_rahit), hit); !s) return s.error();
+  if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::reflect_rahit), kHit); !s) return s.error();
   if (c.info.invocationReorder) {
-    reorder.name = "reflection pass (invocation reorder)";
-    reorder.raygen = SpirvModule::of(spirv::reflect_reorder_rgen);
-    Result<RayTracingPipeline> r = impl->core.createVariant(context, std::move(reorder),
-                                                            SpirvModule::of(spirv::reflect_rahit), hit);
+    Result<RayTracingPipeline> r = impl->core.createVariant(context, reflectionPipelineDesc(true),
+                                                            SpirvModule::of(spirv::reflect_rahit), kHit);
     if (!r) return r.error();
     impl->reorderPipeline = r.value();
   }
@@ -101,6 +147,14 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
     return invalid("ReflectionSettings::roughnessThreshold " + std::to_string(threshold) + " is outside (0, 1]");
   }
   if (settings.raysPerPixel > 64) return invalid("ReflectionSettings::raysPerPixel exceeds 64");
+  if (Status st = s.converged.validate(settings.convergedTiles, "ReflectionPass: ReflectionSettings::convergedTiles");
+      !st) {
+    return st;
+  }
+  if (settings.convergedTiles.enabled && settings.halfResolution) {
+    return invalid("ReflectionSettings::convergedTiles skips tiles of full-resolution pixels: disable halfResolution "
+                   "or convergedTiles");
+  }
   const bool sunUnset = settings.sunDirection[0] == 0.0f && settings.sunDirection[1] == 0.0f &&
                         settings.sunDirection[2] == 0.0f;
   const float sunDirection[3] = {settings.sunDirection[0], sunUnset ? 1.0f : settings.sunDirection[1],
@@ -150,6 +204,12 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   } else {
     s.half.releaseImage(s.ctx);  // full resolution holds no sample image
   }
+  s.reordered = s.reorderPipeline.pipeline && settings.invocationReorder;
+  if (settings.convergedTiles.enabled) {
+    if (Status st = s.ensureTiles(g, s.reordered); !st) return st;
+  } else if (s.tilesReady) {
+    s.retireTiles();  // no tile state while converged tiles are off
+  }
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16G16B16A16_SFLOAT, "reflection radiance"}}); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
   const GBufferImage& rm = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
@@ -159,9 +219,30 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   // The local lights' list when given, else any valid buffer (never read: lightCount is 0).
   w.storageBuffer(RB_REFLECTION_BINDING_LIGHTS,
                   pc.lightCount ? lights.buffer : internal::materialTableImpl(*table).materials.buffer);
-  s.reordered = s.reorderPipeline.pipeline && settings.invocationReorder;
   const RayTracingPipeline* variant = s.reordered ? &s.reorderPipeline : nullptr;
-  if (settings.halfResolution) {
+  bool converged = false;
+  if (settings.convergedTiles.enabled) {
+    const VkDescriptorBufferInfo counters{s.core.metrics.counterBuffer(), s.core.metrics.counterOffset(s.ctx),
+                                          s.core.metrics.counterBytes()};
+    Result<bool> c = s.converged.record(s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel, s.tileState,
+                                        s.core.images[0].view, "ReflectionPass", threshold, counters);
+    if (!c) {
+      s.core.end(s.ctx, cmd);
+      return c.error();
+    }
+    converged = c.value();
+  }
+  if (converged) {
+    // Every pixel, the converged tiles' returning at once (their outputs are written).
+    s.tileState.writeState(w, RB_REFLECTION_BINDING_TILE_STATE);
+    s.core.bind(s.ctx, cmd, w, &pc, sizeof pc, s.reordered ? &s.reorderTilesPipeline : &s.tilesPipeline);
+    (s.reordered ? s.reorderTilesPipeline : s.tilesPipeline).trace(s.ctx, cmd, g.width, g.height);
+    // The check reads the traced radiance and marks held tiles in it, before it is made readable, inside the pass's
+    // time.
+    s.converged.check(s.ctx, cmd, g, s.tileState, s.core.images[0].view);
+    s.core.images.endWrite(s.ctx, cmd);
+    s.core.metrics.writeEnd(s.ctx, cmd);
+  } else if (settings.halfResolution) {
     s.core.traceHalfAndEnd(s.ctx, cmd, w, pc, g, s.half, threshold, variant);
   } else {
     s.core.traceAndEnd(s.ctx, cmd, w, pc, g, variant);

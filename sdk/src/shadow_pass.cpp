@@ -150,8 +150,7 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
     if (!p) return p.error();
     s.adaptivePipeline = p.value();
   }
-  if (Status st = ConvergedTiles::validate(settings.convergedTiles, "ShadowPass: ShadowSettings::convergedTiles");
-      !st) {
+  if (Status st = s.converged.validate(settings.convergedTiles, "ShadowPass: ShadowSettings::convergedTiles"); !st) {
     return st;
   }
   if (settings.convergedTiles.enabled && s.desc.outputHitDistance) {

@@ -33,16 +33,18 @@ VkDeviceSize TileClassifier::listBytes(uint32_t width, uint32_t height) {
   return kHeaderBytes + tiles * sizeof(uint32_t);
 }
 
-Status TileClassifier::ensure(Context& ctx, uint32_t width, uint32_t height) {
-  if (list_.valid() && state_.valid() && width == width_ && height == height_) return {};
+Status TileClassifier::ensure(Context& ctx, uint32_t width, uint32_t height, bool withList) {
+  if (list_.valid() == withList && state_.valid() && width == width_ && height == height_) return {};
   retireBuffer(ctx, list_);
   retireBuffer(ctx, state_);
-  Result<GpuBuffer> b = createBuffer(ctx, listBytes(width, height),
-                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
-                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                                     MemoryLocation::DeviceLocal, MemoryCategory::PassBuffers, "tile list");
-  if (!b) return b.error();
-  list_ = b.value();
+  if (withList) {
+    Result<GpuBuffer> b = createBuffer(ctx, listBytes(width, height),
+                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                           VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                                       MemoryLocation::DeviceLocal, MemoryCategory::PassBuffers, "tile list");
+    if (!b) return b.error();
+    list_ = b.value();
+  }
   const VkDeviceSize tiles = (listBytes(width, height) - kHeaderBytes) / sizeof(uint32_t);
   Result<GpuBuffer> st = createBuffer(ctx, tiles * sizeof(uint32_t),
                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,

@@ -20,8 +20,9 @@ class TileClassifier {
   // Hands the pipeline and the tile list to the context's deferred release (frames in flight may still use them).
   void retire(Context& ctx);
 
-  // (Re)allocates the tile list for a width x height image (the old one is retired).
-  Status ensure(Context& ctx, uint32_t width, uint32_t height);
+  // (Re)allocates the tile list and state for a width x height image (the old ones are retired). `withList` false:
+  // the state alone (a pass that skips converged tiles in its own launch: reflections), with no pipeline to init().
+  Status ensure(Context& ctx, uint32_t width, uint32_t height, bool withList = true);
   // The tile list as a storage buffer at `binding`: the classifier's and the ray generation shader's.
   void writeList(DescriptorWrites& w, uint32_t binding) const;
   // The tile state as a storage buffer at `binding`.

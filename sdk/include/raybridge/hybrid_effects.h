@@ -97,6 +97,11 @@ struct ReflectionEffectSettings {
   // (ReflectionSettings's field of the same name). reflectionPass()->reordered() says whether the latest frame
   // reordered.
   bool invocationReorder = false;
+  // Skip the tiles whose denoised reflection history has converged and whose view has not turned
+  // (ReflectionSettings::convergedTiles; the raw reflection output then holds kept-history marks there, a = -1, the
+  // denoised one is complete). Full resolution only. `history` is ignored (the effect's denoiser, which must be
+  // enabled). Off by default.
+  ConvergedTileSettings convergedTiles;
 };
 
 struct LocalLightEffectSettings {

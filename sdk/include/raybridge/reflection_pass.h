@@ -29,6 +29,20 @@
 // divergent lanes. The rays and the shading are those of the plain pipeline; only the order differs. Elsewhere
 // (lavapipe, say) the plain pipeline runs and the setting is ignored: no error, nothing else built.
 //
+// Converged tiles (ReflectionSettings::convergedTiles, full resolution): as for soft shadows and AO
+// (raybridge/converged_tiles.h), tiles whose denoised reflection history (a DenoiseSignal::Reflection Denoiser) has
+// converged trace no ray and hold kept-history marks for that denoiser: (the reprojected history mean, a = -1). A
+// refreshed tile whose new rays disagree with its history (beyond the noise the denoiser measured, over the tile or
+// in any one pixel) is held, and its pixels get a = 2, which tells the denoiser to drop their stale history. A
+// reflection also depends on where it is seen from, which the history cannot follow: a tile is converged only while
+// the view of its pixels has turned by less than a quarter of their glossy lobe's width since the tile was last
+// traced (summed over the frames between, so a slow orbit is caught too; turning the camera in place turns nothing;
+// a mirror's lobe is a few thousandths of a radian wide). The launch stays one invocation per pixel: those of a
+// skipped tile return at once (a list of the tiles left, as the shadow and AO passes trace, cost the reflection
+// pass more than it saved on an NVIDIA H200: docs/performance.md). PassStats counts the tiles traced, skipped and
+// converged, and the reflection rays saved (not counting the shadow rays their hits would have traced). The tile
+// state takes 4 bytes per tile (MemoryCategory::PassBuffers), held only while the setting is on.
+//
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output image,
 // material table, texture set and measurement objects are handed to the Context's deferred release (see
 // context.h) and freed once those frames are done. Destroy it before its Context.
@@ -37,6 +51,7 @@
 #pragma once
 
 #include <raybridge/acceleration_structures.h>
+#include <raybridge/converged_tiles.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/many_light_pass.h>
@@ -88,11 +103,18 @@ struct ReflectionSettings {
   // measured: on an NVIDIA H200 the pass was 3-4% slower with it (docs/performance.md); measure it on yours.
   // ReflectionPass::reordered() says what a record did.
   bool invocationReorder = false;
+  // Skip the 8x8-pixel tiles whose denoised history has converged and whose view has not turned (see Converged
+  // tiles above): their pixels hold kept-history marks (a = -1) instead of radiance, which the Reflection Denoiser
+  // named in it reads. Full resolution only. Off by default.
+  ConvergedTileSettings convergedTiles;
 };
 
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
 struct ReflectionOutputs {
-  VkImage radiance = VK_NULL_HANDLE;  // R16G16B16A16_SFLOAT: rgb radiance, a = 1 where rays were traced
+  // R16G16B16A16_SFLOAT: rgb radiance, a = 1 where rays were traced. With convergedTiles also a = -1 where a
+  // converged tile kept its history (rgb is then that history's mean), and a = 2 where a converged tile's refresh
+  // found a change (traced; its history is stale, and the denoiser drops it).
+  VkImage radiance = VK_NULL_HANDLE;
   VkImageView radianceView = VK_NULL_HANDLE;
   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   uint32_t width = 0, height = 0;
