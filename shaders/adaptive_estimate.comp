@@ -35,27 +35,14 @@ void main() {
     float depth = texelFetch(gDepth, ip, 0).r;
     float mean = 1.0;
     if (!rbDnSky(depth)) {
-      vec3 rel = rbDnCameraRelative(pixel, depth);
-      vec3 prevRel = rel + pc.cameraDelta;
-      vec2 prevPixel;
-      if ((pc.flags & RB_DN_MOTION) != 0u) {
-        prevPixel = vec2(pixel) + 0.5 - texelFetch(gMotion, ip, 0).xy;
-      } else {
-        vec4 clip = pc.previousViewProjection * vec4(prevRel, 1.0);
-        prevPixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
-      }
       mean = 0.5;
       float frames = kNoHistoryFrames;
-      ivec2 pp = ivec2(floor(prevPixel));
-      if ((pc.flags & RB_DN_HISTORY) != 0u && all(greaterThanEqual(pp, ivec2(0))) &&
-          all(lessThan(pp, ivec2(pc.size)))) {
-        float prevDist = texelFetch(distanceIn, pp, 0).r;
-        // The same surface test as the denoiser's temporal pass.
-        if (prevDist > 0.0 && abs(prevDist - length(prevRel)) <= 0.02 * length(prevRel) + 1e-3) {
-          vec2 h = texelFetch(historyIn, pp, 0).xy;
-          mean = clamp(h.x, 0.0, 1.0);
-          frames = max(h.y, 1.0);
-        }
+      ivec2 pp;
+      // The same reprojection and surface test as the denoiser's temporal pass.
+      if (rbDnFindHistory(pixel, rbDnCameraRelative(pixel, depth), gMotion, distanceIn, pp)) {
+        vec2 h = texelFetch(historyIn, pp, 0).xy;
+        mean = clamp(h.x, 0.0, 1.0);
+        frames = max(h.y, 1.0);
       }
       weight = (mean * (1.0 - mean) + kVarianceFloor) / frames;
       surface = 1u;

@@ -29,15 +29,19 @@ vec3 rbDnViewPosition(uvec2 pixel, float depth) {
 // texel, and whether the same surface is there (its distance from last frame's camera matches what was stored).
 // The temporal pass's test, shared with the readers of its history that must agree with it (converged shadow
 // tiles: a pixel they skip is one the temporal pass finds history for).
+// Where the surface at `pixel` (camera-relative position `rel`) was in last frame's image, in pixels (continuous:
+// texel centres at .5): by the G-buffer's motion vectors where it has them, else by last frame's camera. `prevRel`:
+// the point relative to last frame's camera.
+vec2 rbDnPreviousPixel(uvec2 pixel, vec3 rel, sampler2D motion, out vec3 prevRel) {
+  prevRel = rel + pc.cameraDelta;
+  if ((pc.flags & RB_DN_MOTION) != 0u) return vec2(pixel) + 0.5 - texelFetch(motion, ivec2(pixel), 0).xy;
+  vec4 clip = pc.previousViewProjection * vec4(prevRel, 1.0);
+  return (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
+}
+
 bool rbDnFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D distanceIn, out ivec2 pp) {
-  vec2 prevPixel;
-  vec3 prevRel = rel + pc.cameraDelta;
-  if ((pc.flags & RB_DN_MOTION) != 0u) {
-    prevPixel = vec2(pixel) + 0.5 - texelFetch(motion, ivec2(pixel), 0).xy;
-  } else {
-    vec4 clip = pc.previousViewProjection * vec4(prevRel, 1.0);
-    prevPixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
-  }
+  vec3 prevRel;
+  vec2 prevPixel = rbDnPreviousPixel(pixel, rel, motion, prevRel);
   pp = ivec2(floor(prevPixel));
   if ((pc.flags & RB_DN_HISTORY) == 0u || any(lessThan(pp, ivec2(0))) || any(greaterThanEqual(pp, ivec2(pc.size)))) {
     return false;

@@ -37,15 +37,8 @@ bool rbDnRgbFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D histo
   h = vec4(0.0);
   v = 0.0;
   if ((pc.flags & RB_DN_HISTORY) == 0u) return false;
-  vec2 prevPixel;
-  vec3 prevRel = rel + pc.cameraDelta;
-  if ((pc.flags & RB_DN_MOTION) != 0u) {
-    prevPixel = vec2(pixel) + 0.5 - texelFetch(motion, ivec2(pixel), 0).xy;
-  } else {
-    vec4 clip = pc.previousViewProjection * vec4(prevRel, 1.0);
-    prevPixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
-  }
-  vec2 f = prevPixel - 0.5;
+  vec3 prevRel;
+  vec2 f = rbDnPreviousPixel(pixel, rel, motion, prevRel) - 0.5;
   ivec2 base = ivec2(floor(f));
   vec2 t = f - vec2(base);
   float expected = length(prevRel);

@@ -7,21 +7,10 @@
 #ifndef RAYBRIDGE_SHADOW_CONVERGED_GLSL
 #define RAYBRIDGE_SHADOW_CONVERGED_GLSL
 
-#include "raybridge_pass_constants.glsl"
-layout(push_constant) uniform ConvergedPushConstants { ConvergedTileConstants tc; };
-#define pc tc.denoise
-#define RB_DN_PUSH_CONSTANTS_DECLARED 1
-#include "denoise_common.glsl"
+#include "converged_common.glsl"
 
-layout(local_size_x = RB_SHADOW_TILE_SIZE, local_size_y = RB_SHADOW_TILE_SIZE) in;
-layout(set = 0, binding = RB_CONVERGED_BINDING_DEPTH) uniform sampler2D gDepth;
-layout(set = 0, binding = RB_CONVERGED_BINDING_MOTION) uniform sampler2D gMotion;  // pixels, current - previous
 layout(set = 0, binding = RB_CONVERGED_BINDING_HISTORY) uniform sampler2D historyIn;    // x: mean, y: frames
 layout(set = 0, binding = RB_CONVERGED_BINDING_DISTANCE) uniform sampler2D distanceIn;  // last frame's distance
-layout(set = 0, binding = RB_CONVERGED_BINDING_STATE, std430) buffer TileState { uint tileState[]; };
-
-// The tile's index in the state buffer: the classifier's dispatch covers the same tiles, row by row.
-uint rbConvergedTile() { return gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x; }
 
 struct ConvergedPixel {
   bool inside;   // in the image
