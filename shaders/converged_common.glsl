@@ -1,4 +1,4 @@
-// What the converged-tile dispatches of every pass share (shadow_converged.glsl, reflection_converged.glsl): the
+// What the converged-tile dispatches of every pass share (shadow_converged.glsl, rgb_converged.glsl): the
 // push constants (the denoiser's reprojection, as `pc`, then the test's settings, as `tc`), one workgroup per
 // 8x8-pixel tile, the G-buffer's depth and motion, and the tile state.
 #ifndef RAYBRIDGE_CONVERGED_COMMON_GLSL

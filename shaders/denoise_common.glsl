@@ -25,10 +25,6 @@ vec3 rbDnViewPosition(uvec2 pixel, float depth) {
                                    (pc.flags & RB_DN_REVERSED_Z) != 0u);
 }
 
-// Where the surface at `pixel` (camera-relative position `rel`) was in the latest history: `pp`, that history's
-// texel, and whether the same surface is there (its distance from last frame's camera matches what was stored).
-// The temporal pass's test, shared with the readers of its history that must agree with it (converged shadow
-// tiles: a pixel they skip is one the temporal pass finds history for).
 // Where the surface at `pixel` (camera-relative position `rel`) was in last frame's image, in pixels (continuous:
 // texel centres at .5): by the G-buffer's motion vectors where it has them, else by last frame's camera. `prevRel`:
 // the point relative to last frame's camera.
@@ -39,6 +35,10 @@ vec2 rbDnPreviousPixel(uvec2 pixel, vec3 rel, sampler2D motion, out vec3 prevRel
   return (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
 }
 
+// Where the surface at `pixel` (camera-relative position `rel`) was in the latest history: `pp`, that history's
+// texel, and whether the same surface is there (its distance from last frame's camera matches what was stored).
+// The temporal pass's test, shared with the readers of its history that must agree with it (converged shadow
+// tiles: a pixel they skip is one the temporal pass finds history for).
 bool rbDnFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D distanceIn, out ivec2 pp) {
   vec3 prevRel;
   vec2 prevPixel = rbDnPreviousPixel(pixel, rel, motion, prevRel);

@@ -20,9 +20,9 @@ vec3 rbDnGuideNormal(uvec2 g) { return rbDecodeOctahedral(unpackSnorm2x16(g.y));
 const float kRbDnMinTemporalVarianceFrames = 4.0;
 
 // A pixel of the signal that the reflection pass did not trace because its tile had converged (RB_DN_KEPT_MARKS,
-// reflection_converged.comp): .a = -1, .rgb its reprojected history mean. It keeps its history unchanged.
+// rgb_converged.comp): .a = -1, .rgb its reprojected history mean. It keeps its history unchanged.
 bool rbDnRgbKeptMark(float a) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && a < -0.5; }
-// A pixel traced this frame whose converged tile's refresh found a change (reflection_converged_check.comp): .a = 2.
+// A pixel traced this frame whose converged tile's refresh found a change (rgb_converged_check.comp): .a = 2.
 // Its history is stale: it starts afresh, as a disoccluded pixel does.
 bool rbDnRgbStaleMark(float a) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && a > 1.5; }
 

@@ -6,7 +6,7 @@
 
 #include "raybridge_shader_interface.glsl"
 
-// A shader whose set 0 numbers its bindings otherwise (reflection_converged.comp) defines RB_RAY_COUNTERS_BINDING.
+// A shader whose set 0 numbers its bindings otherwise (rgb_converged.comp) defines RB_RAY_COUNTERS_BINDING.
 #ifndef RB_RAY_COUNTERS_BINDING
 #define RB_RAY_COUNTERS_BINDING RB_BINDING_RAY_COUNTERS
 #endif

@@ -112,7 +112,7 @@ struct PrimaryShadingConstants {
   uint lightCandidates;     // 124: lights weighed per hit to pick the one it traces a shadow ray to
 };
 
-// The denoiser's temporal and a-trous passes. 228 bytes.
+// The denoiser's temporal and a-trous passes. 232 bytes.
 struct DenoiseConstants {
   mat4 inverseProjection;       //   0
   mat3 viewToWorld;             //  64: as GBufferConstants::viewToWorld
@@ -130,7 +130,7 @@ struct DenoiseConstants {
   float roughnessThreshold;     // 228: converged reflection tiles: the reflection pass's (rougher = no reflection)
 };
 
-// The converged-tile dispatches (shadow_converged.glsl, reflection_converged.glsl): the denoiser's reprojection, then
+// The converged-tile dispatches (shadow_converged.glsl, rgb_converged.glsl): the denoiser's reprojection, then
 // the test.
 // 256 bytes.
 struct ConvergedTileConstants {

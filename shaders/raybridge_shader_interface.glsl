@@ -23,7 +23,7 @@
 #define RB_REFLECTION_BINDING_ROUGHNESS_METALNESS 5  // the normal image again when roughness is in normal.w
 #define RB_REFLECTION_BINDING_RADIANCE 6
 #define RB_REFLECTION_BINDING_LIGHTS 10  // the ManyLightPass's light list (GpuLight[]), read by the hits
-// ReflectionSettings::convergedTiles: the tile state (reflection_converged.glsl), at the shadow pass's binding.
+// ReflectionSettings::convergedTiles: the tile state (rgb_converged.glsl), at the shadow pass's binding.
 #define RB_REFLECTION_BINDING_TILE_STATE RB_SHADOW_BINDING_TILE_STATE
 // Adaptive rays (the AO and shadow passes' adaptive ray generation modules): the plan of adaptive_rays.glsl.
 #define RB_BINDING_RAY_PLAN 11
@@ -37,6 +37,7 @@
 #define RB_ML_BINDING_LIGHTS 5      // GpuLight[], TLAS space
 #define RB_ML_BINDING_TILES 6       // per tile: count (RB_ML_TILE_OVERFLOW = all lights), packed 16-bit indices
 #define RB_ML_BINDING_IRRADIANCE 9  // rgba16f output
+#define RB_ML_BINDING_TILE_STATE RB_SHADOW_BINDING_TILE_STATE  // ManyLightSettings::convergedTiles (rgb_converged.glsl)
 #define RB_ML_CULL_BINDING_DEPTH 0
 #define RB_ML_CULL_BINDING_LIGHTS 1
 #define RB_ML_CULL_BINDING_TILES 2
@@ -114,8 +115,8 @@
 #define RB_TILE_HOLD_MASK 0xFFFFu
 #define RB_TILE_SKIP_CONVERGED 0x10000u  // converged: not traced, its pixels already hold their kept-history marks
 #define RB_TILE_REFRESH 0x20000u         // converged, but traced this frame to check its history still holds
-// Reflections only (reflection_converged.comp): bits 18-31 hold how far the view has turned at the tile's pixels
-// since it was last traced, in units of RB_TILE_DRIFT_UNIT of a glossy lobe's width (see there).
+// Reflections only (rgb_converged.comp): bits 18-31 hold how far the view has turned at the tile's pixels
+// from the views its history holds, in units of RB_TILE_DRIFT_UNIT of a glossy lobe's width (see there).
 #define RB_TILE_DRIFT_SHIFT 18u
 #define RB_TILE_DRIFT_MAX 0x3FFFu
 #define RB_TILE_DRIFT_UNIT (1.0 / 4096.0)
@@ -128,10 +129,11 @@
 #define RB_CONVERGED_BINDING_STATE 5     // the tile state buffer
 #define RB_CONVERGED_BINDING_VISIBILITY 6  // storage (shadow_converged.comp) / sampled (the check)
 #define RB_CONVERGED_BINDING_HIT_DISTANCE 7  // shadow_converged.comp, with ShadowPassDesc::outputHitDistance
-// Reflections (reflection_converged.comp, reflection_converged_check.comp): HISTORY is the RGB history (rgb mean, a
-// frames), DISTANCE its surface image (view distance, variance of one frame's colour), VISIBILITY the radiance, and:
+// RGB signals (rgb_converged.comp, rgb_converged_check.comp: reflections, local lights): HISTORY is the RGB history
+// (rgb mean, a frames), DISTANCE its surface image (view distance, variance of one frame's colour), VISIBILITY the
+// pass's output, and:
 #define RB_CONVERGED_BINDING_ROUGHNESS 8  // the roughness image (.x), or the normal image (.w)
-#define RB_CONVERGED_BINDING_COUNTERS 9   // reflection_converged.comp: the pass's ray counters (tiles, rays saved)
+#define RB_CONVERGED_BINDING_COUNTERS 9   // rgb_converged.comp: the pass's ray counters (tiles, rays saved)
 
 // ManyLightConstants::mode: the values of rb::ManyLightMode.
 #define RB_ML_STOCHASTIC 0u

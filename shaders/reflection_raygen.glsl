@@ -5,7 +5,7 @@
 // reflected direction. Everything rougher, and the sky, traces nothing.
 // At half resolution (pc.halfResolution) the launch is one invocation per 2x2 block, each tracing for the pixel of
 // its block that half_resolution.glsl picks this frame and writing the half-resolution image at its own index.
-// With RB_REFLECTION_CONVERGED_TILES (full resolution only) the pixels of the tiles that reflection_converged.comp
+// With RB_REFLECTION_CONVERGED_TILES (full resolution only) the pixels of the tiles that rgb_converged.comp
 // marked converged return at once: they already hold their outputs. The launch stays one invocation per pixel
 // rather than covering a classifier's list of the tiles left, as the shadow and AO passes do: along the perf
 // scene's fly-through, where every tile is traced, the list took the pass from 3.57 to 4.33 ms and this launch to

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "converged_pair.h"
 #include "embree_reference.h"
 #include "synthetic_gbuffer.h"
 #include "test_scene.h"
@@ -104,17 +105,7 @@ struct ReflectionPair {
     rb::HybridFrame f;
     f.gbuffer = gbuffer->desc();
     f.light = light;
-    fx.runAndSettle([&](VkCommandBuffer cmd) {
-      // One TLAS for both, with the shading records reflections read.
-      rb::TlasBuildOptions options = kRebuildTlas;
-      options.writeShadingRecords = true;
-      auto tlas = service->recordTlasBuild(cmd, built.instances, options);
-      RB_REQUIRE_OK(tlas);
-      built.tlas = tlas.value();
-      f.tlas = &built.tlas;
-      RB_REQUIRE_OK(skipping->record(cmd, f));
-      RB_REQUIRE_OK(plain->record(cmd, f));
-    });
+    recordSideBySide(fx, *service, built, f, *skipping, *plain, true);  // reflections read shading records
   }
   std::vector<float> denoised(const rb::HybridEffects& e) {
     return readRgba16f(fx, e.outputs().reflection.image, kWidth, kHeight);
@@ -181,8 +172,8 @@ TEST_CASE("reflections: a static scene converges, then its converged tiles are s
   CHECK(s.tilesConverged * 4 >= s.tilesTotal());
   CHECK(s.raysSaved > 0);
   CHECK(double(s.rays) <= 0.8 * double(reference.rays));
-  // The classifier's tiles without a reflection count as skipped; the converged ones as converged too.
-  CHECK(s.tilesTraced + s.tilesSkipped == s.tilesTotal());
+  // Every tile is counted once: traced, or skipped (converged, or without a reflection).
+  CHECK(s.tilesTotal() == (kWidth / kTile) * (kHeight / kTile));
   const std::vector<float> raw = p.raw(*p.skipping), skipped = p.denoised(*p.skipping), plain = p.denoised(*p.plain);
   size_t marks = 0;
   const std::vector<uint8_t> tiles = ReflectionPair::markedTiles(raw, &marks);
@@ -283,39 +274,26 @@ TEST_CASE("reflections: an object moved in the TLAS alone is re-traced in its re
   for (int i = 0; i < 10; ++i) p.frame();
   REQUIRE(p.stats(*p.skipping).tilesConverged > 0);
   // Before: the reference's raw colour over its last 6 frames.
-  const size_t n = size_t(kWidth) * kHeight * 4;
-  std::vector<float> before(n, 0.0f), since(n, 0.0f);
+  std::vector<float> before, since;
   for (int i = 0; i < 6; ++i) {
     p.frame();
-    const std::vector<float> raw = p.raw(*p.plain);
-    for (size_t k = 0; k < n; ++k) before[k] += raw[k] / 6.0f;
+    addToMean(before, p.raw(*p.plain), 6);
   }
   // The glossy box in front of the spheres slides away over the glossy ground, in the TLAS only: its reflection
   // leaves pixels whose G-buffer and history do not change, so only the refresh and its check can see it.
   p.moveInstance(3, -3.0f, 3.0f);
+  size_t stale = 0;  // pixels of held tiles, whose stale history the denoiser drops
   for (uint32_t i = 0; i <= kRefresh; ++i) {
     p.frame();
-    const std::vector<float> raw = p.raw(*p.plain);
-    for (size_t k = 0; k < n; ++k) since[k] += raw[k] / float(kRefresh + 1);
+    stale += staleMarks(p.raw(*p.skipping));
+    addToMean(since, p.raw(*p.plain), kRefresh + 1);
   }
-  const std::vector<float> after = p.raw(*p.plain), skipping = p.raw(*p.skipping);
-  size_t changed = 0, caught = 0, stale = 0;
-  for (size_t i = 0; i < size_t(kWidth) * kHeight; ++i) {
-    if (after[i * 4 + 3] < 0.5f) continue;
-    const glm::vec3 b(before[i * 4], before[i * 4 + 1], before[i * 4 + 2]);
-    const glm::vec3 s(since[i * 4], since[i * 4 + 1], since[i * 4 + 2]);
-    if (glm::length(s - b) < 0.5f * std::max(glm::length(b), 0.2f)) continue;
-    ++changed;
-    // Traced this frame: the same rays as the reference's (a = 1, or 2 where its tile's refresh found the change).
-    bool same = skipping[i * 4 + 3] > 0.5f;
-    for (int k = 0; k < 3; ++k) same = same && skipping[i * 4 + k] == after[i * 4 + k];
-    caught += same;
-    stale += skipping[i * 4 + 3] > 1.5f;
-  }
-  INFO(changed << " pixels whose reflection changed, " << caught << " traced again, " << stale
-               << " of them marked stale this frame");
-  REQUIRE(changed > 10);
-  CHECK(caught * 20 >= changed * 19);
+  const Retraced r = retracedPixels(before, since, p.raw(*p.plain), p.raw(*p.skipping));
+  INFO(r.changed << " pixels whose reflection changed, " << r.caught << " traced again; " << stale
+                 << " stale marks since the move");
+  REQUIRE(r.changed > 10);
+  CHECK(stale > 0);
+  CHECK(r.caught * 20 >= r.changed * 19);
   // The denoised image follows the change at least as well as without skipping: both against the reference's raw
   // colour averaged over the frames since the move (noisy, but unbiased; the running means of both denoisers still
   // hold some of the old reflection, the held tiles' less, as their stale history was dropped).

@@ -383,6 +383,12 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "has not turned, each still traced once in K frames (full resolution: --half-res ao or none)")
       ->type_name("K")
       ->check(rbCli::wholeNumber(1, 65535));
+  app.add_option_function<uint32_t>(
+         "--converged-lights", [&o](const uint32_t& v) { o.convergedLights = v; },
+         "local lights: skip the 8x8 tiles whose denoised irradiance has converged, each still\n"
+         "traced once in K frames (stochastic: --light-rays N > 0)")
+      ->type_name("K")
+      ->check(rbCli::wholeNumber(1, 65535));
   app.add_option_function<std::string>(
          "--adaptive", [&o](const std::string& v) { parseAdaptive(v, &o); },
          "adaptive rays per pixel for soft shadows and AO, planned from the denoiser's history:\n"
@@ -539,6 +545,8 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.localLights.mode = lightRays ? rb::ManyLightMode::Stochastic : rb::ManyLightMode::Exact;
   h.localLights.raysPerPixel = lightRays;
   h.localLights.disableDenoiser = !o.denoise;
+  h.localLights.convergedTiles.enabled = o.convergedLights.has_value();
+  h.localLights.convergedTiles.refreshPeriod = o.convergedLights.value_or(0);
 
   h.reflections.roughnessThreshold = o.reflectionRoughness ? *o.reflectionRoughness : kDefaultReflectionRoughness;
   h.reflections.raysPerPixel = o.reflectionRays ? *o.reflectionRays : kDefaultReflectionRays;
@@ -586,6 +594,12 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
   if (o.convergedAo && !(o.halfResGiven && !o.halfResAo))
     return "--converged-ao: it skips tiles of full-resolution AO, and every preset traces AO at half resolution: add "
            "--half-res reflections (or --half-res none)";
+  if (o.convergedLights && !o.denoise)
+    return "--converged-lights: converged tiles are read from the local-light denoiser's history; drop --no-denoise";
+  if (o.convergedLights && o.mode != Mode::Hybrid)
+    return "--converged-lights: only --mode hybrid traces the local-light pass whose tiles it skips";
+  if (o.convergedLights && o.lightRays && *o.lightRays == 0)
+    return "--converged-lights: --light-rays 0 traces every light exactly (no noise, no denoiser): give N > 0";
   if (o.convergedReflections && !o.denoise)
     return "--converged-reflections: converged tiles are read from the reflection denoiser's history; drop "
            "--no-denoise";

@@ -64,6 +64,8 @@ struct RenderOptions {
   // --converged-reflections K: HybridEffectsDesc::reflections.convergedTiles, likewise (reflections at full resolution:
   // --half-res without reflections).
   std::optional<uint32_t> convergedReflections;
+  // --converged-lights K: HybridEffectsDesc::localLights.convergedTiles, likewise (stochastic local lights).
+  std::optional<uint32_t> convergedLights;
   // --adaptive EFFECT[=MS],...: adaptive rays per pixel for shadows and ao (AdaptiveRaySettings), with a GPU time
   // target in ms (0 = the uniform rays, redistributed). Unset = uniform rays.
   std::optional<float> adaptiveShadowsMs, adaptiveAoMs;

@@ -118,6 +118,7 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--converged-tiles 0", "--converged-tiles: 0 is outside 1..65535"},
       {"--converged-tiles 8 --no-denoise", "--converged-tiles: converged tiles are read from the shadow denoiser's"},
       {"--converged-reflections 0", "--converged-reflections: 0 is outside 1..65535"},
+      {"--converged-lights 8 --light-rays 0", "--converged-lights: --light-rays 0 traces every light exactly"},
       {"--converged-reflections 8 --no-denoise",
        "--converged-reflections: converged tiles are read from the reflection"},
       {"--converged-reflections 8 --half-res ao,reflections",

@@ -22,8 +22,10 @@ Status ConvergedTiles::validate(const ConvergedTileSettings& s, const char* who)
                    "pass's output: set it, or disable convergedTiles");
   }
   if (s.history->signal() != signal_) {
-    return invalid(std::string("history must be a DenoiseSignal::") +
-                   (signal_ == DenoiseSignal::Reflection ? "Reflection" : "Scalar") +
+    const char* kind = signal_ == DenoiseSignal::Reflection ? "Reflection"
+                       : signal_ == DenoiseSignal::Rgb      ? "Rgb"
+                                                            : "Scalar";
+    return invalid(std::string("history must be a DenoiseSignal::") + kind +
                    " Denoiser (the one filtering this pass's output)");
   }
   if (s.minFrames > RB_TILE_HOLD_MASK) {
@@ -43,15 +45,15 @@ Status ConvergedTiles::init(Context& ctx, const char* who) {
       binding(RB_CONVERGED_BINDING_DEPTH, sampled), binding(RB_CONVERGED_BINDING_MOTION, sampled),
       binding(RB_CONVERGED_BINDING_HISTORY, sampled), binding(RB_CONVERGED_BINDING_DISTANCE, sampled),
       binding(RB_CONVERGED_BINDING_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER)};
-  const bool reflection = signal_ == DenoiseSignal::Reflection;
-  if (reflection) common.push_back(binding(RB_CONVERGED_BINDING_ROUGHNESS, sampled));
+  const bool rgb = signal_ != DenoiseSignal::Scalar;
+  if (rgb) common.push_back(binding(RB_CONVERGED_BINDING_ROUGHNESS, sampled));
   if (!mark_.pipeline) {
     std::vector<VkDescriptorSetLayoutBinding> b = common;
-    if (!reflection) b.push_back(binding(RB_CONVERGED_BINDING_NOISE, sampled));
-    if (reflection) b.push_back(binding(RB_CONVERGED_BINDING_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER));
+    if (!rgb) b.push_back(binding(RB_CONVERGED_BINDING_NOISE, sampled));
+    if (rgb) b.push_back(binding(RB_CONVERGED_BINDING_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER));
     b.push_back(binding(RB_CONVERGED_BINDING_VISIBILITY, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE));
-    const SpirvModule shader = reflection ? SpirvModule::of(spirv::reflection_converged_comp)
-                                          : SpirvModule::of(spirv::shadow_converged_comp);
+    const SpirvModule shader = rgb ? SpirvModule::of(spirv::rgb_converged_comp)
+                                   : SpirvModule::of(spirv::shadow_converged_comp);
     Result<ComputePipeline> p = ComputePipeline::create(ctx, shader, b, sizeof(ConvergedTileConstants),
                                                         (std::string(who) + ": converged tiles").c_str());
     if (!p) return p.error();
@@ -59,10 +61,10 @@ Status ConvergedTiles::init(Context& ctx, const char* who) {
   }
   if (!check_.pipeline) {
     std::vector<VkDescriptorSetLayoutBinding> b = common;
-    // Reflections: the radiance in GENERAL, read and marked where a tile is held (before the pass's endWrite()).
-    b.push_back(binding(RB_CONVERGED_BINDING_VISIBILITY, reflection ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : sampled));
-    const SpirvModule shader = reflection ? SpirvModule::of(spirv::reflection_converged_check_comp)
-                                          : SpirvModule::of(spirv::shadow_converged_check_comp);
+    // RGB signals: the output in GENERAL, read and marked where a tile is held (before the pass's endWrite()).
+    b.push_back(binding(RB_CONVERGED_BINDING_VISIBILITY, rgb ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : sampled));
+    const SpirvModule shader = rgb ? SpirvModule::of(spirv::rgb_converged_check_comp)
+                                   : SpirvModule::of(spirv::shadow_converged_check_comp);
     Result<ComputePipeline> p = ComputePipeline::create(ctx, shader, b, sizeof(ConvergedTileConstants),
                                                         (std::string(who) + ": converged tiles, check").c_str());
     if (!p) return p.error();
@@ -88,7 +90,7 @@ Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBu
   pc.denoise.signalRaysPerPixel = float(raysPerPixel);
   if (signal_ == DenoiseSignal::Reflection) {
     pc.denoise.roughnessThreshold = roughnessThreshold;
-    if (g.roughnessMetalness.view) pc.denoise.flags |= RB_DN_RGB_ROUGHNESS_IMAGE;
+    pc.denoise.flags |= RB_DN_RGB_REFLECTION | (roughnessInImage(g) ? RB_DN_RGB_ROUGHNESS_IMAGE : 0u);
   }
   pc.minFrames = s.minFrames ? s.minFrames : kDefaultConvergedMinFrames;
   pc.maxNoise = s.maxNoise > 0.0f ? s.maxNoise : kDefaultConvergedMaxNoise;
@@ -112,7 +114,7 @@ Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBu
   history_ = history;
   DescriptorWrites w;
   writeCommon(w, g, classifier);
-  if (signal_ != DenoiseSignal::Reflection) {
+  if (signal_ == DenoiseSignal::Scalar) {
     w.sampledImage(RB_CONVERGED_BINDING_NOISE, history.noise, history.sampler,
                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   } else {
@@ -121,10 +123,9 @@ Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBu
   w.storageImage(RB_CONVERGED_BINDING_VISIBILITY, visibility);
   mark_.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
   // The state and the marks, for the classifier (which may overwrite a tile that needs no ray with its exact values),
-  // or for reflections the ray generation shader (which reads the state and writes the traced tiles).
+  // or for an RGB signal the ray generation shader (which reads the state and writes the traced tiles).
   recordMemoryBarrier(vk, cmd, cs, VK_ACCESS_SHADER_WRITE_BIT,
-                      signal_ == DenoiseSignal::Reflection ? cs | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR : cs,
-                      rw);
+                      signal_ != DenoiseSignal::Scalar ? cs | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR : cs, rw);
   internal::expectKeptMarks(*s.history, ctx.frameIndex());
   return true;
 }
@@ -137,9 +138,10 @@ void ConvergedTiles::writeCommon(DescriptorWrites& w, const GBufferDesc& g, cons
   w.sampledImage(RB_CONVERGED_BINDING_HISTORY, history_.mean, history_.sampler, ro);
   w.sampledImage(RB_CONVERGED_BINDING_DISTANCE, history_.distance, history_.sampler, ro);
   classifier.writeState(w, RB_CONVERGED_BINDING_STATE);
-  if (signal_ == DenoiseSignal::Reflection) {
-    // The roughness image, else the normal image (roughness in .w): as the RGB denoiser reads it.
-    const GBufferImage& roughness = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
+  if (signal_ != DenoiseSignal::Scalar) {
+    // The roughness image, else the normal image (roughness in .w): as the RGB denoiser reads it (reflections; for
+    // local lights a valid image the shaders do not read).
+    const GBufferImage& roughness = roughnessImage(g);
     w.sampledImage(RB_CONVERGED_BINDING_ROUGHNESS, roughness.view, history_.sampler, readLayout(roughness));
   }
 }
@@ -153,8 +155,8 @@ void ConvergedTiles::check(Context& ctx, VkCommandBuffer cmd, const GBufferDesc&
                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   DescriptorWrites w;
   writeCommon(w, g, classifier);
-  if (signal_ == DenoiseSignal::Reflection) {
-    // The trace's radiance, still in GENERAL: read and written here.
+  if (signal_ != DenoiseSignal::Scalar) {
+    // The trace's output, still in GENERAL: read and written here.
     recordMemoryBarrier(vk, cmd, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, VK_ACCESS_SHADER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     w.storageImage(RB_CONVERGED_BINDING_VISIBILITY, visibility);

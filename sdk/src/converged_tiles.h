@@ -1,13 +1,13 @@
 // Converged-tile skipping (raybridge/converged_tiles.h) for the shadow pass (ShadowSettings::convergedTiles), the
-// AO pass (AoSettings::convergedTiles) and the reflection pass (ReflectionSettings::convergedTiles): the two compute
-// dispatches around the pass's tile classifier that decide, from its denoiser's history, which tiles have converged
-// and write their kept-history marks into the pass's output, and after the trace check the refreshed tiles for a
-// change the history could not see. Shadows and AO (a Scalar denoiser): shadow_converged.comp and
-// shadow_converged_check.comp, which serve both, as both signals are in [0, 1] with sky at 1. Reflections (a
-// Reflection denoiser): reflection_converged.comp and reflection_converged_check.comp, which also follow how far the
-// view turned, and count the pass's tiles (the reflection pass has no classifier: its ray generation shader skips the
-// converged tiles). The tile state they share lives in the TileClassifier. Owns the two pipelines, created on first
-// use.
+// AO pass (AoSettings::convergedTiles), the reflection pass (ReflectionSettings::convergedTiles) and the many-light
+// pass (ManyLightSettings::convergedTiles): the two compute dispatches around the pass's trace that decide, from its
+// denoiser's history, which tiles have converged and write their kept-history marks into the pass's output, and
+// after the trace check the refreshed tiles for a change the history could not see. Shadows and AO (a Scalar
+// denoiser): shadow_converged.comp and shadow_converged_check.comp, which serve both, as both signals are in [0, 1]
+// with sky at 1, around the pass's tile classifier. Reflections and local lights (a Reflection or Rgb denoiser):
+// rgb_converged.comp and rgb_converged_check.comp, which for reflections also follow how far the view turned, and
+// which count the pass's tiles (those passes have no classifier: their ray generation shader skips the converged
+// tiles). The tile state lives in the TileClassifier. Owns the two pipelines, created on first use.
 #pragma once
 
 #include <raybridge/converged_tiles.h>
@@ -24,7 +24,7 @@ class TileClassifier;
 
 class ConvergedTiles {
  public:
-  // `signal`: the kind of Denoiser whose history it reads: Scalar (shadows, AO) or Reflection.
+  // `signal`: the kind of Denoiser whose history it reads: Scalar (shadows, AO), Reflection or Rgb (local lights).
   explicit ConvergedTiles(DenoiseSignal signal = DenoiseSignal::Scalar) : signal_(signal) {}
   // Checks the settings; `who` names the pass and field in the error ("ShadowPass: ShadowSettings::convergedTiles").
   Status validate(const ConvergedTileSettings& settings, const char* who) const;
@@ -33,16 +33,16 @@ class ConvergedTiles {
   // Records step 1 for `g` and returns true, or returns false and records nothing when the denoiser has no history
   // of this size yet (nothing is converged). `visibility`: the pass's output, writable by compute shaders. After it,
   // the tile state and the skipped tiles' outputs are visible to the classifier. `raysPerPixel`: the pass's uniform
-  // rays (the check's noise model for shadows and AO; the rays saved for reflections). Tells the denoiser that its
-  // next record() this frame reads marks. Reflections only: `roughnessThreshold`, the pass's (rougher pixels have no
-  // reflection), and `counters`, the pass's ray counters (this dispatch counts the tiles and the rays saved); the
-  // tile state is then visible to ray tracing shaders too.
+  // rays (the check's noise model for shadows and AO; the rays saved for RGB signals). Tells the denoiser that its
+  // next record() this frame reads marks. Reflections: `roughnessThreshold`, the pass's (rougher pixels have no
+  // reflection). RGB signals: `counters`, the pass's ray counters (this dispatch counts the tiles and the rays
+  // saved); the tile state is then visible to ray tracing shaders too.
   Result<bool> record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const ConvergedTileSettings& settings,
                       uint32_t raysPerPixel, TileClassifier& classifier, VkImageView visibility, const char* who,
                       float roughnessThreshold = 0.0f, VkDescriptorBufferInfo counters = {});
   // Records step 2, after the trace (only after a record() that returned true, in the same frame): for shadows and
-  // AO once the pass's outputs are readable by compute shaders (after endWrite()); for reflections while the
-  // radiance is still in GENERAL (before endWrite(), which must then cover compute writes), as the check marks the
+  // AO once the pass's outputs are readable by compute shaders (after endWrite()); for RGB signals while the
+  // output is still in GENERAL (before endWrite(), which must then cover compute writes), as the check marks the
   // held tiles' pixels stale in it.
   void check(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const TileClassifier& classifier,
              VkImageView visibility) const;

@@ -236,7 +236,7 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
     w.storageImage(RB_RGB_TEMPORAL_BINDING_GUIDE_OUT, im[6].view);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_NORMAL, g.normal.view, s.sampler, readLayout(g.normal));
     // Read only for reflections (RB_DN_RGB_REFLECTION): the roughness image, else the normal (roughness in .w).
-    const GBufferImage& roughness = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
+    const GBufferImage& roughness = roughnessImage(g);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_ROUGHNESS, roughness.view, s.sampler, readLayout(roughness));
     s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
   }
@@ -443,7 +443,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
       return invalid("a Reflection signal needs the G-buffer's roughness: set GBufferDesc::roughnessInNormalW or "
                      "roughnessMetalness");
     }
-    flags |= RB_DN_RGB_REFLECTION | (g.roughnessMetalness.view ? RB_DN_RGB_ROUGHNESS_IMAGE : 0u);
+    flags |= RB_DN_RGB_REFLECTION | (roughnessInImage(g) ? RB_DN_RGB_ROUGHNESS_IMAGE : 0u);
   }
   if (s.keptMarksFrame == s.ctx.frameIndex()) flags |= RB_DN_KEPT_MARKS;
   if (s.signal != DenoiseSignal::Scalar) {

@@ -63,6 +63,11 @@ Status validate(const HybridEffectsDesc& d) {
   if (d.reflections.convergedTiles.enabled && d.reflections.halfResolution)
     return invalid("reflections.convergedTiles skips tiles of full-resolution pixels: disable "
                    "reflections.halfResolution or convergedTiles");
+  if (d.localLights.convergedTiles.enabled &&
+      (d.localLights.disableDenoiser || d.localLights.mode != ManyLightMode::Stochastic))
+    return invalid("localLights.convergedTiles reads the local-light denoiser's history, which only the Stochastic "
+                   "mode has: set localLights.mode = Stochastic and disableDenoiser = false, or disable "
+                   "convergedTiles");
   if (d.ao.adaptive.enabled && d.ao.disableDenoiser)
     return invalid("ao.adaptive plans from the AO denoiser's history: enable the denoiser (ao.disableDenoiser = "
                    "false) or disable adaptive rays");
@@ -233,6 +238,9 @@ Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridF
   s.raysPerPixel = desc.localLights.raysPerPixel;
   s.candidates = desc.localLights.candidates;
   s.materials = materials.get();
+  s.convergedTiles = desc.localLights.convergedTiles;
+  s.convergedTiles.history = localLightDenoiser.get();
+  s.convergedTiles.enabled = s.convergedTiles.enabled && s.convergedTiles.history;
   if (Status st = localLights->record(cmd, f.gbuffer, tlas, f.localLights, s); !st)
     return wrap("ManyLightPass::record", st.error());
   const ManyLightOutputs& o = localLights->outputs();

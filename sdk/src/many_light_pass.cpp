@@ -7,9 +7,11 @@
 
 #include "compute_pipeline.h"
 #include "context_impl.h"
+#include "converged_tiles.h"
 #include "many_light_pass_impl.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
+#include "tile_classifier.h"  // the tile state
 
 namespace rb {
 
@@ -99,6 +101,13 @@ struct ManyLightPass::Impl {
   std::vector<GpuLight> staging;
   ManyLightOutputs outputs;
   internal::LightListView recorded;  // what the latest record() uploaded, for reflection hits
+  // ManyLightSettings::convergedTiles, created on first use: the launch that skips converged tiles
+  // (many_lights_converged.rgen), the tile state (a TileClassifier without list nor pipeline) and the dispatches.
+  RayTracingPipelineDesc desc;  // the pass's pipeline, for the variant
+  RayTracingPipeline convergedPipeline;
+  TileClassifier tileState;
+  ConvergedTiles converged{DenoiseSignal::Rgb};
+  bool tilesReady = false;
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still use them
     core.retire(ctx);
@@ -106,6 +115,28 @@ struct ManyLightPass::Impl {
     retireBuffer(ctx, ring);
     retireBuffer(ctx, lights);
     retireBuffer(ctx, tiles);
+    retireTiles();
+  }
+  void retireTiles() {
+    convergedPipeline.retire(ctx);
+    tileState.retire(ctx);
+    converged.retire(ctx);
+    tilesReady = false;
+  }
+  // What converged tiles need, before the pass's recording begins (so that a failure records nothing).
+  Status ensureConvergedTiles(const GBufferDesc& g) {
+    if (!convergedPipeline.pipeline) {
+      RayTracingPipelineDesc p = desc;
+      p.name = "many-light pass (converged tiles)";
+      p.raygen = SpirvModule::of(spirv::many_lights_converged_rgen);
+      p.bindings.push_back(
+          {RB_ML_BINDING_TILE_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr});
+      Result<RayTracingPipeline> v = core.createVariant(ctx, std::move(p), SpirvModule::of(spirv::many_lights_rahit));
+      if (!v) return v.error();
+      convergedPipeline = v.value();
+    }
+    tilesReady = true;
+    return tileState.ensure(ctx, g.width, g.height, false);
   }
   Status ensureLightBuffers(uint32_t lightCount);
   Status ensureTiles(VkDeviceSize tileBytes);
@@ -203,6 +234,7 @@ Result<std::unique_ptr<ManyLightPass>> ManyLightPass::create(Context& context) {
   p.bindings.push_back({RB_ML_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr});
   p.bindings.push_back({RB_ML_BINDING_IRRADIANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
   p.pushConstantBytes = sizeof(ManyLightConstants);
+  impl->desc = p;  // init() takes the description
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::many_lights_rahit)); !s) return s.error();
   const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
   Result<ComputePipeline> cull =
@@ -231,6 +263,14 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   if (settings.raysPerPixel > kMaxRaysOrCandidates || settings.candidates > kMaxRaysOrCandidates)
     return invalid("ManyLightSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " and candidates " +
                    std::to_string(settings.candidates) + " must be at most 64");
+  if (Status st = s.converged.validate(settings.convergedTiles, "ManyLightPass: ManyLightSettings::convergedTiles");
+      !st) {
+    return st;
+  }
+  if (settings.convergedTiles.enabled && settings.mode != ManyLightMode::Stochastic) {
+    return invalid("ManyLightSettings::convergedTiles skips converged noise: ManyLightMode::Exact has none to skip "
+                   "(and no denoiser); use Stochastic or disable convergedTiles");
+  }
   ManyLightConstants pc{};
   if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ManyLightPass", pc.gbuffer); !st) return st;
   const uint32_t count = uint32_t(lightList.size());
@@ -246,6 +286,11 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   const VkDeviceSize tileBytes = VkDeviceSize(pc.tiles[0]) * pc.tiles[1] * RB_ML_TILE_UINTS * sizeof(uint32_t);
   if (Status st = s.ensureLightBuffers(std::max(count, 1u)); !st) return st;
   if (Status st = s.ensureTiles(tileBytes); !st) return st;
+  if (settings.convergedTiles.enabled) {
+    if (Status st = s.ensureConvergedTiles(g); !st) return st;
+  } else if (s.tilesReady) {
+    s.retireTiles();  // no tile state while converged tiles are off
+  }
 
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ManyLightPass", pc.gbuffer.flags); !st) return st;
@@ -273,7 +318,32 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   w.storageBuffer(RB_ML_BINDING_LIGHTS, s.lights.buffer);
   w.storageBuffer(RB_ML_BINDING_TILES, s.tiles.buffer);
   w.storageImage(RB_ML_BINDING_IRRADIANCE, images[0].view);
-  s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  bool converged = false;
+  if (settings.convergedTiles.enabled) {
+    const VkDescriptorBufferInfo counters{s.core.metrics.counterBuffer(), s.core.metrics.counterOffset(s.ctx),
+                                          s.core.metrics.counterBytes()};
+    // The rays saved count raysPerPixel per skipped surface pixel: at most what it would have traced (a tile with
+    // fewer lights than rays traces one per light).
+    Result<bool> c = s.converged.record(s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel, s.tileState,
+                                        images[0].view, "ManyLightPass", 0.0f, counters);
+    if (!c) {
+      s.core.end(s.ctx, cmd);
+      return c.error();
+    }
+    converged = c.value();
+  }
+  if (converged) {
+    // Every pixel, the converged tiles' returning at once (their outputs are written); then the check, which marks
+    // held tiles in the output before it is made readable, inside the pass's time.
+    s.tileState.writeState(w, RB_ML_BINDING_TILE_STATE);
+    s.core.bind(s.ctx, cmd, w, &pc, sizeof pc, &s.convergedPipeline);
+    s.convergedPipeline.trace(s.ctx, cmd, g.width, g.height);
+    s.converged.check(s.ctx, cmd, g, s.tileState, images[0].view);
+    s.core.images.endWrite(s.ctx, cmd);
+    s.core.metrics.writeEnd(s.ctx, cmd);
+  } else {
+    s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  }
 
   s.remember(tlas, count);
   ManyLightOutputs& o = s.outputs;

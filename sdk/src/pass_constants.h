@@ -284,4 +284,13 @@ void cameraPosition(const GBufferDesc& gbuffer, double out[3]);
 
 VkImageLayout readLayout(const GBufferImage& image);
 
+// Where the passes read roughness (rbRoughness, shaders/pass_inputs.glsl): the normal's .w when
+// GBufferDesc::roughnessInNormalW, else the roughness image's .x. The denoiser and converged reflection tiles read it
+// the same way, so that they agree with the pass on which pixels have a reflection.
+inline bool roughnessInImage(const GBufferDesc& g) { return !g.roughnessInNormalW && g.roughnessMetalness.view; }
+// The image that holds it.
+inline const GBufferImage& roughnessImage(const GBufferDesc& g) {
+  return roughnessInImage(g) ? g.roughnessMetalness : g.normal;
+}
+
 }  // namespace rb

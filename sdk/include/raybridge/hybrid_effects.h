@@ -111,6 +111,10 @@ struct LocalLightEffectSettings {
   // false = Stochastic output is denoised (an RGB Denoiser, HybridEffectsDesc::denoiser's settings); Exact is
   // never denoised: it has no noise.
   bool disableDenoiser = false;
+  // Stochastic: skip the tiles whose denoised irradiance has converged (ManyLightSettings::convergedTiles; the raw
+  // output then holds kept-history marks there, a = -1, the denoised one is complete). `history` is ignored (the
+  // effect's denoiser, which must be enabled). Off by default.
+  ConvergedTileSettings convergedTiles;
 };
 
 // What runs. A zero-initialised description is valid: no effect, nothing allocated, nothing traced.

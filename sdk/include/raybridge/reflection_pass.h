@@ -35,9 +35,10 @@
 // refreshed tile whose new rays disagree with its history (beyond the noise the denoiser measured, over the tile or
 // in any one pixel) is held, and its pixels get a = 2, which tells the denoiser to drop their stale history. A
 // reflection also depends on where it is seen from, which the history cannot follow: a tile is converged only while
-// the view of its pixels has turned by less than a quarter of their glossy lobe's width since the tile was last
-// traced (summed over the frames between, so a slow orbit is caught too; turning the camera in place turns nothing;
-// a mirror's lobe is a few thousandths of a radian wide). The launch stays one invocation per pixel: those of a
+// the view of its pixels has turned by less than a quarter of their glossy lobe's width from the views its history
+// holds (summed over the frames, a traced frame taking off the share of the history its rays replace, so a slow
+// orbit is caught too; turning the camera in place turns nothing; a mirror's lobe is a few thousandths of a radian
+// wide). The launch stays one invocation per pixel: those of a
 // skipped tile return at once (a list of the tiles left, as the shadow and AO passes trace, cost the reflection
 // pass more than it saved on an NVIDIA H200: docs/performance.md). PassStats counts the tiles traced, skipped and
 // converged, and the reflection rays saved (not counting the shadow rays their hits would have traced). The tile

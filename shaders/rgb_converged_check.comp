@@ -1,8 +1,9 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Converged-tile skipping for reflections, step 2 (after the trace): a tile refreshed this frame (converged, traced
-// anyway) whose new radiance disagrees with its history by more than the noise the denoiser measured there has
-// seen a change the history could not (a moved light or object in the reflection): it is held, traced every frame
+// Converged-tile skipping for RGB signals (reflections, local lights), step 2 (after the trace): a tile refreshed
+// this frame (converged, traced anyway) whose new colour disagrees with its history by more than the noise the
+// denoiser measured there has seen a change the history could not (a moved light, or an object moved in a
+// reflection): it is held, traced every frame
 // for the next tc.minFrames frames, before it may be skipped again. The test: over the tile's covered pixels with
 // history, the sum of |new - mean|^2 over the variance of one frame's colour (the sum of the channels', plus a floor
 // relative to the colour, so that a noise-free mirror whose reflection changes counts without dividing by zero),
@@ -10,7 +11,7 @@
 // deviations), so that a change in a few pixels of a tile (a small object in a mirror) is not diluted by the rest.
 // A held tile's history is stale, and the denoiser's running mean would take many frames to forget it: its covered
 // pixels get a = 2 instead of 1, which the RGB denoiser (RB_DN_KEPT_MARKS) reads as "traced, start afresh".
-#include "reflection_converged.glsl"
+#include "rgb_converged.glsl"
 
 // This frame's, traced (GENERAL: read, and a = 2 written where the tile is held).
 layout(set = 0, binding = RB_CONVERGED_BINDING_VISIBILITY, rgba16f) uniform image2D radiance;
@@ -39,7 +40,7 @@ void main() {
   }
   barrier();
   uvec2 pixel = gl_GlobalInvocationID.xy;
-  ConvergedReflection c = rbConvergedReflection(pixel);
+  ConvergedRgb c = rbConvergedRgb(pixel);
   float d = 0.0;
   vec4 traced = c.covered ? imageLoad(radiance, ivec2(pixel)) : vec4(0.0);
   if (c.covered && c.history) {
