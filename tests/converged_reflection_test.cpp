@@ -227,8 +227,9 @@ TEST_CASE("reflections: a moving camera re-traces converged tiles, however slowl
       p.setView(shifted(p.view, step));
       std::vector<double> frameTurn(turned.size(), 0.0);
       for (size_t k = 0; k < size_t(kWidth) * kHeight; ++k) {
+        if (!p.cpu.hit[k]) continue;  // the sky has no instance
         const float roughness = p.roughness[p.cpu.instance[k]];
-        if (!p.cpu.hit[k] || roughness > kThreshold) continue;
+        if (roughness > kThreshold) continue;
         const glm::dvec3 a = glm::normalize(p.cpu.position[k] - p.view.eye),
                          b = glm::normalize(p.cpu.position[k] - from);
         const double angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
