@@ -7,6 +7,7 @@
 #include "denoise_rgb_interface.glsl"
 #include "denoiser_history.h"
 #include "memory_barrier.h"
+#include "pass_core.h"
 #include "raybridge_shaders.h"
 #include "tile_classifier.h"
 
@@ -165,6 +166,31 @@ void ConvergedTiles::check(Context& ctx, VkCommandBuffer cmd, const GBufferDesc&
                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   }
   check_.dispatch(ctx, cmd, w.writes, &constants_, sizeof constants_, g.width, g.height);
+}
+
+Result<bool> ConvergedTiles::traceSkipping(PassCore& core, Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
+                                           const ConvergedTileSettings& settings, uint32_t raysPerPixel,
+                                           TileClassifier& state, DescriptorWrites& w, const void* constants,
+                                           uint32_t constantBytes, const RayTracingPipeline& skipping,
+                                           uint32_t stateBinding, const char* who, float roughnessThreshold) {
+  const VkDescriptorBufferInfo counters{core.metrics.counterBuffer(), core.metrics.counterOffset(ctx),
+                                        core.metrics.counterBytes()};
+  Result<bool> marked = record(ctx, cmd, g, settings, raysPerPixel, state, core.images[0].view, who, roughnessThreshold,
+                               counters);
+  if (!marked) {
+    core.end(ctx, cmd);
+    return marked.error();
+  }
+  if (!marked.value()) return false;
+  // Every pixel, the converged tiles' returning at once (their outputs are written); then the check, which marks
+  // held tiles in the output before it is made readable, inside the pass's time.
+  state.writeState(w, stateBinding);
+  core.bind(ctx, cmd, w, constants, constantBytes, &skipping);
+  skipping.trace(ctx, cmd, g.width, g.height);
+  check(ctx, cmd, g, state, core.images[0].view);
+  core.images.endWrite(ctx, cmd);
+  core.metrics.writeEnd(ctx, cmd);
+  return true;
 }
 
 }  // namespace rb

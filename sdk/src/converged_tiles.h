@@ -20,6 +20,7 @@
 
 namespace rb {
 
+class PassCore;
 class TileClassifier;
 
 class ConvergedTiles {
@@ -46,6 +47,16 @@ class ConvergedTiles {
   // held tiles' pixels stale in it.
   void check(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const TileClassifier& classifier,
              VkImageView visibility) const;
+  // RGB signals, whose launch skips the converged tiles itself (reflections, local lights), after the pass's
+  // core.begin(): record() into the pass's output 0 with its ray counters and, when it found history, the launch
+  // over every pixel with `skipping` (whose ray generation shader reads the tile state at `stateBinding`, added to
+  // `w`), the check and the end of the pass's recording; returns true then. Returns false, having recorded nothing,
+  // when there is no history yet: the pass traces as usual. On an error the pass's recording is ended.
+  Result<bool> traceSkipping(PassCore& core, Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
+                             const ConvergedTileSettings& settings, uint32_t raysPerPixel, TileClassifier& state,
+                             DescriptorWrites& w, const void* constants, uint32_t constantBytes,
+                             const RayTracingPipeline& skipping, uint32_t stateBinding, const char* who,
+                             float roughnessThreshold = 0.0f);
 
  private:
   Status init(Context& ctx, const char* who);

@@ -107,7 +107,6 @@ struct ManyLightPass::Impl {
   RayTracingPipeline convergedPipeline;
   TileClassifier tileState;
   ConvergedTiles converged{DenoiseSignal::Rgb};
-  bool tilesReady = false;
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still use them
     core.retire(ctx);
@@ -121,7 +120,6 @@ struct ManyLightPass::Impl {
     convergedPipeline.retire(ctx);
     tileState.retire(ctx);
     converged.retire(ctx);
-    tilesReady = false;
   }
   // What converged tiles need, before the pass's recording begins (so that a failure records nothing).
   Status ensureConvergedTiles(const GBufferDesc& g) {
@@ -135,7 +133,6 @@ struct ManyLightPass::Impl {
       if (!v) return v.error();
       convergedPipeline = v.value();
     }
-    tilesReady = true;
     return tileState.ensure(ctx, g.width, g.height, false);
   }
   Status ensureLightBuffers(uint32_t lightCount);
@@ -288,7 +285,7 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   if (Status st = s.ensureTiles(tileBytes); !st) return st;
   if (settings.convergedTiles.enabled) {
     if (Status st = s.ensureConvergedTiles(g); !st) return st;
-  } else if (s.tilesReady) {
+  } else if (s.convergedPipeline.pipeline) {
     s.retireTiles();  // no tile state while converged tiles are off
   }
 
@@ -320,30 +317,15 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   w.storageImage(RB_ML_BINDING_IRRADIANCE, images[0].view);
   bool converged = false;
   if (settings.convergedTiles.enabled) {
-    const VkDescriptorBufferInfo counters{s.core.metrics.counterBuffer(), s.core.metrics.counterOffset(s.ctx),
-                                          s.core.metrics.counterBytes()};
     // The rays saved count raysPerPixel per skipped surface pixel: at most what it would have traced (a tile with
     // fewer lights than rays traces one per light).
-    Result<bool> c = s.converged.record(s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel, s.tileState,
-                                        images[0].view, "ManyLightPass", 0.0f, counters);
-    if (!c) {
-      s.core.end(s.ctx, cmd);
-      return c.error();
-    }
+    Result<bool> c = s.converged.traceSkipping(s.core, s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel,
+                                               s.tileState, w, &pc, sizeof pc, s.convergedPipeline,
+                                               RB_ML_BINDING_TILE_STATE, "ManyLightPass");
+    if (!c) return c.error();
     converged = c.value();
   }
-  if (converged) {
-    // Every pixel, the converged tiles' returning at once (their outputs are written); then the check, which marks
-    // held tiles in the output before it is made readable, inside the pass's time.
-    s.tileState.writeState(w, RB_ML_BINDING_TILE_STATE);
-    s.core.bind(s.ctx, cmd, w, &pc, sizeof pc, &s.convergedPipeline);
-    s.convergedPipeline.trace(s.ctx, cmd, g.width, g.height);
-    s.converged.check(s.ctx, cmd, g, s.tileState, images[0].view);
-    s.core.images.endWrite(s.ctx, cmd);
-    s.core.metrics.writeEnd(s.ctx, cmd);
-  } else {
-    s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
-  }
+  if (!converged) s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
 
   s.remember(tlas, count);
   ManyLightOutputs& o = s.outputs;

@@ -63,7 +63,6 @@ struct ReflectionPass::Impl {
   RayTracingPipeline tilesPipeline, reorderTilesPipeline;
   TileClassifier tileState;
   ConvergedTiles converged{DenoiseSignal::Reflection};
-  bool tilesReady = false;
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still trace with it
     core.retire(ctx);
@@ -76,7 +75,6 @@ struct ReflectionPass::Impl {
     reorderTilesPipeline.retire(ctx);
     tileState.retire(ctx);
     converged.retire(ctx);
-    tilesReady = false;
   }
   // What converged tiles need, before the pass's recording begins (so that a failure records nothing): the launch
   // that skips them (reordered too when `reorder`), and the tile state for this size.
@@ -89,7 +87,6 @@ struct ReflectionPass::Impl {
       if (!v) return v.error();
       p = v.value();
     }
-    tilesReady = true;
     return tileState.ensure(ctx, g.width, g.height, false);
   }
 };
@@ -207,7 +204,7 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   s.reordered = s.reorderPipeline.pipeline && settings.invocationReorder;
   if (settings.convergedTiles.enabled) {
     if (Status st = s.ensureTiles(g, s.reordered); !st) return st;
-  } else if (s.tilesReady) {
+  } else if (s.tilesPipeline.pipeline) {
     s.retireTiles();  // no tile state while converged tiles are off
   }
   if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16G16B16A16_SFLOAT, "reflection radiance"}}); !st) return st;
@@ -222,26 +219,15 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   const RayTracingPipeline* variant = s.reordered ? &s.reorderPipeline : nullptr;
   bool converged = false;
   if (settings.convergedTiles.enabled) {
-    const VkDescriptorBufferInfo counters{s.core.metrics.counterBuffer(), s.core.metrics.counterOffset(s.ctx),
-                                          s.core.metrics.counterBytes()};
-    Result<bool> c = s.converged.record(s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel, s.tileState,
-                                        s.core.images[0].view, "ReflectionPass", threshold, counters);
-    if (!c) {
-      s.core.end(s.ctx, cmd);
-      return c.error();
-    }
+    Result<bool> c = s.converged.traceSkipping(s.core, s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel,
+                                               s.tileState, w, &pc, sizeof pc,
+                                               s.reordered ? s.reorderTilesPipeline : s.tilesPipeline,
+                                               RB_REFLECTION_BINDING_TILE_STATE, "ReflectionPass", threshold);
+    if (!c) return c.error();
     converged = c.value();
   }
   if (converged) {
-    // Every pixel, the converged tiles' returning at once (their outputs are written).
-    s.tileState.writeState(w, RB_REFLECTION_BINDING_TILE_STATE);
-    s.core.bind(s.ctx, cmd, w, &pc, sizeof pc, s.reordered ? &s.reorderTilesPipeline : &s.tilesPipeline);
-    (s.reordered ? s.reorderTilesPipeline : s.tilesPipeline).trace(s.ctx, cmd, g.width, g.height);
-    // The check reads the traced radiance and marks held tiles in it, before it is made readable, inside the pass's
-    // time.
-    s.converged.check(s.ctx, cmd, g, s.tileState, s.core.images[0].view);
-    s.core.images.endWrite(s.ctx, cmd);
-    s.core.metrics.writeEnd(s.ctx, cmd);
+    // Traced, checked and ended by traceSkipping().
   } else if (settings.halfResolution) {
     s.core.traceHalfAndEnd(s.ctx, cmd, w, pc, g, s.half, threshold, variant);
   } else {
