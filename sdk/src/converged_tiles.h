@@ -20,7 +20,7 @@
 
 namespace rb {
 
-class PassCore;
+struct PassCore;
 class TileClassifier;
 
 class ConvergedTiles {
