@@ -216,14 +216,18 @@ TEST_CASE("effects front ends created and destroyed every frame, cycling all pre
       const rb::PresetDesc want = rb::presetDesc(preset);
       const rb::HybridOutputs& out = effects.value()->outputs();
       INFO("frame " << f << " preset " << rb::toString(preset));
-      // Exactly the preset's effects produce images; soft shadows also a denoised one besides the raw.
-      CHECK((out.shadowRaw.view != VK_NULL_HANDLE) == bool(want.effects & rb::kEffectShadows));
-      CHECK((out.ao.view != VK_NULL_HANDLE) == bool(want.effects & rb::kEffectAo));
-      CHECK((out.reflection.view != VK_NULL_HANDLE) == bool(want.effects & rb::kEffectReflections));
+      // Exactly the preset's effects produce images of the frame's size, the others name the 1x1 neutral ones;
+      // soft shadows also a denoised one besides the raw.
+      CHECK((out.shadowRaw.width == 48) == bool(want.effects & rb::kEffectShadows));
+      CHECK((out.ao.width == 48) == bool(want.effects & rb::kEffectAo));
+      CHECK((out.reflection.width == 48) == bool(want.effects & rb::kEffectReflections));
       CHECK((out.shadow.view != out.shadowRaw.view) == (want.shadowRaysPerPixel > 1));
       CHECK((effects.value()->shadowDenoiser() != nullptr) == (want.shadowRaysPerPixel > 1));
-      for (const rb::EffectImage* image : {&out.shadow, &out.ao, &out.reflection})
-        if (image->view) CHECK((image->layout == VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL && image->width == 48));
+      for (const rb::EffectImage* image : {&out.shadow, &out.ao, &out.reflection}) {
+        CHECK(image->view != VK_NULL_HANDLE);
+        CHECK(image->layout == VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        CHECK((image->width == 48 || image->width == 1));
+      }
       ring.submit(slot);
     }  // destroyed while its frame is in flight
     if (f + 1 == 2 * rb::kPresetCount) steady = fx.ctx().memoryStats();

@@ -41,11 +41,14 @@ se::Result<std::unique_ptr<FrameDriver>> FrameDriver::create(const Config& confi
     if (!self->captureNext_) return;
     self->captureNext_ = false;
     const rb::HybridOutputs& fo = self->adapter_->effects().outputs();
-    const std::vector<rbRender::CaptureImage> images = {{"shadow_raw", fo.shadowRaw.image, 1},
-                                                        {"shadow", fo.shadow.image, 1},
-                                                        {"ao_raw", fo.aoRaw.image, 1},
-                                                        {"ao", fo.ao.image, 1},
-                                                        {"reflection", fo.reflection.image, 4}};
+    // An effect that is off names a 1x1 neutral image: nothing to capture.
+    const rb::EffectSet on = self->adapter_->effects().desc().effects;
+    auto of = [&](rb::EffectSet effect, const rb::EffectImage& e) { return (on & effect) ? e.image : VK_NULL_HANDLE; };
+    const std::vector<rbRender::CaptureImage> images = {{"shadow_raw", of(rb::kEffectShadows, fo.shadowRaw), 1},
+                                                        {"shadow", of(rb::kEffectShadows, fo.shadow), 1},
+                                                        {"ao_raw", of(rb::kEffectAo, fo.aoRaw), 1},
+                                                        {"ao", of(rb::kEffectAo, fo.ao), 1},
+                                                        {"reflection", of(rb::kEffectReflections, fo.reflection), 4}};
     if (se::Status s = self->capture_->record(info, info.normalRoughness, images); !s) self->captureError_ = s.error;
   });
   return R::success(std::move(d));

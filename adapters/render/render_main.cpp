@@ -397,11 +397,16 @@ int main(int argc, char** argv) {
       images = {{"distance", shading->outputs().distance, 1, true}};  // the pre-pass images are only cleared
     } else if (adapter) {
       const rb::HybridOutputs& fo = adapter->effects().outputs();
-      images = {{"shadow", fo.shadow.image, 1},
-                {"ao", fo.ao.image, 1},
-                {"ao_raw", fo.aoRaw.image, 1},
-                {"reflection", fo.reflection.image, 4},
-                {"lights", fo.localLights.image, 4}};
+      // An effect that is off names a 1x1 neutral image: nothing to dump.
+      const rb::EffectSet on = adapter->effects().desc().effects;
+      auto of = [&](rb::EffectSet effect, const rb::EffectImage& e) {
+        return (on & effect) ? e.image : VK_NULL_HANDLE;
+      };
+      images = {{"shadow", of(rb::kEffectShadows, fo.shadow), 1},
+                {"ao", of(rb::kEffectAo, fo.ao), 1},
+                {"ao_raw", of(rb::kEffectAo, fo.aoRaw), 1},
+                {"reflection", of(rb::kEffectReflections, fo.reflection), 4},
+                {"lights", of(rb::kEffectLocalLights, fo.localLights), 4}};
       if (fo.shadowRaw.image != fo.shadow.image) images.push_back({"shadow_raw", fo.shadowRaw.image, 1});  // denoised
       if (fo.localLightsRaw.image != fo.localLights.image) images.push_back({"lights_raw", fo.localLightsRaw.image, 4});
     }

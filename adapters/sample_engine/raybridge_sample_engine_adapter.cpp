@@ -267,11 +267,15 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   if (a.fx->desc().effects & rb::kEffectLocalLights) convertLights(info.lights, a.lights), f.localLights = a.lights;
   if (rb::Status s = a.fx->record(info.commandBuffer, f); !s)
     return keepFirst(a.error, message("HybridEffects::record", s.error()));
-  const rb::HybridOutputs& out = a.fx->outputs();  // SHADER_READ_ONLY_OPTIMAL, as LightingInputs requires
-  inputs.sunVisibility = out.shadow.view;
-  inputs.ambientOcclusion = out.ao.view;
-  inputs.reflection = out.reflection.view;
-  inputs.localLightIrradiance = out.localLights.view;  // replaces the engine's local lights and their shadow maps
+  // SHADER_READ_ONLY_OPTIMAL, as LightingInputs requires. An effect that is off names a neutral image; the
+  // engine's own term (its shadow map, its lights) stands in for it instead.
+  const rb::HybridOutputs& out = a.fx->outputs();
+  const rb::EffectSet on = a.fx->desc().effects;
+  inputs.sunVisibility = (on & rb::kEffectShadows) ? out.shadow.view : VK_NULL_HANDLE;
+  inputs.ambientOcclusion = (on & rb::kEffectAo) ? out.ao.view : VK_NULL_HANDLE;
+  inputs.reflection = (on & rb::kEffectReflections) ? out.reflection.view : VK_NULL_HANDLE;
+  // Replaces the engine's local lights and their shadow maps.
+  inputs.localLightIrradiance = (on & rb::kEffectLocalLights) ? out.localLights.view : VK_NULL_HANDLE;
 }
 
 void Adapter::recordRayTraced(const se::PrepassHookInfo& info) {

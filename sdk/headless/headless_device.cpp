@@ -15,6 +15,11 @@
 namespace rb {
 
 namespace {
+// The instance's VkApplicationInfo::apiVersion, handed on in contextDesc().
+constexpr uint32_t kHeadlessApiVersion = VK_API_VERSION_1_3;
+}  // namespace
+
+namespace {
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -122,7 +127,7 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
 
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "raybridge-headless";
-  app.apiVersion = VK_API_VERSION_1_3;
+  app.apiVersion = kHeadlessApiVersion;
   std::vector<const char*> layers, extensions;
   if (impl->validation) {
     layers.push_back("VK_LAYER_KHRONOS_validation");
@@ -312,6 +317,7 @@ ContextDesc HeadlessDevice::contextDesc() const {
   d.framesInFlight = impl_->framesInFlight;
   d.mainQueueFamily = impl_->queueFamily;
   d.invocationReorderEnabled = impl_->invocationReorder;
+  d.apiVersion = kHeadlessApiVersion;
   return d;
 }
 

@@ -99,6 +99,26 @@ struct AoPass::Impl {
   }
 };
 
+namespace {
+
+const std::vector<PassImages::Spec> kAoOutputs = {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}};
+
+void nameOutputs(AoPass::Impl& s) {
+  s.outputs.ao = s.core.images[0].image;
+  s.outputs.aoView = s.core.images[0].view;
+  s.outputs.width = s.core.images[0].width;
+  s.outputs.height = s.core.images[0].height;
+}
+
+}  // namespace
+
+Status AoPass::prepare(uint32_t width, uint32_t height) {
+  Impl& s = *impl_;
+  if (Status st = s.core.prepare(s.ctx, width, height, kAoOutputs, "AoPass"); !st) return st;
+  nameOutputs(s);
+  return {};
+}
+
 AoPass::AoPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 AoPass::~AoPass() = default;
 
@@ -157,7 +177,7 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
     s.retireTiles();  // no tile list nor state while converged tiles are off
   }
   const PassStats latest = s.core.metrics.latest(s.ctx);
-  if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16_SFLOAT, "ambient occlusion"}}); !st) return st;
+  if (Status st = s.core.begin(s.ctx, cmd, g, kAoOutputs); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
   // With half resolution the plan covers every pixel and the traced quarter uses its entries: a quarter of the
   // budget is traced (a time target compensates: it scales the budget it planned by the time measured).
@@ -200,10 +220,7 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
     w.storageImage(RB_AO_BINDING_OUTPUT, s.core.images[0].view);
     s.core.traceAndEnd(s.ctx, cmd, w, pc, g, variant);
   }
-  s.outputs.ao = s.core.images[0].image;
-  s.outputs.aoView = s.core.images[0].view;
-  s.outputs.width = g.width;
-  s.outputs.height = g.height;
+  nameOutputs(s);
   s.outputs.rayPlan = planned ? s.planner.planImage() : VK_NULL_HANDLE;
   s.outputs.rayPlanView = planned ? s.planner.planView() : VK_NULL_HANDLE;
   return {};

@@ -44,7 +44,13 @@ Status checkExtensions(const std::vector<VkExtensionProperties>& available, cons
   return {};
 }
 
-Status checkFeatures(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice, const std::string& deviceName) {
+std::string versionString(uint32_t v) {
+  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v));
+}
+
+// `apiVersion`: ContextDesc::apiVersion (0 = not stated).
+Status checkFeatures(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice, const std::string& deviceName,
+                     uint32_t apiVersion) {
   VkPhysicalDeviceRayTracingPipelineFeaturesKHR rt{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
   VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rt};
@@ -75,6 +81,17 @@ Status checkFeatures(const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
   need((subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
            (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT),
        "subgroup ballot operations in compute shaders");
+  // An instance created with VkApplicationInfo::apiVersion 1.0 or 1.1 gets no Vulkan 1.2 features from a 1.2
+  // device: every one of them reads false. Say so, rather than blame the device.
+  const bool no12Feature = !v12.bufferDeviceAddress && !v12.descriptorIndexing && !v12.scalarBlockLayout &&
+                           !v12.timelineSemaphore && !v12.runtimeDescriptorArray;
+  if (apiVersion == 0 && no12Feature) {
+    return Error{ErrorCode::UnsupportedApiVersion, VK_SUCCESS,
+                 "device '" + deviceName + "' reports none of the Vulkan 1.2 features (" + missing +
+                     "), which is what an instance created with VkApplicationInfo::apiVersion below 1.2 sees: "
+                     "create the instance with apiVersion = VK_API_VERSION_1_2 or newer (and pass it in "
+                     "ContextDesc::apiVersion)"};
+  }
   if (!missing.empty()) {
     return Error{ErrorCode::MissingFeature, VK_SUCCESS,
                  "device '" + deviceName + "' does not support the features Raybridge needs: " + missing};
@@ -178,6 +195,7 @@ const char* toString(ErrorCode code) {
     case ErrorCode::OutOfBudget: return "OutOfBudget";
     case ErrorCode::StaleHandle: return "StaleHandle";
     case ErrorCode::NotReady: return "NotReady";
+    case ErrorCode::UnsupportedApiVersion: return "UnsupportedApiVersion";
   }
   return "Unknown";
 }
@@ -208,6 +226,12 @@ Result<std::unique_ptr<Context>> Context::create(const ContextDesc& desc) {
   if (desc.framesInFlight > 8) {
     return invalid("ContextDesc::framesInFlight is " + std::to_string(desc.framesInFlight) + "; use 1..8 (0 = 2)");
   }
+  if (desc.apiVersion != 0 && desc.apiVersion < kMinimumApiVersion) {
+    return Error{ErrorCode::UnsupportedApiVersion, VK_SUCCESS,
+                 "ContextDesc::apiVersion is Vulkan " + versionString(desc.apiVersion) +
+                     "; Raybridge needs 1.2 or newer: create the instance with VkApplicationInfo::apiVersion = "
+                     "VK_API_VERSION_1_2 (or newer) and pass the same value here"};
+  }
 
   auto impl = std::make_unique<Impl>();
   impl->desc = desc;
@@ -224,7 +248,10 @@ Result<std::unique_ptr<Context>> Context::create(const ContextDesc& desc) {
       desc.getInstanceProcAddr(desc.instance, "vkEnumerateDeviceExtensionProperties"));
   if (!vk.vkGetPhysicalDeviceProperties2 || !vk.vkGetPhysicalDeviceFeatures2 ||
       !vk.vkEnumerateDeviceExtensionProperties) {
-    return invalid("the instance does not expose Vulkan 1.1 queries; create it with apiVersion 1.2 or newer");
+    return Error{ErrorCode::UnsupportedApiVersion, VK_SUCCESS,
+                 "the instance does not expose the Vulkan 1.1 queries (vkGetPhysicalDeviceFeatures2), as an instance "
+                 "created with VkApplicationInfo::apiVersion 1.0 does not: create it with apiVersion = "
+                 "VK_API_VERSION_1_2 or newer (and pass it in ContextDesc::apiVersion)"};
   }
 
   VkPhysicalDeviceAccelerationStructurePropertiesKHR asProps{
@@ -246,7 +273,7 @@ Result<std::unique_ptr<Context>> Context::create(const ContextDesc& desc) {
   // Enumerated once: the required extensions and the optional reorder extension are checked against the same list.
   const std::vector<VkExtensionProperties> extensions = deviceExtensions(vk, desc.physicalDevice);
   if (Status s = checkExtensions(extensions, info.deviceName); !s) return s.error();
-  if (Status s = checkFeatures(vk, desc.physicalDevice, info.deviceName); !s) return s.error();
+  if (Status s = checkFeatures(vk, desc.physicalDevice, info.deviceName, desc.apiVersion); !s) return s.error();
   if (desc.invocationReorderEnabled) {
     if (Status s = checkInvocationReorder(vk, desc.physicalDevice, extensions, info.deviceName); !s) return s.error();
     VkPhysicalDeviceRayTracingInvocationReorderPropertiesNV serProps{

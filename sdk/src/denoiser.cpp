@@ -65,6 +65,7 @@ struct Denoiser::Impl {
   // temporal result (RG16F: value, noise variance); 5 and 7: the a-trous ping-pong (RG16F, 7 only for three steps
   // or more); 6: the output (R16F). Rgb: see recordRgb.
   PassImages images;
+  PassImages extraSpatial;  // Scalar: the second a-trous image (7), only for three steps or more
   PassMetrics metrics;
   DenoiseOutputs outputs;
   uint32_t parity = 0;  // which of each ping-pong pair this frame writes
@@ -84,9 +85,52 @@ struct Denoiser::Impl {
     atrousFinal.retire(ctx);
     internal::contextImpl(ctx).retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
     images.retire(ctx);
+    extraSpatial.retire(ctx);
     metrics.retire(ctx);
   }
 };
+
+namespace {
+
+// The images of either path. Their set never depends on the settings, so the output (Scalar: image 6, Rgb: image
+// 5) stays the same image from prepare() or the first record() until the size changes. Scalar: see Impl::images;
+// Rgb: see recordRgb.
+std::vector<PassImages::Spec> imageSpecs(DenoiseSignal signal) {
+  if (signal == DenoiseSignal::Scalar) {
+    return {{VK_FORMAT_R16G16_SFLOAT, "denoiser history A"}, {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},
+            {VK_FORMAT_R32_SFLOAT, "denoiser distance A"},   {VK_FORMAT_R32_SFLOAT, "denoiser distance B"},
+            {VK_FORMAT_R16G16_SFLOAT, "denoiser temporal"},  {VK_FORMAT_R16G16_SFLOAT, "denoiser spatial A"},
+            {VK_FORMAT_R16_SFLOAT, "denoiser output"}};
+  }
+  return {{VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history A"},
+          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history B"},
+          {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB surface A"},
+          {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB surface B"},
+          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial A"},
+          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial B"},
+          {VK_FORMAT_R32G32_UINT, "denoiser RGB guide"}};
+}
+
+constexpr uint32_t kScalarOutputImage = 6;
+constexpr uint32_t kRgbOutputImage = 5;
+
+// Creates the images at width x height unless they exist at that size, and names the output in s.outputs. New
+// images (a new size, or a set an earlier failure left incomplete) hold no history.
+Status ensureImages(Denoiser::Impl& s, uint32_t width, uint32_t height) {
+  const std::vector<PassImages::Spec> specs = imageSpecs(s.signal);
+  const bool recreated = s.images.size() != specs.size() || s.images[0].width != width || s.images[0].height != height;
+  if (recreated) s.imagesWritten = false;  // even when ensure() fails: it replaces what there was
+  if (Status st = s.images.ensure(s.ctx, width, height, specs); !st) return st;
+  if (recreated) s.historyValid = false;
+  const GpuImage& out = s.images[s.signal == DenoiseSignal::Scalar ? kScalarOutputImage : kRgbOutputImage];
+  s.outputs.denoised = out.image;
+  s.outputs.denoisedView = out.view;
+  s.outputs.width = width;
+  s.outputs.height = height;
+  return {};
+}
+
+}  // namespace
 
 Denoiser::Denoiser(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Denoiser::~Denoiser() = default;
@@ -160,6 +204,15 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
   return std::unique_ptr<Denoiser>(new Denoiser(std::move(impl)));
 }
 
+Status Denoiser::prepare(uint32_t width, uint32_t height) {
+  if (width == 0 || height == 0) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "Denoiser::prepare: size " + std::to_string(width) + "x" + std::to_string(height) +
+                     " is empty; pass the G-buffer's size"};
+  }
+  return ensureImages(*impl_, width, height);
+}
+
 void Denoiser::resetHistory() { impl_->historyValid = false; }
 const DenoiseOutputs& Denoiser::outputs() const { return impl_->outputs; }
 DenoiseSignal Denoiser::signal() const { return impl_->signal; }
@@ -177,18 +230,7 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   // frame's colour: RG32F, a variance of HDR values overflows half floats); 4,5: the temporal result and the
   // a-trous ping-pong (rgb, a: the colour's standard deviation; a = 1 in the output); 6: the guide (distance and
   // normal, see denoise_rgb_common.glsl).
-  std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history A"},
-                                         {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history B"},
-                                         {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB surface A"},
-                                         {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB surface B"},
-                                         {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial A"},
-                                         {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial B"},
-                                         {VK_FORMAT_R32G32_UINT, "denoiser RGB guide"}};
-  // New images (a new size, or a set an earlier failure left incomplete) hold no history.
-  bool resized = s.images.size() != specs.size() || s.images[0].width != g.width || s.images[0].height != g.height;
-  if (resized) s.imagesWritten = false;  // even when ensure() fails: it replaces what there was
-  if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
-  if (resized) s.historyValid = false;
+  if (Status st = ensureImages(s, g.width, g.height); !st) return st;
   const PassImages& im = s.images;
   const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   const uint32_t cur = s.parity, prev = 1 - s.parity;
@@ -220,6 +262,10 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   const uint32_t iterations = settings.disableSpatial
                                   ? 0u
                                   : (settings.spatialIterations ? settings.spatialIterations : kDefaultRgbIterations);
+  // The temporal result starts the a-trous ping-pong on the image from which `iterations` steps land on the output
+  // (kRgbOutputImage, 5): image 4 for an odd count, 5 for an even one (0: the temporal result is the output).
+  const uint32_t first = iterations % 2 == 0 ? kRgbOutputImage : 4u;
+  const uint32_t other = first == 4u ? 5u : 4u;
   pc.flags = flags | (historyUsable ? RB_DN_HISTORY : 0u) | (iterations == 0 ? RB_DN_RGB_FINAL : 0u);
   pc.maxHistoryFrames = settings.disableTemporal ? 1u : (settings.maxHistoryFrames ? settings.maxHistoryFrames : 32u);
   {
@@ -232,7 +278,7 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_SURFACE_IN, im[2 + prev].view, s.sampler, ro);
     w.storageImage(RB_RGB_TEMPORAL_BINDING_HISTORY_OUT, im[cur].view);
     w.storageImage(RB_RGB_TEMPORAL_BINDING_SURFACE_OUT, im[2 + cur].view);
-    w.storageImage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT, im[4].view);
+    w.storageImage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT, im[first].view);
     w.storageImage(RB_RGB_TEMPORAL_BINDING_GUIDE_OUT, im[6].view);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_NORMAL, g.normal.view, s.sampler, readLayout(g.normal));
     // Read only for reflections (RB_DN_RGB_REFLECTION): the roughness image, else the normal (roughness in .w).
@@ -241,7 +287,7 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
     s.temporal.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
   }
   for (uint32_t base : {0u, 2u}) barrier(im[base + cur], gen, ro, write, read);
-  barrier(im[4], gen, ro, write, read);
+  barrier(im[first], gen, ro, write, read);
   barrier(im[6], gen, ro, write, read);
   flush(cs, readers);
   // A history written without temporal filtering holds one frame only: the next frame starts afresh anyway.
@@ -249,10 +295,9 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   s.imagesWritten = true;
   s.parity = prev;
 
-  const GpuImage* last = &im[4];
   for (uint32_t i = 0; i < iterations; ++i) {
-    const GpuImage& in = im[4 + (i % 2)];
-    const GpuImage& out = im[4 + ((i + 1) % 2)];
+    const GpuImage& in = im[i % 2 == 0 ? first : other];
+    const GpuImage& out = im[i % 2 == 0 ? other : first];
     if (i >= 1) {
       // Writing the image read one step earlier (the temporal result or an a-trous step).
       barrier(out, ro, gen, read, write);
@@ -267,20 +312,23 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
     s.atrous.dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
     barrier(out, gen, ro, write, read);
     flush(cs, readers);
-    last = &out;
   }
   if (iterations == 0) {
-    // The second spatial image was not written: keep its layout known.
-    barrier(im[5], gen, ro, 0, read);
+    // The other spatial image was not written: keep its layout known.
+    barrier(im[other], gen, ro, 0, read);
     flush(cs, readers);
   }
   s.metrics.writeEnd(ctx, cmd);
-  s.outputs.denoised = last->image;
-  s.outputs.denoisedView = last->view;
-  s.outputs.width = g.width;
-  s.outputs.height = g.height;
   return {};
 }
+
+// The scalar path's images by number: the fixed set, then the optional second a-trous image as number 7.
+struct ScalarImages {
+  const PassImages& fixed;
+  const PassImages& extra;
+  const GpuImage& operator[](size_t i) const { return i < fixed.size() ? fixed[i] : extra[i - fixed.size()]; }
+  size_t size() const { return fixed.size() + extra.size(); }
+};
 
 // The scalar path (DenoiseSignal::Scalar). The temporal pass always runs: it measures the noise the a-trous
 // weights and the final shift need (with disableTemporal it ignores the history). Its result (value, variance)
@@ -292,19 +340,16 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
   const uint32_t iterations = settings.disableSpatial ? 0u
                                                       : (settings.spatialIterations ? settings.spatialIterations
                                                                                     : kDefaultScalarIterations);
-  std::vector<PassImages::Spec> specs = {
-      {VK_FORMAT_R16G16_SFLOAT, "denoiser history A"}, {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},
-      {VK_FORMAT_R32_SFLOAT, "denoiser distance A"},   {VK_FORMAT_R32_SFLOAT, "denoiser distance B"},
-      {VK_FORMAT_R16G16_SFLOAT, "denoiser temporal"},  {VK_FORMAT_R16G16_SFLOAT, "denoiser spatial A"},
-      {VK_FORMAT_R16_SFLOAT, "denoiser output"}};
-  if (iterations >= 3) specs.push_back({VK_FORMAT_R16G16_SFLOAT, "denoiser spatial B"});
-  // New images (a new size, or a step count that needs the second spatial image or no longer does) hold no history.
-  const bool recreated = s.images.size() != specs.size() || s.images[0].width != g.width ||
-                         s.images[0].height != g.height;
-  if (recreated) s.imagesWritten = false;  // even when ensure() fails: it replaces what there was
-  if (Status st = s.images.ensure(ctx, g.width, g.height, specs); !st) return st;
-  if (recreated) s.historyValid = false;
-  const PassImages& im = s.images;
+  if (Status st = ensureImages(s, g.width, g.height); !st) return st;
+  if (iterations >= 3) {
+    if (Status st = s.extraSpatial.ensure(ctx, g.width, g.height, {{VK_FORMAT_R16G16_SFLOAT, "denoiser spatial B"}});
+        !st)
+      return st;
+  } else {
+    s.extraSpatial.retire(ctx);  // no byte that no step reads
+  }
+  // Images 0-6, then 7 (the second a-trous image) where there are three steps or more.
+  ScalarImages im{s.images, s.extraSpatial};
   const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   const uint32_t cur = s.parity, prev = 1 - s.parity;
 
@@ -379,10 +424,6 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
     if (writable[i]) batch.add(im[i], gen, ro, write, read);
   batch.flush(cs, readers);
   s.metrics.writeEnd(ctx, cmd);
-  s.outputs.denoised = im[6].image;
-  s.outputs.denoisedView = im[6].view;
-  s.outputs.width = g.width;
-  s.outputs.height = g.height;
   return {};
 }
 

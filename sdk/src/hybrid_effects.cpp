@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "adaptive_rays.h"
+#include "neutral_images.h"
+#include "pass_constants.h"
 
 namespace rb {
 
@@ -21,8 +23,18 @@ Error wrap(const char* what, const Error& e) {
   return out;
 }
 
+Status validateSize(uint32_t width, uint32_t height, const char* what) {
+  if ((width == 0) != (height == 0) || width > kMaxHybridOutputSize || height > kMaxHybridOutputSize) {
+    return invalid(std::string(what) + " " + std::to_string(width) + "x" + std::to_string(height) +
+                   " is not a size: give both (1.." + std::to_string(kMaxHybridOutputSize) +
+                   ") or neither (0x0 = follow the G-buffer)");
+  }
+  return {};
+}
+
 Status validate(const HybridEffectsDesc& d) {
   if (d.effects & ~kAllEffects) return invalid("effects has unknown bits " + std::to_string(d.effects & ~kAllEffects));
+  if (Status st = validateSize(d.width, d.height, "width x height"); !st) return st;
   if (d.shadows.raysPerPixel > 4096)
     return invalid("shadows.raysPerPixel " + std::to_string(d.shadows.raysPerPixel) + " exceeds 4096");
   if (!(d.shadows.softAngularRadiusDegrees >= 0.0f && d.shadows.softAngularRadiusDegrees < 45.0f))
@@ -109,6 +121,20 @@ EffectImage image(VkImage i, VkImageView v, VkFormat f, VkImageLayout layout, ui
   return {i, v, f, layout, w, h};
 }
 
+EffectImage image(const GpuImage& i) {
+  return {i.image, i.view, i.format, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, i.width, i.height};
+}
+
+bool sameImages(const EffectImage& a, const EffectImage& b) {
+  return a.image == b.image && a.view == b.view && a.width == b.width && a.height == b.height;
+}
+
+// Whether the shadow effect is soft for any light the frame may bring (so its denoiser is made with the outputs);
+// "the light decides" (0 rays) stays undecided until a frame brings a light with a size.
+bool shadowsSoftByDesc(const ShadowEffectSettings& s) {
+  return !s.disableDenoiser && (s.raysPerPixel > 1 || s.softAngularRadiusDegrees > 0.0f);
+}
+
 template <typename T>
 PassStats statsOf(const std::unique_ptr<T>& p) {
   return p ? p->stats() : PassStats{};
@@ -178,8 +204,116 @@ struct HybridEffects::Impl {
   }
   HybridOutputs outputs;
   TlasInfo tlas;
+  NeutralImages neutral;  // what outputs() names for an effect that is off (or not sized yet)
 
   Impl(Context& c, AccelerationStructureService* s) : ctx(c), service(s) {}
+  ~Impl() { neutral.retire(ctx); }
+
+  // A denoiser made with the outputs, so that its output is named from create() on.
+  Status ensureDenoiser(std::unique_ptr<Denoiser>& slot, DenoiseSignal kind, const char* what) {
+    DenoiserDesc dd;
+    dd.signal = kind;
+    return ensure(slot, true, what, [&] { return Denoiser::create(ctx, dd); });
+  }
+
+  // Allocates every enabled output at desc.width x desc.height (HybridEffectsDesc: a size is set).
+  Status prepareOutputs() {
+    const uint32_t w = desc.width, h = desc.height;
+    if (w == 0) return {};
+    if (shadow && shadowsSoftByDesc(desc.shadows)) {
+      if (Status st = ensureDenoiser(shadowDenoiser, DenoiseSignal::Scalar, "Denoiser (shadows)"); !st) return st;
+    }
+    if (ao && !desc.ao.disableDenoiser) {
+      if (Status st = ensureDenoiser(aoDenoiser, DenoiseSignal::Scalar, "Denoiser (AO)"); !st) return st;
+    }
+    if (localLightsDenoised()) {
+      if (Status st = ensureDenoiser(localLightDenoiser, DenoiseSignal::Rgb, "Denoiser (local lights)"); !st) return st;
+    }
+    if (reflection && !desc.reflections.disableDenoiser) {
+      if (Status st = ensureDenoiser(reflectionDenoiser, DenoiseSignal::Reflection, "Denoiser (reflections)"); !st)
+        return st;
+    }
+    auto prepare = [&](auto* object, const char* what) -> Status {
+      if (!object) return {};
+      if (Status st = object->prepare(w, h); !st) return wrap(what, st.error());
+      return {};
+    };
+    for (Status st :
+         {prepare(shadow.get(), "ShadowPass::prepare"), prepare(ao.get(), "AoPass::prepare"),
+          prepare(localLights.get(), "ManyLightPass::prepare"), prepare(reflection.get(), "ReflectionPass::prepare"),
+          prepare(shadowDenoiser.get(), "Denoiser::prepare (shadows)"),
+          prepare(aoDenoiser.get(), "Denoiser::prepare (AO)"),
+          prepare(localLightDenoiser.get(), "Denoiser::prepare (local lights)"),
+          prepare(reflectionDenoiser.get(), "Denoiser::prepare (reflections)")}) {
+      if (!st) return st;
+    }
+    return {};
+  }
+
+  // outputs() from what exists now: each effect's pass and denoiser, else the neutral image (created here when
+  // first needed, retired when nothing names it). Moves `generation` when any image changed.
+  Status refreshOutputs() {
+    HybridOutputs next;
+    bool needNeutral = false;
+    auto pick = [&](VkImage i, VkImageView v, VkFormat f, uint32_t w, uint32_t h) {
+      if (v) return image(i, v, f, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, w, h);
+      needNeutral = true;
+      return EffectImage{};  // filled below, once the neutral images exist
+    };
+    auto denoised = [&](const std::unique_ptr<Denoiser>& d, const EffectImage& raw) {
+      if (!d || !d->outputs().denoisedView) return raw;
+      const DenoiseOutputs& o = d->outputs();
+      return image(o.denoised, o.denoisedView, raw.format, o.layout, o.width, o.height);
+    };
+    constexpr VkFormat r16 = VK_FORMAT_R16_SFLOAT, rgba16 = VK_FORMAT_R16G16B16A16_SFLOAT;
+    if (shadow) {
+      const ShadowOutputs& o = shadow->outputs();
+      next.shadowRaw = pick(o.visibility, o.visibilityView, r16, o.width, o.height);
+    }
+    if (ao) {
+      const AoOutputs& o = ao->outputs();
+      next.aoRaw = pick(o.ao, o.aoView, r16, o.width, o.height);
+    }
+    if (reflection) {
+      const ReflectionOutputs& o = reflection->outputs();
+      next.reflectionRaw = pick(o.radiance, o.radianceView, rgba16, o.width, o.height);
+    }
+    if (localLights) {
+      const ManyLightOutputs& o = localLights->outputs();
+      next.localLightsRaw = pick(o.irradiance, o.irradianceView, rgba16, o.width, o.height);
+    }
+    needNeutral = needNeutral || !shadow || !ao || !reflection || !localLights;
+    if (needNeutral) {
+      if (Status st = neutral.ensure(ctx); !st) return wrap("neutral output images", st.error());
+    } else {
+      neutral.retire(ctx);  // no byte that nothing reads
+    }
+    for (EffectImage* raw : {&next.shadowRaw, &next.aoRaw}) {
+      if (!raw->view) *raw = image(neutral.white());
+    }
+    for (EffectImage* raw : {&next.reflectionRaw, &next.localLightsRaw}) {
+      if (!raw->view) *raw = image(neutral.black());
+    }
+    next.shadow = shadow && shadow->outputs().visibilityView ? denoised(shadowDenoiser, next.shadowRaw)
+                                                             : next.shadowRaw;
+    next.ao = ao && ao->outputs().aoView ? denoised(aoDenoiser, next.aoRaw) : next.aoRaw;
+    next.reflection = reflection && reflection->outputs().radianceView
+                          ? denoised(reflectionDenoiser, next.reflectionRaw)
+                          : next.reflectionRaw;
+    next.localLights = localLights && localLights->outputs().irradianceView
+                           ? denoised(localLightDenoiser, next.localLightsRaw)
+                           : next.localLightsRaw;
+    next.generation = outputs.generation;
+    bool changed = false;
+    for (auto member : {&HybridOutputs::shadow, &HybridOutputs::shadowRaw, &HybridOutputs::ao, &HybridOutputs::aoRaw,
+                        &HybridOutputs::reflection, &HybridOutputs::reflectionRaw, &HybridOutputs::localLights,
+                        &HybridOutputs::localLightsRaw}) {
+      changed = changed || !sameImages(next.*member, outputs.*member);
+    }
+    if (changed) ++next.generation;
+    outputs = next;
+    return {};
+  }
 
   // Passes follow the effect set; denoisers are decided per frame (hard shadows need none).
   Status applyDesc() {
@@ -200,7 +334,9 @@ struct HybridEffects::Impl {
     if (!ao || desc.ao.disableDenoiser) aoDenoiser.reset();
     if (!localLightsDenoised()) localLightDenoiser.reset();
     if (!reflection || desc.reflections.disableDenoiser) reflectionDenoiser.reset();
-    return syncMaterialTable();
+    if (Status st = syncMaterialTable(); !st) return st;
+    if (Status st = prepareOutputs(); !st) return st;
+    return refreshOutputs();
   }
 
   // Stochastic local lights are noisy; the exact mode has no noise to remove.
@@ -208,10 +344,10 @@ struct HybridEffects::Impl {
     return localLights && desc.localLights.mode == ManyLightMode::Stochastic && !desc.localLights.disableDenoiser;
   }
 
-  // The denoiser of one signal: created when wanted, retired when not; `out` becomes its output when it runs.
+  // The denoiser of one signal: created when wanted, retired when not (refreshOutputs names its output).
   // `rays`: binary rays behind a scalar signal (DenoiseSettings::raysPerPixel; 0 = estimate the noise).
   Status denoise(std::unique_ptr<Denoiser>& slot, bool wanted, const char* what, VkCommandBuffer cmd,
-                 const GBufferDesc& gbuffer, VkImageView signal, uint32_t rays, EffectImage& out,
+                 const GBufferDesc& gbuffer, VkImageView signal, uint32_t rays,
                  DenoiseSignal kind = DenoiseSignal::Scalar) {
     DenoiserDesc dd;
     dd.signal = kind;
@@ -220,9 +356,6 @@ struct HybridEffects::Impl {
     DenoiseSettings d = desc.denoiser;
     d.raysPerPixel = kind == DenoiseSignal::Scalar ? rays : 0u;
     if (Status st = slot->record(cmd, gbuffer, signal, d); !st) return wrap(what, st.error());
-    const DenoiseOutputs& dn = slot->outputs();
-    const VkFormat format = kind == DenoiseSignal::Scalar ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
-    out = image(dn.denoised, dn.denoisedView, format, dn.layout, dn.width, dn.height);
     return {};
   }
 
@@ -244,10 +377,8 @@ Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridF
   if (Status st = localLights->record(cmd, f.gbuffer, tlas, f.localLights, s); !st)
     return wrap("ManyLightPass::record", st.error());
   const ManyLightOutputs& o = localLights->outputs();
-  outputs.localLights = outputs.localLightsRaw = image(o.irradiance, o.irradianceView, VK_FORMAT_R16G16B16A16_SFLOAT,
-                                                       o.layout, o.width, o.height);
   return denoise(localLightDenoiser, localLightsDenoised(), "Denoiser (local lights)", cmd, f.gbuffer, o.irradianceView,
-                 0, outputs.localLights, DenoiseSignal::Rgb);
+                 0, DenoiseSignal::Rgb);
 }
 
 Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -267,12 +398,10 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   if (Status st = shadow->record(cmd, f.gbuffer, tlas, plan.light, s); !st)
     return wrap("ShadowPass::record", st.error());
   const ShadowOutputs& o = shadow->outputs();
-  outputs.shadowRaw = outputs.shadow = image(o.visibility, o.visibilityView, VK_FORMAT_R16_SFLOAT, o.layout, o.width,
-                                             o.height);
   // The visibility is a fraction of plan.rays binary rays; with adaptive rays the count varies per pixel, so the
   // denoiser measures the noise instead.
   return denoise(shadowDenoiser, plan.soft && !desc.shadows.disableDenoiser, "Denoiser (shadows)", cmd, f.gbuffer,
-                 o.visibilityView, desc.shadows.adaptive.enabled ? 0u : plan.rays, outputs.shadow);
+                 o.visibilityView, desc.shadows.adaptive.enabled ? 0u : plan.rays);
 }
 
 Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -290,13 +419,12 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   s.convergedTiles.enabled = s.convergedTiles.enabled && s.convergedTiles.history;
   if (Status st = ao->record(cmd, f.gbuffer, tlas, s); !st) return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
-  outputs.aoRaw = outputs.ao = image(o.ao, o.aoView, VK_FORMAT_R16_SFLOAT, o.layout, o.width, o.height);
   // Binary AO is a fraction of binary rays; distance-weighted AO is not, nor is adaptive AO (the count varies per
   // pixel), so their noise is estimated.
   const uint32_t rays = s.estimator == AoEstimator::Binary && !desc.ao.adaptive.enabled
                             ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays)
                             : 0u;
-  return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, f.gbuffer, o.aoView, rays, outputs.ao);
+  return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, f.gbuffer, o.aoView, rays);
 }
 
 Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -324,11 +452,9 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   const GBufferDesc& g = f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer;
   if (Status st = reflection->record(cmd, g, tlas, s); !st) return wrap("ReflectionPass::record", st.error());
   const ReflectionOutputs& o = reflection->outputs();
-  outputs.reflection = outputs.reflectionRaw = image(o.radiance, o.radianceView, VK_FORMAT_R16G16B16A16_SFLOAT,
-                                                     o.layout, o.width, o.height);
   // Guided by the roughness of the G-buffer the rays were traced from.
   return denoise(reflectionDenoiser, !desc.reflections.disableDenoiser, "Denoiser (reflections)", cmd, g,
-                 o.radianceView, 0, outputs.reflection, DenoiseSignal::Reflection);
+                 o.radianceView, 0, DenoiseSignal::Reflection);
 }
 
 Result<std::unique_ptr<HybridEffects>> HybridEffects::create(Context& context, AccelerationStructureService* service,
@@ -349,6 +475,18 @@ Status HybridEffects::setDesc(const HybridEffectsDesc& desc) {
   return impl_->applyDesc();
 }
 
+Status HybridEffects::resize(uint32_t width, uint32_t height) {
+  if (width == 0 || height == 0) {
+    return invalid(
+        "resize " + std::to_string(width) + "x" + std::to_string(height) +
+        " is empty: pass the G-buffer's size (setDesc with width = height = 0 follows the G-buffer instead)");
+  }
+  HybridEffectsDesc d = impl_->desc;
+  d.width = width;
+  d.height = height;
+  return setDesc(d);
+}
+
 const HybridEffectsDesc& HybridEffects::desc() const { return impl_->desc; }
 
 Status HybridEffects::setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures) {
@@ -365,9 +503,25 @@ Status HybridEffects::setMaterials(std::span<const Material> materials, std::spa
 
 Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
   Impl& a = *impl_;
-  a.outputs = {};
-  if (a.desc.effects == 0) return {};  // nothing enabled: no TLAS, no rays
   if (!cmd) return invalid("record: cmd is VK_NULL_HANDLE");
+  if (a.desc.effects == 0) {
+    a.neutral.recordInit(a.ctx, cmd);
+    return {};  // nothing enabled: no TLAS, no rays
+  }
+  const GBufferDesc& g = frame.gbuffer;
+  if (a.desc.width && (g.width != a.desc.width || g.height != a.desc.height)) {
+    return invalid("record: HybridFrame::gbuffer is " + std::to_string(g.width) + "x" + std::to_string(g.height) +
+                   " but the outputs are " + std::to_string(a.desc.width) + "x" + std::to_string(a.desc.height) +
+                   ": call resize(" + std::to_string(g.width) + ", " + std::to_string(g.height) +
+                   ") when the G-buffer changes size");
+  }
+  // The hand-over (gbuffer.h) before anything is recorded: a bad layout, usage or aspect names its field.
+  if (Status st = validateGBufferImages(g, "HybridEffects: record: HybridFrame::gbuffer"); !st) return st;
+  if (frame.reflectionGBuffer) {
+    if (Status st = validateGBufferImages(*frame.reflectionGBuffer, "HybridEffects: record: reflectionGBuffer"); !st)
+      return st;
+  }
+  a.neutral.recordInit(a.ctx, cmd);
   if (frame.tlas && frame.tlas->tlas) {
     a.tlas = *frame.tlas;
   } else {
@@ -395,8 +549,12 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
   if (st && a.ao) st = a.recordAo(cmd, frame);
   if (st && a.localLights) st = a.recordLocalLights(cmd, frame);
   if (st && a.reflection) st = a.recordReflections(cmd, frame);
-  if (!st) a.outputs = {};
-  return st;
+  // A first frame of a size-following description, or the shadow effect between soft and hard, may have changed
+  // the images; an error leaves the existing ones named.
+  Status refreshed = a.refreshOutputs();
+  a.neutral.recordInit(a.ctx, cmd);
+  if (!st) return st;
+  return refreshed;
 }
 
 const HybridOutputs& HybridEffects::outputs() const { return impl_->outputs; }

@@ -214,6 +214,26 @@ Status ManyLightPass::Impl::uploadLights(VkCommandBuffer cmd, const TlasInfo& tl
   return {};
 }
 
+namespace {
+
+const std::vector<PassImages::Spec> kManyLightOutputs = {{VK_FORMAT_R16G16B16A16_SFLOAT, "many-light irradiance"}};
+
+void nameOutputs(ManyLightPass::Impl& s) {
+  s.outputs.irradiance = s.core.images[0].image;
+  s.outputs.irradianceView = s.core.images[0].view;
+  s.outputs.width = s.core.images[0].width;
+  s.outputs.height = s.core.images[0].height;
+}
+
+}  // namespace
+
+Status ManyLightPass::prepare(uint32_t width, uint32_t height) {
+  Impl& s = *impl_;
+  if (Status st = s.core.prepare(s.ctx, width, height, kManyLightOutputs, "ManyLightPass"); !st) return st;
+  nameOutputs(s);
+  return {};
+}
+
 ManyLightPass::ManyLightPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 ManyLightPass::~ManyLightPass() = default;
 
@@ -291,8 +311,7 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
 
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ManyLightPass", pc.gbuffer.flags); !st) return st;
-  if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16G16B16A16_SFLOAT, "many-light irradiance"}}); !st)
-    return st;
+  if (Status st = s.core.begin(s.ctx, cmd, g, kManyLightOutputs); !st) return st;
   const DeviceFunctions& vk = internal::deviceFunctions(s.ctx);
   s.recordUpload(cmd, count);
   // Tile culling: last frame's rays read the lists this overwrites.
@@ -328,11 +347,7 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   if (!converged) s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
 
   s.remember(tlas, count);
-  ManyLightOutputs& o = s.outputs;
-  o.irradiance = images[0].image;
-  o.irradianceView = images[0].view;
-  o.width = g.width;
-  o.height = g.height;
+  nameOutputs(s);
   return {};
 }
 

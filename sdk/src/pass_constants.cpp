@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace rb {
 
@@ -69,6 +70,73 @@ void cameraPosition(const GBufferDesc& g, double out[3]) {
   for (int i = 0; i < 3; ++i) out[i] = inv[12 + i];
 }
 
+namespace {
+
+bool isCombinedDepthStencil(VkFormat f) {
+  return f == VK_FORMAT_D32_SFLOAT_S8_UINT || f == VK_FORMAT_D24_UNORM_S8_UINT || f == VK_FORMAT_D16_UNORM_S8_UINT;
+}
+
+// One G-buffer image against the hand-over contract of gbuffer.h ("Images"): a sampled-read layout, and where
+// the engine states them, SAMPLED usage and a single aspect. Returns "" when it holds, else the message.
+std::string checkImage(const GBufferImage& image, const char* field, bool depth) {
+  if (!image.view) return {};
+  const std::string name = std::string("GBufferDesc::") + field;
+  switch (image.layout) {
+    case VK_IMAGE_LAYOUT_UNDEFINED:
+    case VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL:
+    case VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL:
+    case VK_IMAGE_LAYOUT_GENERAL: break;
+    case VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL:
+    case VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL:
+    case VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL:
+      if (depth) break;
+      [[fallthrough]];
+    default:
+      return name + ".layout " + std::to_string(int(image.layout)) +
+             " does not allow sampled reads: transition the image to SHADER_READ_ONLY_OPTIMAL" +
+             (depth ? " or DEPTH_READ_ONLY_OPTIMAL" : "") + " before record() and state that layout here";
+  }
+  if (image.usage != 0 && !(image.usage & VK_IMAGE_USAGE_SAMPLED_BIT)) {
+    return name + ".usage lacks VK_IMAGE_USAGE_SAMPLED_BIT: the passes read it through a sampler; add the bit to "
+                  "the image's VkImageCreateInfo::usage";
+  }
+  const VkImageAspectFlags wanted = depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+  if (image.aspectMask != 0 && image.aspectMask != wanted) {
+    if (depth && (image.aspectMask & VK_IMAGE_ASPECT_STENCIL_BIT)) {
+      return name + ".aspectMask has the STENCIL aspect: a depth-stencil view cannot be sampled; create a view of "
+                    "the depth image with subresourceRange.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT alone and pass "
+                    "that";
+    }
+    return name + ".aspectMask " + std::to_string(image.aspectMask) + " is not " +
+           (depth ? "VK_IMAGE_ASPECT_DEPTH_BIT" : "VK_IMAGE_ASPECT_COLOR_BIT") + ": pass a view of that aspect alone";
+  }
+  return {};
+}
+
+}  // namespace
+
+Status validateGBufferImages(const GBufferDesc& g, const char* passName) {
+  auto invalid = [&](const std::string& m) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, std::string(passName) + ": " + m};
+  };
+  if (isCombinedDepthStencil(g.depthFormat) && g.depth.aspectMask == 0) {
+    return invalid("GBufferDesc::depthFormat " + std::to_string(int(g.depthFormat)) +
+                   " has a stencil aspect, and a view of both aspects cannot be sampled: create the depth view with "
+                   "subresourceRange.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT and set GBufferDesc::depth.aspectMask "
+                   "to VK_IMAGE_ASPECT_DEPTH_BIT to say so");
+  }
+  const std::pair<const GBufferImage*, const char*> images[] = {{&g.depth, "depth"},
+                                                                {&g.normal, "normal"},
+                                                                {&g.geometricNormal, "geometricNormal"},
+                                                                {&g.roughnessMetalness, "roughnessMetalness"},
+                                                                {&g.albedo, "albedo"},
+                                                                {&g.motionVectors, "motionVectors"}};
+  for (const auto& [image, field] : images) {
+    if (std::string m = checkImage(*image, field, image == &g.depth); !m.empty()) return invalid(m);
+  }
+  return {};
+}
+
 Status fillGBufferConstants(const GBufferDesc& g, const TlasInfo& tlas, uint64_t frame, const char* passName,
                             GBufferConstants& out) {
   auto invalid = [&](const std::string& m) {
@@ -80,6 +148,7 @@ Status fillGBufferConstants(const GBufferDesc& g, const TlasInfo& tlas, uint64_t
   }
   if (!g.depth.view) return invalid("GBufferDesc::depth.view is VK_NULL_HANDLE; the depth buffer is required");
   if (!g.normal.view) return invalid("GBufferDesc::normal.view is VK_NULL_HANDLE; a normal image is required");
+  if (Status st = validateGBufferImages(g, passName); !st) return st;
   if (!tlas.tlas) return invalid("the TLAS is VK_NULL_HANDLE; build one with recordTlasBuild() first");
   if (g.normalEncoding != NormalEncoding::WorldFloat && g.normalEncoding != NormalEncoding::Octahedral) {
     return invalid("GBufferDesc::normalEncoding has an unknown value");

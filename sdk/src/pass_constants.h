@@ -276,6 +276,9 @@ static_assert(RB_CLUSTER_TRIANGLES == kRefitClusterTriangles);
 
 // Checks the description (names the offending field) and fills the camera and G-buffer part of `out`.
 // `passName` prefixes messages.
+// The G-buffer images against the hand-over contract (gbuffer.h, "Images"): sampled-read layouts, and the usage
+// and aspect the engine states. Called by fillGBufferConstants; HybridEffects calls it before recording anything.
+Status validateGBufferImages(const GBufferDesc& gbuffer, const char* passName);
 Status fillGBufferConstants(const GBufferDesc& gbuffer, const TlasInfo& tlas, uint64_t frame, const char* passName,
                             GBufferConstants& out);
 

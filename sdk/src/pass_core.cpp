@@ -113,6 +113,16 @@ void PassCore::bind(Context& ctx, VkCommandBuffer cmd, const DescriptorWrites& w
   }
 }
 
+Status PassCore::prepare(Context& ctx, uint32_t width, uint32_t height, const std::vector<PassImages::Spec>& outputs,
+                         const char* passName) {
+  if (width == 0 || height == 0) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 std::string(passName) + "::prepare: size " + std::to_string(width) + "x" + std::to_string(height) +
+                     " is empty; pass the G-buffer's size"};
+  }
+  return images.ensure(ctx, width, height, outputs);
+}
+
 Status PassCore::begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
                        const std::vector<PassImages::Spec>& outputs) {
   if (Status s = images.ensure(ctx, g.width, g.height, outputs); !s) return s;

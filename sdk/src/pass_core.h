@@ -54,6 +54,10 @@ struct PassCore {
   Status writeMaterials(DescriptorWrites& w, const TlasInfo& tlas, const MaterialTable* materials, const char* passName,
                         uint32_t& gbufferFlags);
 
+  // Creates the outputs at width x height unless they exist at that size (a pass's prepare()); `passName` names
+  // the pass in the error for an empty size.
+  Status prepare(Context& ctx, uint32_t width, uint32_t height, const std::vector<PassImages::Spec>& outputs,
+                 const char* passName);
   // Ensures the outputs, starts the measurements and makes the outputs writable.
   Status begin(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const std::vector<PassImages::Spec>& outputs);
   // Binds the pipeline (or `variant`, from createVariant()), set 0 (`w`), the texture set (when the pass has one)

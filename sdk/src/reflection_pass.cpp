@@ -91,6 +91,26 @@ struct ReflectionPass::Impl {
   }
 };
 
+namespace {
+
+const std::vector<PassImages::Spec> kReflectionOutputs = {{VK_FORMAT_R16G16B16A16_SFLOAT, "reflection radiance"}};
+
+void nameOutputs(ReflectionPass::Impl& s) {
+  s.outputs.radiance = s.core.images[0].image;
+  s.outputs.radianceView = s.core.images[0].view;
+  s.outputs.width = s.core.images[0].width;
+  s.outputs.height = s.core.images[0].height;
+}
+
+}  // namespace
+
+Status ReflectionPass::prepare(uint32_t width, uint32_t height) {
+  Impl& s = *impl_;
+  if (Status st = s.core.prepare(s.ctx, width, height, kReflectionOutputs, "ReflectionPass"); !st) return st;
+  nameOutputs(s);
+  return {};
+}
+
 ReflectionPass::ReflectionPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 ReflectionPass::~ReflectionPass() = default;
 
@@ -207,7 +227,7 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   } else if (s.tilesPipeline.pipeline) {
     s.retireTiles();  // no tile state while converged tiles are off
   }
-  if (Status st = s.core.begin(s.ctx, cmd, g, {{VK_FORMAT_R16G16B16A16_SFLOAT, "reflection radiance"}}); !st) return st;
+  if (Status st = s.core.begin(s.ctx, cmd, g, kReflectionOutputs); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
   const GBufferImage& rm = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
   w.sampledImage(RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, rm.view, s.core.sampler, readLayout(rm));
@@ -233,10 +253,7 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   } else {
     s.core.traceAndEnd(s.ctx, cmd, w, pc, g, variant);
   }
-  s.outputs.radiance = s.core.images[0].image;
-  s.outputs.radianceView = s.core.images[0].view;
-  s.outputs.width = g.width;
-  s.outputs.height = g.height;
+  nameOutputs(s);
   return {};
 }
 

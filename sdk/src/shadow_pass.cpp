@@ -37,6 +37,28 @@ struct ShadowPass::Impl {
   }
 };
 
+namespace {
+
+std::vector<PassImages::Spec> outputSpecs(const ShadowPassDesc& desc) {
+  std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16_SFLOAT, "shadow visibility"}};
+  if (desc.outputHitDistance) specs.push_back({VK_FORMAT_R32_SFLOAT, "shadow hit distance"});
+  return specs;
+}
+
+// outputs() from the images (the ray plan is the record's to name).
+void nameOutputs(ShadowPass::Impl& s) {
+  const PassImages& images = s.core.images;
+  ShadowOutputs& o = s.outputs;
+  o.visibility = images[0].image;
+  o.visibilityView = images[0].view;
+  o.hitDistance = s.desc.outputHitDistance ? images[1].image : VK_NULL_HANDLE;
+  o.hitDistanceView = s.desc.outputHitDistance ? images[1].view : VK_NULL_HANDLE;
+  o.width = images[0].width;
+  o.height = images[0].height;
+}
+
+}  // namespace
+
 ShadowPass::ShadowPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 ShadowPass::~ShadowPass() = default;
 
@@ -159,8 +181,7 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   }
   const PassStats latest = s.core.metrics.latest(s.ctx);
 
-  std::vector<PassImages::Spec> specs = {{VK_FORMAT_R16_SFLOAT, "shadow visibility"}};
-  if (s.desc.outputHitDistance) specs.push_back({VK_FORMAT_R32_SFLOAT, "shadow hit distance"});
+  const std::vector<PassImages::Spec> specs = outputSpecs(s.desc);
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ShadowPass", pc.gbuffer.flags); !st) return st;
   // The tile list before begin(), so that a failed allocation records nothing.
@@ -213,15 +234,17 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
     }
   }
 
+  nameOutputs(s);
   ShadowOutputs& o = s.outputs;
-  o.visibility = images[0].image;
-  o.visibilityView = images[0].view;
-  o.hitDistance = s.desc.outputHitDistance ? images[1].image : VK_NULL_HANDLE;
-  o.hitDistanceView = s.desc.outputHitDistance ? images[1].view : VK_NULL_HANDLE;
-  o.width = g.width;
-  o.height = g.height;
   o.rayPlan = planned ? s.planner.planImage() : VK_NULL_HANDLE;
   o.rayPlanView = planned ? s.planner.planView() : VK_NULL_HANDLE;
+  return {};
+}
+
+Status ShadowPass::prepare(uint32_t width, uint32_t height) {
+  Impl& s = *impl_;
+  if (Status st = s.core.prepare(s.ctx, width, height, outputSpecs(s.desc), "ShadowPass"); !st) return st;
+  nameOutputs(s);
   return {};
 }
 

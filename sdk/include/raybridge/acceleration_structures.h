@@ -162,7 +162,7 @@ struct MeshDesc {
 
 // One TLAS instance. Instance{} is the identity transform, visible to every ray mask.
 struct Instance {
-  MeshHandle mesh;  // required
+  MeshHandle mesh{};  // required
   // Row-major 3x4 object-to-world matrix (the layout of VkTransformMatrixKHR). Default identity.
   float transform[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
   uint32_t customIndex = 0;  // 24 bits; gl_InstanceCustomIndexEXT
@@ -280,7 +280,7 @@ struct AsServiceDesc {
   // family, or a family without VK_QUEUE_COMPUTE_BIT, means the fallback.
   uint32_t asyncQueueFamily = 0;
   DynamicBuildMode dynamicMode = DynamicBuildMode::InFrame;  // default InFrame
-  RefitPolicy refitPolicy;                                   // zero = the defaults above
+  RefitPolicy refitPolicy{};                                 // zero = the defaults above
 };
 
 // What changed about a dynamic mesh (updateMesh). Plain value; thread-safe to copy.

@@ -55,12 +55,12 @@ struct AoSettings {
   const MaterialTable* materials = nullptr;
   // Rays per pixel where the denoiser's history says the estimate is uncertain, within a budget
   // (adaptive_rays.h): raysPerPixel is then the average the budget is made of. Disabled by default.
-  AdaptiveRaySettings adaptive;
+  AdaptiveRaySettings adaptive{};
   // Trace a quarter of the pixels and upsample (see Half resolution above). false = every pixel traces its rays.
   bool halfResolution = false;
   // Skip the 8x8-pixel tiles whose denoised history has converged (raybridge/converged_tiles.h): their pixels hold
   // kept-history marks instead of AO, which the denoiser named in it reads. Full resolution only. Off by default.
-  ConvergedTileSettings convergedTiles;
+  ConvergedTileSettings convergedTiles{};
 };
 
 // Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record().
@@ -84,6 +84,10 @@ class AoPass {
   ~AoPass();
 
   Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas, const AoSettings& settings = {});
+  // Creates the output images at width x height now, so that outputs() names them before the first record()
+  // (HybridEffects hands out views that stay valid this way); record() at the same size keeps them, at another
+  // size it recreates them. Written by the first record().
+  Status prepare(uint32_t width, uint32_t height);
   const AoOutputs& outputs() const;
   PassStats stats() const;
 

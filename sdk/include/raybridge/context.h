@@ -33,8 +33,15 @@ namespace internal {
 struct ContextAccess;  // the SDK's own way in (sdk/src/context_access.h); not part of the API
 }
 
+// The Vulkan API version Raybridge needs: the engine's VkApplicationInfo::apiVersion and the device's.
+inline constexpr uint32_t kMinimumApiVersion = VK_API_VERSION_1_2;
+
 // What the engine hands over. A zero-initialised ContextDesc is invalid only because the four handles below
-// are required; every other field's zero value is a documented default.
+// are required; every other field's zero value is a documented default. Fill it with designated initialisers
+// (the fields are in this order):
+//   rb::ContextDesc desc{.instance = instance, .physicalDevice = gpu, .device = device,
+//                        .getInstanceProcAddr = vkGetInstanceProcAddr, .framesInFlight = 2,
+//                        .mainQueueFamily = graphicsFamily, .apiVersion = VK_API_VERSION_1_3};
 struct ContextDesc {
   VkInstance instance = VK_NULL_HANDLE;                        // required
   VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;            // required
@@ -52,6 +59,11 @@ struct ContextDesc {
   // shading (opt-in: ReflectionSettings::invocationReorder); Context::create fails with MissingExtension or
   // MissingFeature when the physical device does not support it (check supportsInvocationReorder() first).
   bool invocationReorderEnabled = false;
+  // The VkApplicationInfo::apiVersion the engine created its instance with. 0 = not stated: Context::create then
+  // infers a version below 1.2 from the Vulkan 1.2 features all reading as unsupported. Below
+  // kMinimumApiVersion, Context::create fails with ErrorCode::UnsupportedApiVersion (the Vulkan 1.2 functions and
+  // features Raybridge uses do not exist for such an instance, whatever the device supports).
+  uint32_t apiVersion = 0;
 };
 
 // Device extensions the engine must enable on its VkDevice for Raybridge (Vulkan 1.2 or newer).

@@ -112,6 +112,10 @@ class Denoiser {
   // The G-buffer is the one the signal was traced from.
   Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, VkImageView signal,
                 const DenoiseSettings& settings = {});
+  // Creates the images at width x height now (the history starts empty), so that outputs() names the output
+  // before the first record(); record() at the same size keeps them, at another size it recreates them. The output
+  // image is the same whatever the DenoiseSettings, until the size changes. Written by the first record().
+  Status prepare(uint32_t width, uint32_t height);
   // Forget the history (after a camera cut or a scene change).
   void resetHistory();
   const DenoiseOutputs& outputs() const;

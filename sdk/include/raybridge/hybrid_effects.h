@@ -3,21 +3,34 @@
 // samples. Engines that want the passes one by one still use ShadowPass, AoPass, ReflectionPass and Denoiser
 // directly; this object only composes them.
 //
-//   auto fx = rb::HybridEffects::create(context, &service, rb::withPreset({}, rb::Preset::High)).value();
-//   fx->setMaterials(materials, textureViews);          // once per scene: reflection hits and alpha tests
+//   rb::HybridEffectsDesc desc{.effects = rb::kEffectShadows | rb::kEffectAo, .width = w, .height = h};
+//   auto fx = rb::HybridEffects::create(context, &service, desc);
+//   if (!fx) return fail(fx.what());                    // the message names the field and the fix
+//   writeDescriptors(fx.value()->outputs());            // once: the views stay valid (see Outputs below)
+//   fx.value()->setMaterials(materials, textureViews);  // once per scene: reflection hits and alpha tests
 //   // each frame, after ctx.beginFrame() and the G-buffer pass:
 //   rb::HybridFrame frame;
 //   frame.gbuffer = gbuffer;                            // the engine's pre-pass (gbuffer.h)
 //   frame.instances = instances;                        // or frame.tlas = the engine's own TLAS
 //   frame.light = sun;                                  // the light the shadow effect shadows
 //   frame.localLights = lights;                         // the engine's light list (local lights effect)
-//   fx->record(cmd, frame);                             // BLAS work, TLAS, shadows, AO, reflections, denoising
-//   fx->outputs().shadow.view ...                       // SHADER_READ_ONLY_OPTIMAL, readable by fragment and
-//                                                       // compute shaders
+//   if (rb::Status st = fx->record(cmd, frame); !st) log(st.what());  // BLAS work, TLAS, effects, denoising
+//   // the engine's lighting samples outputs().shadow.view ... (SHADER_READ_ONLY_OPTIMAL, no barrier needed)
+//
+// Outputs: with HybridEffectsDesc::width/height set, create() and resize() allocate every output, so outputs()
+// names its images before the first record() and its views stay valid, frame after frame, until the next resize(),
+// setDesc() or applyPreset() that changes them; HybridOutputs::generation counts those changes (compare it each
+// frame and rewrite descriptors only when it moved). An effect that is off names a 1x1 neutral image: white
+// (1.0) for shadow and AO, zero for reflection and local lights; sample outputs with normalized coordinates
+// (texture(), any address mode but CLAMP_TO_BORDER) and a disabled effect reads as "no effect". Every image is
+// written (neutral ones cleared) by the first record(): sample none before it. One output changes by itself: the
+// shadow effect's switches between denoised and raw when the frame's light switches between soft and hard
+// (ShadowEffectSettings), and generation says so.
 //
 // Order inside record(): pending BLAS work and the TLAS (when it builds one) -> shadows [-> denoiser] -> AO
 // [-> denoiser] -> local lights [-> denoiser] -> reflections [-> denoiser]. Only what the description enables exists: a
-// disabled effect has no pass, no denoiser, no image and traces no ray; hard shadows (one ray) are never denoised.
+// disabled effect has no pass, no denoiser, no image of its own and traces no ray; hard shadows (one ray) are never
+// denoised. The G-buffer hand-over (stages, accesses, layouts) is in gbuffer.h.
 //
 // Lifetime: setDesc()/applyPreset() and the destructor retire passes to the Context's deferred release (see
 // context.h), so switching effects mid-run needs no wait-idle. Destroy it before its Context and before the
@@ -47,6 +60,9 @@ namespace rb {
 // Angular radius given to a directional light without one when more than one shadow ray is asked for: the
 // sun's apparent size (0.27 degrees) widened a little, as games do to read as a soft sun.
 inline constexpr float kDefaultSoftLightAngularRadiusDegrees = 0.5f;
+// Largest HybridEffectsDesc::width and height (Vulkan's guaranteed maxImageDimension2D is 4096; every ray tracing
+// device seen allows 16384 or more).
+inline constexpr uint32_t kMaxHybridOutputSize = 16384;
 
 struct ShadowEffectSettings {
   // 0 = the light decides: kDefaultSoftShadowRays for a light with a size, one ray (hard) for one without.
@@ -61,11 +77,11 @@ struct ShadowEffectSettings {
   bool tileClassifier = false;   // ShadowSettings::tileClassifier (off by default: see shadow_pass.h)
   // Soft shadows: rays per pixel planned from the shadow denoiser's history (adaptive_rays.h); raysPerPixel is the
   // average the budget is made of. `history` is ignored (the effect's denoiser, which must be enabled).
-  AdaptiveRaySettings adaptive;
+  AdaptiveRaySettings adaptive{};
   // Soft shadows: skip the tiles whose denoised history has converged (ShadowSettings::convergedTiles; the raw
   // shadow output then holds kept-history marks there, the denoised one is complete). `history` is ignored (the
   // effect's denoiser, which must be enabled). Off by default.
-  ConvergedTileSettings convergedTiles;
+  ConvergedTileSettings convergedTiles{};
 };
 
 struct AoEffectSettings {
@@ -75,13 +91,13 @@ struct AoEffectSettings {
   bool disableDenoiser = false;  // false = denoised
   // Rays per pixel planned from the AO denoiser's history (adaptive_rays.h); raysPerPixel is the average the budget
   // is made of. `history` is ignored (the effect's denoiser, which must be enabled).
-  AdaptiveRaySettings adaptive;
+  AdaptiveRaySettings adaptive{};
   // false = every pixel traces; true = AoSettings::halfResolution (a quarter of the rays, depth-aware upsample).
   bool halfResolution = false;
   // Skip the tiles whose denoised AO history has converged (AoSettings::convergedTiles; the raw AO output then
   // holds kept-history marks there, the denoised one is complete). Full resolution only. `history` is ignored
   // (the effect's denoiser, which must be enabled). Off by default.
-  ConvergedTileSettings convergedTiles;
+  ConvergedTileSettings convergedTiles{};
 };
 
 struct ReflectionEffectSettings {
@@ -101,7 +117,7 @@ struct ReflectionEffectSettings {
   // (ReflectionSettings::convergedTiles; the raw reflection output then holds kept-history marks there, a = -1, the
   // denoised one is complete). Full resolution only. `history` is ignored (the effect's denoiser, which must be
   // enabled). Off by default.
-  ConvergedTileSettings convergedTiles;
+  ConvergedTileSettings convergedTiles{};
 };
 
 struct LocalLightEffectSettings {
@@ -114,18 +130,24 @@ struct LocalLightEffectSettings {
   // Stochastic: skip the tiles whose denoised irradiance has converged (ManyLightSettings::convergedTiles; the raw
   // output then holds kept-history marks there, a = -1, the denoised one is complete). `history` is ignored (the
   // effect's denoiser, which must be enabled). Off by default.
-  ConvergedTileSettings convergedTiles;
+  ConvergedTileSettings convergedTiles{};
 };
 
-// What runs. A zero-initialised description is valid: no effect, nothing allocated, nothing traced.
+// What runs. A zero-initialised description is valid: no effect, nothing traced, nothing allocated but the two 1x1
+// neutral images the outputs name (see Outputs).
 struct HybridEffectsDesc {
   EffectSet effects = 0;
-  ShadowEffectSettings shadows;
-  AoEffectSettings ao;
-  ReflectionEffectSettings reflections;
-  LocalLightEffectSettings localLights;
+  // Size of the outputs, the G-buffer's. Set: create()/setDesc()/resize() allocate the outputs at this size and
+  // record() requires a G-buffer of it (an error names both sizes otherwise). 0 = follow the G-buffer: the outputs
+  // are allocated by the first record() and re-allocated when its size changes (generation reports it).
+  uint32_t width = 0;
+  uint32_t height = 0;
+  ShadowEffectSettings shadows{};
+  AoEffectSettings ao{};
+  ReflectionEffectSettings reflections{};
+  LocalLightEffectSettings localLights{};
   // Shared by the shadow, AO, local light and reflection denoisers (raysPerPixel is filled in per scalar signal).
-  DenoiseSettings denoiser;
+  DenoiseSettings denoiser{};
   // Build the TLAS with camera-relative origin (TlasBuildOptions::originOffset = the G-buffer's camera
   // position), so precision holds far from the world origin. Only used when record() builds the TLAS.
   bool worldSpaceTlas = false;  // false = camera-relative (recommended)
@@ -146,18 +168,18 @@ enum HybridFrameFlags : uint32_t {
 
 // One frame's inputs. gbuffer is required; the scene comes from `tlas` or `instances`.
 struct HybridFrame {
-  GBufferDesc gbuffer;
+  GBufferDesc gbuffer{};
   // Optional G-buffer with the shading normal and roughness for reflections, when `gbuffer` uses another
   // normal (e.g. geometric normals for conformance checks). nullptr = gbuffer.
   const GBufferDesc* reflectionGBuffer = nullptr;
   // The engine's TLAS (tlas->tlas != VK_NULL_HANDLE): used as is; with reflections it must carry shading
   // records. nullptr = record() records the service's pending work and builds a TLAS over `instances`.
   const TlasInfo* tlas = nullptr;
-  std::span<const Instance> instances;
-  Light light;  // the light the shadow effect shadows and reflection hits are lit by (default: the sun, up)
+  std::span<const Instance> instances{};
+  Light light{};  // the light the shadow effect shadows and reflection hits are lit by (default: the sun, up)
   // The engine's light list for the local lights effect (many_light_pass.h; at most kMaxLights), this frame's
   // positions. Copied during record(). Empty = black, no rays.
-  std::span<const LightSource> localLights;
+  std::span<const LightSource> localLights{};
   // Lighting of reflection hits: the light's radiance (colour * intensity), the sky's radiance returned by
   // escaping rays, and the sky light on hit surfaces (ambientIntensity * skyRadiance). Zero = the default
   // constants above unless kFrameExplicitLighting.
@@ -167,18 +189,24 @@ struct HybridFrame {
   uint32_t flags = 0;  // HybridFrameFlags
 };
 
-// An image the front end owns: left in `layout` after record(), readable by fragment and compute shaders.
+// An image the front end owns: left in `layout` after record(), readable by fragment, compute and ray tracing
+// shaders with no barrier of the engine's.
 struct EffectImage {
-  VkImage image = VK_NULL_HANDLE;  // VK_NULL_HANDLE = not produced this frame
+  VkImage image = VK_NULL_HANDLE;  // never VK_NULL_HANDLE once create() succeeded (a 1x1 neutral image when off)
   VkImageView view = VK_NULL_HANDLE;
   VkFormat format = VK_FORMAT_UNDEFINED;
   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   uint32_t width = 0, height = 0;
 };
 
-// What the latest record() produced. `shadow` and `ao` are what the engine's lighting should sample (denoised
-// where a denoiser ran, else raw); the raw images stay available.
+// The images the engine's lighting samples (see Outputs above). `shadow`, `ao`, `reflection` and `localLights` are
+// denoised where a denoiser runs, else raw; the raw images stay available. An effect that is off names the neutral
+// image. After a record() that failed, the images hold an earlier frame (or, before any record, nothing): keep the
+// engine's own lighting terms for that frame.
 struct HybridOutputs {
+  // Changes whenever any image or view below changes (resize, an effect switched, the shadow effect between soft
+  // and hard); equal generations name the same images.
+  uint64_t generation = 0;
   EffectImage shadow, shadowRaw;  // R16_SFLOAT visibility, 1 = lit
   EffectImage ao, aoRaw;          // R16_SFLOAT open fraction, 1 = open
   // R16G16B16A16_SFLOAT radiance, a = 1 where rays were traced: reflection is denoised unless
@@ -202,16 +230,21 @@ struct HybridStats {
 class HybridEffects {
  public:
   // `service` builds the TLAS when a frame gives instances instead of a TLAS; nullptr = every frame brings
-  // its own TLAS. The description's passes are created now (their images follow on the first record()).
+  // its own TLAS. The description's passes are created now, with their outputs when it has a size (else the
+  // first record() makes them).
   static Result<std::unique_ptr<HybridEffects>> create(Context& context, AccelerationStructureService* service,
                                                        const HybridEffectsDesc& desc = {});
   ~HybridEffects();
   HybridEffects(const HybridEffects&) = delete;
   HybridEffects& operator=(const HybridEffects&) = delete;
 
-  // Switches effects and settings between frames: passes of newly enabled effects are created now, those of
-  // disabled effects retired (see Lifetime). Validated first: on an error nothing changes.
+  // Switches effects and settings between frames: passes of newly enabled effects are created now (with their
+  // outputs, when the description has a size), those of disabled effects retired (see Lifetime). Validated
+  // first: on an error nothing changes.
   Status setDesc(const HybridEffectsDesc& desc);
+  // The G-buffer's new size: re-allocates the outputs (desc().width/height become it; the history restarts).
+  // Views of the old outputs stay valid for the frames already recorded, and generation moves.
+  Status resize(uint32_t width, uint32_t height);
   Status applyPreset(Preset preset) { return setDesc(withPreset(desc(), preset)); }
   const HybridEffectsDesc& desc() const;
 
@@ -222,8 +255,8 @@ class HybridEffects {
   // Without a call every instance is white and opaque.
   Status setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures);
 
-  // Records the enabled effects (see Order above). On an error, outputs() names no image of this frame and
-  // the engine should keep its own lighting terms.
+  // Records the enabled effects (see Order above); with none enabled, only the neutral images' first clear.
+  // On an error the engine keeps its own lighting terms this frame (see HybridOutputs).
   Status record(VkCommandBuffer cmd, const HybridFrame& frame);
   const HybridOutputs& outputs() const;
   const TlasInfo& lastTlas() const;  // the TLAS the latest record() traced

@@ -63,7 +63,7 @@ struct LightSource {
   // type, direction (directional: towards the light; spot: the direction it shines), position, range (0 =
   // unlimited: no range window), spotOuterAngleDegrees (0 = 45), and the softness: radius (point, spot) or
   // angularRadiusDegrees (directional), 0 = hard shadows.
-  Light light;
+  Light light{};
   float color[3] = {1.0f, 1.0f, 1.0f};  // linear RGB, >= 0
   float intensity = 1.0f;               // candela (point, spot) or lux (directional), finite and >= 0
   float spotInnerAngleDegrees = 0.0f;   // spot: full intensity inside it; in [0, outer]
@@ -87,7 +87,7 @@ struct ManyLightSettings {
   // The launch stays one invocation per pixel; a skipped tile's return at once. Off by default: a moved light shows
   // on a converged tile up to refreshPeriod frames late. PassStats counts the tiles and raysPerPixel per skipped
   // surface pixel as rays saved (at most what it would have traced). The tile state takes 4 bytes per tile.
-  ConvergedTileSettings convergedTiles;
+  ConvergedTileSettings convergedTiles{};
 };
 
 // Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record(), readable by
@@ -114,6 +114,10 @@ class ManyLightPass {
   // Records the light upload alone (no culling, no rays, no output image), for passes lit by the list without a
   // G-buffer (PrimaryShadingSettings::lights); checked as record() checks it. stats() does not measure it.
   Status recordLightList(VkCommandBuffer cmd, const TlasInfo& tlas, std::span<const LightSource> lights);
+  // Creates the output images at width x height now, so that outputs() names them before the first record()
+  // (HybridEffects hands out views that stay valid this way); record() at the same size keeps them, at another
+  // size it recreates them. Written by the first record().
+  Status prepare(uint32_t width, uint32_t height);
   const ManyLightOutputs& outputs() const;
   // GPU time (upload, culling and tracing) and rays of the latest recording whose frame has finished.
   PassStats stats() const;

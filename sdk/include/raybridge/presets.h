@@ -72,7 +72,7 @@ struct PresetDesc {
   uint32_t shadowRaysPerPixel = 0;  // 0 when the preset has no shadows; 1 = hard shadows
   uint32_t aoRaysPerPixel = 0;      // 0 when the preset has no AO
   bool aoHalfResolution = false;    // AoSettings::halfResolution (true for every preset with AO, above)
-  RasterShadowDesc raster;
+  RasterShadowDesc raster{};
 };
 
 PresetDesc presetDesc(Preset preset);

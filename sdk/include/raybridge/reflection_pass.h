@@ -107,7 +107,7 @@ struct ReflectionSettings {
   // Skip the 8x8-pixel tiles whose denoised history has converged and whose view has not turned (see Converged
   // tiles above): their pixels hold kept-history marks (a = -1) instead of radiance, which the Reflection Denoiser
   // named in it reads. Full resolution only. Off by default.
-  ConvergedTileSettings convergedTiles;
+  ConvergedTileSettings convergedTiles{};
 };
 
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
@@ -133,6 +133,10 @@ class ReflectionPass {
   Status setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures);
   Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas,
                 const ReflectionSettings& settings = {});
+  // Creates the output images at width x height now, so that outputs() names them before the first record()
+  // (HybridEffects hands out views that stay valid this way); record() at the same size keeps them, at another
+  // size it recreates them. Written by the first record().
+  Status prepare(uint32_t width, uint32_t height);
   const ReflectionOutputs& outputs() const;
   PassStats stats() const;
   // Whether the latest record() traced with shader execution reordering (ReflectionSettings::invocationReorder,

@@ -64,10 +64,10 @@ struct ShadowSettings {
   // Soft lights: rays per pixel where the denoiser's history says the visibility is uncertain, within a budget
   // (adaptive_rays.h); raysPerPixel is then the average the budget is made of. A hard light traces one ray per
   // pixel regardless. Not with ShadowPassDesc::outputHitDistance. Disabled by default.
-  AdaptiveRaySettings adaptive;
+  AdaptiveRaySettings adaptive{};
   // Skip the tiles whose denoised history has converged (soft shadows). Off by default. Not with
   // ShadowPassDesc::outputHitDistance (a skipped pixel has no occluder distance).
-  ConvergedTileSettings convergedTiles;
+  ConvergedTileSettings convergedTiles{};
 };
 
 // Images owned by the pass, sized to the G-buffer, left in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL after
@@ -97,6 +97,10 @@ class ShadowPass {
   // originOffset = the camera position); the G-buffer images must be in their declared layouts.
   Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas, const Light& light,
                 const ShadowSettings& settings = {});
+  // Creates the output images at width x height now, so that outputs() names them before the first record()
+  // (HybridEffects hands out views that stay valid this way); record() at the same size keeps them, at another
+  // size it recreates them. Written by the first record().
+  Status prepare(uint32_t width, uint32_t height);
   const ShadowOutputs& outputs() const;
   // GPU time (classifier included), rays and classified tiles of the latest recording whose frame has finished.
   PassStats stats() const;
