@@ -258,7 +258,7 @@ TEST_CASE("many-light bad lights fail naming the light and field; nothing is rec
   expectError(lights, "lights[2]: spotInnerAngleDegrees");
   lights = roomLights();
   lights[0].light.position[1] = INFINITY;
-  expectError(lights, "lights[0]: position");
+  expectError(lights, "lights[0]: Light::position must be finite");
   expectError(std::vector<rb::LightSource>(70000, roomLights()[0]), "70000 lights exceed kMaxLights");
   // No lights: black, no rays.
   ManyLightRun none = runManyLights(fx, scene, cpu, {}, {});

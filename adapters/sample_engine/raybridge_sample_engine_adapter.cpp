@@ -8,6 +8,12 @@
 namespace rbAdapter {
 namespace se = sample_engine;
 namespace {
+
+// glTF's MASK cutoff 0 cuts nothing; rb::Material's 0 means its default (0.5): the smallest cutoff that still
+// cuts nothing stands for glTF's 0.
+constexpr float kSmallestAlphaCutoff = 1e-6f;
+// The UVs' offset in the engine's interleaved attributes {vec3 normal; vec2 uv; vec4 tangent} (engine.h).
+constexpr VkDeviceSize kTexcoordOffset = 3 * sizeof(float);
 static_assert(uint32_t(se::AlphaMode::Mask) == uint32_t(rb::AlphaMode::Mask) &&
               uint32_t(se::AlphaMode::Blend) == uint32_t(rb::AlphaMode::Blend));
 
@@ -42,7 +48,7 @@ void convertMaterials(const se::Scene& scene, std::span<const se::GpuTexture> gp
     std::memcpy(r.emissive, &m.emissiveFactor[0], sizeof(r.emissive));
     // Cut-outs and blending (same enumerator order), with the UVs the engine samples (texture transforms baked).
     r.alphaMode = rb::AlphaMode(uint32_t(m.alphaMode));
-    r.alphaCutoff = m.alphaMode == se::AlphaMode::Mask ? std::max(m.alphaCutoff, 1e-6f) : 0.0f;  // 0 = default
+    r.alphaCutoff = m.alphaMode == se::AlphaMode::Mask ? std::max(m.alphaCutoff, kSmallestAlphaCutoff) : 0.0f;
     out.push_back(r);
   }
   if (out.empty()) out.emplace_back();
@@ -58,7 +64,7 @@ rb::MeshDesc describeMesh(VkDeviceAddress positions, uint32_t positionStride, ui
   d.indexType = topology.indexCount ? rb::IndexType::Uint32 : rb::IndexType::None;
   d.indexAddress = topology.indexAddress, d.indexBufferBytes = VkDeviceSize(topology.indexCount) * sizeof(uint32_t);
   d.triangleCount = (topology.indexCount ? topology.indexCount : vertexCount) / 3;
-  if (attributes) d.normalAddress = attributes, d.texcoordAddress = attributes + 12;
+  if (attributes) d.normalAddress = attributes, d.texcoordAddress = attributes + kTexcoordOffset;
   d.normalStride = d.texcoordStride = attributeStride;
   if (topology.cpu) d.debugName = topology.cpu->name.c_str();
   return d;

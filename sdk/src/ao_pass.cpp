@@ -138,8 +138,9 @@ Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo&
   if (!(range > 0.0f) || !std::isfinite(range)) {
     return invalid("AoSettings::range " + std::to_string(settings.range) + " must be a positive number");
   }
-  if (settings.raysPerPixel > 4096) {
-    return invalid("AoSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " exceeds 4096");
+  if (settings.raysPerPixel > kMaxRaysPerPixel) {
+    return invalid("AoSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " exceeds " +
+                   std::to_string(kMaxRaysPerPixel));
   }
   if (settings.estimator != AoEstimator::Binary && settings.estimator != AoEstimator::DistanceWeighted) {
     return invalid("AoSettings::estimator has an unknown value");

@@ -6,16 +6,20 @@
 #include <string>
 #include <utility>
 
+#include "align_up.h"
 #include "as_service_impl.h"
 
 namespace rb {
 
 namespace {
 
+// A compacted size that saves less than this share of the built size is not worth the copy (lavapipe reports the
+// built size itself: every compaction there would copy for nothing).
+constexpr VkDeviceSize kMinCompactionSavingPercent = 2;
+
 constexpr VkDeviceSize kDefaultScratchBudget = 64ull << 20;
 constexpr VkDeviceSize kDefaultBlockBytes = 32ull << 20;
 
-VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
 
 }  // namespace
 
@@ -420,7 +424,7 @@ void AccelerationStructureService::Impl::resolveBatches() {
           if (e.generation != b.compactGenerations[i] || e.state != BlasState::Built || !e.compactionPending) continue;
           e.compactionPending = false;
           // Lavapipe reports the built size: a copy would cost time and save nothing.
-          if (sizes[i] == 0 || sizes[i] * 50 >= e.builtSize * 49) {
+          if (sizes[i] == 0 || sizes[i] * 100 >= e.builtSize * (100 - kMinCompactionSavingPercent)) {
             ++counters.compactionsSkipped;
           } else {
             e.compactedSize = sizes[i];

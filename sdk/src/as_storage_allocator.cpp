@@ -2,11 +2,9 @@
 
 #include <algorithm>
 
-namespace rb {
+#include "align_up.h"
 
-namespace {
-VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
-}  // namespace
+namespace rb {
 
 AsStorageAllocator::~AsStorageAllocator() {
   for (Block& b : blocks_) destroyBuffer(ctx_, b.buffer);

@@ -111,6 +111,12 @@ std::vector<PassImages::Spec> imageSpecs(DenoiseSignal signal) {
           {VK_FORMAT_R32G32_UINT, "denoiser RGB guide"}};
 }
 
+// DenoiseSettings::maxHistoryFrames with its default; one frame without temporal filtering.
+uint32_t historyFrames(const DenoiseSettings& s) {
+  if (s.disableTemporal) return 1u;
+  return s.maxHistoryFrames ? s.maxHistoryFrames : kDefaultMaxHistoryFrames;
+}
+
 constexpr uint32_t kScalarOutputImage = 6;
 constexpr uint32_t kRgbOutputImage = 5;
 
@@ -267,7 +273,7 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   const uint32_t first = iterations % 2 == 0 ? kRgbOutputImage : 4u;
   const uint32_t other = first == 4u ? 5u : 4u;
   pc.flags = flags | (historyUsable ? RB_DN_HISTORY : 0u) | (iterations == 0 ? RB_DN_RGB_FINAL : 0u);
-  pc.maxHistoryFrames = settings.disableTemporal ? 1u : (settings.maxHistoryFrames ? settings.maxHistoryFrames : 32u);
+  pc.maxHistoryFrames = historyFrames(settings);
   {
     DescriptorWrites w;
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
@@ -375,7 +381,7 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
   for (size_t i = 5; i < im.size(); ++i) writable[i] = true;
 
   pc.flags = flags | (historyUsable ? RB_DN_HISTORY : 0u) | (iterations == 0 ? RB_DN_TEMPORAL_FINAL : 0u);
-  pc.maxHistoryFrames = settings.disableTemporal ? 1u : (settings.maxHistoryFrames ? settings.maxHistoryFrames : 32u);
+  pc.maxHistoryFrames = historyFrames(settings);
   {
     DescriptorWrites w;
     w.sampledImage(RB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));

@@ -5,13 +5,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "align_up.h"
 #include "as_service_impl.h"
 
 namespace rb {
 
 namespace {
 
-VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
 
 struct RebuildCandidate {
   uint32_t entry;

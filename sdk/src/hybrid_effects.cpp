@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "adaptive_rays.h"
+#include "light_validation.h"
 #include "neutral_images.h"
 #include "pass_constants.h"
 
@@ -35,13 +36,15 @@ Status validateSize(uint32_t width, uint32_t height, const char* what) {
 Status validate(const HybridEffectsDesc& d) {
   if (d.effects & ~kAllEffects) return invalid("effects has unknown bits " + std::to_string(d.effects & ~kAllEffects));
   if (Status st = validateSize(d.width, d.height, "width x height"); !st) return st;
-  if (d.shadows.raysPerPixel > 4096)
-    return invalid("shadows.raysPerPixel " + std::to_string(d.shadows.raysPerPixel) + " exceeds 4096");
-  if (!(d.shadows.softAngularRadiusDegrees >= 0.0f && d.shadows.softAngularRadiusDegrees < 45.0f))
+  const std::string maxRays = std::to_string(kMaxRaysPerPixel);
+  if (d.shadows.raysPerPixel > kMaxRaysPerPixel)
+    return invalid("shadows.raysPerPixel " + std::to_string(d.shadows.raysPerPixel) + " exceeds " + maxRays);
+  if (!(d.shadows.softAngularRadiusDegrees >= 0.0f &&
+        d.shadows.softAngularRadiusDegrees < kMaxLightAngularRadiusDegrees))
     return invalid("shadows.softAngularRadiusDegrees " + std::to_string(d.shadows.softAngularRadiusDegrees) +
-                   " is outside [0, 45)");
-  if (d.ao.raysPerPixel > 4096)
-    return invalid("ao.raysPerPixel " + std::to_string(d.ao.raysPerPixel) + " exceeds 4096");
+                   " is outside [0, " + std::to_string(int(kMaxLightAngularRadiusDegrees)) + ")");
+  if (d.ao.raysPerPixel > kMaxRaysPerPixel)
+    return invalid("ao.raysPerPixel " + std::to_string(d.ao.raysPerPixel) + " exceeds " + maxRays);
   if (!(d.ao.range >= 0.0f) || !std::isfinite(d.ao.range))
     return invalid("ao.range " + std::to_string(d.ao.range) + " must be >= 0 and finite");
   if (!(d.reflections.roughnessThreshold >= 0.0f && d.reflections.roughnessThreshold <= 1.0f))
@@ -520,6 +523,10 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
   if (frame.reflectionGBuffer) {
     if (Status st = validateGBufferImages(*frame.reflectionGBuffer, "HybridEffects: record: reflectionGBuffer"); !st)
       return st;
+  }
+  // The light shadows and lights reflection hits: checked as every effect checks a light.
+  if (a.shadow || a.reflection) {
+    if (Status st = validateLight(frame.light, "HybridEffects: record: HybridFrame::light: "); !st) return st;
   }
   a.neutral.recordInit(a.ctx, cmd);
   if (frame.tlas && frame.tlas->tlas) {

@@ -8,6 +8,7 @@
 #include "compute_pipeline.h"
 #include "context_impl.h"
 #include "converged_tiles.h"
+#include "light_validation.h"
 #include "many_light_pass_impl.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
@@ -17,7 +18,6 @@ namespace rb {
 
 namespace {
 
-constexpr float kDegrees = 3.14159265358979f / 180.0f;
 static_assert(RB_ML_STOCHASTIC == uint32_t(ManyLightMode::Stochastic));
 static_assert(RB_ML_EXACT == uint32_t(ManyLightMode::Exact));
 static_assert(RB_ML_MAX_TILE_LIGHTS == kMaxTileLights && RB_ML_TILE_SIZE == kManyLightTileSize);
@@ -27,55 +27,39 @@ constexpr uint32_t kMaxRaysOrCandidates = 64;
 
 bool finite3(const float v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 
-// Checks one light and converts it to the GPU's form in the TLAS's space; the error names the light and field.
+// Checks one light (validateLight, then what a LightSource adds) and converts it to the GPU's form in the TLAS's
+// space; the error names the light and field.
 Status convertLight(const LightSource& s, uint32_t index, const double originOffset[3], GpuLight& out) {
-  auto invalid = [&](const std::string& m) {
-    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: lights[" + std::to_string(index) + "]: " + m};
-  };
+  const std::string who = "ManyLightPass: lights[" + std::to_string(index) + "]: ";
+  auto invalid = [&](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, who + m}; };
   const Light& l = s.light;
+  if (Status st = validateLight(l, who); !st) return st;
   if (!(std::isfinite(s.intensity) && s.intensity >= 0.0f))
     return invalid("intensity " + std::to_string(s.intensity) + " must be finite and >= 0");
   if (!finite3(s.color) || s.color[0] < 0.0f || s.color[1] < 0.0f || s.color[2] < 0.0f)
     return invalid("color must be finite and >= 0");
   out = {};
   for (int i = 0; i < 3; ++i) out.intensity[i] = s.color[i] * s.intensity;
-  float dir[3] = {l.direction[0], l.direction[1], l.direction[2]};
-  if (!finite3(dir)) return invalid("direction must be finite");
-  if (dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) dir[1] = l.type == LightType::Spot ? -1.0f : 1.0f;
-  const float len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-  for (int i = 0; i < 3; ++i) out.direction[i] = dir[i] / len;
+  lightDirection(l, out.direction);
   out.type = uint32_t(l.type);
-  switch (l.type) {
-    case LightType::Directional:
-      if (!(l.angularRadiusDegrees >= 0.0f && l.angularRadiusDegrees < 45.0f))
-        return invalid("angularRadiusDegrees " + std::to_string(l.angularRadiusDegrees) + " is outside [0, 45)");
-      out.softness = std::tan(l.angularRadiusDegrees * kDegrees);
-      return {};
-    case LightType::Point:
-    case LightType::Spot: {
-      for (int i = 0; i < 3; ++i) {
-        if (!std::isfinite(l.position[i])) return invalid("position must be finite");
-        out.position[i] = float(l.position[i] - originOffset[i]);
-      }
-      if (!(l.radius >= 0.0f && std::isfinite(l.radius))) return invalid("radius must be finite and >= 0");
-      if (!(l.range >= 0.0f && std::isfinite(l.range))) return invalid("range must be finite and >= 0 (0 = unlimited)");
-      out.range = l.range;
-      out.softness = l.radius;
-      if (l.type == LightType::Point) return {};
-      const float outer = l.spotOuterAngleDegrees == 0.0f ? 45.0f : l.spotOuterAngleDegrees;
-      if (!(outer > 0.0f && outer <= 90.0f))
-        return invalid("spotOuterAngleDegrees " + std::to_string(outer) + " is outside (0, 90]");
-      if (!(s.spotInnerAngleDegrees >= 0.0f && s.spotInnerAngleDegrees <= outer))
-        return invalid("spotInnerAngleDegrees " + std::to_string(s.spotInnerAngleDegrees) +
-                       " must be in [0, the outer angle " + std::to_string(outer) + "]");
-      const float cosOuter = std::cos(outer * kDegrees), cosInner = std::cos(s.spotInnerAngleDegrees * kDegrees);
-      out.cosOuter = cosOuter;
-      out.coneScale = 1.0f / std::max(1e-3f, cosInner - cosOuter);  // KHR_lights_punctual's formula
-      out.coneOffset = -cosOuter * out.coneScale;
-      return {};
-    }
+  if (l.type == LightType::Directional) {
+    out.softness = std::tan(l.angularRadiusDegrees * kRadiansPerDegree);
+    return {};
   }
-  return invalid("light.type has an unknown value");
+  for (int i = 0; i < 3; ++i) out.position[i] = float(l.position[i] - originOffset[i]);
+  out.range = l.range;
+  out.softness = l.radius;
+  if (l.type == LightType::Point) return {};
+  const float outer = spotOuterAngleDegrees(l);
+  if (!(s.spotInnerAngleDegrees >= 0.0f && s.spotInnerAngleDegrees <= outer))
+    return invalid("spotInnerAngleDegrees " + std::to_string(s.spotInnerAngleDegrees) +
+                   " must be in [0, the outer angle " + std::to_string(outer) + "]");
+  const float cosOuter = std::cos(outer * kRadiansPerDegree);
+  const float cosInner = std::cos(s.spotInnerAngleDegrees * kRadiansPerDegree);
+  out.cosOuter = cosOuter;
+  out.coneScale = 1.0f / std::max(1e-3f, cosInner - cosOuter);  // KHR_lights_punctual's formula
+  out.coneOffset = -cosOuter * out.coneScale;
+  return {};
 }
 
 VkBufferMemoryBarrier bufferBarrier(VkBuffer buffer, VkAccessFlags src, VkAccessFlags dst) {

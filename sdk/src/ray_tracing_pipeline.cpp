@@ -3,13 +3,13 @@
 #include <cstring>
 #include <string>
 
+#include "align_up.h"
 #include "context_impl.h"
 
 namespace rb {
 
 namespace {
 
-VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
 
 Result<VkShaderModule> makeModule(Context::Impl& c, const SpirvModule& m, const char* name) {
   VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};

@@ -6,15 +6,14 @@
 #include "adaptive_rays.h"
 #include "context_impl.h"
 #include "converged_tiles.h"
+#include "light_validation.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
 #include "tile_classifier.h"
 
 namespace rb {
 
-namespace {
-constexpr float kDegrees = 3.14159265358979f / 180.0f;
-}
+namespace {}
 
 struct ShadowPass::Impl {
   Context& ctx;
@@ -115,47 +114,28 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
   ShadowConstants pc{};
   if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ShadowPass", pc.gbuffer); !st) return st;
 
-  // Light parameters in the TLAS's space.
-  float dir[3] = {light.direction[0], light.direction[1], light.direction[2]};
-  if (dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) dir[1] = light.type == LightType::Spot ? -1.0f : 1.0f;
-  float len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-  if (!(len > 0.0f) || !std::isfinite(len)) return invalid("Light::direction must be a finite vector");
-  for (float& d : dir) d /= len;
+  // Light parameters in the TLAS's space (the light checked as every effect checks it).
+  if (Status st = validateLight(light, "ShadowPass: "); !st) return st;
+  float dir[3];
+  lightDirection(light, dir);
   bool soft;
-  switch (light.type) {
-    case LightType::Directional: {
-      if (!(light.angularRadiusDegrees >= 0.0f && light.angularRadiusDegrees < 45.0f)) {
-        return invalid("Light::angularRadiusDegrees " + std::to_string(light.angularRadiusDegrees) +
-                       " is outside [0, 45)");
-      }
-      for (int i = 0; i < 3; ++i) pc.lightDirection[i] = dir[i];
-      pc.lightType = RB_LIGHT_DIRECTIONAL;
-      pc.tanAngularRadius = std::tan(light.angularRadiusDegrees * kDegrees);
-      soft = light.angularRadiusDegrees > 0.0f;
-      break;
-    }
-    case LightType::Point:
-    case LightType::Spot: {
-      if (!(light.radius >= 0.0f) || !(light.range >= 0.0f)) {
-        return invalid("Light::radius and Light::range must be >= 0");
-      }
-      for (int i = 0; i < 3; ++i) pc.lightPosition[i] = static_cast<float>(light.position[i] - tlas.originOffset[i]);
-      pc.lightType = light.type == LightType::Point ? RB_LIGHT_POINT : RB_LIGHT_SPOT;
-      pc.lightRadius = light.radius;
-      pc.range = light.range;
-      float outer = light.spotOuterAngleDegrees == 0.0f ? 45.0f : light.spotOuterAngleDegrees;
-      if (light.type == LightType::Spot && !(outer > 0.0f && outer <= 90.0f)) {
-        return invalid("Light::spotOuterAngleDegrees " + std::to_string(outer) + " is outside (0, 90]");
-      }
-      pc.cosSpotOuterAngle = std::cos(outer * kDegrees);
-      for (int i = 0; i < 3; ++i) pc.spotDirection[i] = dir[i];
-      soft = light.radius > 0.0f;
-      break;
-    }
-    default: return invalid("Light::type has an unknown value");
+  if (light.type == LightType::Directional) {
+    for (int i = 0; i < 3; ++i) pc.lightDirection[i] = dir[i];
+    pc.lightType = RB_LIGHT_DIRECTIONAL;
+    pc.tanAngularRadius = std::tan(light.angularRadiusDegrees * kRadiansPerDegree);
+    soft = light.angularRadiusDegrees > 0.0f;
+  } else {
+    for (int i = 0; i < 3; ++i) pc.lightPosition[i] = static_cast<float>(light.position[i] - tlas.originOffset[i]);
+    pc.lightType = light.type == LightType::Point ? RB_LIGHT_POINT : RB_LIGHT_SPOT;
+    pc.lightRadius = light.radius;
+    pc.range = light.range;
+    pc.cosSpotOuterAngle = std::cos(spotOuterAngleDegrees(light) * kRadiansPerDegree);
+    for (int i = 0; i < 3; ++i) pc.spotDirection[i] = dir[i];
+    soft = light.radius > 0.0f;
   }
-  if (settings.raysPerPixel > 4096) {
-    return invalid("ShadowSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " exceeds 4096");
+  if (settings.raysPerPixel > kMaxRaysPerPixel) {
+    return invalid("ShadowSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " exceeds " +
+                   std::to_string(kMaxRaysPerPixel));
   }
   pc.raysPerPixel = soft ? (settings.raysPerPixel ? settings.raysPerPixel : kDefaultSoftShadowRays) : 1u;
   if (Status st = AdaptiveRayPlanner::validate(settings.adaptive, "ShadowPass: ShadowSettings::adaptive"); !st) {

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <string>
 
+#include "align_up.h"
 #include "as_service_impl.h"
 #include "content_hash.h"
 #include "memory_barrier.h"
@@ -12,7 +13,6 @@ namespace rb {
 
 namespace {
 
-VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
 
 // Grows `buffer` to hold `bytes`, retiring the old one (a frame in flight may still read it).
 Status ensureBuffer(Context& ctx, GpuBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage,

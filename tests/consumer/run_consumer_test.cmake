@@ -8,6 +8,27 @@ execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_
 if(r)
   message(FATAL_ERROR "installing Raybridge failed (${r})")
 endif()
+# What the package holds: the public headers (the SDK's and the headless device's), the public GLSL, the library
+# with its embedded SPIR-V and the CMake package; no internal header or shader.
+get_filename_component(raybridge_root ${SOURCE_DIR}/../.. ABSOLUTE)
+file(GLOB want_headers RELATIVE ${raybridge_root}/sdk/include/raybridge ${raybridge_root}/sdk/include/raybridge/*.h)
+list(APPEND want_headers headless_device.h)
+file(GLOB got_headers RELATIVE ${WORK_DIR}/prefix/include/raybridge ${WORK_DIR}/prefix/include/raybridge/*)
+list(SORT want_headers)
+list(SORT got_headers)
+if(NOT want_headers STREQUAL got_headers)
+  message(FATAL_ERROR "installed headers differ from the public ones:\n want ${want_headers}\n got  ${got_headers}")
+endif()
+file(GLOB_RECURSE got_glsl RELATIVE ${WORK_DIR}/prefix ${WORK_DIR}/prefix/*.glsl ${WORK_DIR}/prefix/*.rgen
+     ${WORK_DIR}/prefix/*.comp ${WORK_DIR}/prefix/*.rchit ${WORK_DIR}/prefix/*.rahit ${WORK_DIR}/prefix/*.rmiss)
+if(NOT got_glsl STREQUAL "share/raybridge/shaders/raybridge_gbuffer.glsl")
+  message(FATAL_ERROR "installed shaders are not the public GLSL alone (raybridge_gbuffer.glsl): ${got_glsl}")
+endif()
+file(GLOB libraries ${WORK_DIR}/prefix/lib*/libraybridge.a ${WORK_DIR}/prefix/lib*/libraybridge.so)
+if(NOT libraries)
+  message(FATAL_ERROR "the library (with the SPIR-V embedded) was not installed")
+endif()
+
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/build -G Ninja
                         -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=Release
                 RESULT_VARIABLE r)

@@ -102,9 +102,9 @@ enum class RefitPolicyKind : uint8_t {
 // (measured on the GPU by every update of an Adaptive mesh, read back once its work is known done: framesInFlight
 // frames later in-frame, usually the next frame async) exceeds this multiple of its value at the last build.
 // Refits keep the tree's topology, so triangles that drift apart grow its boxes; by the time the leaves cover half
-// as much again, rays pay more than a fast rebuild, which costs about six refits (H200: 0.69 ms against 0.11 ms
-// for 523k triangles). Uniform growth of the mesh (an inflating morph) counts as well; scale that belongs to the
-// whole mesh should stay in the instance transform. The clusters follow the index order, which meshes optimised
+// as much again, rays pay more than a fast rebuild, which costs about six refits (measured build and refit times:
+// docs/benchmarks.md, "animated"). Uniform growth of the mesh (an inflating morph) counts as well; scale that belongs
+// to the whole mesh should stay in the instance transform. The clusters follow the index order, which meshes optimised
 // for the vertex cache keep spatially coherent; a mesh whose buffers the measure cannot read (not 4-byte
 // aligned, or past its 32-bit indexing: over 715,827,882 triangles or 8 GiB of positions) rebuilds by refit count
 // only.
@@ -112,9 +112,9 @@ constexpr float kDefaultMaxAreaGrowth = 1.5f;
 // Rebuild after this many refits in a row even when the measure stays low (two seconds at 60 frames per second):
 // clusters of consecutive triangles only approximate the tree's leaves, so drift they do not see is bounded too.
 constexpr uint32_t kDefaultMaxRefitsBeforeRebuild = 120;
-// Triangles of dynamic BLAS rebuilds per frame (staggered, highest measure first): about 0.7 ms of
-// PREFER_FAST_BUILD work on an H200 (measured: 0.69 ms for 523k triangles, 2.3 ms for 2.1M), so rebuilds cost a
-// 60 Hz frame a small, bounded share.
+// Triangles of dynamic BLAS rebuilds per frame (staggered, highest measure first): under a millisecond of
+// PREFER_FAST_BUILD work on a current data-centre GPU (docs/benchmarks.md, "animated"), so rebuilds cost a 60 Hz
+// frame a small, bounded share.
 constexpr uint64_t kDefaultRebuildTrianglesPerFrame = 512ull * 1024;
 // Triangles per cluster of the refit-quality measure (and threads per workgroup of its shader).
 constexpr uint32_t kRefitClusterTriangles = 64;
@@ -183,8 +183,8 @@ struct Instance {
 enum class TlasBuildMode : uint8_t {
   Adaptive = 0,      // default: refit the previous frame's TLAS when UpdateIfPossible could, and rebuild instead
                      // when the instances drifted apart since the last rebuild (TlasBuildOptions::maxAreaGrowth)
-                     // or after maxRefits refits in a row. H200, 10k instances: 0.05 ms a frame on average
-                     // against 0.25 for Rebuild, tracing as fast (docs/performance.md, "TLAS refits")
+                     // or after maxRefits refits in a row: a fifth of Rebuild's cost a frame, tracing as fast
+                     // (docs/performance.md, "TLAS refits")
   Rebuild,           // a full build every frame (for a list whose instances all jump every frame)
   UpdateIfPossible,  // refit the previous frame's TLAS when the instance list has the same meshes and count
                      // (and BLAS copies: see DynamicBuildMode) and it was built with the same preference; never

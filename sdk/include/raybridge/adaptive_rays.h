@@ -15,8 +15,8 @@
 //
 // Granularity (AdaptiveRaySettings::granularity). A ray generation launch runs neighbouring launch cells together,
 // one warp of 32 lanes on NVIDIA, and a warp takes as long as its busiest lane: with a count per pixel the warp
-// traces its maximum in every lane (on an H200, per-pixel adaptive AO had 22-25% more error than uniform AO at
-// equal GPU time, while it had 17% less at equal rays). So by
+// traces its maximum in every lane (measured: per-pixel adaptive AO had more error than uniform AO at equal GPU
+// time, though less at equal rays; docs/performance.md, "Adaptive rays"). So by
 // default the plan is per tile: step 2 shares the budget between tiles of tileWidth x tileHeight launch cells
 // (aligned to multiples of the tile size) in proportion to the tile's summed weight, and gives every surface pixel
 // of a tile the same count (sky pixels still 0); the claim under the budget also takes whole tiles, so a tile
@@ -55,7 +55,7 @@ inline constexpr uint32_t kDefaultAdaptiveMinRays = 1;
 inline constexpr uint32_t kDefaultAdaptiveMaxRaysFactor = 4;
 inline constexpr uint32_t kMaxAdaptiveRays = 256;
 // The most rays one adaptive frame plans, whatever maxRaysPerFrame, the time target or the uniform rays ask: 2^31,
-// a third of a second of an H200's peak trace rate (64 rays per pixel at 8K). The GPU claims rays with a 32-bit
+// 64 rays per pixel at 8K, far past any frame's budget. The GPU claims rays with a 32-bit
 // counter; under 2^31 it cannot wrap (a wrapped counter handed out rays again).
 inline constexpr uint64_t kMaxAdaptiveRaysPerFrame = uint64_t(1) << 31;
 

@@ -64,6 +64,9 @@ struct DenoiserDesc {
 // up to twice that the filter's shift is ramped in.
 inline constexpr float kDefaultDenoiseConvergedNoise = 0.1f;
 
+// Default of DenoiseSettings::maxHistoryFrames: frames the temporal running mean averages at most.
+inline constexpr uint32_t kDefaultMaxHistoryFrames = 32;
+
 struct DenoiseSettings {
   // false = accumulate over frames. Rgb: true still runs the temporal dispatch (it measures the noise), without
   // history.
@@ -73,7 +76,7 @@ struct DenoiseSettings {
   // their weights follow the measured noise, so the wide reach only blurs where the signal is still noisy).
   // At most 6.
   uint32_t spatialIterations = 0;
-  uint32_t maxHistoryFrames = 0;  // 0 = 32: the running mean forgets more slowly than this
+  uint32_t maxHistoryFrames = 0;  // 0 = kDefaultMaxHistoryFrames: the running mean forgets more slowly than this
   float depthSigma = 0.0f;        // 0 = 0.005: plane-distance tolerance relative to view distance, per step
   float normalPower = 0.0f;       // 0 = 32: exponent of the normal similarity weight
   // Scalar signals: rays per pixel behind the signal, when it is a fraction of binary rays (shadow visibility,

@@ -13,6 +13,15 @@ enum class LightType : uint8_t {
   Spot,
 };
 
+// Limits every effect checks a Light against (one validator, the same message wherever a light is taken).
+// A directional light's disk below 45 degrees of angular radius (the cone-sampling of soft shadows assumes it):
+inline constexpr float kMaxLightAngularRadiusDegrees = 45.0f;
+// A spot's half-angle when Light::spotOuterAngleDegrees is 0, and its largest value:
+inline constexpr float kDefaultSpotOuterAngleDegrees = 45.0f;
+inline constexpr float kMaxSpotOuterAngleDegrees = 90.0f;
+// Rays per pixel any effect traces for one signal at most (shadow and AO settings).
+inline constexpr uint32_t kMaxRaysPerPixel = 4096;
+
 struct Light {
   LightType type = LightType::Directional;
   // Directional: direction towards the light (need not be normalised). Spot: the direction the spot shines.
@@ -23,7 +32,7 @@ struct Light {
   float angularRadiusDegrees = 0.0f;
   float radius = 0.0f;  // point and spot: radius of the emitting disk facing the surface; 0 = hard shadows
   float range = 0.0f;   // point and spot: beyond it a surface is unlit and traces nothing; 0 = unlimited
-  float spotOuterAngleDegrees = 0.0f;  // spot: half-angle of the cone; 0 = 45 degrees
+  float spotOuterAngleDegrees = 0.0f;  // spot: half-angle of the cone; 0 = kDefaultSpotOuterAngleDegrees
 };
 
 // What one recorded pass did, resolved once its frame has finished on the GPU.

@@ -17,9 +17,9 @@
 //
 // One shadow ray means hard shadows (towards the light's centre); more rays sample the light's disk.
 // Every preset with AO traces it at half resolution (AoSettings::halfResolution: a quarter of the pixels, a
-// depth-aware upsample): on the H200 at 2560x1440 that costs a third of the time at a lower denoised error for 1
-// to 16 rays (docs/performance.md, "Half resolution"). Reflections stay at full resolution: at half resolution
-// they are 3.6x faster but their denoised error is 2 to 3 times worse. Set the flag back to false for the
+// depth-aware upsample): a fraction of the time at a lower denoised error for 1 to 16 rays (docs/performance.md,
+// "Half resolution"). Reflections stay at full resolution: at half resolution they are several times faster but
+// their denoised error is several times worse (same section). Set the flag back to false for the
 // thesis's full-resolution AO.
 //
 // Thread safety: plain data and pure functions.

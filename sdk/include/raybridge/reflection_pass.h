@@ -40,7 +40,7 @@
 // orbit is caught too; turning the camera in place turns nothing; a mirror's lobe is a few thousandths of a radian
 // wide). The launch stays one invocation per pixel: those of a
 // skipped tile return at once (a list of the tiles left, as the shadow and AO passes trace, cost the reflection
-// pass more than it saved on an NVIDIA H200: docs/performance.md). PassStats counts the tiles traced, skipped and
+// pass more than it saved where measured: docs/performance.md). PassStats counts the tiles traced, skipped and
 // converged, and the reflection rays saved (not counting the shadow rays their hits would have traced). The tile
 // state takes 4 bytes per tile (MemoryCategory::PassBuffers), held only while the setting is on.
 //
@@ -101,7 +101,7 @@ struct ReflectionSettings {
   // false (default) = trace as usual; true = reorder the hits before shading them (shader execution reordering)
   // where the Context has it (DeviceInfo::invocationReorder), else trace as usual. Same rays and shading either
   // way; only the order the closest-hit shaders run in differs. Opt-in because it did not pay on the one device
-  // measured: on an NVIDIA H200 the pass was 3-4% slower with it (docs/performance.md); measure it on yours.
+  // measured (the pass was slower with it: docs/performance.md); measure it on yours.
   // ReflectionPass::reordered() says what a record did.
   bool invocationReorder = false;
   // Skip the 8x8-pixel tiles whose denoised history has converged and whose view has not turned (see Converged

@@ -9,8 +9,8 @@
 // A tile classifier (ShadowSettings::tileClassifier) can run that same per-pixel test first, in a compute pass
 // over 8x8-pixel tiles: tiles where no pixel needs a ray get their outputs from it, and only the others are
 // traced (vkCmdTraceRaysIndirectKHR). The outputs are the same bit for bit either way; PassStats counts the tiles
-// traced and skipped. It is off by default: on an NVIDIA H200 the pass was 0.08 ms slower with it at 2560x1440
-// (docs/performance.md), since the pixels it skips already end before their first ray. Its tile list takes 16
+// traced and skipped. It is off by default: where measured the pass was slower with it (docs/performance.md),
+// since the pixels it skips already end before their first ray. Its tile list takes 16
 // bytes + 8 bytes per tile (the list and the converged-tile state; MemoryCategory::PassBuffers, about 260 KB at
 // 1920x1080), allocated with the output images.
 //

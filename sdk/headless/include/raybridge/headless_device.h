@@ -78,7 +78,7 @@ class HeadlessDevice {
   std::vector<std::string> validationErrors() const;
   bool validationEnabled() const;
 
-  // One-shot recording: begin() returns a command buffer in the recording state; submitAndWait() ends,
+  // One-shot recording: beginCommands() returns a command buffer in the recording state; submitAndWait() ends,
   // submits and waits for it, then frees it.
   Result<VkCommandBuffer> beginCommands();
   Status submitAndWait(VkCommandBuffer cmd);
