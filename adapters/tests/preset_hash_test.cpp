@@ -1,0 +1,97 @@
+// Every preset's images, bit for bit, against hashes recorded at a named commit (preset_image_hashes.json): the
+// safety net of a change that must change no image (issue 31's redesign). raybridge-render renders the demo scene
+// at a small size for each preset with --dump; every image it writes (final, depth, normal, shadow and
+// shadow_raw, ao and ao_raw, reflection, lights and lights_raw) is hashed. The images are deterministic on one
+// driver (two runs give the same bytes), not across drivers: on another driver than the one the hashes were recorded
+// on, the test is skipped with a message. To record them again (after a change that is meant to change images, with
+// the reason in its commit message): RAYBRIDGE_RECORD_PRESET_HASHES=1 raybridge_preset_hash_tests, then set
+// "commit" in the file to the commit that made them.
+#include <raybridge/presets.h>
+
+#include <catch2/catch_test_macros.hpp>
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "render_command_support.h"
+
+namespace fs = std::filesystem;
+using namespace rbRenderTest;
+
+namespace {
+
+constexpr uint32_t kWidth = 96, kHeight = 64;
+
+// FNV-1a over the file's bytes, as 16 hex digits: enough to see any changed byte, no dependency.
+std::string fileHash(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+// The hashes of one preset's dumped images, by file name (stats.json, with its timings, left out).
+nlohmann::json renderHashes(const std::string& preset, std::string& driver) {
+  const fs::path out = fs::temp_directory_path() / ("raybridge_preset_hash_" + preset);
+  fs::remove_all(out);
+  const int status = runRender("--width " + std::to_string(kWidth) + " --height " + std::to_string(kHeight) +
+                               " --preset " + preset + " --dump --out \"" + out.string() + "\" > /dev/null");
+  REQUIRE(status == 0);
+  const nlohmann::json stats = readJson(out / "stats.json");
+  REQUIRE_FALSE(stats.is_discarded());
+  driver = stats["device"]["name"].get<std::string>() + " / " + stats["device"]["driver_info"].get<std::string>();
+  nlohmann::json hashes = nlohmann::json::object();
+  for (const fs::directory_entry& e : fs::directory_iterator(out)) {
+    if (e.path().filename() == "stats.json") continue;
+    hashes[e.path().filename().string()] = fileHash(e.path());
+  }
+  fs::remove_all(out);
+  return hashes;
+}
+
+}  // namespace
+
+TEST_CASE("every preset renders the images recorded at the named commit, bit for bit", "[render][presets][golden]") {
+  const fs::path file = fs::path(RAYBRIDGE_PRESET_HASHES);
+  const bool record = std::getenv("RAYBRIDGE_RECORD_PRESET_HASHES") != nullptr;
+  nlohmann::json recorded = readJson(file);
+  if (!record) REQUIRE_FALSE(recorded.is_discarded());
+
+  nlohmann::json now = {{"size", {kWidth, kHeight}}, {"presets", nlohmann::json::object()}};
+  std::string driver;
+  for (uint32_t i = 0; i < rb::kPresetCount; ++i) {
+    const std::string preset = rb::toString(rb::Preset(i));
+    now["presets"][preset] = renderHashes(preset, driver);
+    if (i == 0 && !record && recorded["driver"] != driver) {
+      SKIP("the hashes were recorded on " << recorded["driver"].get<std::string>() << " (commit "
+                                          << recorded["commit"].get<std::string>() << "), this is " << driver
+                                          << ": images are bit-identical on one driver only");
+    }
+  }
+  now["driver"] = driver;
+  if (record) {
+    now["commit"] = "set to the commit that made these images";
+    std::ofstream(file) << now.dump(2) << "\n";
+    WARN("recorded " << file.string() << " on " << driver << ": set its \"commit\"");
+    return;
+  }
+  INFO("hashes of commit " << recorded["commit"].get<std::string>() << " on " << driver);
+  CHECK(recorded["size"] == now["size"]);
+  for (const auto& [preset, images] : recorded["presets"].items()) {
+    INFO("preset " << preset);
+    REQUIRE(now["presets"].contains(preset));
+    for (const auto& [image, hash] : images.items()) {
+      INFO("image " << image);
+      CHECK(now["presets"][preset].value(image, std::string("missing")) == hash.get<std::string>());
+    }
+    CHECK(now["presets"][preset].size() == images.size());  // no image appeared or vanished
+  }
+  CHECK(now["presets"].size() == recorded["presets"].size());
+}
