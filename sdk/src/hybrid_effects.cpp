@@ -212,11 +212,12 @@ struct HybridEffects::Impl {
   Impl(Context& c, AccelerationStructureService* s) : ctx(c), service(s) {}
   ~Impl() { neutral.retire(ctx); }
 
-  // A denoiser made with the outputs, so that its output is named from create() on.
-  Status ensureDenoiser(std::unique_ptr<Denoiser>& slot, DenoiseSignal kind, const char* what) {
+  // The denoiser of one signal: created when wanted (with the outputs, so its output is named from create() on,
+  // or by record()), retired when not.
+  Status ensureDenoiser(std::unique_ptr<Denoiser>& slot, bool wanted, DenoiseSignal kind, const char* what) {
     DenoiserDesc dd;
     dd.signal = kind;
-    return ensure(slot, true, what, [&] { return Denoiser::create(ctx, dd); });
+    return ensure(slot, wanted, what, [&] { return Denoiser::create(ctx, dd); });
   }
 
   // Allocates every enabled output at desc.width x desc.height (HybridEffectsDesc: a size is set).
@@ -224,16 +225,18 @@ struct HybridEffects::Impl {
     const uint32_t w = desc.width, h = desc.height;
     if (w == 0) return {};
     if (shadow && shadowsSoftByDesc(desc.shadows)) {
-      if (Status st = ensureDenoiser(shadowDenoiser, DenoiseSignal::Scalar, "Denoiser (shadows)"); !st) return st;
+      if (Status st = ensureDenoiser(shadowDenoiser, true, DenoiseSignal::Scalar, "Denoiser (shadows)"); !st) return st;
     }
     if (ao && !desc.ao.disableDenoiser) {
-      if (Status st = ensureDenoiser(aoDenoiser, DenoiseSignal::Scalar, "Denoiser (AO)"); !st) return st;
+      if (Status st = ensureDenoiser(aoDenoiser, true, DenoiseSignal::Scalar, "Denoiser (AO)"); !st) return st;
     }
     if (localLightsDenoised()) {
-      if (Status st = ensureDenoiser(localLightDenoiser, DenoiseSignal::Rgb, "Denoiser (local lights)"); !st) return st;
+      if (Status st = ensureDenoiser(localLightDenoiser, true, DenoiseSignal::Rgb, "Denoiser (local lights)"); !st)
+        return st;
     }
     if (reflection && !desc.reflections.disableDenoiser) {
-      if (Status st = ensureDenoiser(reflectionDenoiser, DenoiseSignal::Reflection, "Denoiser (reflections)"); !st)
+      if (Status st = ensureDenoiser(reflectionDenoiser, true, DenoiseSignal::Reflection, "Denoiser (reflections)");
+          !st)
         return st;
     }
     auto prepare = [&](auto* object, const char* what) -> Status {
@@ -253,59 +256,51 @@ struct HybridEffects::Impl {
     return {};
   }
 
-  // outputs() from what exists now: each effect's pass and denoiser, else the neutral image (created here when
-  // first needed, retired when nothing names it). Moves `generation` when any image changed.
+  // outputs() from what exists now: each effect's pass image (raw) and its denoiser's where one has run or been
+  // prepared, else the neutral image (created here when first needed, retired when nothing names it). Moves
+  // `generation` when any image changed.
   Status refreshOutputs() {
-    HybridOutputs next;
-    bool needNeutral = false;
-    auto pick = [&](VkImage i, VkImageView v, VkFormat f, uint32_t w, uint32_t h) {
-      if (v) return image(i, v, f, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, w, h);
-      needNeutral = true;
-      return EffectImage{};  // filled below, once the neutral images exist
-    };
-    auto denoised = [&](const std::unique_ptr<Denoiser>& d, const EffectImage& raw) {
-      if (!d || !d->outputs().denoisedView) return raw;
-      const DenoiseOutputs& o = d->outputs();
-      return image(o.denoised, o.denoisedView, raw.format, o.layout, o.width, o.height);
-    };
     constexpr VkFormat r16 = VK_FORMAT_R16_SFLOAT, rgba16 = VK_FORMAT_R16G16B16A16_SFLOAT;
+    constexpr VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    HybridOutputs next;
+    // The passes' own images; none (a null view) for an effect that is off or not sized yet.
     if (shadow) {
       const ShadowOutputs& o = shadow->outputs();
-      next.shadowRaw = pick(o.visibility, o.visibilityView, r16, o.width, o.height);
+      next.shadowRaw = image(o.visibility, o.visibilityView, r16, ro, o.width, o.height);
     }
     if (ao) {
       const AoOutputs& o = ao->outputs();
-      next.aoRaw = pick(o.ao, o.aoView, r16, o.width, o.height);
+      next.aoRaw = image(o.ao, o.aoView, r16, ro, o.width, o.height);
     }
     if (reflection) {
       const ReflectionOutputs& o = reflection->outputs();
-      next.reflectionRaw = pick(o.radiance, o.radianceView, rgba16, o.width, o.height);
+      next.reflectionRaw = image(o.radiance, o.radianceView, rgba16, ro, o.width, o.height);
     }
     if (localLights) {
       const ManyLightOutputs& o = localLights->outputs();
-      next.localLightsRaw = pick(o.irradiance, o.irradianceView, rgba16, o.width, o.height);
+      next.localLightsRaw = image(o.irradiance, o.irradianceView, rgba16, ro, o.width, o.height);
     }
-    needNeutral = needNeutral || !shadow || !ao || !reflection || !localLights;
-    if (needNeutral) {
+    if (!next.shadowRaw.view || !next.aoRaw.view || !next.reflectionRaw.view || !next.localLightsRaw.view) {
       if (Status st = neutral.ensure(ctx); !st) return wrap("neutral output images", st.error());
     } else {
       neutral.retire(ctx);  // no byte that nothing reads
     }
-    for (EffectImage* raw : {&next.shadowRaw, &next.aoRaw}) {
-      if (!raw->view) *raw = image(neutral.white());
-    }
-    for (EffectImage* raw : {&next.reflectionRaw, &next.localLightsRaw}) {
-      if (!raw->view) *raw = image(neutral.black());
-    }
-    next.shadow = shadow && shadow->outputs().visibilityView ? denoised(shadowDenoiser, next.shadowRaw)
-                                                             : next.shadowRaw;
-    next.ao = ao && ao->outputs().aoView ? denoised(aoDenoiser, next.aoRaw) : next.aoRaw;
-    next.reflection = reflection && reflection->outputs().radianceView
-                          ? denoised(reflectionDenoiser, next.reflectionRaw)
-                          : next.reflectionRaw;
-    next.localLights = localLights && localLights->outputs().irradianceView
-                           ? denoised(localLightDenoiser, next.localLightsRaw)
-                           : next.localLightsRaw;
+    // The image the engine samples: the denoiser's output where it has one, the raw image else, the neutral one
+    // (for raw and sampled alike) where the pass has none.
+    auto finish = [&](EffectImage& raw, EffectImage& out, const std::unique_ptr<Denoiser>& d, const GpuImage& none) {
+      if (!raw.view) {
+        raw = out = image(none);
+      } else if (d && d->outputs().denoisedView) {
+        const DenoiseOutputs& o = d->outputs();
+        out = image(o.denoised, o.denoisedView, raw.format, o.layout, o.width, o.height);
+      } else {
+        out = raw;
+      }
+    };
+    finish(next.shadowRaw, next.shadow, shadowDenoiser, neutral.white());
+    finish(next.aoRaw, next.ao, aoDenoiser, neutral.white());
+    finish(next.reflectionRaw, next.reflection, reflectionDenoiser, neutral.black());
+    finish(next.localLightsRaw, next.localLights, localLightDenoiser, neutral.black());
     next.generation = outputs.generation;
     bool changed = false;
     for (auto member : {&HybridOutputs::shadow, &HybridOutputs::shadowRaw, &HybridOutputs::ao, &HybridOutputs::aoRaw,
@@ -347,14 +342,12 @@ struct HybridEffects::Impl {
     return localLights && desc.localLights.mode == ManyLightMode::Stochastic && !desc.localLights.disableDenoiser;
   }
 
-  // The denoiser of one signal: created when wanted, retired when not (refreshOutputs names its output).
+  // Records the denoiser of one signal when wanted (ensureDenoiser; refreshOutputs names its output).
   // `rays`: binary rays behind a scalar signal (DenoiseSettings::raysPerPixel; 0 = estimate the noise).
   Status denoise(std::unique_ptr<Denoiser>& slot, bool wanted, const char* what, VkCommandBuffer cmd,
                  const GBufferDesc& gbuffer, VkImageView signal, uint32_t rays,
                  DenoiseSignal kind = DenoiseSignal::Scalar) {
-    DenoiserDesc dd;
-    dd.signal = kind;
-    if (Status st = ensure(slot, wanted, what, [&] { return Denoiser::create(ctx, dd); }); !st) return st;
+    if (Status st = ensureDenoiser(slot, wanted, kind, what); !st) return st;
     if (!slot) return {};
     DenoiseSettings d = desc.denoiser;
     d.raysPerPixel = kind == DenoiseSignal::Scalar ? rays : 0u;
