@@ -1,4 +1,4 @@
-// Adaptive rays per pixel (raybridge/adaptive_rays.h): the budget controller on a simulated cost, and on lavapipe
+// Adaptive rays per pixel (raybridge/ray_schedule.h): the budget controller on a simulated cost, and on lavapipe
 // the ray budget as counted by the shaders, the plan's agreement with the counters, and where the rays go.
 #include <raybridge/raybridge.h>
 
@@ -195,9 +195,9 @@ TEST_CASE("a per-tile cap under one tile's rays still traces one tile a frame", 
   desc.effects = rb::kEffectAo;
   desc.ao.raysPerPixel = 4;
   desc.ao.range = 2.0f;
-  desc.ao.adaptive.enabled = true;
-  desc.ao.adaptive.granularity = rb::AdaptiveRayGranularity::Tile;
-  desc.ao.adaptive.maxRaysPerFrame = 16;  // a quarter of the default 8x8 tile
+  desc.ao.schedule.adaptive.enabled = true;
+  desc.ao.schedule.adaptive.granularity = rb::AdaptiveRayGranularity::Tile;
+  desc.ao.schedule.adaptive.maxRaysPerFrame = 16;  // a quarter of the default 8x8 tile
   auto fxr = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
   RB_REQUIRE_OK(fxr);
   rb::HybridEffects& effects = *fxr.value();
@@ -247,7 +247,7 @@ TEST_CASE("adaptive AO at 8K (7680x4320) without history shares its budget evenl
     desc.effects = rb::kEffectAo;
     desc.ao.raysPerPixel = 2;  // the budget: one ray everywhere (the minimum) and one more shared by weight
     desc.ao.range = 0.25f;
-    desc.ao.adaptive.enabled = true;
+    desc.ao.schedule.adaptive.enabled = true;
     auto fxr = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
     RB_REQUIRE_OK(fxr);
     rb::HybridEffects& effects = *fxr.value();
@@ -291,9 +291,9 @@ TEST_CASE("adaptive AO traces no more rays than its budget, the plan matches the
   desc.effects = rb::kEffectAo;
   desc.ao.raysPerPixel = 4;
   desc.ao.range = 2.0f;
-  desc.ao.adaptive.enabled = true;
-  desc.ao.adaptive.granularity = granularity;
-  desc.ao.adaptive.maxRaysPerFrame = 3 * uint64_t(s.surfacePixels);  // under the uniform 4 per pixel
+  desc.ao.schedule.adaptive.enabled = true;
+  desc.ao.schedule.adaptive.granularity = granularity;
+  desc.ao.schedule.adaptive.maxRaysPerFrame = 3 * uint64_t(s.surfacePixels);  // under the uniform 4 per pixel
   auto fxr = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
   RB_REQUIRE_OK(fxr);
   rb::HybridEffects& effects = *fxr.value();
@@ -318,10 +318,10 @@ TEST_CASE("adaptive AO traces no more rays than its budget, the plan matches the
       if (!s.cpu.hit[p]) CHECK(plan[2 * p] == 0.0f);  // sky: no ray
     }
     INFO("frame " << i << ": " << rays << " rays counted, " << planned << " planned, budget "
-                  << desc.ao.adaptive.maxRaysPerFrame);
+                  << desc.ao.schedule.adaptive.maxRaysPerFrame);
     CHECK(rays == planned);  // the shader traced exactly what the plan says
-    CHECK(rays <= desc.ao.adaptive.maxRaysPerFrame);
-    CHECK(rays >= desc.ao.adaptive.maxRaysPerFrame * 9 / 10);  // and the budget is spent
+    CHECK(rays <= desc.ao.schedule.adaptive.maxRaysPerFrame);
+    CHECK(rays >= desc.ao.schedule.adaptive.maxRaysPerFrame * 9 / 10);  // and the budget is spent
     CHECK(maxRays <= rb::kDefaultAdaptiveMaxRaysFactor * 4);
     if (tiles) {
       // The default tile: one count per 8x8 block of surface pixels.
@@ -421,33 +421,33 @@ TEST_CASE("adaptive rays per tile: every surface pixel of a tile gets the same r
   SECTION("AO at full resolution, 8x4 tiles, a budget under the minimum of one ray everywhere") {
     desc.effects = rb::kEffectAo;
     desc.ao.raysPerPixel = 4;
-    desc.ao.adaptive.enabled = true;
-    desc.ao.adaptive.tileWidth = 8;
-    desc.ao.adaptive.tileHeight = 4;
+    desc.ao.schedule.adaptive.enabled = true;
+    desc.ao.schedule.adaptive.tileWidth = 8;
+    desc.ao.schedule.adaptive.tileHeight = 4;
     // Half a ray per surface pixel: half the tiles get one ray per pixel, the claim cuts the rest to whole tiles.
-    desc.ao.adaptive.maxRaysPerFrame = s.surfacePixels / 2;
+    desc.ao.schedule.adaptive.maxRaysPerFrame = s.surfacePixels / 2;
     auto e = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
     RB_REQUIRE_OK(e);
-    run(*e.value(), true, 8, 4, desc.ao.adaptive.maxRaysPerFrame, true);
+    run(*e.value(), true, 8, 4, desc.ao.schedule.adaptive.maxRaysPerFrame, true);
   }
   SECTION("AO at half resolution: the default 8x8 tiles of launch cells are 16x16 pixels") {
     desc.effects = rb::kEffectAo;
     desc.ao.raysPerPixel = 4;
-    desc.ao.halfResolution = true;
-    desc.ao.adaptive.enabled = true;
-    desc.ao.adaptive.maxRaysPerFrame = 3ull * s.surfacePixels;
+    desc.ao.schedule.halfResolution = true;
+    desc.ao.schedule.adaptive.enabled = true;
+    desc.ao.schedule.adaptive.maxRaysPerFrame = 3ull * s.surfacePixels;
     auto e = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
     RB_REQUIRE_OK(e);
     // A quarter of the plan is traced: the counters are not the plan.
-    run(*e.value(), true, 16, 16, desc.ao.adaptive.maxRaysPerFrame, false);
+    run(*e.value(), true, 16, 16, desc.ao.schedule.adaptive.maxRaysPerFrame, false);
   }
   SECTION("soft shadows over the tile classifier's launch, 4x8 tiles") {
     desc.effects = rb::kEffectShadows;
     desc.shadows.raysPerPixel = 4;
-    desc.shadows.tileClassifier = true;
-    desc.shadows.adaptive.enabled = true;
-    desc.shadows.adaptive.tileWidth = 4;
-    desc.shadows.adaptive.tileHeight = 8;
+    desc.shadows.schedule.tileClassifier = true;
+    desc.shadows.schedule.adaptive.enabled = true;
+    desc.shadows.schedule.adaptive.tileWidth = 4;
+    desc.shadows.schedule.adaptive.tileHeight = 8;
     auto e = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
     RB_REQUIRE_OK(e);
     // Pixels facing away from the light are planned rays but trace none.
@@ -468,8 +468,8 @@ TEST_CASE("adaptive soft shadows stay within the uniform rays by default and fol
   rb::HybridEffectsDesc desc;
   desc.effects = rb::kEffectShadows;
   desc.shadows.raysPerPixel = 4;
-  desc.shadows.adaptive.enabled = true;  // no cap, no time target: the uniform rays, redistributed
-  desc.shadows.adaptive.granularity = granularity;
+  desc.shadows.schedule.adaptive.enabled = true;  // no cap, no time target: the uniform rays, redistributed
+  desc.shadows.schedule.adaptive.granularity = granularity;
   auto fxr = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
   RB_REQUIRE_OK(fxr);
   rb::HybridEffects& effects = *fxr.value();
@@ -493,7 +493,7 @@ TEST_CASE("adaptive soft shadows stay within the uniform rays by default and fol
   }
   // A time target no pass can meet: the budget falls to its floor (one ray per 64 pixels; per tile, at least one
   // ray in every pixel of a tile) within a few frames.
-  desc.shadows.adaptive.timeBudgetMs = 1e-6f;
+  desc.shadows.schedule.adaptive.timeBudgetMs = 1e-6f;
   RB_REQUIRE_OK(effects.setDesc(desc));
   uint64_t last = 0;
   for (int i = 0; i < 12; ++i) {
@@ -524,48 +524,48 @@ TEST_CASE("bad adaptive ray settings are named", "[adaptive][bad_input]") {
     });
   };
   rb::AoSettings a;
-  a.adaptive.enabled = true;
+  a.schedule.adaptive.enabled = true;
   expectError(a, "history is nullptr");
   auto rgb = rb::Denoiser::create(fx.ctx(), rb::DenoiserDesc{rb::DenoiseSignal::Rgb});
   RB_REQUIRE_OK(rgb);
-  a.adaptive.history = rgb.value().get();
+  a.schedule.history = rgb.value().get();
   expectError(a, "DenoiseSignal::Scalar");
   auto scalar = rb::Denoiser::create(fx.ctx());
   RB_REQUIRE_OK(scalar);
-  a.adaptive.history = scalar.value().get();
-  a.adaptive.timeBudgetMs = std::nanf("");
+  a.schedule.history = scalar.value().get();
+  a.schedule.adaptive.timeBudgetMs = std::nanf("");
   expectError(a, "timeBudgetMs");
-  a.adaptive.timeBudgetMs = 0.0f;
-  a.adaptive.maxRaysPerPixel = 1000;
+  a.schedule.adaptive.timeBudgetMs = 0.0f;
+  a.schedule.adaptive.maxRaysPerPixel = 1000;
   expectError(a, "maxRaysPerPixel 1000 exceeds 256");
-  a.adaptive.maxRaysPerPixel = 2;
-  a.adaptive.minRaysPerPixel = 3;
+  a.schedule.adaptive.maxRaysPerPixel = 2;
+  a.schedule.adaptive.minRaysPerPixel = 3;
   expectError(a, "minRaysPerPixel 3 exceeds maxRaysPerPixel 2");
-  a.adaptive.minRaysPerPixel = 0;
-  a.adaptive.tileWidth = 3;
+  a.schedule.adaptive.minRaysPerPixel = 0;
+  a.schedule.adaptive.tileWidth = 3;
   expectError(a, "tileWidth 3 must be 0 (default 8x8) or a power of two at most 8");
-  a.adaptive.tileWidth = 0;
-  a.adaptive.tileHeight = 16;
+  a.schedule.adaptive.tileWidth = 0;
+  a.schedule.adaptive.tileHeight = 16;
   expectError(a, "tileHeight 16 must be 0");
-  a.adaptive.tileHeight = 0;
-  a.adaptive.granularity = static_cast<rb::AdaptiveRayGranularity>(7);
+  a.schedule.adaptive.tileHeight = 0;
+  a.schedule.adaptive.granularity = static_cast<rb::AdaptiveRayGranularity>(7);
   expectError(a, "granularity has an unknown value (7)");
-  a.adaptive.granularity = rb::AdaptiveRayGranularity::Tile;
+  a.schedule.adaptive.granularity = rb::AdaptiveRayGranularity::Tile;
 
   rb::HybridEffectsDesc desc;
   desc.effects = rb::kEffectAo;
-  desc.ao.adaptive.enabled = true;
+  desc.ao.schedule.adaptive.enabled = true;
   desc.ao.disableDenoiser = true;
   auto bad = rb::HybridEffects::create(fx.ctx(), s.service.get(), desc);
   REQUIRE_FALSE(bad.ok());
-  CHECK(bad.error().message.find("ao.adaptive") != std::string::npos);
+  CHECK(bad.error().message.find("ao.schedule.adaptive") != std::string::npos);
 
   auto shadow = rb::ShadowPass::create(fx.ctx(), rb::ShadowPassDesc{true});
   RB_REQUIRE_OK(shadow);
   fx.runFrame([&](VkCommandBuffer cmd) {
     rb::ShadowSettings ss;
-    ss.adaptive.enabled = true;
-    ss.adaptive.history = scalar.value().get();
+    ss.schedule.adaptive.enabled = true;
+    ss.schedule.history = scalar.value().get();
     rb::Light soft;
     soft.angularRadiusDegrees = 2.0f;
     rb::Status st = shadow.value()->record(cmd, s.gbuffer->desc(), s.built.tlas, soft, ss);

@@ -46,7 +46,7 @@ struct LightsPair {
     auto p = rb::HybridEffects::create(fx.ctx(), service.get(), desc);
     RB_REQUIRE_OK(p);
     plain = std::move(p.value());
-    rb::ConvergedTileSettings& tiles = desc.localLights.convergedTiles;
+    rb::ConvergedTileSettings& tiles = desc.localLights.schedule.convergedTiles;
     tiles.enabled = true;
     tiles.minFrames = kMinFrames;
     tiles.maxNoise = kMaxNoise;
@@ -158,11 +158,11 @@ TEST_CASE("bad local-light converged-tile settings are named", "[many_lights][co
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
         rb::ManyLightSettings s;
-        s.convergedTiles.enabled = true;  // without the denoiser whose history it reads
+        s.schedule.convergedTiles.enabled = true;  // without the denoiser whose history it reads
         rb::Status st = pass.value()->record(cmd, desc, tlas, lights, s);
         REQUIRE(!st);
-        CHECK(st.error().message.find("ManyLightSettings::convergedTiles: history is nullptr") != std::string::npos);
-        s.convergedTiles.history = scalar.value().get();  // the wrong kind of history
+        CHECK(st.error().message.find("ManyLightSettings::schedule.history is nullptr") != std::string::npos);
+        s.schedule.history = scalar.value().get();  // the wrong kind of history
         st = pass.value()->record(cmd, desc, tlas, lights, s);
         REQUIRE(!st);
         CHECK(st.error().message.find("history must be a DenoiseSignal::Rgb Denoiser") != std::string::npos);
@@ -170,12 +170,12 @@ TEST_CASE("bad local-light converged-tile settings are named", "[many_lights][co
       [](const rb::GBufferDesc&) {});
   rb::HybridEffectsDesc d;
   d.effects = rb::kEffectLocalLights;
-  d.localLights.convergedTiles.enabled = true;
+  d.localLights.schedule.convergedTiles.enabled = true;
   d.localLights.mode = rb::ManyLightMode::Exact;  // no noise, no denoiser
   auto exact = rb::HybridEffects::create(fx.ctx(), nullptr, d);
   REQUIRE(!exact);
-  CHECK(exact.error().message.find("localLights.convergedTiles reads the local-light denoiser's history") !=
-        std::string::npos);
+  CHECK(exact.error().message.find("HybridEffectsDesc::localLights.schedule.convergedTiles.enabled: converged tiles "
+                                   "are read from the effect's denoiser's history") != std::string::npos);
   d.localLights.mode = rb::ManyLightMode::Stochastic;
   d.localLights.disableDenoiser = true;
   auto noDenoiser = rb::HybridEffects::create(fx.ctx(), nullptr, d);

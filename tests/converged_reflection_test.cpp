@@ -71,7 +71,7 @@ struct ReflectionPair {
     auto p = rb::HybridEffects::create(fx.ctx(), service.get(), desc);
     RB_REQUIRE_OK(p);
     plain = std::move(p.value());
-    rb::ConvergedTileSettings& tiles = desc.reflections.convergedTiles;
+    rb::ConvergedTileSettings& tiles = desc.reflections.schedule.convergedTiles;
     tiles.enabled = true;
     tiles.minFrames = kMinFrames;
     tiles.maxNoise = kMaxNoise;
@@ -324,21 +324,21 @@ TEST_CASE("bad reflection converged-tile settings are named", "[reflection][conv
       fx, scene, cpu, true,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
         rb::ReflectionSettings s;
-        s.convergedTiles.enabled = true;  // without the denoiser whose history it reads
+        s.schedule.convergedTiles.enabled = true;  // without the denoiser whose history it reads
         rb::Status st = pass.value()->record(cmd, desc, tlas, s);
         REQUIRE(!st);
-        CHECK(st.error().message.find("ReflectionSettings::convergedTiles: history is nullptr") != std::string::npos);
-        s.convergedTiles.history = scalar.value().get();  // the wrong kind of history
+        CHECK(st.error().message.find("ReflectionSettings::schedule.history is nullptr") != std::string::npos);
+        s.schedule.history = scalar.value().get();  // the wrong kind of history
         st = pass.value()->record(cmd, desc, tlas, s);
         REQUIRE(!st);
         CHECK(st.error().message.find("history must be a DenoiseSignal::Reflection Denoiser") != std::string::npos);
-        s.convergedTiles.history = reflection.value().get();
-        s.halfResolution = true;  // the tiles are of full-resolution pixels
+        s.schedule.history = reflection.value().get();
+        s.schedule.halfResolution = true;  // the tiles are of full-resolution pixels
         st = pass.value()->record(cmd, desc, tlas, s);
         REQUIRE(!st);
         CHECK(st.error().message.find("disable halfResolution or convergedTiles") != std::string::npos);
-        s.halfResolution = false;
-        s.convergedTiles.maxNoise = -1.0f;
+        s.schedule.halfResolution = false;
+        s.schedule.convergedTiles.maxNoise = -1.0f;
         st = pass.value()->record(cmd, desc, tlas, s);
         REQUIRE(!st);
         CHECK(st.error().message.find("maxNoise") != std::string::npos);
@@ -346,15 +346,17 @@ TEST_CASE("bad reflection converged-tile settings are named", "[reflection][conv
       [](const rb::GBufferDesc&) {});
   rb::HybridEffectsDesc d;
   d.effects = rb::kEffectReflections;
-  d.reflections.convergedTiles.enabled = true;
+  d.reflections.schedule.convergedTiles.enabled = true;
   d.reflections.disableDenoiser = true;
   auto noDenoiser = rb::HybridEffects::create(fx.ctx(), nullptr, d);
   REQUIRE(!noDenoiser);
-  CHECK(noDenoiser.error().message.find("reflections.convergedTiles reads the reflection denoiser's history") !=
-        std::string::npos);
+  CHECK(noDenoiser.error().message.find("HybridEffectsDesc::reflections.schedule.convergedTiles.enabled: converged "
+                                        "tiles are read from the effect's denoiser's history") != std::string::npos);
   d.reflections.disableDenoiser = false;
-  d.reflections.halfResolution = true;
+  d.reflections.schedule.halfResolution = true;
   auto half = rb::HybridEffects::create(fx.ctx(), nullptr, d);
   REQUIRE(!half);
-  CHECK(half.error().message.find("disable reflections.halfResolution or convergedTiles") != std::string::npos);
+  CHECK(half.error().message.find("HybridEffectsDesc::reflections.schedule.convergedTiles skips tiles of "
+                                  "full-resolution pixels: disable halfResolution or convergedTiles") !=
+        std::string::npos);
 }

@@ -72,11 +72,12 @@ struct Pair {
     desc.shadows.raysPerPixel = 4;
     desc.ao.raysPerPixel = 4;
     desc.ao.range = 2.0f;
-    desc.ao.adaptive.enabled = desc.shadows.adaptive.enabled = adaptive;
+    desc.ao.schedule.adaptive.enabled = desc.shadows.schedule.adaptive.enabled = adaptive;
     auto p = rb::HybridEffects::create(fx.ctx(), service.get(), desc);
     RB_REQUIRE_OK(p);
     plain = std::move(p.value());
-    rb::ConvergedTileSettings& tiles = e == Effect::Ao ? desc.ao.convergedTiles : desc.shadows.convergedTiles;
+    rb::ConvergedTileSettings& tiles = e == Effect::Ao ? desc.ao.schedule.convergedTiles
+                                                       : desc.shadows.schedule.convergedTiles;
     tiles.enabled = true;
     tiles.minFrames = kMinFrames;
     tiles.maxNoise = kMaxNoise;
@@ -367,13 +368,13 @@ TEST_CASE("bad converged-tile settings are named", "[shadow][converged][bad_inpu
   addToEmbree(embree, scene);
   const CpuGBuffer cpu = traceGBuffer(embree, conformanceView(kWidth, kHeight));
   rb::ShadowSettings s;
-  s.convergedTiles.enabled = true;  // without the denoiser whose history it reads
+  s.schedule.convergedTiles.enabled = true;  // without the denoiser whose history it reads
   runPassFrame(
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
         const rb::Status st = shadow.value()->record(cmd, desc, tlas, rb::Light{}, s);
         REQUIRE(!st);
-        CHECK(st.error().message.find("ShadowSettings::convergedTiles: history is nullptr") != std::string::npos);
+        CHECK(st.error().message.find("ShadowSettings::schedule.history is nullptr") != std::string::npos);
       },
       [](const rb::GBufferDesc&) {});
 }
@@ -392,12 +393,12 @@ TEST_CASE("bad AO converged-tile settings are named", "[ao][converged][bad_input
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
         rb::AoSettings s;
-        s.convergedTiles.enabled = true;  // without the denoiser whose history it reads
+        s.schedule.convergedTiles.enabled = true;  // without the denoiser whose history it reads
         rb::Status st = ao.value()->record(cmd, desc, tlas, s);
         REQUIRE(!st);
-        CHECK(st.error().message.find("AoSettings::convergedTiles: history is nullptr") != std::string::npos);
-        s.convergedTiles.history = denoiser.value().get();
-        s.halfResolution = true;  // the tiles are of full-resolution pixels
+        CHECK(st.error().message.find("AoSettings::schedule.history is nullptr") != std::string::npos);
+        s.schedule.history = denoiser.value().get();
+        s.schedule.halfResolution = true;  // the tiles are of full-resolution pixels
         st = ao.value()->record(cmd, desc, tlas, s);
         REQUIRE(!st);
         CHECK(st.error().message.find("disable halfResolution or convergedTiles") != std::string::npos);
@@ -405,14 +406,16 @@ TEST_CASE("bad AO converged-tile settings are named", "[ao][converged][bad_input
       [](const rb::GBufferDesc&) {});
   rb::HybridEffectsDesc d;
   d.effects = rb::kEffectAo;
-  d.ao.convergedTiles.enabled = true;
+  d.ao.schedule.convergedTiles.enabled = true;
   d.ao.disableDenoiser = true;
   auto noDenoiser = rb::HybridEffects::create(fx.ctx(), nullptr, d);
   REQUIRE(!noDenoiser);
-  CHECK(noDenoiser.error().message.find("ao.convergedTiles reads the AO denoiser's history") != std::string::npos);
+  CHECK(noDenoiser.error().message.find("HybridEffectsDesc::ao.schedule.convergedTiles.enabled: converged tiles are "
+                                        "read from the effect's denoiser's history") != std::string::npos);
   d.ao.disableDenoiser = false;
-  d.ao.halfResolution = true;
+  d.ao.schedule.halfResolution = true;
   auto half = rb::HybridEffects::create(fx.ctx(), nullptr, d);
   REQUIRE(!half);
-  CHECK(half.error().message.find("disable ao.halfResolution or convergedTiles") != std::string::npos);
+  CHECK(half.error().message.find("HybridEffectsDesc::ao.schedule.convergedTiles skips tiles of full-resolution "
+                                  "pixels: disable halfResolution or convergedTiles") != std::string::npos);
 }

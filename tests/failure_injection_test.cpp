@@ -124,9 +124,9 @@ class Scenario {
   static rb::HybridEffectsDesc effectsDesc(rb::EffectSet effects) {
     rb::HybridEffectsDesc d = rb::withPreset({}, rb::Preset::Ultra);
     d.effects = effects;
-    d.shadows.tileClassifier = true;
-    d.shadows.adaptive.enabled = true;
-    d.ao.adaptive.enabled = true;
+    d.shadows.schedule.tileClassifier = true;
+    d.shadows.schedule.adaptive.enabled = true;
+    d.ao.schedule.adaptive.enabled = true;
     d.ao.range = 2.0f;
     return d;
   }

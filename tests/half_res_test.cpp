@@ -119,7 +119,7 @@ TEST_CASE("half-resolution AO on an open plane equals full resolution, with a qu
   }
   {
     GpuFixture fx;
-    settings.halfResolution = true;
+    settings.schedule.halfResolution = true;
     half = runAo(fx, scene, cpu, settings);
   }
   uint64_t hits = 0, sky = 0;
@@ -171,7 +171,7 @@ TEST_CASE("half-resolution AO stays close to full resolution and keeps silhouett
   }
   {
     GpuFixture fx;
-    settings.halfResolution = true;
+    settings.schedule.halfResolution = true;
     half = runAo(fx, scene, cpu, settings);
   }
   // Fresh contexts record in the same frame, so a sample traces its pixel with the full-resolution pass's noise:
@@ -300,7 +300,7 @@ TEST_CASE("half-resolution AO at odd sizes writes every pixel in every frame of 
   rb::AoSettings settings;
   settings.raysPerPixel = 4;
   settings.range = 1e6f;
-  settings.halfResolution = true;
+  settings.schedule.halfResolution = true;
   std::set<uint32_t> offsets;
   uint64_t lastFrame = 0;
   for (int round = 0; round < 4; ++round) {
@@ -363,7 +363,7 @@ TEST_CASE("half-resolution reflections of a mirror floor match full resolution a
   }
   {
     GpuFixture fx;
-    settings.halfResolution = true;
+    settings.schedule.halfResolution = true;
     half = runReflections(fx, scene, cpu, materials, settings);
   }
   uint32_t sky = 0, rough = 0, mirror = 0, coverageAgrees = 0, smooth = 0, close = 0;
@@ -435,7 +435,7 @@ TEST_CASE("toggling half resolution between frames of the front end re-makes and
   VkDeviceSize fullBytes = 0, halfBytes = 0;
   for (int i = 0; i < 6; ++i) {
     const bool halfRes = i % 2 == 1;
-    desc.ao.halfResolution = desc.reflections.halfResolution = halfRes;
+    desc.ao.schedule.halfResolution = desc.reflections.schedule.halfResolution = halfRes;
     RB_REQUIRE_OK(fxs.setDesc(desc));
     fx.runFrame([&](VkCommandBuffer cmd) {
       rb::HybridFrame f;

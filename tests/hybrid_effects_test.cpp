@@ -44,10 +44,11 @@ TEST_CASE("preset names round-trip and the table matches the thesis", "[presets]
   base.reflections.roughnessThreshold = 0.7f;
   const rb::HybridEffectsDesc low = rb::withPreset(base, rb::Preset::Low);
   CHECK(low.effects == (rb::kEffectShadows | rb::kEffectAo));
-  CHECK(low.ao.halfResolution);
+  CHECK(low.ao.schedule.halfResolution);
   CHECK(low.ao.range == 3.0f);
   CHECK(low.reflections.roughnessThreshold == 0.7f);
-  CHECK(rb::withPreset(low, rb::Preset::HardShadows).ao.halfResolution);  // no AO in the preset: AO fields kept
+  CHECK(
+      rb::withPreset(low, rb::Preset::HardShadows).ao.schedule.halfResolution);  // no AO in the preset: AO fields kept
   CHECK((low.shadows.raysPerPixel == 1 && low.ao.raysPerPixel == 4 && low.ao.range == 3.0f));
   CHECK(low.reflections.roughnessThreshold == 0.7f);
 }
@@ -115,7 +116,7 @@ TEST_CASE("the front end's hard shadows and AO equal the passes recorded one by 
 
   rb::HybridEffectsDesc desc = rb::withPreset({}, rb::Preset::Low);  // hard shadows, AO 4 rays
   desc.ao.disableDenoiser = true;                                    // compare the raw AO
-  desc.ao.halfResolution = false;                                    // as the AO pass below, which traces every pixel
+  desc.ao.schedule.halfResolution = false;                           // as the AO pass below, which traces every pixel
   desc.ao.range = 2.0f;
   auto effects = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
   RB_REQUIRE_OK(effects);

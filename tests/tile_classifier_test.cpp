@@ -41,9 +41,9 @@ ClassifierComparison compareClassifier(GpuFixture& fx, const TestScene& scene, c
   RB_REQUIRE_OK(plain);
   rb::ShadowSettings settings;
   settings.raysPerPixel = raysPerPixel;
-  settings.tileClassifier = true;
+  settings.schedule.tileClassifier = true;
   rb::ShadowSettings unclassified = settings;
-  unclassified.tileClassifier = false;
+  unclassified.schedule.tileClassifier = false;
   ClassifierComparison c;
   const VkDeviceSize created = fx.ctx().memoryStats().of(rb::MemoryCategory::PassBuffers);
   auto read = [&](const rb::ShadowPass& pass, const rb::GBufferDesc& desc, ClassifiedRun& run) {

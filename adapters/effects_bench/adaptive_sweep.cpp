@@ -1,5 +1,5 @@
 // The adaptive-rays scenario (--scenario adaptive): soft shadows and AO accumulated over frames with the denoiser
-// on a still camera, uniform rays per pixel against adaptive rays (raybridge/adaptive_rays.h), each scored by the
+// on a still camera, uniform rays per pixel against adaptive rays (raybridge/ray_schedule.h), each scored by the
 // RMSE of the denoised image after kAccumulatedFrames frames against the converged reference. Per uniform ray
 // count n it reports, for each planning granularity G (AdaptiveRaySettings::granularity and tile):
 //   pixel (one count per pixel), tile (the default tile, 8x8 launch cells) and the warp shapes tile8x4, tile4x8:
@@ -8,7 +8,7 @@
 //   adaptive_G_equal_time  a GPU time target equal to the uniform row's pass time (planning included);
 //   adaptive_G_budget      (pixel and tile) fractions of the uniform rays (AdaptiveRaySettings::maxRaysPerFrame),
 //                          from which the summary interpolates the rays saved at the uniform row's error.
-// Then converged tiles (raybridge/converged_tiles.h, default settings), over kConvergedFrames frames, long enough
+// Then converged tiles (raybridge/ray_schedule.h, default settings), over kConvergedFrames frames, long enough
 // for tiles to converge (kDefaultConvergedMinFrames) and then skip:
 //   uniform_long           n rays in every pixel;
 //   converged_tiles        the same with converged tiles skipped: the rays saved, the time, and the error.
@@ -52,7 +52,7 @@ struct Effect {
 };
 
 rb::AdaptiveRaySettings& adaptiveOf(rb::HybridEffectsDesc& d, const Effect& fx) {
-  return fx.flag == rb::kEffectAo ? d.ao.adaptive : d.shadows.adaptive;
+  return fx.flag == rb::kEffectAo ? d.ao.schedule.adaptive : d.shadows.schedule.adaptive;
 }
 
 // A planning granularity the sweep compares (the row names' G).
@@ -274,7 +274,8 @@ se::Result<EffectResult> runAdaptiveSweep(FrameDriver& driver, const SweepPlan& 
     longUniform.params = {{"rays_per_pixel", n}, {"adaptive", false}};
     if (std::string err = runOnce(d, longUniform, kConvergedFrames); !err.empty()) return R::failure(err);
     const Row lu = result.rows.back();
-    rb::ConvergedTileSettings& c = fx.flag == rb::kEffectAo ? d.ao.convergedTiles : d.shadows.convergedTiles;
+    rb::ConvergedTileSettings& c = fx.flag == rb::kEffectAo ? d.ao.schedule.convergedTiles
+                                                            : d.shadows.schedule.convergedTiles;
     c.enabled = true;
     Row converged;
     converged.method = "converged_tiles";

@@ -56,7 +56,7 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
   auto apply = [&](uint32_t rays, bool denoise = false, bool halfResolution = false) {
     desc.reflections.raysPerPixel = rays;
     desc.reflections.disableDenoiser = !denoise;
-    desc.reflections.halfResolution = halfResolution;
+    desc.reflections.schedule.halfResolution = halfResolution;
     rb::Status st = adapter.effects().setDesc(desc);
     return st ? se::Status::success() : se::Status::failure("HybridEffects::setDesc: " + st.error().message);
   };
@@ -136,7 +136,7 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
   // history); times are the medians of the second half, where tiles have converged.
   const uint32_t n = plan.reflectionRays.back();
   for (bool converged : {false, true}) {
-    desc.reflections.convergedTiles.enabled = converged;
+    desc.reflections.schedule.convergedTiles.enabled = converged;
     if (se::Status st = apply(n, true); !st) return R::failure(st.error);
     adapter.effects().resetHistory();
     auto samples = driver.run(base, 0, kConvergedFrames);
@@ -161,7 +161,7 @@ se::Result<EffectResult> runReflectionSweep(FrameDriver& driver, const SweepPlan
     row.effectMsOf = "reflection + reflection_denoise";
     if (se::Status st = finish(std::move(row), settled, rgb.value); !st) return R::failure(st.error);
   }
-  desc.reflections.convergedTiles.enabled = false;
+  desc.reflections.schedule.convergedTiles.enabled = false;
 
   // Raster rows: constant sky (probe off) and the probe at each resolution.
   s.enabled = false;

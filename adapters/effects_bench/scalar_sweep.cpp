@@ -238,7 +238,7 @@ se::Result<EffectResult> runAoSweep(FrameDriver& driver, const SweepPlan& plan) 
     d.ao.range = range;
     d.ao.estimator = rb::AoEstimator::Binary;  // the SSAO counterpart is binary too (occluded or not)
   };
-  fx.setHalfResolution = [](rb::HybridEffectsDesc& d, bool half) { d.ao.halfResolution = half; };
+  fx.setHalfResolution = [](rb::HybridEffectsDesc& d, bool half) { d.ao.schedule.halfResolution = half; };
   fx.rays = plan.aoRays;
   fx.referenceRays = plan.referenceAo;
   fx.tracedParams = driver.baseParams();

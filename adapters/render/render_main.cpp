@@ -537,11 +537,12 @@ int main(int argc, char** argv) {
                                                                            : rb::kDefaultReflectionRoughnessThreshold},
       {"reflection_rays_per_pixel",
        wantReflections ? (hd.reflections.raysPerPixel ? hd.reflections.raysPerPixel : rb::kDefaultReflectionRays) : 0u},
-      {"ao_half_resolution", hybrid && wantAo && hd.ao.halfResolution},
-      {"reflection_half_resolution", hybrid && wantReflections && hd.reflections.halfResolution}};
+      {"ao_half_resolution", hybrid && wantAo && hd.ao.schedule.halfResolution},
+      {"reflection_half_resolution", hybrid && wantReflections && hd.reflections.schedule.halfResolution}};
   // Adaptive rays (--adaptive): per effect, the time target (0 = the uniform rays, redistributed) and the
   // granularity ("pixel", or the tile in launch cells, "8x8").
-  for (auto [name, a] : {std::pair{"shadows", &hd.shadows.adaptive}, std::pair{"ao", &hd.ao.adaptive}}) {
+  for (auto [name, a] :
+       {std::pair{"shadows", &hd.shadows.schedule.adaptive}, std::pair{"ao", &hd.ao.schedule.adaptive}}) {
     std::string granularity = "pixel";
     if (a->granularity == rb::AdaptiveRayGranularity::Tile) {
       const uint32_t tw = a->tileWidth ? a->tileWidth : rb::kDefaultAdaptiveTileWidth;

@@ -516,14 +516,14 @@ ResolvedEffects resolve(const RenderOptions& o) {
   }
   h.shadows.raysPerPixel = shadowRays;
   h.shadows.disableDenoiser = !o.denoise;
-  h.shadows.tileClassifier = o.tileClassifier;
-  h.shadows.convergedTiles.enabled = o.convergedTiles.has_value();
-  h.shadows.convergedTiles.refreshPeriod = o.convergedTiles.value_or(0);
-  h.shadows.adaptive.enabled = o.adaptiveShadowsMs.has_value();
-  h.shadows.adaptive.timeBudgetMs = o.adaptiveShadowsMs.value_or(0.0f);
-  h.shadows.adaptive.granularity = o.adaptiveGranularity;
-  h.shadows.adaptive.tileWidth = o.adaptiveTileWidth;
-  h.shadows.adaptive.tileHeight = o.adaptiveTileHeight;
+  h.shadows.schedule.tileClassifier = o.tileClassifier;
+  h.shadows.schedule.convergedTiles.enabled = o.convergedTiles.has_value();
+  h.shadows.schedule.convergedTiles.refreshPeriod = o.convergedTiles.value_or(0);
+  h.shadows.schedule.adaptive.enabled = o.adaptiveShadowsMs.has_value();
+  h.shadows.schedule.adaptive.timeBudgetMs = o.adaptiveShadowsMs.value_or(0.0f);
+  h.shadows.schedule.adaptive.granularity = o.adaptiveGranularity;
+  h.shadows.schedule.adaptive.tileWidth = o.adaptiveTileWidth;
+  h.shadows.schedule.adaptive.tileHeight = o.adaptiveTileHeight;
   if ((h.effects & rb::kEffectShadows) && shadowRays > 1)
     r.sunRadiusDegrees = h.shadows.softAngularRadiusDegrees > 0.0f ? h.shadows.softAngularRadiusDegrees
                                                                    : rb::kDefaultSoftLightAngularRadiusDegrees;
@@ -532,27 +532,27 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.range = o.aoRange ? *o.aoRange : rb::kDefaultAoRange;
   h.ao.estimator = o.aoEstimator;
   h.ao.disableDenoiser = !o.denoise;
-  h.ao.adaptive.enabled = o.adaptiveAoMs.has_value();
-  h.ao.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
-  h.ao.adaptive.granularity = o.adaptiveGranularity;
-  h.ao.adaptive.tileWidth = o.adaptiveTileWidth;
-  h.ao.adaptive.tileHeight = o.adaptiveTileHeight;
-  h.ao.halfResolution = o.halfResGiven ? o.halfResAo : p.aoHalfResolution;
-  h.ao.convergedTiles.enabled = o.convergedAo.has_value();
-  h.ao.convergedTiles.refreshPeriod = o.convergedAo.value_or(0);
+  h.ao.schedule.adaptive.enabled = o.adaptiveAoMs.has_value();
+  h.ao.schedule.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
+  h.ao.schedule.adaptive.granularity = o.adaptiveGranularity;
+  h.ao.schedule.adaptive.tileWidth = o.adaptiveTileWidth;
+  h.ao.schedule.adaptive.tileHeight = o.adaptiveTileHeight;
+  h.ao.schedule.halfResolution = o.halfResGiven ? o.halfResAo : p.aoHalfResolution;
+  h.ao.schedule.convergedTiles.enabled = o.convergedAo.has_value();
+  h.ao.schedule.convergedTiles.refreshPeriod = o.convergedAo.value_or(0);
 
   const uint32_t lightRays = o.lightRays ? *o.lightRays : kDefaultLightRays;
   h.localLights.mode = lightRays ? rb::ManyLightMode::Stochastic : rb::ManyLightMode::Exact;
   h.localLights.raysPerPixel = lightRays;
   h.localLights.disableDenoiser = !o.denoise;
-  h.localLights.convergedTiles.enabled = o.convergedLights.has_value();
-  h.localLights.convergedTiles.refreshPeriod = o.convergedLights.value_or(0);
+  h.localLights.schedule.convergedTiles.enabled = o.convergedLights.has_value();
+  h.localLights.schedule.convergedTiles.refreshPeriod = o.convergedLights.value_or(0);
 
   h.reflections.roughnessThreshold = o.reflectionRoughness ? *o.reflectionRoughness : kDefaultReflectionRoughness;
   h.reflections.raysPerPixel = o.reflectionRays ? *o.reflectionRays : kDefaultReflectionRays;
-  h.reflections.halfResolution = o.halfResReflections;
-  h.reflections.convergedTiles.enabled = o.convergedReflections.has_value();
-  h.reflections.convergedTiles.refreshPeriod = o.convergedReflections.value_or(0);
+  h.reflections.schedule.halfResolution = o.halfResReflections;
+  h.reflections.schedule.convergedTiles.enabled = o.convergedReflections.has_value();
+  h.reflections.schedule.convergedTiles.refreshPeriod = o.convergedReflections.value_or(0);
   h.reflections.invocationReorder = o.invocationReorder;
   h.tlasMode = o.tlasMode;
 

@@ -45,7 +45,7 @@ struct RenderOptions {
   // light that reaches the pixel). Else kDefaultLightRays below.
   std::optional<uint32_t> lightRays;
   // --half-res ao,reflections (any subset, or none): the effects traced at half resolution with the depth-aware
-  // upsample (HybridEffectsDesc::ao/reflections.halfResolution). Unset: the preset's (AO at half resolution in
+  // upsample (HybridEffectsDesc::ao/reflections.schedule.halfResolution). Unset: the preset's (AO at half resolution in
   // every preset with AO, presets.h); `--half-res none` traces both at full resolution.
   bool halfResGiven = false;
   bool halfResAo = false, halfResReflections = false;
@@ -56,15 +56,18 @@ struct RenderOptions {
   bool invocationReorder = false;
   // --tlas-mode: HybridEffectsDesc::tlasMode (adaptive, rebuild or refit = UpdateIfPossible)
   rb::TlasBuildMode tlasMode = rb::TlasBuildMode::Adaptive;
-  bool tileClassifier = false;  // --tile-classifier: HybridEffectsDesc::shadows.tileClassifier
-  // --converged-tiles K: HybridEffectsDesc::shadows.convergedTiles, each converged tile traced once in K frames.
+  bool tileClassifier = false;  // --tile-classifier: HybridEffectsDesc::shadows.schedule.tileClassifier
+  // --converged-tiles K: HybridEffectsDesc::shadows.schedule.convergedTiles, each converged tile traced once in K
+  // frames.
   std::optional<uint32_t> convergedTiles;
-  // --converged-ao K: HybridEffectsDesc::ao.convergedTiles, likewise (AO at full resolution: --half-res without ao).
+  // --converged-ao K: HybridEffectsDesc::ao.schedule.convergedTiles, likewise (AO at full resolution: --half-res
+  // without ao).
   std::optional<uint32_t> convergedAo;
-  // --converged-reflections K: HybridEffectsDesc::reflections.convergedTiles, likewise (reflections at full resolution:
+  // --converged-reflections K: HybridEffectsDesc::reflections.schedule.convergedTiles, likewise (reflections at full
+  // resolution:
   // --half-res without reflections).
   std::optional<uint32_t> convergedReflections;
-  // --converged-lights K: HybridEffectsDesc::localLights.convergedTiles, likewise (stochastic local lights).
+  // --converged-lights K: HybridEffectsDesc::localLights.schedule.convergedTiles, likewise (stochastic local lights).
   std::optional<uint32_t> convergedLights;
   // --adaptive EFFECT[=MS],...: adaptive rays per pixel for shadows and ao (AdaptiveRaySettings), with a GPU time
   // target in ms (0 = the uniform rays, redistributed). Unset = uniform rays.

@@ -430,7 +430,7 @@ TEST_CASE("pass memory follows the enabled effects at run time", "[adapter][memo
   CHECK(stats.reflection.rays > 0);
   // Ultra: 8 soft shadow rays per lit pixel, 16 AO rays per surface pixel of one in each 2x2 block (AO at half
   // resolution), at most.
-  CHECK(fx.desc().ao.halfResolution);
+  CHECK(fx.desc().ao.schedule.halfResolution);
   CHECK(stats.shadow.rays <= uint64_t(64 * 48 * 8));
   CHECK(stats.ao.rays <= uint64_t(32 * 24 * 16));
   CHECK(stats.ao.rays > uint64_t(32 * 24 * 4));

@@ -418,7 +418,7 @@ void SoakRun::changeSetting() {
     case 0: d.shadows.raysPerPixel = kRays[pick(4)]; break;
     case 1: d.shadows.softAngularRadiusDegrees = std::array<float, 3>{0.0f, 0.5f, 2.0f}[pick(3)]; break;
     case 2: d.shadows.disableDenoiser = !d.shadows.disableDenoiser; break;
-    case 3: d.shadows.tileClassifier = !d.shadows.tileClassifier; break;
+    case 3: d.shadows.schedule.tileClassifier = !d.shadows.schedule.tileClassifier; break;
     case 4: d.ao.raysPerPixel = kRays[pick(4)]; break;
     case 5:
       d.ao.estimator = d.ao.estimator == rb::AoEstimator::Binary ? rb::AoEstimator::DistanceWeighted

@@ -33,48 +33,6 @@ uint32_t adaptiveTileHeight(const AdaptiveRaySettings& s) {
   return s.tileHeight ? s.tileHeight : kDefaultAdaptiveTileHeight;
 }
 
-Status AdaptiveRayPlanner::validate(const AdaptiveRaySettings& s, const char* who, bool needHistory) {
-  if (!s.enabled) return {};
-  auto invalid = [&](const std::string& m) {
-    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, std::string(who) + ": " + m};
-  };
-  if (!needHistory) {
-    // The caller supplies the history itself (HybridEffects: the effect's denoiser).
-  } else if (!s.history) {
-    return invalid("history is nullptr; adaptive rays plan from the history of the Denoiser that filters this "
-                   "pass's output: set it, or disable adaptive rays");
-  }
-  if (needHistory && s.history->signal() != DenoiseSignal::Scalar) {
-    return invalid("history must be a DenoiseSignal::Scalar Denoiser (the one filtering this pass's output)");
-  }
-  if (!(s.timeBudgetMs >= 0.0f) || !std::isfinite(s.timeBudgetMs)) {
-    return invalid("timeBudgetMs " + std::to_string(s.timeBudgetMs) + " must be a finite number >= 0 (0 = no target)");
-  }
-  if (s.maxRaysPerPixel > kMaxAdaptiveRays) {
-    return invalid("maxRaysPerPixel " + std::to_string(s.maxRaysPerPixel) + " exceeds " +
-                   std::to_string(kMaxAdaptiveRays));
-  }
-  if (s.minRaysPerPixel > kMaxAdaptiveRays) {
-    return invalid("minRaysPerPixel " + std::to_string(s.minRaysPerPixel) + " exceeds " +
-                   std::to_string(kMaxAdaptiveRays));
-  }
-  if (s.maxRaysPerPixel && s.minRaysPerPixel > s.maxRaysPerPixel) {
-    return invalid("minRaysPerPixel " + std::to_string(s.minRaysPerPixel) + " exceeds maxRaysPerPixel " +
-                   std::to_string(s.maxRaysPerPixel));
-  }
-  if (s.granularity != AdaptiveRayGranularity::Tile && s.granularity != AdaptiveRayGranularity::Pixel) {
-    return invalid("granularity has an unknown value (" + std::to_string(uint32_t(s.granularity)) + ")");
-  }
-  for (auto [name, side] : {std::pair{"tileWidth", s.tileWidth}, std::pair{"tileHeight", s.tileHeight}}) {
-    if (side > kMaxAdaptiveTileSize || (side & (side - 1)) != 0) {
-      return invalid(std::string(name) + " " + std::to_string(side) + " must be 0 (default " +
-                     std::to_string(kDefaultAdaptiveTileWidth) + "x" + std::to_string(kDefaultAdaptiveTileHeight) +
-                     ") or a power of two at most " + std::to_string(kMaxAdaptiveTileSize));
-    }
-  }
-  return {};
-}
-
 Status AdaptiveRayPlanner::init(Context& ctx, AdaptiveRayGranularity granularity) {
   const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
   auto sampled = [&](uint32_t b) {
@@ -127,8 +85,8 @@ void AdaptiveRayPlanner::retire(Context& ctx) {
 }
 
 Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
-                                        const AdaptiveRaySettings& s, uint32_t raysPerPixel, const PassStats& latest,
-                                        const char* who, uint32_t cellPixels) {
+                                        const AdaptiveRaySettings& s, const Denoiser* denoiser, uint32_t raysPerPixel,
+                                        const PassStats& latest, const char* who, uint32_t cellPixels) {
   if (s.timeBudgetMs > 0.0f && !ctx.deviceInfo().timestampsSupported) {
     // Without a measurement the budget would stay where it started, frame after frame, whatever the target.
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
@@ -137,10 +95,10 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
                      std::to_string(ctx.deviceInfo().timestampValidBits) +
                      "): set timeBudgetMs = 0 and cap the rays with maxRaysPerFrame"};
   }
-  const internal::DenoiserHistory history = internal::latestHistory(*s.history, g);
+  const internal::DenoiserHistory history = internal::latestHistory(*denoiser, g);
   if (!history.mean) return false;
   DenoiseConstants dn{};
-  if (Status st = internal::historyReprojection(*s.history, g, who, dn); !st) return st.error();
+  if (Status st = internal::historyReprojection(*denoiser, g, who, dn); !st) return st.error();
   if (Status st = init(ctx, s.granularity); !st) return st.error();
   if (Status st = images_.ensure(ctx, g.width, g.height,
                                  {{VK_FORMAT_R16G16_SFLOAT, "adaptive ray weights"},
@@ -240,11 +198,11 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
 }
 
 Result<bool> AdaptiveRayPlanner::recordForPass(PassCore& core, Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
-                                               const AdaptiveRaySettings& settings, uint32_t raysPerPixel,
-                                               const PassStats& latest, const char* who, DescriptorWrites& w,
-                                               uint32_t cellPixels) {
+                                               const AdaptiveRaySettings& settings, const Denoiser* history,
+                                               uint32_t raysPerPixel, const PassStats& latest, const char* who,
+                                               DescriptorWrites& w, uint32_t cellPixels) {
   if (!settings.enabled) return false;
-  Result<bool> planned = record(ctx, cmd, g, settings, raysPerPixel, latest, who, cellPixels);
+  Result<bool> planned = record(ctx, cmd, g, settings, history, raysPerPixel, latest, who, cellPixels);
   if (!planned) {
     core.end(ctx, cmd);
     return planned.error();

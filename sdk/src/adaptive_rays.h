@@ -1,4 +1,4 @@
-// The planning half of adaptive rays (raybridge/adaptive_rays.h): two compute dispatches that give every pixel its
+// The planning half of adaptive rays (raybridge/ray_schedule.h): two compute dispatches that give every pixel its
 // rays for this frame from the history of the pass's denoiser, within a ray budget (adaptive_estimate.comp, then
 // adaptive_allocate.comp per pixel or adaptive_allocate_tiles.comp per tile), and the controller that moves the budget
 // towards a GPU time target (adaptive_budget.h). A pass that supports adaptive rays owns one, and traces with its
@@ -6,8 +6,8 @@
 // size (MemoryCategory::PassImages) and a 16-byte counter buffer (PassBuffers), created on first use.
 #pragma once
 
-#include <raybridge/adaptive_rays.h>
 #include <raybridge/gbuffer.h>
+#include <raybridge/ray_schedule.h>
 
 #include "adaptive_budget.h"
 #include "compute_pipeline.h"
@@ -19,9 +19,6 @@ struct PassCore;
 
 class AdaptiveRayPlanner {
  public:
-  // Checks the settings (`needHistory` = false: all but AdaptiveRaySettings::history, which the caller fills
-  // in); `who` names the pass and field in the error ("AoPass: AoSettings::adaptive").
-  static Status validate(const AdaptiveRaySettings& settings, const char* who, bool needHistory = true);
   // Hands the pipelines, images and counters to the context's deferred release.
   void retire(Context& ctx);
 
@@ -32,14 +29,15 @@ class AdaptiveRayPlanner {
   // plan() holds each pixel's rays and history mean in SHADER_READ_ONLY_OPTIMAL, visible to ray tracing, compute
   // and fragment shaders.
   Result<bool> record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const AdaptiveRaySettings& settings,
-                      uint32_t raysPerPixel, const PassStats& latest, const char* who, uint32_t cellPixels = 1);
+                      const Denoiser* history, uint32_t raysPerPixel, const PassStats& latest, const char* who,
+                      uint32_t cellPixels = 1);
   // What a pass does with it each frame, between its PassCore::begin() and its trace: record() when `settings` are
   // enabled, and bind the plan at RB_BINDING_RAY_PLAN of `w` with the pass's sampler. On an error the pass's
   // recording is ended (its outputs stay in a known layout; nothing is traced). Returns whether the frame was
   // planned: the pass then traces with its adaptive ray generation module.
   Result<bool> recordForPass(PassCore& core, Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
-                             const AdaptiveRaySettings& settings, uint32_t raysPerPixel, const PassStats& latest,
-                             const char* who, DescriptorWrites& w, uint32_t cellPixels = 1);
+                             const AdaptiveRaySettings& settings, const Denoiser* history, uint32_t raysPerPixel,
+                             const PassStats& latest, const char* who, DescriptorWrites& w, uint32_t cellPixels = 1);
   VkImageView planView() const { return images_.size() > 1 ? images_[1].view : VK_NULL_HANDLE; }
   VkImage planImage() const { return images_.size() > 1 ? images_[1].image : VK_NULL_HANDLE; }
   // The ray budget of the latest record() (UINT32_MAX when it was the uniform rays, resolved on the GPU).

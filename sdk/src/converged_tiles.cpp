@@ -13,31 +13,6 @@
 
 namespace rb {
 
-Status ConvergedTiles::validate(const ConvergedTileSettings& s, const char* who) const {
-  if (!s.enabled) return {};
-  auto invalid = [&](const std::string& m) {
-    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, std::string(who) + ": " + m};
-  };
-  if (!s.history) {
-    return invalid("history is nullptr; converged tiles are read from the history of the Denoiser that filters this "
-                   "pass's output: set it, or disable convergedTiles");
-  }
-  if (s.history->signal() != signal_) {
-    const char* kind = signal_ == DenoiseSignal::Reflection ? "Reflection"
-                       : signal_ == DenoiseSignal::Rgb      ? "Rgb"
-                                                            : "Scalar";
-    return invalid(std::string("history must be a DenoiseSignal::") + kind +
-                   " Denoiser (the one filtering this pass's output)");
-  }
-  if (s.minFrames > RB_TILE_HOLD_MASK) {
-    return invalid("minFrames " + std::to_string(s.minFrames) + " exceeds " + std::to_string(RB_TILE_HOLD_MASK));
-  }
-  if (!(s.maxNoise >= 0.0f) || !std::isfinite(s.maxNoise)) {
-    return invalid("maxNoise " + std::to_string(s.maxNoise) + " must be a finite number >= 0 (0 = default)");
-  }
-  return {};
-}
-
 Status ConvergedTiles::init(Context& ctx, const char* who) {
   const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
   auto binding = [&](uint32_t b, VkDescriptorType t) { return VkDescriptorSetLayoutBinding{b, t, 1, cs, nullptr}; };
@@ -80,13 +55,13 @@ void ConvergedTiles::retire(Context& ctx) {
 }
 
 Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
-                                    const ConvergedTileSettings& s, uint32_t raysPerPixel, TileClassifier& classifier,
-                                    VkImageView visibility, const char* who, float roughnessThreshold,
-                                    VkDescriptorBufferInfo counters) {
-  const internal::DenoiserHistory history = internal::latestHistory(*s.history, g);
+                                    const ConvergedTileSettings& s, const Denoiser* denoiser, uint32_t raysPerPixel,
+                                    TileClassifier& classifier, VkImageView visibility, const char* who,
+                                    float roughnessThreshold, VkDescriptorBufferInfo counters) {
+  const internal::DenoiserHistory history = internal::latestHistory(*denoiser, g);
   if (!history.mean || !history.valid) return false;
   ConvergedTileConstants pc{};
-  if (Status st = internal::historyReprojection(*s.history, g, who, pc.denoise); !st) return st.error();
+  if (Status st = internal::historyReprojection(*denoiser, g, who, pc.denoise); !st) return st.error();
   if (Status st = init(ctx, who); !st) return st.error();
   pc.denoise.signalRaysPerPixel = float(raysPerPixel);
   if (signal_ == DenoiseSignal::Reflection) {
@@ -127,7 +102,7 @@ Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBu
   // or for an RGB signal the ray generation shader (which reads the state and writes the traced tiles).
   recordMemoryBarrier(vk, cmd, cs, VK_ACCESS_SHADER_WRITE_BIT,
                       signal_ != DenoiseSignal::Scalar ? cs | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR : cs, rw);
-  internal::expectKeptMarks(*s.history, ctx.frameIndex());
+  internal::expectKeptMarks(*denoiser, ctx.frameIndex());
   return true;
 }
 
@@ -169,14 +144,15 @@ void ConvergedTiles::check(Context& ctx, VkCommandBuffer cmd, const GBufferDesc&
 }
 
 Result<bool> ConvergedTiles::traceSkipping(PassCore& core, Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
-                                           const ConvergedTileSettings& settings, uint32_t raysPerPixel,
-                                           TileClassifier& state, DescriptorWrites& w, const void* constants,
-                                           uint32_t constantBytes, const RayTracingPipeline& skipping,
-                                           uint32_t stateBinding, const char* who, float roughnessThreshold) {
+                                           const ConvergedTileSettings& settings, const Denoiser* history,
+                                           uint32_t raysPerPixel, TileClassifier& state, DescriptorWrites& w,
+                                           const void* constants, uint32_t constantBytes,
+                                           const RayTracingPipeline& skipping, uint32_t stateBinding, const char* who,
+                                           float roughnessThreshold) {
   const VkDescriptorBufferInfo counters{core.metrics.counterBuffer(), core.metrics.counterOffset(ctx),
                                         core.metrics.counterBytes()};
-  Result<bool> marked = record(ctx, cmd, g, settings, raysPerPixel, state, core.images[0].view, who, roughnessThreshold,
-                               counters);
+  Result<bool> marked = record(ctx, cmd, g, settings, history, raysPerPixel, state, core.images[0].view, who,
+                               roughnessThreshold, counters);
   if (!marked) {
     core.end(ctx, cmd);
     return marked.error();

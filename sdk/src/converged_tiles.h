@@ -1,4 +1,4 @@
-// Converged-tile skipping (raybridge/converged_tiles.h) for the shadow pass (ShadowSettings::convergedTiles), the
+// Converged-tile skipping (raybridge/ray_schedule.h) for the shadow pass (ShadowSettings::convergedTiles), the
 // AO pass (AoSettings::convergedTiles), the reflection pass (ReflectionSettings::convergedTiles) and the many-light
 // pass (ManyLightSettings::convergedTiles): the two compute dispatches around the pass's trace that decide, from its
 // denoiser's history, which tiles have converged and write their kept-history marks into the pass's output, and
@@ -10,9 +10,9 @@
 // tiles). The tile state lives in the TileClassifier. Owns the two pipelines, created on first use.
 #pragma once
 
-#include <raybridge/converged_tiles.h>
 #include <raybridge/denoiser.h>
 #include <raybridge/gbuffer.h>
+#include <raybridge/ray_schedule.h>
 
 #include "compute_pipeline.h"
 #include "denoiser_history.h"
@@ -27,8 +27,6 @@ class ConvergedTiles {
  public:
   // `signal`: the kind of Denoiser whose history it reads: Scalar (shadows, AO), Reflection or Rgb (local lights).
   explicit ConvergedTiles(DenoiseSignal signal = DenoiseSignal::Scalar) : signal_(signal) {}
-  // Checks the settings; `who` names the pass and field in the error ("ShadowPass: ShadowSettings::convergedTiles").
-  Status validate(const ConvergedTileSettings& settings, const char* who) const;
   void retire(Context& ctx);
 
   // Records step 1 for `g` and returns true, or returns false and records nothing when the denoiser has no history
@@ -39,8 +37,9 @@ class ConvergedTiles {
   // reflection). RGB signals: `counters`, the pass's ray counters (this dispatch counts the tiles and the rays
   // saved); the tile state is then visible to ray tracing shaders too.
   Result<bool> record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const ConvergedTileSettings& settings,
-                      uint32_t raysPerPixel, TileClassifier& classifier, VkImageView visibility, const char* who,
-                      float roughnessThreshold = 0.0f, VkDescriptorBufferInfo counters = {});
+                      const Denoiser* history, uint32_t raysPerPixel, TileClassifier& classifier,
+                      VkImageView visibility, const char* who, float roughnessThreshold = 0.0f,
+                      VkDescriptorBufferInfo counters = {});
   // Records step 2, after the trace (only after a record() that returned true, in the same frame): for shadows and
   // AO once the pass's outputs are readable by compute shaders (after endWrite()); for RGB signals while the
   // output is still in GENERAL (before endWrite(), which must then cover compute writes), as the check marks the
@@ -53,8 +52,8 @@ class ConvergedTiles {
   // `w`), the check and the end of the pass's recording; returns true then. Returns false, having recorded nothing,
   // when there is no history yet: the pass traces as usual. On an error the pass's recording is ended.
   Result<bool> traceSkipping(PassCore& core, Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g,
-                             const ConvergedTileSettings& settings, uint32_t raysPerPixel, TileClassifier& state,
-                             DescriptorWrites& w, const void* constants, uint32_t constantBytes,
+                             const ConvergedTileSettings& settings, const Denoiser* history, uint32_t raysPerPixel,
+                             TileClassifier& state, DescriptorWrites& w, const void* constants, uint32_t constantBytes,
                              const RayTracingPipeline& skipping, uint32_t stateBinding, const char* who,
                              float roughnessThreshold = 0.0f);
 

@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
-#include "adaptive_rays.h"
 #include "light_validation.h"
 #include "neutral_images.h"
 #include "pass_constants.h"
+#include "ray_schedule_stage.h"
 
 namespace rb {
 
@@ -60,36 +60,50 @@ Status validate(const HybridEffectsDesc& d) {
                    std::to_string(d.localLights.candidates) + " must be at most 64");
   if (d.reflections.raysPerPixel > 64)
     return invalid("reflections.raysPerPixel " + std::to_string(d.reflections.raysPerPixel) + " exceeds 64");
-  if (Status st = AdaptiveRayPlanner::validate(d.ao.adaptive, "HybridEffects: ao.adaptive", false); !st) return st;
-  if (Status st = AdaptiveRayPlanner::validate(d.shadows.adaptive, "HybridEffects: shadows.adaptive", false); !st)
-    return st;
-  if (d.shadows.convergedTiles.enabled && d.shadows.disableDenoiser)
-    return invalid("shadows.convergedTiles reads the shadow denoiser's history: enable the denoiser "
-                   "(shadows.disableDenoiser = false) or disable convergedTiles");
-  if (d.ao.convergedTiles.enabled && d.ao.disableDenoiser)
-    return invalid("ao.convergedTiles reads the AO denoiser's history: enable the denoiser (ao.disableDenoiser = "
-                   "false) or disable convergedTiles");
-  if (d.ao.convergedTiles.enabled && d.ao.halfResolution)
-    return invalid("ao.convergedTiles skips tiles of full-resolution pixels: disable ao.halfResolution or "
-                   "convergedTiles");
-  if (d.reflections.convergedTiles.enabled && d.reflections.disableDenoiser)
-    return invalid("reflections.convergedTiles reads the reflection denoiser's history: enable the denoiser "
-                   "(reflections.disableDenoiser = false) or disable convergedTiles");
-  if (d.reflections.convergedTiles.enabled && d.reflections.halfResolution)
-    return invalid("reflections.convergedTiles skips tiles of full-resolution pixels: disable "
-                   "reflections.halfResolution or convergedTiles");
-  if (d.localLights.convergedTiles.enabled &&
-      (d.localLights.disableDenoiser || d.localLights.mode != ManyLightMode::Stochastic))
-    return invalid("localLights.convergedTiles reads the local-light denoiser's history, which only the Stochastic "
-                   "mode has: set localLights.mode = Stochastic and disableDenoiser = false, or disable "
-                   "convergedTiles");
-  if (d.ao.adaptive.enabled && d.ao.disableDenoiser)
-    return invalid("ao.adaptive plans from the AO denoiser's history: enable the denoiser (ao.disableDenoiser = "
-                   "false) or disable adaptive rays");
-  if (d.shadows.adaptive.enabled && d.shadows.disableDenoiser)
-    return invalid("shadows.adaptive plans from the shadow denoiser's history: enable the denoiser "
-                   "(shadows.disableDenoiser = false) or disable adaptive rays");
+  // Each effect's schedule by the one validator, then against its denoiser (history is the effect's own).
+  struct Scheduled {
+    const RaySchedule& schedule;
+    uint32_t capabilities;
+    DenoiseSignal signal;
+    const char* field;
+    bool denoised;
+    const char* denoiserFix;
+  };
+  const bool stochasticLights = d.localLights.mode == ManyLightMode::Stochastic;
+  const Scheduled scheduled[] = {
+      {d.shadows.schedule, kShadowScheduleCapabilities, DenoiseSignal::Scalar, "shadows", !d.shadows.disableDenoiser,
+       "shadows.disableDenoiser = false"},
+      {d.ao.schedule, kAoScheduleCapabilities, DenoiseSignal::Scalar, "ao", !d.ao.disableDenoiser,
+       "ao.disableDenoiser = false"},
+      {d.reflections.schedule, kReflectionScheduleCapabilities, DenoiseSignal::Reflection, "reflections",
+       !d.reflections.disableDenoiser, "reflections.disableDenoiser = false"},
+      {d.localLights.schedule, kLocalLightScheduleCapabilities, DenoiseSignal::Rgb, "localLights",
+       !d.localLights.disableDenoiser && stochasticLights,
+       "localLights.mode = Stochastic and localLights.disableDenoiser = false (only that mode is denoised)"},
+  };
+  for (const Scheduled& e : scheduled) {
+    const std::string field = std::string("HybridEffects: HybridEffectsDesc::") + e.field + ".schedule";
+    if (Status st = validateRaySchedule(e.schedule, e.capabilities, e.signal, field, true); !st) return st;
+    const char* user = e.schedule.adaptive.enabled         ? "adaptive.enabled: adaptive rays plan from"
+                       : e.schedule.convergedTiles.enabled ? "convergedTiles.enabled: converged tiles are read from"
+                                                           : nullptr;
+    if (user && !e.denoised) {
+      return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                   field + "." + user + " the effect's denoiser's history: set " + e.denoiserFix + ", or disable it"};
+    }
+  }
   return {};
+}
+
+// An effect's schedule as its pass runs it: its history is the effect's denoiser, and the stages that read it wait
+// for the denoiser's first frame (none before it: uniform rays, nothing skipped). `allowed` false (a hard shadow)
+// turns them off.
+RaySchedule effectSchedule(const RaySchedule& wanted, const Denoiser* history, bool allowed = true) {
+  RaySchedule s = wanted;
+  s.history = history;
+  s.adaptive.enabled = s.adaptive.enabled && history && allowed;
+  s.convergedTiles.enabled = s.convergedTiles.enabled && history && allowed;
+  return s;
 }
 
 bool hasSize(const Light& l) {
@@ -165,7 +179,7 @@ HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset) {
   if (p.effects & kEffectShadows) base.shadows.raysPerPixel = p.shadowRaysPerPixel;
   if (p.effects & kEffectAo) {
     base.ao.raysPerPixel = p.aoRaysPerPixel;
-    base.ao.halfResolution = p.aoHalfResolution;
+    base.ao.schedule.halfResolution = p.aoHalfResolution;
   }
   return base;
 }
@@ -367,9 +381,7 @@ Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridF
   s.raysPerPixel = desc.localLights.raysPerPixel;
   s.candidates = desc.localLights.candidates;
   s.materials = materials.get();
-  s.convergedTiles = desc.localLights.convergedTiles;
-  s.convergedTiles.history = localLightDenoiser.get();
-  s.convergedTiles.enabled = s.convergedTiles.enabled && s.convergedTiles.history;
+  s.schedule = effectSchedule(desc.localLights.schedule, localLightDenoiser.get());
   if (Status st = localLights->record(cmd, f.gbuffer, tlas, f.localLights, s); !st)
     return wrap("ManyLightPass::record", st.error());
   const ManyLightOutputs& o = localLights->outputs();
@@ -382,22 +394,15 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   ShadowSettings s;
   s.raysPerPixel = plan.rays;
   s.materials = materials.get();  // alpha tests non-opaque geometry
-  s.tileClassifier = desc.shadows.tileClassifier;
-  // Adaptive rays plan from the denoiser's history: none before its first frame (the pass then traces uniformly).
-  s.adaptive = desc.shadows.adaptive;
-  s.adaptive.history = shadowDenoiser.get();
-  s.adaptive.enabled = s.adaptive.enabled && s.adaptive.history && plan.soft;
-  // Converged tiles too: only for soft shadows, whose denoiser runs after the pass this frame.
-  s.convergedTiles = desc.shadows.convergedTiles;
-  s.convergedTiles.history = shadowDenoiser.get();
-  s.convergedTiles.enabled = s.convergedTiles.enabled && s.convergedTiles.history && plan.soft;
+  // Adaptive rays and converged tiles: only for soft shadows, whose denoiser runs after the pass this frame.
+  s.schedule = effectSchedule(desc.shadows.schedule, shadowDenoiser.get(), plan.soft);
   if (Status st = shadow->record(cmd, f.gbuffer, tlas, plan.light, s); !st)
     return wrap("ShadowPass::record", st.error());
   const ShadowOutputs& o = shadow->outputs();
   // The visibility is a fraction of plan.rays binary rays; with adaptive rays the count varies per pixel, so the
   // denoiser measures the noise instead.
   return denoise(shadowDenoiser, plan.soft && !desc.shadows.disableDenoiser, "Denoiser (shadows)", cmd, f.gbuffer,
-                 o.visibilityView, desc.shadows.adaptive.enabled ? 0u : plan.rays);
+                 o.visibilityView, desc.shadows.schedule.adaptive.enabled ? 0u : plan.rays);
 }
 
 Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -406,18 +411,12 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   s.raysPerPixel = desc.ao.raysPerPixel;
   s.range = desc.ao.range;
   s.estimator = desc.ao.estimator;
-  s.adaptive = desc.ao.adaptive;
-  s.adaptive.history = aoDenoiser.get();  // none before the denoiser's first frame: uniform rays then
-  s.adaptive.enabled = s.adaptive.enabled && s.adaptive.history;
-  s.halfResolution = desc.ao.halfResolution;
-  s.convergedTiles = desc.ao.convergedTiles;
-  s.convergedTiles.history = aoDenoiser.get();
-  s.convergedTiles.enabled = s.convergedTiles.enabled && s.convergedTiles.history;
+  s.schedule = effectSchedule(desc.ao.schedule, aoDenoiser.get());
   if (Status st = ao->record(cmd, f.gbuffer, tlas, s); !st) return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
   // Binary AO is a fraction of binary rays; distance-weighted AO is not, nor is adaptive AO (the count varies per
   // pixel), so their noise is estimated.
-  const uint32_t rays = s.estimator == AoEstimator::Binary && !desc.ao.adaptive.enabled
+  const uint32_t rays = s.estimator == AoEstimator::Binary && !desc.ao.schedule.adaptive.enabled
                             ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays)
                             : 0u;
   return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, f.gbuffer, o.aoView, rays);
@@ -428,11 +427,8 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.materials = materials.get();
   s.roughnessThreshold = desc.reflections.roughnessThreshold;
   s.raysPerPixel = desc.reflections.raysPerPixel;
-  s.halfResolution = desc.reflections.halfResolution;
   s.invocationReorder = desc.reflections.invocationReorder;
-  s.convergedTiles = desc.reflections.convergedTiles;
-  s.convergedTiles.history = reflectionDenoiser.get();
-  s.convergedTiles.enabled = s.convergedTiles.enabled && s.convergedTiles.history;
+  s.schedule = effectSchedule(desc.reflections.schedule, reflectionDenoiser.get());
   s.flags = (f.flags & kFrameExplicitLighting) ? kReflectionExplicitLighting : 0u;
   for (int i = 0; i < 3; ++i) {
     s.sunRadiance[i] = f.lightRadiance[i];

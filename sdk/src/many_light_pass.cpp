@@ -7,12 +7,11 @@
 
 #include "compute_pipeline.h"
 #include "context_impl.h"
-#include "converged_tiles.h"
 #include "light_validation.h"
 #include "many_light_pass_impl.h"
 #include "pass_core.h"
+#include "ray_schedule_stage.h"
 #include "raybridge_shaders.h"
-#include "tile_classifier.h"  // the tile state
 
 namespace rb {
 
@@ -85,12 +84,9 @@ struct ManyLightPass::Impl {
   std::vector<GpuLight> staging;
   ManyLightOutputs outputs;
   internal::LightListView recorded;  // what the latest record() uploaded, for reflection hits
-  // ManyLightSettings::convergedTiles, created on first use: the launch that skips converged tiles
-  // (many_lights_converged.rgen), the tile state (a TileClassifier without list nor pipeline) and the dispatches.
-  RayTracingPipelineDesc desc;  // the pass's pipeline, for the variant
-  RayTracingPipeline convergedPipeline;
-  TileClassifier tileState;
-  ConvergedTiles converged{DenoiseSignal::Rgb};
+  // Converged tiles (ManyLightSettings::schedule), created on first use: the launch that skips them
+  // (many_lights_converged.rgen), the tile state and the dispatches. Set by create().
+  std::unique_ptr<ScheduleStage> schedule;
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still use them
     core.retire(ctx);
@@ -98,26 +94,7 @@ struct ManyLightPass::Impl {
     retireBuffer(ctx, ring);
     retireBuffer(ctx, lights);
     retireBuffer(ctx, tiles);
-    retireTiles();
-  }
-  void retireTiles() {
-    convergedPipeline.retire(ctx);
-    tileState.retire(ctx);
-    converged.retire(ctx);
-  }
-  // What converged tiles need, before the pass's recording begins (so that a failure records nothing).
-  Status ensureConvergedTiles(const GBufferDesc& g) {
-    if (!convergedPipeline.pipeline) {
-      RayTracingPipelineDesc p = desc;
-      p.name = "many-light pass (converged tiles)";
-      p.raygen = SpirvModule::of(spirv::many_lights_converged_rgen);
-      p.bindings.push_back(
-          {RB_ML_BINDING_TILE_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr});
-      Result<RayTracingPipeline> v = core.createVariant(ctx, std::move(p), SpirvModule::of(spirv::many_lights_rahit));
-      if (!v) return v.error();
-      convergedPipeline = v.value();
-    }
-    return tileState.ensure(ctx, g.width, g.height, false);
+    if (schedule) schedule->retire(ctx);
   }
   Status ensureLightBuffers(uint32_t lightCount);
   Status ensureTiles(VkDeviceSize tileBytes);
@@ -235,8 +212,26 @@ Result<std::unique_ptr<ManyLightPass>> ManyLightPass::create(Context& context) {
   p.bindings.push_back({RB_ML_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr});
   p.bindings.push_back({RB_ML_BINDING_IRRADIANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, rg, nullptr});
   p.pushConstantBytes = sizeof(ManyLightConstants);
-  impl->desc = p;  // init() takes the description
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::many_lights_rahit)); !s) return s.error();
+  // To the schedule stage: an Rgb signal whose launch skips converged tiles itself (adding the tile state).
+  ScheduledEffect e;
+  e.passName = "ManyLightPass";
+  e.capabilities = kLocalLightScheduleCapabilities;
+  e.signal = DenoiseSignal::Rgb;
+  e.outputBinding = RB_ML_BINDING_IRRADIANCE;
+  e.tileStateBinding = RB_ML_BINDING_TILE_STATE;
+  e.variantMask = kVariantTiles;
+  e.pipelineDesc = [p](uint32_t) {
+    RayTracingPipelineDesc v = p;
+    v.name = "many-light pass (converged tiles)";
+    v.raygen = SpirvModule::of(spirv::many_lights_converged_rgen);
+    v.bindings.push_back(
+        {RB_ML_BINDING_TILE_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr});
+    return v;
+  };
+  e.alphaAnyHit = SpirvModule::of(spirv::many_lights_rahit);
+  e.constantBytes = sizeof(ManyLightConstants);
+  impl->schedule = std::make_unique<ScheduleStage>(std::move(e));
   const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
   Result<ComputePipeline> cull =
       ComputePipeline::create(context, SpirvModule::of(spirv::many_lights_cull_comp),
@@ -264,13 +259,14 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   if (settings.raysPerPixel > kMaxRaysOrCandidates || settings.candidates > kMaxRaysOrCandidates)
     return invalid("ManyLightSettings::raysPerPixel " + std::to_string(settings.raysPerPixel) + " and candidates " +
                    std::to_string(settings.candidates) + " must be at most 64");
-  if (Status st = s.converged.validate(settings.convergedTiles, "ManyLightPass: ManyLightSettings::convergedTiles");
+  if (Status st = validateRaySchedule(settings.schedule, kLocalLightScheduleCapabilities, DenoiseSignal::Rgb,
+                                      "ManyLightPass: ManyLightSettings::schedule");
       !st) {
     return st;
   }
-  if (settings.convergedTiles.enabled && settings.mode != ManyLightMode::Stochastic) {
-    return invalid("ManyLightSettings::convergedTiles skips converged noise: ManyLightMode::Exact has none to skip "
-                   "(and no denoiser); use Stochastic or disable convergedTiles");
+  if (settings.schedule.convergedTiles.enabled && settings.mode != ManyLightMode::Stochastic) {
+    return invalid("ManyLightSettings::schedule.convergedTiles skips converged noise: ManyLightMode::Exact has none "
+                   "to skip (and no denoiser); use Stochastic or disable convergedTiles");
   }
   ManyLightConstants pc{};
   if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ManyLightPass", pc.gbuffer); !st) return st;
@@ -287,11 +283,7 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   const VkDeviceSize tileBytes = VkDeviceSize(pc.tiles[0]) * pc.tiles[1] * RB_ML_TILE_UINTS * sizeof(uint32_t);
   if (Status st = s.ensureLightBuffers(std::max(count, 1u)); !st) return st;
   if (Status st = s.ensureTiles(tileBytes); !st) return st;
-  if (settings.convergedTiles.enabled) {
-    if (Status st = s.ensureConvergedTiles(g); !st) return st;
-  } else if (s.convergedPipeline.pipeline) {
-    s.retireTiles();  // no tile state while converged tiles are off
-  }
+  if (Status st = s.schedule->prepare(s.ctx, s.core, g, settings.schedule); !st) return st;
 
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ManyLightPass", pc.gbuffer.flags); !st) return st;
@@ -313,22 +305,13 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
   vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, 0, 0,
                           nullptr, 1, &tilesReady, 0, nullptr);
 
-  const PassImages& images = s.core.images;
   s.core.writeCommon(s.ctx, w, g, tlas);
   w.storageBuffer(RB_ML_BINDING_LIGHTS, s.lights.buffer);
   w.storageBuffer(RB_ML_BINDING_TILES, s.tiles.buffer);
-  w.storageImage(RB_ML_BINDING_IRRADIANCE, images[0].view);
-  bool converged = false;
-  if (settings.convergedTiles.enabled) {
-    // The rays saved count raysPerPixel per skipped surface pixel: at most what it would have traced (a tile with
-    // fewer lights than rays traces one per light).
-    Result<bool> c = s.converged.traceSkipping(s.core, s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel,
-                                               s.tileState, w, &pc, sizeof pc, s.convergedPipeline,
-                                               RB_ML_BINDING_TILE_STATE, "ManyLightPass");
-    if (!c) return c.error();
-    converged = c.value();
-  }
-  if (!converged) s.core.traceAndEnd(s.ctx, cmd, w, pc, g);
+  // The rays saved count raysPerPixel per skipped surface pixel: at most what it would have traced (a tile with
+  // fewer lights than rays traces one per light).
+  ScheduleFrame frame{g, settings.schedule, w, &pc, &pc.gbuffer, pc.raysPerPixel};
+  if (Result<bool> traced = s.schedule->trace(s.ctx, s.core, cmd, frame); !traced) return traced.error();
 
   s.remember(tlas, count);
   nameOutputs(s);

@@ -5,12 +5,11 @@
 #include <string>
 
 #include "context_impl.h"
-#include "converged_tiles.h"
 #include "many_light_pass_impl.h"
 #include "material_table_impl.h"
 #include "pass_core.h"
+#include "ray_schedule_stage.h"
 #include "raybridge_shaders.h"
-#include "tile_classifier.h"  // the tile state
 
 namespace rb {
 
@@ -18,9 +17,10 @@ namespace {
 const VkShaderStageFlags kRaygen = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
 const VkShaderStageFlags kHit = VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR;
 
-// The pipelines of the pass: reflect.rgen, reflect_reorder.rgen (shader execution reordering), and both skipping
-// the converged tiles (reflect_converged.rgen, reflect_reorder_converged.rgen: which add the tile state's binding).
-RayTracingPipelineDesc reflectionPipelineDesc(bool reorder, bool tiles = false) {
+// The pipelines of the pass: reflect.rgen, and its variants (ScheduleVariant bits) with shader execution
+// reordering and skipping the converged tiles (which adds the tile state's binding).
+RayTracingPipelineDesc reflectionPipelineDesc(uint32_t variant) {
+  const bool reorder = variant & kVariantReorder, tiles = variant & kVariantTiles;
   RayTracingPipelineDesc p;
   p.name = reorder ? (tiles ? "reflection pass (invocation reorder, converged tiles)"
                             : "reflection pass (invocation reorder)")
@@ -45,49 +45,38 @@ RayTracingPipelineDesc reflectionPipelineDesc(bool reorder, bool tiles = false) 
   return p;
 }
 
+
+// Reflections to the schedule stage: a Reflection signal with half resolution and converged tiles, skipped inside
+// its launch (one invocation per pixel, see reflection_raygen.glsl), with reordered variants.
+ScheduledEffect reflectionSchedule() {
+  ScheduledEffect e;
+  e.passName = "ReflectionPass";
+  e.capabilities = kReflectionScheduleCapabilities;
+  e.signal = DenoiseSignal::Reflection;
+  e.halfSignal = HalfResolution::Signal::Reflection;
+  e.outputBinding = RB_REFLECTION_BINDING_RADIANCE;
+  e.tileStateBinding = RB_REFLECTION_BINDING_TILE_STATE;
+  e.variantMask = kVariantReorder | kVariantTiles;
+  e.pipelineDesc = reflectionPipelineDesc;
+  e.alphaAnyHit = SpirvModule::of(spirv::reflect_rahit);
+  e.recordStages = kHit;
+  e.constantBytes = sizeof(ReflectionConstants);
+  return e;
+}
+
 }  // namespace
 
 struct ReflectionPass::Impl {
   Context& ctx;
   PassCore core;
-  std::unique_ptr<MaterialTable> ownMaterials;  // setMaterials(); retires its buffer and set itself
-  // ReflectionSettings::halfResolution: the sample image and the upsample, made on first use.
-  HalfResolution half{HalfResolution::Signal::Reflection};
+  std::unique_ptr<MaterialTable> ownMaterials;   // setMaterials(); retires its buffer and set itself
+  ScheduleStage schedule{reflectionSchedule()};  // half resolution, converged tiles, the reordered variants
   ReflectionOutputs outputs;
-  // The same pipeline with reflect_reorder.rgen: only on a context with DeviceInfo::invocationReorder.
-  RayTracingPipeline reorderPipeline;
-  bool reordered = false;  // the latest record() traced with reorderPipeline
-  // ReflectionSettings::convergedTiles, created on first use: the launches that skip converged tiles (plain, and
-  // with reordering where the context has it), the tile state (a TileClassifier without list nor pipeline: the
-  // launch stays one invocation per pixel, see reflection_raygen.glsl), and the converged-tile dispatches.
-  RayTracingPipeline tilesPipeline, reorderTilesPipeline;
-  TileClassifier tileState;
-  ConvergedTiles converged{DenoiseSignal::Reflection};
+  bool reordered = false;  // the latest record() traced with a reordered variant
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still trace with it
     core.retire(ctx);
-    half.retire(ctx);
-    reorderPipeline.retire(ctx);
-    retireTiles();
-  }
-  void retireTiles() {
-    tilesPipeline.retire(ctx);
-    reorderTilesPipeline.retire(ctx);
-    tileState.retire(ctx);
-    converged.retire(ctx);
-  }
-  // What converged tiles need, before the pass's recording begins (so that a failure records nothing): the launch
-  // that skips them (reordered too when `reorder`), and the tile state for this size.
-  Status ensureTiles(const GBufferDesc& g, bool reorder) {
-    for (bool r : {false, true}) {
-      RayTracingPipeline& p = r ? reorderTilesPipeline : tilesPipeline;
-      if (p.pipeline || (r && !reorder)) continue;
-      Result<RayTracingPipeline> v = core.createVariant(ctx, reflectionPipelineDesc(r, true),
-                                                        SpirvModule::of(spirv::reflect_rahit), kHit);
-      if (!v) return v.error();
-      p = v.value();
-    }
-    return tileState.ensure(ctx, g.width, g.height, false);
+    schedule.retire(ctx);
   }
 };
 
@@ -125,14 +114,11 @@ Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context)
   Result<std::unique_ptr<MaterialTable>> table = MaterialTable::create(context);
   if (!table) return table.error();
   impl->ownMaterials = std::move(table.value());
-  RayTracingPipelineDesc p = reflectionPipelineDesc(false);
+  RayTracingPipelineDesc p = reflectionPipelineDesc(0);
   // Shading records and materials: read by the hits (shading) and the any-hits (alpha).
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::reflect_rahit), kHit); !s) return s.error();
   if (c.info.invocationReorder) {
-    Result<RayTracingPipeline> r = impl->core.createVariant(context, reflectionPipelineDesc(true),
-                                                            SpirvModule::of(spirv::reflect_rahit), kHit);
-    if (!r) return r.error();
-    impl->reorderPipeline = r.value();
+    if (Status s = impl->schedule.ensureVariant(context, impl->core, kVariantReorder); !s) return s.error();
   }
   // The own table holds one white material until the engine gives its own.
   return std::unique_ptr<ReflectionPass>(new ReflectionPass(std::move(impl)));
@@ -152,6 +138,11 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ReflectionPass: " + m};
   };
   if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
+  if (Status st = validateRaySchedule(settings.schedule, kReflectionScheduleCapabilities, DenoiseSignal::Reflection,
+                                      "ReflectionPass: ReflectionSettings::schedule");
+      !st) {
+    return st;
+  }
   if (!tlas.shadingRecords) {
     return invalid("the TLAS has no shading records; build it with TlasBuildOptions::writeShadingRecords = true");
   }
@@ -164,14 +155,6 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
     return invalid("ReflectionSettings::roughnessThreshold " + std::to_string(threshold) + " is outside (0, 1]");
   }
   if (settings.raysPerPixel > 64) return invalid("ReflectionSettings::raysPerPixel exceeds 64");
-  if (Status st = s.converged.validate(settings.convergedTiles, "ReflectionPass: ReflectionSettings::convergedTiles");
-      !st) {
-    return st;
-  }
-  if (settings.convergedTiles.enabled && settings.halfResolution) {
-    return invalid("ReflectionSettings::convergedTiles skips tiles of full-resolution pixels: disable halfResolution "
-                   "or convergedTiles");
-  }
   const bool sunUnset = settings.sunDirection[0] == 0.0f && settings.sunDirection[1] == 0.0f &&
                         settings.sunDirection[2] == 0.0f;
   const float sunDirection[3] = {settings.sunDirection[0], sunUnset ? 1.0f : settings.sunDirection[1],
@@ -197,7 +180,7 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   pc.ambientIntensity = settings.ambientIntensity == 0.0f && !explicitLighting ? kDefaultAmbientIntensity
                                                                                : settings.ambientIntensity;
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultReflectionRays;
-  pc.halfResolution = settings.halfResolution ? 1u : 0u;
+  pc.halfResolution = settings.schedule.halfResolution ? 1u : 0u;
 
   internal::LightListView lights;
   if (settings.lights) {
@@ -216,43 +199,18 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   DescriptorWrites w;
   const MaterialTable* table = settings.materials ? settings.materials : s.ownMaterials.get();
   if (Status st = s.core.writeMaterials(w, tlas, table, "ReflectionPass", pc.gbuffer.flags); !st) return st;
-  if (settings.halfResolution) {
-    if (Status st = s.half.ensure(s.ctx, g.width, g.height); !st) return st;
-  } else {
-    s.half.releaseImage(s.ctx);  // full resolution holds no sample image
-  }
-  s.reordered = s.reorderPipeline.pipeline && settings.invocationReorder;
-  if (settings.convergedTiles.enabled) {
-    if (Status st = s.ensureTiles(g, s.reordered); !st) return st;
-  } else if (s.tilesPipeline.pipeline) {
-    s.retireTiles();  // no tile state while converged tiles are off
-  }
+  s.reordered = s.ctx.deviceInfo().invocationReorder && settings.invocationReorder;
+  const uint32_t variant = s.reordered ? uint32_t(kVariantReorder) : 0u;
+  if (Status st = s.schedule.prepare(s.ctx, s.core, g, settings.schedule, variant); !st) return st;
   if (Status st = s.core.begin(s.ctx, cmd, g, kReflectionOutputs); !st) return st;
   s.core.writeCommon(s.ctx, w, g, tlas);
   const GBufferImage& rm = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
   w.sampledImage(RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, rm.view, s.core.sampler, readLayout(rm));
-  w.storageImage(RB_REFLECTION_BINDING_RADIANCE,
-                 settings.halfResolution ? s.half.samplesView() : s.core.images[0].view);
   // The local lights' list when given, else any valid buffer (never read: lightCount is 0).
   w.storageBuffer(RB_REFLECTION_BINDING_LIGHTS,
                   pc.lightCount ? lights.buffer : internal::materialTableImpl(*table).materials.buffer);
-  const RayTracingPipeline* variant = s.reordered ? &s.reorderPipeline : nullptr;
-  bool converged = false;
-  if (settings.convergedTiles.enabled) {
-    Result<bool> c = s.converged.traceSkipping(s.core, s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel,
-                                               s.tileState, w, &pc, sizeof pc,
-                                               s.reordered ? s.reorderTilesPipeline : s.tilesPipeline,
-                                               RB_REFLECTION_BINDING_TILE_STATE, "ReflectionPass", threshold);
-    if (!c) return c.error();
-    converged = c.value();
-  }
-  if (converged) {
-    // Traced, checked and ended by traceSkipping().
-  } else if (settings.halfResolution) {
-    s.core.traceHalfAndEnd(s.ctx, cmd, w, pc, g, s.half, threshold, variant);
-  } else {
-    s.core.traceAndEnd(s.ctx, cmd, w, pc, g, variant);
-  }
+  ScheduleFrame frame{g, settings.schedule, w, &pc, &pc.gbuffer, pc.raysPerPixel, {}, threshold, variant};
+  if (Result<bool> traced = s.schedule.trace(s.ctx, s.core, cmd, frame); !traced) return traced.error();
   nameOutputs(s);
   return {};
 }

@@ -1,38 +1,28 @@
 #include <raybridge/shadow_pass.h>
 
 #include <cmath>
+#include <cstddef>
 #include <string>
 
-#include "adaptive_rays.h"
 #include "context_impl.h"
-#include "converged_tiles.h"
 #include "light_validation.h"
 #include "pass_core.h"
+#include "ray_schedule_stage.h"
 #include "raybridge_shaders.h"
-#include "tile_classifier.h"
 
 namespace rb {
-
-namespace {}
 
 struct ShadowPass::Impl {
   Context& ctx;
   ShadowPassDesc desc;
   PassCore core;
-  TileClassifier classifier;
-  ConvergedTiles converged;  // ShadowSettings::convergedTiles, pipelines created on first use
-  // Adaptive rays (soft lights), created on first use: shadow_adaptive.rgen and its planner.
-  RayTracingPipelineDesc adaptiveDesc;
-  RayTracingPipeline adaptivePipeline;
-  AdaptiveRayPlanner planner;
+  // The tile classifier (its own: always bound), converged tiles and adaptive rays (soft lights).
+  std::unique_ptr<ScheduleStage> schedule;
   ShadowOutputs outputs;
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still trace with it
     core.retire(ctx);
-    classifier.retire(ctx);
-    converged.retire(ctx);
-    adaptivePipeline.retire(ctx);
-    planner.retire(ctx);
+    if (schedule) schedule->retire(ctx);
   }
 };
 
@@ -80,29 +70,42 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
   }
   p.bindings.push_back({RB_SHADOW_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr});
   p.pushConstantBytes = sizeof(ShadowConstants);
-  if (!desc.outputHitDistance) {
-    impl->adaptiveDesc = p;
-    impl->adaptiveDesc.name = "shadow pass (adaptive rays)";
-    impl->adaptiveDesc.raygen = SpirvModule::of(spirv::shadow_adaptive_rgen);
-    impl->adaptiveDesc.bindings.push_back(
-        {RB_BINDING_RAY_PLAN, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr});
-  }
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::shadow_rahit)); !s) return s.error();
 
-  // The classifier: the ray generation shader's bindings but the TLAS and the material bindings, in a compute
-  // stage (PassCore::writeGBuffer and writeOutputs in record() fill them).
-  std::vector<VkDescriptorSetLayoutBinding> cb;
+  // To the schedule stage: a Scalar signal whose classifier is its own (the ray generation shader's bindings but
+  // the TLAS and the material bindings, and the tile state, in a compute stage), and whose adaptive variant adds
+  // the plan's binding (not with the occluder distance).
+  ScheduledEffect e;
+  e.passName = "ShadowPass";
+  e.capabilities = kShadowScheduleCapabilities;
+  e.outputBinding = RB_SHADOW_BINDING_VISIBILITY;
+  e.tileListBinding = RB_SHADOW_BINDING_TILES;
+  e.tileStateBinding = RB_SHADOW_BINDING_TILE_STATE;
+  e.convergedFlagOffset = offsetof(ShadowConstants, convergedTiles);
+  e.launchOverTilesOffset = offsetof(ShadowConstants, launchOverTiles);
+  e.classifierAlwaysBound = true;
+  e.variantMask = desc.outputHitDistance ? 0u : uint32_t(kVariantAdaptive);
+  e.pipelineDesc = [p](uint32_t) {
+    RayTracingPipelineDesc adaptive = p;
+    adaptive.name = "shadow pass (adaptive rays)";
+    adaptive.raygen = SpirvModule::of(spirv::shadow_adaptive_rgen);
+    adaptive.bindings.push_back(
+        {RB_BINDING_RAY_PLAN, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR, nullptr});
+    return adaptive;
+  };
+  e.alphaAnyHit = SpirvModule::of(spirv::shadow_rahit);
+  e.classifierShader = desc.outputHitDistance ? SpirvModule::of(spirv::shadow_classify_distance_comp)
+                                              : SpirvModule::of(spirv::shadow_classify_comp);
   for (const VkDescriptorSetLayoutBinding& b : p.bindings) {
     if (b.binding == RB_BINDING_TLAS) continue;
-    cb.push_back({b.binding, b.descriptorType, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+    e.classifierBindings.push_back({b.binding, b.descriptorType, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
   }
-  cb.push_back(
+  e.classifierBindings.push_back(
       {RB_SHADOW_BINDING_TILE_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-  const SpirvModule classify = desc.outputHitDistance ? SpirvModule::of(spirv::shadow_classify_distance_comp)
-                                                      : SpirvModule::of(spirv::shadow_classify_comp);
-  if (Status s = impl->classifier.init(context, classify, cb, sizeof(ShadowConstants), "shadow tile classifier"); !s) {
-    return s.error();
-  }
+  e.constantBytes = sizeof(ShadowConstants);
+  e.classifierName = "shadow tile classifier";
+  impl->schedule = std::make_unique<ScheduleStage>(std::move(e));
+  if (Status s = impl->schedule->init(context); !s) return s.error();
   return std::unique_ptr<ShadowPass>(new ShadowPass(std::move(impl)));
 }
 
@@ -138,86 +141,41 @@ Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasI
                    std::to_string(kMaxRaysPerPixel));
   }
   pc.raysPerPixel = soft ? (settings.raysPerPixel ? settings.raysPerPixel : kDefaultSoftShadowRays) : 1u;
-  if (Status st = AdaptiveRayPlanner::validate(settings.adaptive, "ShadowPass: ShadowSettings::adaptive"); !st) {
+  if (Status st = validateRaySchedule(settings.schedule, kShadowScheduleCapabilities, DenoiseSignal::Scalar,
+                                      "ShadowPass: ShadowSettings::schedule");
+      !st) {
     return st;
   }
-  if (settings.adaptive.enabled && s.desc.outputHitDistance) {
-    return invalid("adaptive rays do not write the occluder distance: create the pass without "
-                   "ShadowPassDesc::outputHitDistance, or disable ShadowSettings::adaptive");
+  if (s.desc.outputHitDistance && (settings.schedule.adaptive.enabled || settings.schedule.convergedTiles.enabled)) {
+    return invalid("ShadowSettings::schedule: adaptive rays and converged tiles do not write the occluder distance: "
+                   "create the pass without ShadowPassDesc::outputHitDistance, or disable them");
   }
   // A hard light's one ray per pixel is exact: nothing to adapt.
-  const bool adaptive = settings.adaptive.enabled && soft;
-  if (adaptive && !s.adaptivePipeline.pipeline) {
-    Result<RayTracingPipeline> p = s.core.createVariant(s.ctx, s.adaptiveDesc, SpirvModule::of(spirv::shadow_rahit));
-    if (!p) return p.error();
-    s.adaptivePipeline = p.value();
-  }
-  if (Status st = s.converged.validate(settings.convergedTiles, "ShadowPass: ShadowSettings::convergedTiles"); !st) {
-    return st;
-  }
-  if (settings.convergedTiles.enabled && s.desc.outputHitDistance) {
-    return invalid("converged tiles have no occluder distance: create the pass without "
-                   "ShadowPassDesc::outputHitDistance, or disable ShadowSettings::convergedTiles");
-  }
-  const PassStats latest = s.core.metrics.latest(s.ctx);
-
+  RaySchedule schedule = settings.schedule;
+  schedule.adaptive.enabled = schedule.adaptive.enabled && soft;
   const std::vector<PassImages::Spec> specs = outputSpecs(s.desc);
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ShadowPass", pc.gbuffer.flags); !st) return st;
-  // The tile list before begin(), so that a failed allocation records nothing.
-  if (Status st = s.classifier.ensure(s.ctx, g.width, g.height); !st) return st;
+  // What the schedule needs (the tile list among it) before begin(), so that a failed allocation records nothing.
+  if (Status st = s.schedule->prepare(s.ctx, s.core, g, schedule); !st) return st;
+  const PassStats latest = s.core.metrics.latest(s.ctx);
   if (Status st = s.core.begin(s.ctx, cmd, g, specs); !st) return st;
-  const PassImages& images = s.core.images;
-  auto writeOutputs = [&](DescriptorWrites& writes) {
-    writes.storageImage(RB_SHADOW_BINDING_VISIBILITY, images[0].view);
-    if (s.desc.outputHitDistance) writes.storageImage(RB_SHADOW_BINDING_HIT_DISTANCE, images[1].view);
-    // Bound without the classifier too: the ray generation shader statically uses it.
-    s.classifier.writeList(writes, RB_SHADOW_BINDING_TILES);
-  };
   s.core.writeCommon(s.ctx, w, g, tlas);
-  writeOutputs(w);
-  AdaptiveRaySettings planning = settings.adaptive;
-  planning.enabled = adaptive;  // a hard light traces its one ray uniformly
-  Result<bool> plan = s.planner.recordForPass(s.core, s.ctx, cmd, g, planning, pc.raysPerPixel, latest, "ShadowPass",
-                                              w);
+  const PassImages& images = s.core.images;
+  auto writeHitDistance = [&](DescriptorWrites& writes) {
+    if (s.desc.outputHitDistance) writes.storageImage(RB_SHADOW_BINDING_HIT_DISTANCE, images[1].view);
+  };
+  writeHitDistance(w);
+  ScheduleFrame frame{g, schedule, w, &pc, &pc.gbuffer, pc.raysPerPixel, latest};
+  frame.writeExtraOutputs = writeHitDistance;
+  Result<bool> plan = s.schedule->trace(s.ctx, s.core, cmd, frame);
   if (!plan) return plan.error();
   const bool planned = plan.value();
-  const RayTracingPipeline* variant = planned ? &s.adaptivePipeline : nullptr;
-  if (!settings.tileClassifier && !settings.convergedTiles.enabled) {
-    s.core.traceAndEnd(s.ctx, cmd, w, pc, g, variant);
-  } else {
-    bool converged = false;
-    if (settings.convergedTiles.enabled) {
-      Result<bool> c = s.converged.record(s.ctx, cmd, g, settings.convergedTiles, pc.raysPerPixel, s.classifier,
-                                          images[0].view, "ShadowPass");
-      if (!c) {
-        s.core.end(s.ctx, cmd);
-        return c.error();
-      }
-      converged = c.value();
-    }
-    pc.convergedTiles = converged ? 1u : 0u;
-    DescriptorWrites cw;
-    s.core.writeGBuffer(s.ctx, cw, g);
-    writeOutputs(cw);
-    s.classifier.writeState(cw, RB_SHADOW_BINDING_TILE_STATE);
-    s.classifier.classify(s.ctx, cmd, cw, &pc, sizeof pc);
-    pc.launchOverTiles = 1;
-    if (!converged) {
-      s.core.traceIndirectAndEnd(s.ctx, cmd, w, pc, s.classifier.traceArguments(), variant);
-    } else {
-      // The check reads the traced visibility, so it comes after the outputs are readable, inside the pass's time.
-      s.core.traceIndirect(s.ctx, cmd, w, pc, s.classifier.traceArguments(), variant);
-      s.core.images.endWrite(s.ctx, cmd);
-      s.converged.check(s.ctx, cmd, g, s.classifier, images[0].view);
-      s.core.metrics.writeEnd(s.ctx, cmd);
-    }
-  }
 
   nameOutputs(s);
   ShadowOutputs& o = s.outputs;
-  o.rayPlan = planned ? s.planner.planImage() : VK_NULL_HANDLE;
-  o.rayPlanView = planned ? s.planner.planView() : VK_NULL_HANDLE;
+  o.rayPlan = planned ? s.schedule->planImage() : VK_NULL_HANDLE;
+  o.rayPlanView = planned ? s.schedule->planView() : VK_NULL_HANDLE;
   return {};
 }
 

@@ -4,8 +4,8 @@
 // Two estimators, as in the thesis: binary occlusion, and distance-weighted ("distance rays"), where a hit at
 // distance t counts t / R open, so far occluders fade out.
 //
-// Half resolution (AoSettings::halfResolution): one ray generation invocation per 2x2 block of the G-buffer traces
-// for one pixel of its block (the same corner in every block, a different one each frame: every pixel within 4
+// Half resolution (AoSettings::schedule.halfResolution): one ray generation invocation per 2x2 block of the G-buffer
+// traces for one pixel of its block (the same corner in every block, a different one each frame: every pixel within 4
 // frames, so a temporal denoiser sees them all) into an internal R16_SFLOAT image of ceil(w/2) x ceil(h/2) (half
 // a byte per pixel, MemoryCategory::PassImages, held only while the setting is on). A compute pass then writes the
 // full-resolution output from it: each pixel weights the samples around it bilinearly times their depth (distance
@@ -13,12 +13,12 @@
 // creases; a pixel whose sample it is gets that sample exactly. The output keeps its format, size and layout.
 // stats() then counts the rays actually traced (about a quarter) and its gpuMs covers the trace and the upsample.
 //
-// Converged tiles (AoSettings::convergedTiles, full resolution): as for soft shadows (raybridge/converged_tiles.h),
-// tiles whose denoised AO history has converged trace no ray, and hold kept-history marks for the AO denoiser. A
-// compute classifier over 8x8 tiles then lists the tiles that still need rays (any surface pixel, not converged)
-// and the launch covers those alone (vkCmdTraceRaysIndirectKHR); all-sky tiles get their 1 from it. PassStats
-// counts the tiles traced, skipped and converged, and the rays saved. The tile list and state take 16 bytes + 8
-// bytes per tile (MemoryCategory::PassBuffers), held only while the setting is on.
+// Converged tiles (AoSettings::schedule.convergedTiles, full resolution): as for soft shadows
+// (raybridge/ray_schedule.h), tiles whose denoised AO history has converged trace no ray, and hold kept-history marks
+// for the AO denoiser. A compute classifier over 8x8 tiles then lists the tiles that still need rays (any surface
+// pixel, not converged) and the launch covers those alone (vkCmdTraceRaysIndirectKHR); all-sky tiles get their 1 from
+// it. PassStats counts the tiles traced, skipped and converged, and the rays saved. The tile list and state take 16
+// bytes + 8 bytes per tile (MemoryCategory::PassBuffers), held only while the setting is on.
 //
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output image and
 // measurement objects are handed to the Context's deferred release (see context.h) and freed once those
@@ -28,11 +28,10 @@
 #pragma once
 
 #include <raybridge/acceleration_structures.h>
-#include <raybridge/adaptive_rays.h>
-#include <raybridge/converged_tiles.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/material_table.h>
+#include <raybridge/ray_schedule.h>
 
 #include <memory>
 
@@ -53,14 +52,10 @@ struct AoSettings {
   // The materials that alpha-test non-opaque geometry (MaterialTable: Mask cut-outs, stochastic Blend), read
   // through the TLAS's shading records (needed then). nullptr = none: every surface occludes.
   const MaterialTable* materials = nullptr;
-  // Rays per pixel where the denoiser's history says the estimate is uncertain, within a budget
-  // (adaptive_rays.h): raysPerPixel is then the average the budget is made of. Disabled by default.
-  AdaptiveRaySettings adaptive{};
-  // Trace a quarter of the pixels and upsample (see Half resolution above). false = every pixel traces its rays.
-  bool halfResolution = false;
-  // Skip the 8x8-pixel tiles whose denoised history has converged (raybridge/converged_tiles.h): their pixels hold
-  // kept-history marks instead of AO, which the denoiser named in it reads. Full resolution only. Off by default.
-  ConvergedTileSettings convergedTiles{};
+  // Where and how many rays (ray_schedule.h): adaptive rays (raysPerPixel is then the average the budget is made
+  // of), half resolution (see Half resolution above) and converged tiles (their pixels hold kept-history marks
+  // instead of AO, which schedule.history reads; full resolution only). Zero = every pixel traces its rays.
+  RaySchedule schedule{};
 };
 
 // Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record().
@@ -69,7 +64,7 @@ struct AoOutputs {
   VkImageView aoView = VK_NULL_HANDLE;
   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   uint32_t width = 0, height = 0;
-  // Adaptive rays (AoSettings::adaptive): the latest record()'s plan, R16G16_SFLOAT, .x = the rays the pixel
+  // Adaptive rays (AoSettings::schedule.adaptive): the latest record()'s plan, R16G16_SFLOAT, .x = the rays the pixel
   // traced, .y = its reprojected history mean (a debug view of where rays went), in `layout`. VK_NULL_HANDLE when
   // that record() did not plan (adaptive rays off, or no history yet).
   VkImage rayPlan = VK_NULL_HANDLE;

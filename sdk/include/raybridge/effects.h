@@ -43,14 +43,14 @@ struct PassStats {
   // Any-hit shader invocations (alpha tests on non-opaque geometry, MeshDesc::nonOpaque); 0 when every mesh the
   // rays reached is opaque.
   uint64_t anyHitInvocations = 0;
-  // A pass with a tile classifier (ShadowPass; AoPass with AoSettings::convergedTiles): of the image's 8x8-pixel
-  // tiles, those traced and those skipped (pixels that all needed no ray, written without tracing, or converged).
-  // Both 0 when the pass ran without one.
+  // A pass with a tile classifier (ShadowPass; AoPass with AoSettings::schedule.convergedTiles): of the image's
+  // 8x8-pixel tiles, those traced and those skipped (pixels that all needed no ray, written without tracing, or
+  // converged). Both 0 when the pass ran without one.
   uint64_t tilesTraced = 0;
   uint64_t tilesSkipped = 0;
   // Of tilesSkipped, those that needed rays but were skipped because their history had converged
-  // (ShadowSettings::convergedTiles, AoSettings::convergedTiles), and the rays their pixels would have traced at
-  // the uniform rays per pixel.
+  // (ShadowSettings::schedule.convergedTiles, AoSettings::schedule.convergedTiles), and the rays their pixels would
+  // have traced at the uniform rays per pixel.
   uint64_t tilesConverged = 0;
   uint64_t raysSaved = 0;
   uint64_t tilesTotal() const { return tilesTraced + tilesSkipped; }

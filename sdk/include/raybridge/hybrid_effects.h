@@ -74,14 +74,11 @@ struct ShadowEffectSettings {
   // Directional lights: the angular radius to use instead of the light's own. 0 = the light's own.
   float softAngularRadiusDegrees = 0.0f;
   bool disableDenoiser = false;  // false = soft shadows are denoised (hard shadows never are)
-  bool tileClassifier = false;   // ShadowSettings::tileClassifier (off by default: see shadow_pass.h)
-  // Soft shadows: rays per pixel planned from the shadow denoiser's history (adaptive_rays.h); raysPerPixel is the
-  // average the budget is made of. `history` is ignored (the effect's denoiser, which must be enabled).
-  AdaptiveRaySettings adaptive{};
-  // Soft shadows: skip the tiles whose denoised history has converged (ShadowSettings::convergedTiles; the raw
-  // shadow output then holds kept-history marks there, the denoised one is complete). `history` is ignored (the
-  // effect's denoiser, which must be enabled). Off by default.
-  ConvergedTileSettings convergedTiles{};
+  // Where and how many rays (ray_schedule.h; ShadowSettings::schedule): the tile classifier, and for soft shadows
+  // adaptive rays (raysPerPixel is then the average the budget is made of) and converged tiles (the raw shadow
+  // output then holds kept-history marks there, the denoised one is complete). Adaptive rays and converged tiles
+  // need the effect's denoiser (disableDenoiser = false); schedule.history is set to it (a value given is ignored).
+  RaySchedule schedule{};
 };
 
 struct AoEffectSettings {
@@ -89,15 +86,11 @@ struct AoEffectSettings {
   float range = 0.0f;         // 0 = kDefaultAoRange
   AoEstimator estimator = AoEstimator::Binary;
   bool disableDenoiser = false;  // false = denoised
-  // Rays per pixel planned from the AO denoiser's history (adaptive_rays.h); raysPerPixel is the average the budget
-  // is made of. `history` is ignored (the effect's denoiser, which must be enabled).
-  AdaptiveRaySettings adaptive{};
-  // false = every pixel traces; true = AoSettings::halfResolution (a quarter of the rays, depth-aware upsample).
-  bool halfResolution = false;
-  // Skip the tiles whose denoised AO history has converged (AoSettings::convergedTiles; the raw AO output then
-  // holds kept-history marks there, the denoised one is complete). Full resolution only. `history` is ignored
-  // (the effect's denoiser, which must be enabled). Off by default.
-  ConvergedTileSettings convergedTiles{};
+  // Where and how many rays (ray_schedule.h; AoSettings::schedule): adaptive rays, half resolution (a quarter of
+  // the rays, depth-aware upsample; every preset with AO sets it) and converged tiles (full resolution; the raw AO
+  // output then holds kept-history marks there, the denoised one is complete). Adaptive rays and converged tiles
+  // need the effect's denoiser; schedule.history is set to it (a value given is ignored).
+  RaySchedule schedule{};
 };
 
 struct ReflectionEffectSettings {
@@ -106,18 +99,15 @@ struct ReflectionEffectSettings {
   // false = denoised (a DenoiseSignal::Reflection Denoiser, HybridEffectsDesc::denoiser's settings): glossy
   // pixels are filtered as far as their noise asks, mirrors (roughness 0) are not blurred.
   bool disableDenoiser = false;
-  // false = every pixel traces; true = ReflectionSettings::halfResolution (a quarter of the rays, depth-aware
-  // upsample).
-  bool halfResolution = false;
   // false (default) = never reorder; true = shader execution reordering where the Context has it
   // (ReflectionSettings's field of the same name). reflectionPass()->reordered() says whether the latest frame
   // reordered.
   bool invocationReorder = false;
-  // Skip the tiles whose denoised reflection history has converged and whose view has not turned
-  // (ReflectionSettings::convergedTiles; the raw reflection output then holds kept-history marks there, a = -1, the
-  // denoised one is complete). Full resolution only. `history` is ignored (the effect's denoiser, which must be
-  // enabled). Off by default.
-  ConvergedTileSettings convergedTiles{};
+  // Where and how many rays (ray_schedule.h; ReflectionSettings::schedule): half resolution, and converged tiles
+  // (full resolution; skip the tiles whose denoised history has converged and whose view has not turned: the raw
+  // output then holds kept-history marks there, a = -1, the denoised one is complete; needs the effect's
+  // denoiser). schedule.history is set to the effect's denoiser (a value given is ignored).
+  RaySchedule schedule{};
 };
 
 struct LocalLightEffectSettings {
@@ -127,10 +117,10 @@ struct LocalLightEffectSettings {
   // false = Stochastic output is denoised (an RGB Denoiser, HybridEffectsDesc::denoiser's settings); Exact is
   // never denoised: it has no noise.
   bool disableDenoiser = false;
-  // Stochastic: skip the tiles whose denoised irradiance has converged (ManyLightSettings::convergedTiles; the raw
-  // output then holds kept-history marks there, a = -1, the denoised one is complete). `history` is ignored (the
-  // effect's denoiser, which must be enabled). Off by default.
-  ConvergedTileSettings convergedTiles{};
+  // Where and how many rays (ray_schedule.h; ManyLightSettings::schedule): converged tiles, Stochastic only (skip
+  // the tiles whose denoised irradiance has converged: the raw output then holds kept-history marks there, a = -1,
+  // the denoised one is complete; needs the effect's denoiser). schedule.history is set to the effect's denoiser.
+  RaySchedule schedule{};
 };
 
 // What runs. A zero-initialised description is valid: no effect, nothing traced, nothing allocated but the two 1x1

@@ -35,10 +35,10 @@
 #pragma once
 
 #include <raybridge/acceleration_structures.h>
-#include <raybridge/converged_tiles.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/material_table.h>
+#include <raybridge/ray_schedule.h>
 
 #include <memory>
 #include <span>
@@ -81,19 +81,21 @@ struct ManyLightSettings {
   // Alpha-tested geometry (see ShadowSettings::materials); nullptr = every surface casts a solid shadow.
   const MaterialTable* materials = nullptr;
   // Stochastic: skip the 8x8-pixel tiles whose denoised irradiance (a DenoiseSignal::Rgb Denoiser, named in it) has
-  // converged, as for soft shadows (raybridge/converged_tiles.h): maxNoise is relative to the irradiance's colour
+  // converged, as for soft shadows (raybridge/ray_schedule.h): maxNoise is relative to the irradiance's colour
   // (see there); their pixels hold kept-history marks (the reprojected mean, a = -1) instead of irradiance, and a
   // refreshed tile whose new rays disagree with its history is held and marked stale (a = 2: the denoiser drops it).
   // The launch stays one invocation per pixel; a skipped tile's return at once. Off by default: a moved light shows
   // on a converged tile up to refreshPeriod frames late. PassStats counts the tiles and raysPerPixel per skipped
   // surface pixel as rays saved (at most what it would have traced). The tile state takes 4 bytes per tile.
-  ConvergedTileSettings convergedTiles{};
+  // That is schedule.convergedTiles, with schedule.history: the one stage this pass allows (ray_schedule.h).
+  RaySchedule schedule{};
 };
 
 // Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record(), readable by
 // fragment, compute and ray tracing shaders.
 struct ManyLightOutputs {
-  // R16G16B16A16_SFLOAT: rgb = E, a = 1; sky pixels 0. With convergedTiles also a = -1 (kept) and a = 2 (stale).
+  // R16G16B16A16_SFLOAT: rgb = E, a = 1; sky pixels 0. With schedule.convergedTiles also a = -1 (kept) and a = 2
+  // (stale).
   VkImage irradiance = VK_NULL_HANDLE;
   VkImageView irradianceView = VK_NULL_HANDLE;
   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;

@@ -16,7 +16,7 @@
 //   ultra                8         16, half res   yes       8192, PCF 8
 //
 // One shadow ray means hard shadows (towards the light's centre); more rays sample the light's disk.
-// Every preset with AO traces it at half resolution (AoSettings::halfResolution: a quarter of the pixels, a
+// Every preset with AO traces it at half resolution (AoSettings::schedule.halfResolution: a quarter of the pixels, a
 // depth-aware upsample): a fraction of the time at a lower denoised error for 1 to 16 rays (docs/performance.md,
 // "Half resolution"). Reflections stay at full resolution: at half resolution they are several times faster but
 // their denoised error is several times worse (same section). Set the flag back to false for the
@@ -71,7 +71,7 @@ struct PresetDesc {
   EffectSet effects = 0;
   uint32_t shadowRaysPerPixel = 0;  // 0 when the preset has no shadows; 1 = hard shadows
   uint32_t aoRaysPerPixel = 0;      // 0 when the preset has no AO
-  bool aoHalfResolution = false;    // AoSettings::halfResolution (true for every preset with AO, above)
+  bool aoHalfResolution = false;    // AoSettings::schedule.halfResolution (true for every preset with AO, above)
   RasterShadowDesc raster{};
 };
 

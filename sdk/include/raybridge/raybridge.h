@@ -6,7 +6,6 @@
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/ao_pass.h>
 #include <raybridge/context.h>
-#include <raybridge/converged_tiles.h>
 #include <raybridge/denoiser.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
@@ -16,6 +15,7 @@
 #include <raybridge/presets.h>
 #include <raybridge/primary_ray_pass.h>
 #include <raybridge/primary_shading_pass.h>
+#include <raybridge/ray_schedule.h>
 #include <raybridge/reflection_pass.h>
 #include <raybridge/result.h>
 #include <raybridge/shadow_pass.h>

@@ -11,9 +11,9 @@
 // table given to setMaterials(). Reflection rays and the shadow rays from their hits alpha-test non-opaque
 // geometry with the same table (material_table.h).
 //
-// Half resolution (ReflectionSettings::halfResolution): one ray generation invocation per 2x2 block of the G-buffer
-// traces for one pixel of its block (the same corner in every block, a different one each frame: every pixel within
-// 4 frames, so a temporal denoiser sees them all) into an internal R16G16B16A16_SFLOAT image of ceil(w/2) x
+// Half resolution (ReflectionSettings::schedule.halfResolution): one ray generation invocation per 2x2 block of the
+// G-buffer traces for one pixel of its block (the same corner in every block, a different one each frame: every pixel
+// within 4 frames, so a temporal denoiser sees them all) into an internal R16G16B16A16_SFLOAT image of ceil(w/2) x
 // ceil(h/2) (2 bytes per pixel, MemoryCategory::PassImages, held only while the setting is on). A compute pass then
 // writes the full-resolution output from it: each pixel weights the covered samples around it bilinearly times
 // their depth (distance from the pixel's tangent plane) and normal similarity, so reflections do not bleed across
@@ -29,8 +29,8 @@
 // divergent lanes. The rays and the shading are those of the plain pipeline; only the order differs. Elsewhere
 // (lavapipe, say) the plain pipeline runs and the setting is ignored: no error, nothing else built.
 //
-// Converged tiles (ReflectionSettings::convergedTiles, full resolution): as for soft shadows and AO
-// (raybridge/converged_tiles.h), tiles whose denoised reflection history (a DenoiseSignal::Reflection Denoiser) has
+// Converged tiles (ReflectionSettings::schedule.convergedTiles, full resolution): as for soft shadows and AO
+// (raybridge/ray_schedule.h), tiles whose denoised reflection history (a DenoiseSignal::Reflection Denoiser) has
 // converged trace no ray and hold kept-history marks for that denoiser: (the reprojected history mean, a = -1). A
 // refreshed tile whose new rays disagree with its history (beyond the noise the denoiser measured, over the tile or
 // in any one pixel) is held, and its pixels get a = 2, which tells the denoiser to drop their stale history. A
@@ -52,11 +52,11 @@
 #pragma once
 
 #include <raybridge/acceleration_structures.h>
-#include <raybridge/converged_tiles.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/many_light_pass.h>
 #include <raybridge/material_table.h>
+#include <raybridge/ray_schedule.h>
 
 #include <memory>
 #include <span>
@@ -96,23 +96,22 @@ struct ReflectionSettings {
   // contribution there, with a shadow ray (unbiased, noisy like glossy rays). nullptr = sun and sky only.
   const ManyLightPass* lights = nullptr;
   uint32_t lightCandidates = 0;  // 0 = kDefaultReflectionLightCandidates; at most 64
-  // Trace a quarter of the pixels and upsample (see Half resolution above). false = every pixel traces its rays.
-  bool halfResolution = false;
   // false (default) = trace as usual; true = reorder the hits before shading them (shader execution reordering)
   // where the Context has it (DeviceInfo::invocationReorder), else trace as usual. Same rays and shading either
   // way; only the order the closest-hit shaders run in differs. Opt-in because it did not pay on the one device
   // measured (the pass was slower with it: docs/performance.md); measure it on yours.
   // ReflectionPass::reordered() says what a record did.
   bool invocationReorder = false;
-  // Skip the 8x8-pixel tiles whose denoised history has converged and whose view has not turned (see Converged
-  // tiles above): their pixels hold kept-history marks (a = -1) instead of radiance, which the Reflection Denoiser
-  // named in it reads. Full resolution only. Off by default.
-  ConvergedTileSettings convergedTiles{};
+  // Where and how many rays (ray_schedule.h): half resolution (see Half resolution above) and converged tiles
+  // (skip the 8x8-pixel tiles whose denoised history has converged and whose view has not turned, see Converged
+  // tiles above: their pixels hold kept-history marks, a = -1, which the Reflection Denoiser schedule.history
+  // reads; full resolution only). Zero = every pixel traces its rays.
+  RaySchedule schedule{};
 };
 
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
 struct ReflectionOutputs {
-  // R16G16B16A16_SFLOAT: rgb radiance, a = 1 where rays were traced. With convergedTiles also a = -1 where a
+  // R16G16B16A16_SFLOAT: rgb radiance, a = 1 where rays were traced. With schedule.convergedTiles also a = -1 where a
   // converged tile kept its history (rgb is then that history's mean), and a = 2 where a converged tile's refresh
   // found a change (traced; its history is stale, and the denoiser drops it).
   VkImage radiance = VK_NULL_HANDLE;

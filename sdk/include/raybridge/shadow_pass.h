@@ -6,7 +6,7 @@
 // cone or light range. Ray origins are offset along the geometric normal by the depth buffer's
 // reconstruction error, so grazing light does not cause acne.
 //
-// A tile classifier (ShadowSettings::tileClassifier) can run that same per-pixel test first, in a compute pass
+// A tile classifier (ShadowSettings::schedule.tileClassifier) can run that same per-pixel test first, in a compute pass
 // over 8x8-pixel tiles: tiles where no pixel needs a ray get their outputs from it, and only the others are
 // traced (vkCmdTraceRaysIndirectKHR). The outputs are the same bit for bit either way; PassStats counts the tiles
 // traced and skipped. It is off by default: where measured the pass was slower with it (docs/performance.md),
@@ -14,8 +14,8 @@
 // bytes + 8 bytes per tile (the list and the converged-tile state; MemoryCategory::PassBuffers, about 260 KB at
 // 1920x1080), allocated with the output images.
 //
-// Converged tiles (ShadowSettings::convergedTiles, with the classifier): for denoised shadows, a tile whose every
-// surface pixel has a reprojected history in the shadow denoiser of at least minFrames frames, with the noise the
+// Converged tiles (ShadowSettings::schedule.convergedTiles, with the classifier): for denoised shadows, a tile whose
+// every surface pixel has a reprojected history in the shadow denoiser of at least minFrames frames, with the noise the
 // denoiser measured there under maxNoise, traces no ray. Its pixels are not a sample: they hold kept-history marks,
 // -1 - (the reprojected history mean), in [-2, -1], which that denoiser's next record() reads as "no new frame":
 // it carries the history to the pixel's new position unchanged (the reprojection, and its disocclusion test, are
@@ -33,11 +33,10 @@
 #pragma once
 
 #include <raybridge/acceleration_structures.h>
-#include <raybridge/adaptive_rays.h>
-#include <raybridge/converged_tiles.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/material_table.h>
+#include <raybridge/ray_schedule.h>
 
 #include <memory>
 
@@ -58,30 +57,27 @@ struct ShadowSettings {
   // The materials that alpha-test non-opaque geometry (MaterialTable: Mask cut-outs, stochastic Blend), read
   // through the TLAS's shading records (needed then). nullptr = none: every surface casts a solid shadow.
   const MaterialTable* materials = nullptr;
-  // true = classify 8x8 tiles first and trace only those with a pixel that needs a ray; false = trace every
-  // pixel's launch (default: faster where skipped pixels are cheap, see the top of this file).
-  bool tileClassifier = false;
-  // Soft lights: rays per pixel where the denoiser's history says the visibility is uncertain, within a budget
-  // (adaptive_rays.h); raysPerPixel is then the average the budget is made of. A hard light traces one ray per
-  // pixel regardless. Not with ShadowPassDesc::outputHitDistance. Disabled by default.
-  AdaptiveRaySettings adaptive{};
-  // Skip the tiles whose denoised history has converged (soft shadows). Off by default. Not with
-  // ShadowPassDesc::outputHitDistance (a skipped pixel has no occluder distance).
-  ConvergedTileSettings convergedTiles{};
+  // Where and how many rays (ray_schedule.h): the tile classifier (schedule.tileClassifier: classify 8x8 tiles
+  // first and trace only those with a pixel that needs a ray; off by default, faster where skipped pixels are
+  // cheap, see the top of this file), and for soft lights adaptive rays (a hard light traces one ray per pixel
+  // regardless) and converged tiles (which turn the classifier on). Adaptive rays and converged tiles are not
+  // available with ShadowPassDesc::outputHitDistance (a skipped or planned pixel has no occluder distance).
+  RaySchedule schedule{};
 };
 
 // Images owned by the pass, sized to the G-buffer, left in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL after
 // record() with a barrier that makes them readable by fragment and compute shaders.
 struct ShadowOutputs {
-  // R16_SFLOAT, 1 = lit; with ShadowSettings::convergedTiles, skipped pixels hold kept-history marks (see the top).
+  // R16_SFLOAT, 1 = lit; with ShadowSettings::schedule.convergedTiles, skipped pixels hold kept-history marks (see the
+  // top).
   VkImage visibility = VK_NULL_HANDLE;
   VkImageView visibilityView = VK_NULL_HANDLE;
   VkImage hitDistance = VK_NULL_HANDLE;  // R32_SFLOAT, world units; 0 = no occluder; only with outputHitDistance
   VkImageView hitDistanceView = VK_NULL_HANDLE;
   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   uint32_t width = 0, height = 0;
-  // Adaptive rays (ShadowSettings::adaptive): the latest record()'s plan, as AoOutputs::rayPlan (.x rays per pixel,
-  // .y reprojected history mean). VK_NULL_HANDLE when that record() did not plan.
+  // Adaptive rays (ShadowSettings::schedule.adaptive): the latest record()'s plan, as AoOutputs::rayPlan (.x rays per
+  // pixel, .y reprojected history mean). VK_NULL_HANDLE when that record() did not plan.
   VkImage rayPlan = VK_NULL_HANDLE;
   VkImageView rayPlanView = VK_NULL_HANDLE;
 };
