@@ -1,16 +1,29 @@
-# raybridge_embed_shaders(TARGET <target> NAMESPACE <c++ namespace> HEADER <name.h> SOURCES <glsl files...>
+# raybridge_embed_shaders(TARGET <target> NAMESPACE <c++ namespace> HEADER <name.h>
+#                         [SOURCES <glsl files...>] [VARIANTS <rows...>] [BASE_DIR <dir>]
 #                         [INCLUDE_DIRS <dirs...>] [PREBUILT_SPIRV_DIR <dir>] [EXPORT_TARGET <name> EXPORT_DIR <dir>])
 # Generates one header that holds every module as a `constexpr uint32_t` array, so the program that links
-# <target> ships no shader files. The variable name is the file name with '.' replaced by '_'
+# <target> ships no shader files. The variable name is the module name with '.' replaced by '_'
 # (shadow.rgen -> shadow_rgen).
-# By default each GLSL file is compiled with glslangValidator at build time to <file name>.spv (shadow.rgen.spv).
-# With PREBUILT_SPIRV_DIR the modules are read from <dir>/<file name>.spv instead and glslang is not needed; the
-# GLSL files are then only the rebuild trigger when present.
+# A module is either a file of SOURCES, compiled as it is, its stage taken from its extension (shadow.rgen), or a
+# row of VARIANTS: one body compiled with a set of defines. A row is three words,
+#   <module name> <body file> <defines>
+# where the module name's extension is the stage (ao_tiles.rgen -> glslangValidator -S rgen), the body is a GLSL
+# file that starts with its own #version, and the defines are a comma-separated list (NAME or NAME=VALUE, passed
+# as -D in that order) or "-" for none. A row compiles to exactly what a file holding `#version`, those
+# `#define`s and `#include "<body>"` would.
+# Relative SOURCES and bodies are taken from BASE_DIR (default: the current source folder).
+# By default each module is compiled with glslangValidator at build time to <module name>.spv (shadow.rgen.spv);
+# it is rebuilt when its file or body, or any file they include, changes (glslang's depfile).
+# With PREBUILT_SPIRV_DIR the modules are read from <dir>/<module name>.spv instead and glslang is not needed.
 # EXPORT_TARGET adds a target that copies the compiled .spv files into EXPORT_DIR (the input a prebuilt build
 # reads); ${CMAKE_CURRENT_BINARY_DIR}/embedded_shaders/<target>/spirv_files.txt lists them for ExportSpirv.cmake.
 function(raybridge_embed_shaders)
-  cmake_parse_arguments(ARG "" "TARGET;NAMESPACE;HEADER;PREBUILT_SPIRV_DIR;EXPORT_TARGET;EXPORT_DIR"
-                        "SOURCES;INCLUDE_DIRS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TARGET;NAMESPACE;HEADER;BASE_DIR;PREBUILT_SPIRV_DIR;EXPORT_TARGET;EXPORT_DIR"
+                        "SOURCES;VARIANTS;INCLUDE_DIRS" ${ARGN})
+  set(stages vert tesc tese geom frag comp rgen rint rahit rchit rmiss rcall mesh task)  # glslangValidator -S
+  if(NOT ARG_BASE_DIR)
+    set(ARG_BASE_DIR ${CMAKE_CURRENT_SOURCE_DIR})
+  endif()
   set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/embedded_shaders/${ARG_TARGET})
   file(MAKE_DIRECTORY ${out_dir})
   if(NOT ARG_PREBUILT_SPIRV_DIR)
@@ -21,11 +34,46 @@ function(raybridge_embed_shaders)
   foreach(dir ${ARG_INCLUDE_DIRS})
     list(APPEND include_flags -I${dir})
   endforeach()
+
+  # Every module as name, source file and extra glslang flags (the stage and defines of a variant).
+  set(names)
+  foreach(src ${ARG_SOURCES})
+    get_filename_component(name ${src} NAME)
+    get_filename_component(source_${name} ${src} ABSOLUTE BASE_DIR ${ARG_BASE_DIR})
+    set(flags_${name})
+    list(APPEND names ${name})
+  endforeach()
+  list(LENGTH ARG_VARIANTS n)
+  math(EXPR rest "${n} % 3")
+  if(NOT rest EQUAL 0)
+    message(FATAL_ERROR "raybridge_embed_shaders(${ARG_TARGET}): VARIANTS takes rows of three words "
+                        "(<module name> <body> <defines or ->), got ${n} words: ${ARG_VARIANTS}")
+  endif()
+  while(ARG_VARIANTS)
+    list(POP_FRONT ARG_VARIANTS name body defines)
+    if(name IN_LIST names)
+      message(FATAL_ERROR "raybridge_embed_shaders(${ARG_TARGET}): the module ${name} is declared twice")
+    endif()
+    get_filename_component(stage ${name} LAST_EXT)
+    string(SUBSTRING "${stage}" 1 -1 stage)
+    if(NOT stage IN_LIST stages)
+      message(FATAL_ERROR "raybridge_embed_shaders(${ARG_TARGET}): the variant ${name} must end in a stage "
+                          "(${stages})")
+    endif()
+    get_filename_component(source_${name} ${body} ABSOLUTE BASE_DIR ${ARG_BASE_DIR})
+    set(flags_${name} -S ${stage})
+    if(NOT defines STREQUAL "-")
+      string(REPLACE "," ";" defines "${defines}")
+      foreach(define ${defines})
+        list(APPEND flags_${name} -D${define})
+      endforeach()
+    endif()
+    list(APPEND names ${name})
+  endwhile()
+
   set(parts)
   set(spvs)
-  foreach(src ${ARG_SOURCES})
-    get_filename_component(abs ${src} ABSOLUTE)
-    get_filename_component(name ${src} NAME)
+  foreach(name ${names})
     string(REPLACE "." "_" var ${name})
     set(part ${out_dir}/${var}.inc)
     if(ARG_PREBUILT_SPIRV_DIR)
@@ -38,9 +86,9 @@ function(raybridge_embed_shaders)
       set(spv ${out_dir}/${name}.spv)
       add_custom_command(
         OUTPUT ${spv}
-        COMMAND ${GLSLANG_VALIDATOR} --quiet --target-env vulkan1.2 ${include_flags} -o ${spv} --depfile ${spv}.d
-                ${abs}
-        DEPENDS ${abs}
+        COMMAND ${GLSLANG_VALIDATOR} --quiet --target-env vulkan1.2 ${include_flags} ${flags_${name}} -o ${spv}
+                --depfile ${spv}.d ${source_${name}}
+        DEPENDS ${source_${name}}
         DEPFILE ${spv}.d
         COMMENT "glslang ${name}"
         VERBATIM)

@@ -1,3 +1,6 @@
+#version 460
+#extension GL_EXT_ray_tracing : require
+#extension GL_GOOGLE_include_directive : require
 // Ambient occlusion on G-buffer surfaces: n cosine-weighted rays over the hemisphere around the normal,
 // limited to range R. Output = the open fraction AO = (1/pi) * integral of V_R(p, w) cos(theta) dw, estimated
 // as the mean over cosine-weighted directions (1 = fully open).
@@ -5,10 +8,11 @@
 //   distance-weighted: a hit at distance t contributes t / R (occluders fade out towards the range)
 // At half resolution (pc.halfResolution) the launch is one invocation per 2x2 block, each tracing for the pixel of
 // its block that half_resolution.glsl picks this frame and writing the half-resolution image at its own index.
-// Included by ao.rgen (pc.raysPerPixel rays everywhere) and ao_adaptive.rgen (RB_ADAPTIVE_RAYS: each pixel's rays
-// come from the plan of adaptive_rays.glsl; a pixel given none keeps its reprojected history mean), and by
-// ao_tiles.rgen and ao_adaptive_tiles.rgen (RB_AO_TILE_LIST, converged tiles, full resolution only): the launch
-// covers the tile classifier's list (ao_classify.comp); the tiles it left out already hold their outputs.
+// The body of the variants ao.rgen (pc.raysPerPixel rays everywhere) and ao_adaptive.rgen (RB_ADAPTIVE_RAYS: each
+// pixel's rays come from the plan of adaptive_rays.glsl; a pixel given none keeps its reprojected history mean), and
+// of ao_tiles.rgen and ao_adaptive_tiles.rgen (RB_AO_TILE_LIST, converged tiles, full resolution only): the launch
+// covers the tile classifier's list (ao_classify.comp); the tiles it left out already hold their outputs. The
+// variants are rows of shaders/variants.cmake.
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform AoPushConstants { AoConstants pc; };
 #include "half_resolution.glsl"

@@ -1,12 +1,14 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
 // One iteration of the edge-aware a-trous wavelet filter (Dammertz et al. 2010): a 5x5 B3-spline kernel with
 // holes of `step` pixels, whose weights fall off across depth discontinuities (relative view distance), normal
 // creases, and differences of the signal larger than its noise (the SVGF term, Schied et al. 2017, with the
 // variance measured by the temporal pass and carried through the steps): noise within a surface is smoothed,
 // but not silhouettes, and not a shadow or occlusion edge that stands out of the noise. The tolerance follows
 // the centre's noise, so a noise-free pixel (umbra, fully lit, open, many rays) takes nothing from its
-// neighbours. Body of denoise_atrous.comp (intermediate steps: value and variance out) and
+// neighbours. Body of the variants denoise_atrous.comp (intermediate steps: value and variance out) and
 // denoise_atrous_final.comp (RB_DN_ATROUS_FINAL: the output, the temporal value moved at most as far as its
-// noise explains, see rbDnLimitedShift).
+// noise explains, see rbDnLimitedShift), rows of shaders/variants.cmake.
 #include "denoise_noise.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

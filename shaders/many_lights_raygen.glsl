@@ -1,4 +1,8 @@
-// ManyLightPass, step 2 (many_lights.rgen; many_lights_converged.rgen defines RB_ML_CONVERGED_TILES first): the shadowed irradiance of every G-buffer pixel from the lights its tile lists
+#version 460
+#extension GL_EXT_ray_tracing : require
+#extension GL_GOOGLE_include_directive : require
+// ManyLightPass, step 2 (the variants many_lights.rgen and many_lights_converged.rgen, with RB_ML_CONVERGED_TILES;
+// rows of shaders/variants.cmake): the shadowed irradiance of every G-buffer pixel from the lights its tile lists
 // (many_light_pass.h). Stochastic: each ray keeps one light in proportion to its unshadowed luminance among the
 // candidates (all the tile's lights when it lists at most `candidates`, else `candidates` drawn uniformly from its
 // list: resampled importance sampling) and traces one shadow ray to it:
@@ -9,8 +13,6 @@
 // Exact, or a tile with no more lights than rays: one ray per light.
 // With RB_ML_CONVERGED_TILES (ManyLightSettings::convergedTiles) the pixels of the 8x8 tiles that rgb_converged.comp
 // marked converged return at once: they already hold their outputs.
-#ifndef RAYBRIDGE_MANY_LIGHTS_RAYGEN_GLSL
-#define RAYBRIDGE_MANY_LIGHTS_RAYGEN_GLSL
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ManyLightPushConstants { ManyLightConstants pc; };
 #include "light_list.glsl"
@@ -162,5 +164,3 @@ void main() {
   imageStore(outIrradiance, ip, vec4(irradiance, 1.0));
   if (gRays != 0u) rbCountRays(pixel, gRays);
 }
-
-#endif

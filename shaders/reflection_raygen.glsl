@@ -1,5 +1,12 @@
-// The reflection pass's ray generation, shared by reflect.rgen and reflect_reorder.rgen (which defines
-// RB_REFLECTION_REORDER before including it): one source for the rays, only the trace call differs.
+#version 460
+#extension GL_EXT_ray_tracing : require
+#ifdef RB_REFLECTION_REORDER
+#extension GL_NV_shader_invocation_reorder : require
+#endif
+#extension GL_GOOGLE_include_directive : require
+// The reflection pass's ray generation, the body of the variants reflect.rgen and reflect_reorder.rgen (which
+// defines RB_REFLECTION_REORDER), each also with RB_REFLECTION_CONVERGED_TILES (rows of shaders/variants.cmake):
+// one source for the rays, only the trace call differs.
 // Reflection rays from G-buffer surfaces under the roughness threshold: the mirror direction, or for glossy
 // surfaces GGX directions sampled by visible normals (Heitz 2018), weighted by the Smith masking of the
 // reflected direction. Everything rougher, and the sky, traces nothing.
@@ -10,8 +17,6 @@
 // rather than covering a classifier's list of the tiles left, as the shadow and AO passes do: along the perf
 // scene's fly-through, where every tile is traced, the list took the pass from 3.57 to 4.33 ms and this launch to
 // 3.70 ms (NVIDIA H200, docs/performance.md), the same rays.
-#ifndef RAYBRIDGE_REFLECTION_RAYGEN_GLSL
-#define RAYBRIDGE_REFLECTION_RAYGEN_GLSL
 
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ReflectionPushConstants { ReflectionConstants pc; };
@@ -133,5 +138,3 @@ void main() {
   imageStore(outRadiance, target, vec4(sum / float(count), 1.0));
   if (traced != 0u) rbCountRays(pixel, traced);
 }
-
-#endif

@@ -1,9 +1,12 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
 // The shadow pass's tile classifier, one workgroup per 8x8-pixel tile: runs the ray generation shader's own
 // per-pixel test (rbShadowPixel) on every pixel. A tile where no pixel needs a ray gets its outputs here, the values
 // the ray generation shader would have written; any other tile is appended to the tile list, whose trace arguments
 // grow by one tile. With pc.convergedTiles, a tile that needs rays but that shadow_converged.comp marked converged
 // is skipped too (its outputs are already written). Counts the tiles traced and skipped, the converged ones and the
-// rays they saved, for PassStats.
+// rays they saved, for PassStats. The body of the variants shadow_classify.comp and shadow_classify_distance.comp
+// (RB_WRITE_HIT_DISTANCE: the occluder-distance output too), rows of shaders/variants.cmake.
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ShadowPushConstants { ShadowConstants pc; };
 #include "ray_counters.glsl"

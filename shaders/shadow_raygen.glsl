@@ -1,9 +1,13 @@
+#version 460
+#extension GL_EXT_ray_tracing : require
+#extension GL_GOOGLE_include_directive : require
 // Shadow rays from G-buffer surfaces towards a directional, point or spot light. Hard: one ray to the light's
 // centre. Soft: n rays over the light's disk (stratified Fibonacci spiral, rotated per pixel and frame).
 // No ray for sky pixels, surfaces facing away from the light, or pixels outside a spot cone or light range
 // (rbShadowPixel, shared with the tile classifier). With the classifier the launch covers its tile list
 // (pc.launchOverTiles); the tiles it left out already hold their outputs. With RB_ADAPTIVE_RAYS (shadow_adaptive.rgen)
-// each traced pixel's ray count comes from the adaptive plan (adaptive_rays.glsl).
+// each traced pixel's ray count comes from the adaptive plan (adaptive_rays.glsl). The body of the variants
+// shadow.rgen, shadow_distance.rgen and shadow_adaptive.rgen (rows of shaders/variants.cmake).
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ShadowPushConstants { ShadowConstants pc; };
 #include "adaptive_rays.glsl"
@@ -11,7 +15,7 @@ layout(push_constant) uniform ShadowPushConstants { ShadowConstants pc; };
 #include "shadow_pixel.glsl"
 #include "shadow_tiles.glsl"
 
-// RB_WRITE_HIT_DISTANCE (set by shadow_distance.rgen) adds the occluder-distance output. A separate module
+// RB_WRITE_HIT_DISTANCE (set for shadow_distance.rgen) adds the occluder-distance output. A separate module
 // rather than a specialization constant: the binding must not exist at all when the image is not allocated.
 #ifdef RB_WRITE_HIT_DISTANCE
 const bool kWriteHitDistance = true;

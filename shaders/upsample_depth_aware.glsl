@@ -1,3 +1,5 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
 // The depth-aware upsample of a pass traced at half resolution (one sample per 2x2 block, half_resolution.glsl)
 // into its full-resolution output. Each pixel weights the samples of its bilinear footprint (the 2x2 samples
 // around it on this frame's sample grid) by
@@ -8,8 +10,8 @@
 // bleed into the background as a plain bilinear upsample would. Where no footprint sample lies on the pixel's
 // surface (a feature thinner than the sample spacing), the most similar sample of the 3x3 around the nearest one
 // stands in. A pixel a sample was traced for gets that sample exactly (its bilinear weight is 1).
-// Body of upsample_depth_aware_ao.comp (R16F open fraction) and upsample_depth_aware_reflection.comp
-// (RB_UPSAMPLE_REFLECTION: RGBA16F radiance, a = coverage).
+// Body of the variants upsample_depth_aware_ao.comp (R16F open fraction) and upsample_depth_aware_reflection.comp
+// (RB_UPSAMPLE_REFLECTION: RGBA16F radiance, a = coverage), rows of shaders/variants.cmake.
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform UpsamplePushConstants { UpsampleConstants pc; };
 #include "half_resolution.glsl"

@@ -1,7 +1,7 @@
 // minimal_integration: Raybridge in a bare Vulkan program, independent of the sample engine and of
 // rb::HeadlessDevice. It creates its own instance (volk loads Vulkan), device and queue, rasterizes its own
 // G-buffer with dynamic rendering — reversed-Z D32 depth with an infinite far plane, octahedral normals
-// (rbEncodeOctahedral from shaders/raybridge_gbuffer.glsl) and motion vectors of a moving camera — describes
+// (rbEncodeOctahedral from shaders/public/raybridge_gbuffer.glsl) and motion vectors of a moving camera — describes
 // it as an rb::GBufferDesc and lets rb::HybridEffects (preset Low: hard shadows, 4-ray AO, denoised) trace
 // into its own command buffers, two frames in flight. What it proves: the public headers are enough to
 // integrate. main() takes the steps of the quick start (docs/quickstart.md) in order: (1) device, (2) context,
