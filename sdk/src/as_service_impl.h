@@ -1,4 +1,5 @@
-// Internal state of the acceleration-structure service, shared by the BLAS side (as_service.cpp) and the
+// Internal state of the acceleration-structure service, shared by its parts: the BLAS side (as_service.cpp,
+// as_registration.cpp, as_builds.cpp, as_compaction.cpp, as_mesh_state.cpp, as_stats.cpp, dynamic_*.cpp) and the
 // TLAS side (tlas_builder.cpp).
 #pragma once
 
@@ -271,6 +272,20 @@ struct AccelerationStructureService::Impl {
   Status recordDynamicOps(VkCommandBuffer cmd, std::vector<DynamicOp>& ops, bool onAsyncQueue, DynamicSubmission& sub,
                           std::vector<GpuBuffer>& transientScratch);
   void commitDynamicOps(std::vector<DynamicOp>& ops, uint64_t signalValue);
+};
+
+// Held by registerMesh/releaseMesh: the service lock, and the Context's retire queue left alone (see
+// AccelerationStructureService::Impl::deferRetires).
+class RegistrationLock {
+ public:
+  explicit RegistrationLock(AccelerationStructureService::Impl& s) : s_(s), lock_(s.mutex) { s_.deferRetires = true; }
+  ~RegistrationLock() { s_.deferRetires = false; }
+  RegistrationLock(const RegistrationLock&) = delete;
+  RegistrationLock& operator=(const RegistrationLock&) = delete;
+
+ private:
+  AccelerationStructureService::Impl& s_;
+  std::lock_guard<std::mutex> lock_;
 };
 
 // Where a TLAS instance's surface data is, for hit shading (mirrors ShadingRecord in
