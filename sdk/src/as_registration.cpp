@@ -14,9 +14,8 @@ void AccelerationStructureService::Impl::destroyEntry(uint32_t index) {
   BlasEntry& e = entries[index];
   auto it = byKey.find(e.key);
   if (it != byKey.end() && it->second == index) byKey.erase(it);
-  if (e.state == BlasState::Queued) {
-    queue.erase(std::remove(queue.begin(), queue.end(), index), queue.end());
-  }
+  queue.erase(std::remove(queue.begin(), queue.end(), index), queue.end());
+  failedBuilds.erase(std::remove(failedBuilds.begin(), failedBuilds.end(), index), failedBuilds.end());
   if (e.mesh.desc.role == MeshRole::Dynamic) {
     retireCopies(e.dyn.copies);  // `as` only mirrors the newest copy
   } else if (e.as) {
@@ -99,6 +98,12 @@ Result<MeshHandle> AccelerationStructureService::registerMesh(const MeshDesc& de
   bool dedupable = v->desc.role == MeshRole::Static || v->desc.contentKey != 0;
   if (dedupable) {
     if (auto it = s.byKey.find(v->key); it != s.byKey.end()) {
+      // An evicted BLAS is built again for the new registration, if the budget can hold it.
+      if (s.entries[it->second].state == BlasState::Evicted) {
+        if (Status st = s.requeueEvicted(it->second, "registering " + name + " (sharing an evicted BLAS)"); !st) {
+          return st.error();
+        }
+      }
       ++s.counters.dedupHits;
       BlasEntry& shared = s.entries[it->second];
       MeshHandle h = addRegistration(it->second);
@@ -159,8 +164,9 @@ Status AccelerationStructureService::releaseMesh(MeshHandle mesh) {
     return {};
   }
   bool cacheable = s.byKey.count(entry.key) && s.byKey[entry.key] == index;
-  if (entry.state == BlasState::Queued || !cacheable) {
-    // Nothing to gain from keeping it: never built, or (dynamic) no registration can ever match it again.
+  if (entry.state != BlasState::Built || !cacheable) {
+    // Nothing to gain from keeping it: not built (queued, failed or evicted), or (dynamic) no registration can ever
+    // match it again.
     s.destroyEntry(index);
   } else {
     entry.releasedOrder = ++s.releaseCounter;

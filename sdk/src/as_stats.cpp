@@ -26,11 +26,15 @@ AsStats AccelerationStructureService::stats() const {
   out.meshHandles = s.liveRegistrations();
   out.nonOpaqueMeshes = 0;
   for (const Registration& r : s.registrations) out.nonOpaqueMeshes += r.live && r.mesh.desc.nonOpaque;
-  out.blasCount = out.blasQueued = 0;
+  out.blasCount = out.blasQueued = out.blasFailed = out.blasEvicted = 0;
   out.triangles = out.blasBytes = out.blasBytesBeforeCompaction = out.dynamicBlasBytes = 0;
   for (uint32_t i = 1; i < s.entries.size(); ++i) {
     const BlasEntry& e = s.entries[i];
     if (e.state == BlasState::Free) continue;
+    if (e.state == BlasState::Failed || e.state == BlasState::Evicted) {
+      ++(e.state == BlasState::Failed ? out.blasFailed : out.blasEvicted);
+      continue;
+    }
     ++out.blasCount;
     if (e.state == BlasState::Queued) {
       ++out.blasQueued;

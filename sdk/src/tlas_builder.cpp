@@ -170,7 +170,7 @@ VkAccelerationStructureInstanceKHR vulkanInstance(const Instance& in, const Tlas
 
 // What writeInstances wrote into the slot's buffers.
 struct WrittenInstances {
-  uint32_t written = 0, skipped = 0, stale = 0, nonOpaque = 0;
+  uint32_t written = 0, skipped = 0, failed = 0, stale = 0, nonOpaque = 0;
   uint64_t signature = 0;  // hash of the BLAS addresses in order (TlasSlot::blasSignature)
 };
 
@@ -188,6 +188,16 @@ VkDeviceAddress blasForInstance(Impl& s, BlasEntry& e, uint32_t& stale) {
   return copy.address;
 }
 
+// An evicted mesh a TLAS references is built again: Queued, or Failed when the budget cannot hold it.
+void requeueForTlas(Impl& s, uint32_t index) {
+  const std::string what = "recordTlasBuild: re-queuing the build of the evicted " + s.meshName(s.entries[index]);
+  if (Status st = s.requeueEvicted(index, what); !st) {
+    Error e = st.error();
+    e.message += "; until then TLAS builds leave it out (TlasInfo::failedInstances) and recordPendingWork retries it";
+    s.markBuildFailed(index, std::move(e));
+  }
+}
+
 // Writes the instances of built meshes (and their shading records) into the slot's host-visible buffers, the
 // transforms for the Adaptive measure into s.tlasTransforms, and marks the BLASes used by TLAS `serial`.
 WrittenInstances writeInstances(Impl& s, TlasSlot& slot, std::span<const Instance> instances,
@@ -202,6 +212,11 @@ WrittenInstances writeInstances(Impl& s, TlasSlot& slot, std::span<const Instanc
   for (const Instance& in : instances) {
     const Registration& reg = s.registrations[in.mesh.index];
     BlasEntry& e = s.entries[reg.blas];
+    if (e.state == BlasState::Evicted) requeueForTlas(s, reg.blas);
+    if (e.state == BlasState::Failed) {
+      ++w.failed;
+      continue;
+    }
     const VkDeviceAddress blas = blasForInstance(s, e, w.stale);
     if (blas == 0) {
       ++w.skipped;
@@ -432,6 +447,7 @@ Result<TlasInfo> AccelerationStructureService::recordTlasBuild(VkCommandBuffer c
   result.address = c.vk.vkGetAccelerationStructureDeviceAddressKHR(c.desc.device, &ai);
   result.instanceCount = w.written;
   result.skippedInstances = w.skipped;
+  result.failedInstances = w.failed;
   result.nonOpaqueInstances = w.nonOpaque;
   result.updated = source != nullptr;
   result.areaGrowth = growth;
