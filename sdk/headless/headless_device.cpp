@@ -78,6 +78,14 @@ struct HeadlessDevice::Impl {
     return VK_FALSE;
   }
 
+  // The steps of HeadlessDevice::create, in order.
+  Status openLoader();
+  Status createInstance(const HeadlessDeviceDesc& desc);
+  Status pickPhysicalDevice(const HeadlessDeviceDesc& desc);
+  Status pickQueueFamilies(const HeadlessDeviceDesc& desc);
+  Status createDevice(const HeadlessDeviceDesc& desc);
+  Status createCommandPool();
+
   ~Impl() {
     if (device) {
       dp<PFN_vkDeviceWaitIdle>("vkDeviceWaitIdle")(device);
@@ -92,19 +100,23 @@ struct HeadlessDevice::Impl {
   }
 };
 
-Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDeviceDesc& desc) {
-  auto impl = std::make_unique<Impl>();
-  impl->framesInFlight = desc.framesInFlight ? desc.framesInFlight : 2;
-  // The loader is opened at run time so neither the SDK nor its users link libvulkan at build time.
-  impl->loader = dlopen("libvulkan.so.1", RTLD_NOW | RTLD_LOCAL);
-  if (!impl->loader) impl->loader = dlopen("libvulkan.so", RTLD_NOW | RTLD_LOCAL);
-  if (!impl->loader) {
+// The loader is opened at run time so neither the SDK nor its users link libvulkan at build time.
+Status HeadlessDevice::Impl::openLoader() {
+  loader = dlopen("libvulkan.so.1", RTLD_NOW | RTLD_LOCAL);
+  if (!loader) loader = dlopen("libvulkan.so", RTLD_NOW | RTLD_LOCAL);
+  if (!loader) {
     return Error{ErrorCode::NoSuitableDevice, VK_SUCCESS,
                  "the Vulkan loader libvulkan.so.1 was not found; install Debian's libvulkan1 (scripts/setup.sh)"};
   }
-  impl->gipa = reinterpret_cast<PFN_vkGetInstanceProcAddr>(dlsym(impl->loader, "vkGetInstanceProcAddr"));
-  auto createInstance = impl->ip<PFN_vkCreateInstance>("vkCreateInstance");
-  auto enumerateLayers = impl->ip<PFN_vkEnumerateInstanceLayerProperties>("vkEnumerateInstanceLayerProperties");
+  gipa = reinterpret_cast<PFN_vkGetInstanceProcAddr>(dlsym(loader, "vkGetInstanceProcAddr"));
+  return {};
+}
+
+// The instance, with the validation layer, synchronization validation and the error-counting messenger when
+// validation is asked for (desc or RAYBRIDGE_VALIDATION) and installed.
+Status HeadlessDevice::Impl::createInstance(const HeadlessDeviceDesc& desc) {
+  auto createInstanceFn = ip<PFN_vkCreateInstance>("vkCreateInstance");
+  auto enumerateLayers = ip<PFN_vkEnumerateInstanceLayerProperties>("vkEnumerateInstanceLayerProperties");
 
   bool wantValidation = desc.enableValidation || envFlag("RAYBRIDGE_VALIDATION");
   bool haveLayer = false;
@@ -123,13 +135,13 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
     }
     std::fprintf(stderr, "raybridge: validation requested but VK_LAYER_KHRONOS_validation is missing; continuing\n");
   }
-  impl->validation = wantValidation && haveLayer;
+  validation = wantValidation && haveLayer;
 
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "raybridge-headless";
   app.apiVersion = kHeadlessApiVersion;
   std::vector<const char*> layers, extensions;
-  if (impl->validation) {
+  if (validation) {
     layers.push_back("VK_LAYER_KHRONOS_validation");
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   }
@@ -140,32 +152,37 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
                               VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                               VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
   messengerInfo.pfnUserCallback = &Impl::onMessage;
-  messengerInfo.pUserData = impl.get();
+  messengerInfo.pUserData = this;
   VkValidationFeatureEnableEXT syncValidation = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
   VkValidationFeaturesEXT validationFeatures{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT, &messengerInfo};
   validationFeatures.enabledValidationFeatureCount = 1;
   validationFeatures.pEnabledValidationFeatures = &syncValidation;
   VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-  ici.pNext = impl->validation ? &validationFeatures : nullptr;
+  ici.pNext = validation ? &validationFeatures : nullptr;
   ici.pApplicationInfo = &app;
   ici.enabledLayerCount = static_cast<uint32_t>(layers.size());
   ici.ppEnabledLayerNames = layers.data();
   ici.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
   ici.ppEnabledExtensionNames = extensions.data();
-  VkResult r = createInstance(&ici, nullptr, &impl->instance);
+  VkResult r = createInstanceFn(&ici, nullptr, &instance);
   if (r != VK_SUCCESS) return vulkanError(r, "vkCreateInstance");
-  if (impl->validation) {
-    impl->ip<PFN_vkCreateDebugUtilsMessengerEXT>("vkCreateDebugUtilsMessengerEXT")(impl->instance, &messengerInfo,
-                                                                                   nullptr, &impl->messenger);
+  if (validation) {
+    ip<PFN_vkCreateDebugUtilsMessengerEXT>("vkCreateDebugUtilsMessengerEXT")(instance, &messengerInfo, nullptr,
+                                                                             &messenger);
   }
+  return {};
+}
 
-  auto enumerateDevices = impl->ip<PFN_vkEnumeratePhysicalDevices>("vkEnumeratePhysicalDevices");
-  auto getProps = impl->ip<PFN_vkGetPhysicalDeviceProperties>("vkGetPhysicalDeviceProperties");
-  auto enumerateExts = impl->ip<PFN_vkEnumerateDeviceExtensionProperties>("vkEnumerateDeviceExtensionProperties");
+// The best device (discrete, then integrated, then any) with every required extension whose name contains the
+// filter (desc, else RAYBRIDGE_DEVICE).
+Status HeadlessDevice::Impl::pickPhysicalDevice(const HeadlessDeviceDesc& desc) {
+  auto enumerateDevices = ip<PFN_vkEnumeratePhysicalDevices>("vkEnumeratePhysicalDevices");
+  auto getProps = ip<PFN_vkGetPhysicalDeviceProperties>("vkGetPhysicalDeviceProperties");
+  auto enumerateExts = ip<PFN_vkEnumerateDeviceExtensionProperties>("vkEnumerateDeviceExtensionProperties");
   uint32_t count = 0;
-  enumerateDevices(impl->instance, &count, nullptr);
+  enumerateDevices(instance, &count, nullptr);
   std::vector<VkPhysicalDevice> devices(count);
-  enumerateDevices(impl->instance, &count, devices.data());
+  enumerateDevices(instance, &count, devices.data());
 
   std::string filter = desc.deviceNameFilter ? desc.deviceNameFilter : "";
   if (filter.empty() && std::getenv("RAYBRIDGE_DEVICE")) filter = std::getenv("RAYBRIDGE_DEVICE");
@@ -192,47 +209,56 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
                                                                          : 1;
     if (score > bestScore) {
       bestScore = score;
-      impl->physicalDevice = pd;
-      impl->name = p.deviceName;
+      physicalDevice = pd;
+      name = p.deviceName;
     }
   }
-  if (!impl->physicalDevice) {
+  if (!physicalDevice) {
     std::string why = filter.empty() ? "no device supports ray tracing pipelines"
                                      : "no device whose name contains '" + filter + "' supports ray tracing pipelines";
     return Error{ErrorCode::NoSuitableDevice, VK_SUCCESS,
                  why + " (devices: " + (seen.empty() ? "none" : seen) +
                      "). Install Mesa 25 lavapipe from bookworm-backports (scripts/setup.sh) or set RAYBRIDGE_DEVICE"};
   }
+  return {};
+}
 
-  auto queueProps = impl->ip<PFN_vkGetPhysicalDeviceQueueFamilyProperties>("vkGetPhysicalDeviceQueueFamilyProperties");
+// The first graphics+compute family; with desc.requestAsyncComputeQueue also a compute-only one.
+Status HeadlessDevice::Impl::pickQueueFamilies(const HeadlessDeviceDesc& desc) {
+  auto queueProps = ip<PFN_vkGetPhysicalDeviceQueueFamilyProperties>("vkGetPhysicalDeviceQueueFamilyProperties");
   uint32_t familyCount = 0;
-  queueProps(impl->physicalDevice, &familyCount, nullptr);
+  queueProps(physicalDevice, &familyCount, nullptr);
   std::vector<VkQueueFamilyProperties> families(familyCount);
-  queueProps(impl->physicalDevice, &familyCount, families.data());
+  queueProps(physicalDevice, &familyCount, families.data());
   bool foundFamily = false;
   for (uint32_t i = 0; i < familyCount; ++i) {
     if ((families[i].queueFlags & (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) ==
         (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) {
-      impl->queueFamily = i;
+      queueFamily = i;
       foundFamily = true;
       break;
     }
   }
   if (!foundFamily) {
-    return Error{ErrorCode::NoSuitableDevice, VK_SUCCESS, "device '" + impl->name + "' has no graphics+compute queue"};
+    return Error{ErrorCode::NoSuitableDevice, VK_SUCCESS, "device '" + name + "' has no graphics+compute queue"};
   }
   if (desc.requestAsyncComputeQueue) {
     // A compute-only family; among several, one that can write timestamps.
     for (uint32_t i = 0; i < familyCount; ++i) {
       const VkQueueFlags f = families[i].queueFlags;
       if (!(f & VK_QUEUE_COMPUTE_BIT) || (f & VK_QUEUE_GRAPHICS_BIT) || families[i].queueCount == 0) continue;
-      if (impl->asyncFamily == UINT32_MAX ||
-          (families[impl->asyncFamily].timestampValidBits == 0 && families[i].timestampValidBits != 0)) {
-        impl->asyncFamily = i;
+      if (asyncFamily == UINT32_MAX ||
+          (families[asyncFamily].timestampValidBits == 0 && families[i].timestampValidBits != 0)) {
+        asyncFamily = i;
       }
     }
   }
+  return {};
+}
 
+// The device with the required features and extensions (and invocation reorder where supported and not
+// disabled), its queues and memory properties.
+Status HeadlessDevice::Impl::createDevice(const HeadlessDeviceDesc& desc) {
   RequiredFeatures required;
   VkPhysicalDeviceVulkan13Features v13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   v13.synchronization2 = VK_TRUE;
@@ -243,43 +269,56 @@ Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDev
   float priority = 1.0f;
   VkDeviceQueueCreateInfo qci[2] = {{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO},
                                     {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO}};
-  qci[0].queueFamilyIndex = impl->queueFamily;
+  qci[0].queueFamilyIndex = queueFamily;
   qci[0].queueCount = 1;
   qci[0].pQueuePriorities = &priority;
-  qci[1].queueFamilyIndex = impl->asyncFamily;
+  qci[1].queueFamilyIndex = asyncFamily;
   qci[1].queueCount = 1;
   qci[1].pQueuePriorities = &priority;
   std::vector<const char*> ext(requiredDeviceExtensions().begin(), requiredDeviceExtensions().end());
   // Optional features last in the chain: the feature struct of an extension is only chained with the extension.
   OptionalFeatures optional;
-  impl->invocationReorder = !desc.disableInvocationReorder &&
-                            supportsInvocationReorder(impl->instance, impl->physicalDevice, impl->gipa);
-  if (impl->invocationReorder) {
+  invocationReorder = !desc.disableInvocationReorder && supportsInvocationReorder(instance, physicalDevice, gipa);
+  if (invocationReorder) {
     ext.push_back(kInvocationReorderExtension);
     optional.invocationReorder.pNext = features.pNext;
     features.pNext = &optional.invocationReorder;
   }
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features};
-  dci.queueCreateInfoCount = impl->asyncFamily == UINT32_MAX ? 1 : 2;
+  dci.queueCreateInfoCount = asyncFamily == UINT32_MAX ? 1 : 2;
   dci.pQueueCreateInfos = qci;
   dci.enabledExtensionCount = static_cast<uint32_t>(ext.size());
   dci.ppEnabledExtensionNames = ext.data();
-  r = impl->ip<PFN_vkCreateDevice>("vkCreateDevice")(impl->physicalDevice, &dci, nullptr, &impl->device);
-  if (r != VK_SUCCESS) return vulkanError(r, "vkCreateDevice on '" + impl->name + "'");
-  impl->gdpa = impl->ip<PFN_vkGetDeviceProcAddr>("vkGetDeviceProcAddr");
-  impl->dp<PFN_vkGetDeviceQueue>("vkGetDeviceQueue")(impl->device, impl->queueFamily, 0, &impl->queue);
-  if (impl->asyncFamily != UINT32_MAX) {
-    impl->dp<PFN_vkGetDeviceQueue>("vkGetDeviceQueue")(impl->device, impl->asyncFamily, 0, &impl->asyncQueue);
-    impl->bufferFamilies = {impl->queueFamily, impl->asyncFamily};
+  VkResult r = ip<PFN_vkCreateDevice>("vkCreateDevice")(physicalDevice, &dci, nullptr, &device);
+  if (r != VK_SUCCESS) return vulkanError(r, "vkCreateDevice on '" + name + "'");
+  gdpa = ip<PFN_vkGetDeviceProcAddr>("vkGetDeviceProcAddr");
+  dp<PFN_vkGetDeviceQueue>("vkGetDeviceQueue")(device, queueFamily, 0, &queue);
+  if (asyncFamily != UINT32_MAX) {
+    dp<PFN_vkGetDeviceQueue>("vkGetDeviceQueue")(device, asyncFamily, 0, &asyncQueue);
+    bufferFamilies = {queueFamily, asyncFamily};
   }
-  impl->ip<PFN_vkGetPhysicalDeviceMemoryProperties>("vkGetPhysicalDeviceMemoryProperties")(impl->physicalDevice,
-                                                                                           &impl->memoryProperties);
+  ip<PFN_vkGetPhysicalDeviceMemoryProperties>("vkGetPhysicalDeviceMemoryProperties")(physicalDevice, &memoryProperties);
+  return {};
+}
 
+Status HeadlessDevice::Impl::createCommandPool() {
   VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pci.queueFamilyIndex = impl->queueFamily;
-  r = impl->dp<PFN_vkCreateCommandPool>("vkCreateCommandPool")(impl->device, &pci, nullptr, &impl->pool);
+  pci.queueFamilyIndex = queueFamily;
+  VkResult r = dp<PFN_vkCreateCommandPool>("vkCreateCommandPool")(device, &pci, nullptr, &pool);
   if (r != VK_SUCCESS) return vulkanError(r, "vkCreateCommandPool");
+  return {};
+}
+
+Result<std::unique_ptr<HeadlessDevice>> HeadlessDevice::create(const HeadlessDeviceDesc& desc) {
+  auto impl = std::make_unique<Impl>();
+  impl->framesInFlight = desc.framesInFlight ? desc.framesInFlight : 2;
+  if (Status st = impl->openLoader(); !st) return st.error();
+  if (Status st = impl->createInstance(desc); !st) return st.error();
+  if (Status st = impl->pickPhysicalDevice(desc); !st) return st.error();
+  if (Status st = impl->pickQueueFamilies(desc); !st) return st.error();
+  if (Status st = impl->createDevice(desc); !st) return st.error();
+  if (Status st = impl->createCommandPool(); !st) return st.error();
   return std::unique_ptr<HeadlessDevice>(new HeadlessDevice(std::move(impl)));
 }
 

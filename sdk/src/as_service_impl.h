@@ -1,4 +1,5 @@
-// Internal state of the acceleration-structure service, shared by the BLAS side (as_service.cpp) and the
+// Internal state of the acceleration-structure service, shared by its parts: the BLAS side (as_service.cpp,
+// as_registration.cpp, as_builds.cpp, as_compaction.cpp, as_mesh_state.cpp, as_stats.cpp, dynamic_*.cpp) and the
 // TLAS side (tlas_builder.cpp).
 #pragma once
 
@@ -26,9 +27,11 @@ namespace rb {
 constexpr size_t kMaxBatchTimings = 64;  // AsStats::batches keeps the most recent ones
 
 enum class BlasState : uint8_t {
-  Free,    // slot unused (its generation is bumped on reuse)
-  Queued,  // registered, build not yet recorded
-  Built,   // build recorded; usable by TLAS builds recorded after it
+  Free,     // slot unused (its generation is bumped on reuse)
+  Queued,   // registered, build not yet recorded
+  Built,    // build recorded; usable by TLAS builds recorded after it
+  Failed,   // static only: its latest build attempt failed (BlasEntry::failure); in failedBuilds or the queue
+  Evicted,  // static only: evictMesh freed its BLAS; registrations keep it, it holds no storage nor budget
 };
 
 // One copy of a dynamic BLAS; the copies of a mesh form a ring (see DynamicBuildMode).
@@ -85,6 +88,7 @@ struct BlasEntry {
   uint64_t lastUsedFrame = 0;   // frame of the last TLAS that referenced it
   uint64_t lastTlasSerial = 0;  // serial of the last TLAS that referenced it
   uint64_t releasedOrder = 0;   // LRU order among released entries
+  Error failure;                // BlasState::Failed: why (MeshStatus::error)
 };
 
 // One registerMesh call: what a MeshHandle names. Registrations of equal geometry share one BlasEntry but
@@ -188,7 +192,9 @@ struct AccelerationStructureService::Impl {
   std::vector<uint32_t> freeRegistrations;
   std::unordered_map<uint64_t, uint32_t> byKey;
   std::deque<uint32_t> queue;  // entry indices waiting for a build, in registration order
-  GpuBuffer scratch;           // persistent build scratch (scratchBudgetBytes)
+  // Failed entries waiting for their retry: the next recordPendingWork moves them to the back of `queue`.
+  std::vector<uint32_t> failedBuilds;
+  GpuBuffer scratch;  // persistent build scratch (scratchBudgetBytes)
   std::vector<BuildBatch> inFlightBatches;
   std::vector<VkQueryPool> freeTimestampPools;
   std::vector<BuildBatchTiming> timings;
@@ -232,13 +238,27 @@ struct AccelerationStructureService::Impl {
   uint32_t liveRegistrations() const;
   void destroyEntry(uint32_t index);  // retires its AS and storage; frees the slot
   Status makeRoom(VkDeviceSize bytes, const std::string& forWhat);
+  // Mesh states (as_mesh_state.cpp).
+  std::string meshName(const BlasEntry& e) const;  // "mesh 'name'", or the handle of its source registration
+  // Failed with `error` (the message as given), waiting in failedBuilds for the next recordPendingWork.
+  void markBuildFailed(uint32_t index, Error error);
+  // Frees the entry's BLAS (retired: frames in flight keep it) and its budget: BlasState::Evicted.
+  void evictEntry(uint32_t index);
+  // Evicted -> Queued, reserving its storage against the budget (makeRoom's error when it cannot).
+  Status requeueEvicted(uint32_t index, const std::string& forWhat);
+  // Moves the failed builds to the back of the queue (those failed for the budget reserve again first, or stay
+  // Failed with the new error, kept in `failure` when it is the first of the call).
+  void retryFailedBuilds(Status& failure);
   // Reads the queries of the batches whose frames are done, and releases them. A failed read (a lost device) is
   // kept in queryError, which the next recordPendingWork() returns.
   void resolveBatches();
   void addTiming(const BuildBatchTiming& timing);
   Status recordCompactions(VkCommandBuffer cmd, bool& recordedAny);
+  // Records one batch of builds. A mesh whose BLAS cannot be created is marked Failed and left out (the first
+  // such error goes to `meshFailure`); any other failure puts the batch back at the front of the queue and is
+  // returned.
   Status recordBuildBatch(VkCommandBuffer cmd, std::vector<uint32_t>& batch, VkDeviceSize scratchBytes,
-                          bool& recordedAny);
+                          bool& recordedAny, Status& meshFailure);
   Result<VkAccelerationStructureKHR> createAs(VkAccelerationStructureTypeKHR type, VkBuffer buffer, VkDeviceSize offset,
                                               VkDeviceSize size);
   void buildGeometry(const BlasEntry& e, VkAccelerationStructureGeometryKHR& geometry,
@@ -271,6 +291,20 @@ struct AccelerationStructureService::Impl {
   Status recordDynamicOps(VkCommandBuffer cmd, std::vector<DynamicOp>& ops, bool onAsyncQueue, DynamicSubmission& sub,
                           std::vector<GpuBuffer>& transientScratch);
   void commitDynamicOps(std::vector<DynamicOp>& ops, uint64_t signalValue);
+};
+
+// Held by registerMesh/releaseMesh: the service lock, and the Context's retire queue left alone (see
+// AccelerationStructureService::Impl::deferRetires).
+class RegistrationLock {
+ public:
+  explicit RegistrationLock(AccelerationStructureService::Impl& s) : s_(s), lock_(s.mutex) { s_.deferRetires = true; }
+  ~RegistrationLock() { s_.deferRetires = false; }
+  RegistrationLock(const RegistrationLock&) = delete;
+  RegistrationLock& operator=(const RegistrationLock&) = delete;
+
+ private:
+  AccelerationStructureService::Impl& s_;
+  std::lock_guard<std::mutex> lock_;
 };
 
 // Where a TLAS instance's surface data is, for hit shading (mirrors ShadingRecord in

@@ -12,7 +12,6 @@ namespace rb {
 
 namespace {
 
-
 struct RebuildCandidate {
   uint32_t entry;
   double ratio;
@@ -143,83 +142,104 @@ Result<std::vector<DynamicOp>> AccelerationStructureService::Impl::planDynamicWo
   return ops;
 }
 
-Status AccelerationStructureService::Impl::recordDynamicOps(VkCommandBuffer cmd, std::vector<DynamicOp>& ops,
-                                                            bool onAsyncQueue, DynamicSubmission& sub,
-                                                            std::vector<GpuBuffer>& transientScratch) {
-  const VkDeviceSize align = scratchAlignment();
+namespace {
 
-  // Everything that can fail comes first, so that a failure leaves nothing recorded: the readback of the
-  // cluster measure (one float per cluster of every measured mesh), scratch, the timestamp queries.
-  uint32_t clusters = 0;
+using Impl = AccelerationStructureService::Impl;
+
+// The readback of the cluster measure: one float per cluster of every measured mesh (`clusters` in all).
+Status prepareMeasureReadback(Impl& s, const std::vector<DynamicOp>& ops, DynamicSubmission& sub, uint32_t& clusters) {
+  clusters = 0;
   for (const DynamicOp& op : ops) {
-    if (op.measure) clusters += ClusterBoundsPass::clusterCount(entries[op.entry].mesh.desc.triangleCount);
+    if (op.measure) clusters += ClusterBoundsPass::clusterCount(s.entries[op.entry].mesh.desc.triangleCount);
   }
-  if (clusters > 0) {
-    if (!clusterBoundsCreated) {
-      if (Status st = clusterBounds.create(ctx); !st) return st;
-      clusterBoundsCreated = true;
-    }
-    const VkDeviceSize bytes = VkDeviceSize(clusters) * sizeof(float);
-    auto fit = std::find_if(freeReadbacks.begin(), freeReadbacks.end(),
-                            [&](const GpuBuffer& b) { return b.size >= bytes; });
-    if (fit != freeReadbacks.end()) {
-      sub.readback = *fit;
-      freeReadbacks.erase(fit);
-    } else {
-      Result<GpuBuffer> b = createBuffer(ctx, std::max<VkDeviceSize>(bytes, 4096),
-                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                                         MemoryLocation::HostVisible, MemoryCategory::Scratch,
-                                         "dynamic BLAS cluster measure readback");
-      if (!b) return b.error();
-      sub.readback = b.value();
-    }
+  if (clusters == 0) return {};
+  if (!s.clusterBoundsCreated) {
+    if (Status st = s.clusterBounds.create(s.ctx); !st) return st;
+    s.clusterBoundsCreated = true;
   }
+  const VkDeviceSize bytes = VkDeviceSize(clusters) * sizeof(float);
+  auto fit = std::find_if(s.freeReadbacks.begin(), s.freeReadbacks.end(),
+                          [&](const GpuBuffer& b) { return b.size >= bytes; });
+  if (fit != s.freeReadbacks.end()) {
+    sub.readback = *fit;
+    s.freeReadbacks.erase(fit);
+    return {};
+  }
+  Result<GpuBuffer> b = createBuffer(s.ctx, std::max<VkDeviceSize>(bytes, 4096),
+                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                                     MemoryLocation::HostVisible, MemoryCategory::Scratch,
+                                     "dynamic BLAS cluster measure readback");
+  if (!b) return b.error();
+  sub.readback = b.value();
+  return {};
+}
 
-  std::vector<VkAccelerationStructureGeometryKHR> geometries(ops.size());
-  std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges(ops.size());
-  std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> rangePtrs(ops.size());
-  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos(ops.size());
-  std::vector<VkDeviceSize> scratchNeed(ops.size());
+// The build (or refit) description of every op, and the scratch each needs.
+struct DynamicBuildInfos {
+  std::vector<VkAccelerationStructureGeometryKHR> geometries;
+  std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges;
+  std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> rangePtrs;
+  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos;
+  std::vector<VkDeviceSize> scratchNeed;
+};
+
+void fillDynamicBuildInfos(const Impl& s, const std::vector<DynamicOp>& ops, DynamicBuildInfos& b,
+                           DynamicSubmission& sub) {
+  const VkDeviceSize align = s.scratchAlignment();
+  b.geometries.resize(ops.size());
+  b.ranges.resize(ops.size());
+  b.rangePtrs.resize(ops.size());
+  b.infos.resize(ops.size());
+  b.scratchNeed.resize(ops.size());
   for (size_t i = 0; i < ops.size(); ++i) {
     const DynamicOp& op = ops[i];
-    const BlasEntry& e = entries[op.entry];
+    const BlasEntry& e = s.entries[op.entry];
     const std::vector<BlasCopy>& copies = op.replacement.empty() ? e.dyn.copies : op.replacement;
     const bool refit = op.kind == DynamicOp::Refit;
-    buildGeometry(e, geometries[i], ranges[i]);
-    rangePtrs[i] = &ranges[i];
-    VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
+    s.buildGeometry(e, b.geometries[i], b.ranges[i]);
+    b.rangePtrs[i] = &b.ranges[i];
+    VkAccelerationStructureBuildGeometryInfoKHR& info = b.infos[i];
     info = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
     info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-    info.flags = blasFlags(e);
+    info.flags = s.blasFlags(e);
     info.mode = refit ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR
                       : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
     info.srcAccelerationStructure = refit ? copies[op.src].as : VK_NULL_HANDLE;
     info.dstAccelerationStructure = copies[op.dst].as;
     info.geometryCount = 1;
-    info.pGeometries = &geometries[i];
-    scratchNeed[i] = alignUp(refit ? e.sizes.updateScratchSize : e.sizes.buildScratchSize, align);
+    info.pGeometries = &b.geometries[i];
+    b.scratchNeed[i] = alignUp(refit ? e.sizes.updateScratchSize : e.sizes.buildScratchSize, align);
     sub.triangles += e.mesh.desc.triangleCount;
   }
   sub.builds = static_cast<uint32_t>(ops.size());
+}
 
-  // Batches whose scratch fits the budget; one BLAS that alone needs more gets transient scratch.
-  struct Batch {
-    size_t end;
-    VkDeviceSize bytes;
-    VkDeviceAddress transientBase;  // 0 = the shared scratch
-  };
+// Consecutive ops whose scratch is one region: the shared scratch, or transient scratch for a BLAS that alone
+// needs more than the budget.
+struct ScratchBatch {
+  size_t end;
+  VkDeviceSize bytes;
+  VkDeviceAddress transientBase;  // 0 = the shared scratch
+};
+
+// Packs the ops into batches whose scratch fits the budget, creates the scratch they need and points each build
+// at its share.
+Result<std::vector<ScratchBatch>> placeDynamicScratch(Impl& s, DynamicBuildInfos& b, bool onAsyncQueue,
+                                                      std::vector<GpuBuffer>& transientScratch) {
+  const VkDeviceSize align = s.scratchAlignment();
+  const VkDeviceSize budget = s.desc.scratchBudgetBytes;
   const VkBufferUsageFlags scratchUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                           VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
-  std::vector<Batch> batches;
+  std::vector<ScratchBatch> batches;
   VkDeviceSize largestShared = 0;
-  for (size_t begin = 0; begin < ops.size();) {
-    Batch batch{begin, 0, 0};
-    while (batch.end < ops.size() &&
-           (batch.end == begin || batch.bytes + scratchNeed[batch.end] <= desc.scratchBudgetBytes)) {
-      batch.bytes += scratchNeed[batch.end++];
+  const size_t count = b.infos.size();
+  for (size_t begin = 0; begin < count;) {
+    ScratchBatch batch{begin, 0, 0};
+    while (batch.end < count && (batch.end == begin || batch.bytes + b.scratchNeed[batch.end] <= budget)) {
+      batch.bytes += b.scratchNeed[batch.end++];
     }
-    if (batch.bytes > desc.scratchBudgetBytes) {
-      Result<GpuBuffer> t = createBuffer(ctx, batch.bytes + align, scratchUsage, MemoryLocation::DeviceLocal,
+    if (batch.bytes > budget) {
+      Result<GpuBuffer> t = createBuffer(s.ctx, batch.bytes + align, scratchUsage, MemoryLocation::DeviceLocal,
                                          MemoryCategory::Scratch, "oversized dynamic BLAS scratch");
       if (!t) return t.error();
       transientScratch.push_back(t.value());
@@ -233,29 +253,74 @@ Status AccelerationStructureService::Impl::recordDynamicOps(VkCommandBuffer cmd,
   VkDeviceAddress sharedBase = 0;
   if (largestShared > 0) {
     // The async queue has scratch of its own (exclusive to its family), grown to what its batches need.
-    GpuBuffer& buffer = onAsyncQueue ? asyncScratch : scratch;
+    GpuBuffer& buffer = onAsyncQueue ? s.asyncScratch : s.scratch;
     if (!buffer.valid() || buffer.size < largestShared + align) {
       if (buffer.valid()) {
         GpuBuffer old = buffer;
-        Context* context = &ctx;
-        retireAfterAsync([context, old]() mutable { destroyBuffer(*context, old); });
+        Context* context = &s.ctx;
+        s.retireAfterAsync([context, old]() mutable { destroyBuffer(*context, old); });
         buffer = GpuBuffer{};
       }
-      Result<GpuBuffer> t = createBuffer(ctx, (onAsyncQueue ? largestShared : desc.scratchBudgetBytes) + align,
-                                         scratchUsage, MemoryLocation::DeviceLocal, MemoryCategory::Scratch,
+      Result<GpuBuffer> t = createBuffer(s.ctx, (onAsyncQueue ? largestShared : budget) + align, scratchUsage,
+                                         MemoryLocation::DeviceLocal, MemoryCategory::Scratch,
                                          onAsyncQueue ? "async BLAS build scratch" : "BLAS build scratch");
       if (!t) return t.error();
       buffer = t.value();
     }
     sharedBase = alignUp(buffer.address, align);
   }
-  for (size_t b = 0, begin = 0; b < batches.size(); begin = batches[b++].end) {
-    VkDeviceAddress address = batches[b].transientBase ? batches[b].transientBase : sharedBase;
-    for (size_t i = begin; i < batches[b].end; ++i) {
-      infos[i].scratchData.deviceAddress = address;
-      address += scratchNeed[i];
+  for (size_t k = 0, begin = 0; k < batches.size(); begin = batches[k++].end) {
+    VkDeviceAddress address = batches[k].transientBase ? batches[k].transientBase : sharedBase;
+    for (size_t i = begin; i < batches[k].end; ++i) {
+      b.infos[i].scratchData.deviceAddress = address;
+      address += b.scratchNeed[i];
     }
   }
+  return batches;
+}
+
+// The measure reads the same vertices as the builds, before them; its results go to the host.
+void recordClusterMeasures(Impl& s, VkCommandBuffer cmd, const std::vector<DynamicOp>& ops, uint32_t clusters,
+                           DynamicSubmission& sub) {
+  uint32_t firstCluster = 0;
+  for (const DynamicOp& op : ops) {
+    if (!op.measure) continue;
+    const BlasEntry& e = s.entries[op.entry];
+    ClusterSample sample;
+    sample.entry = op.entry;
+    sample.entryGeneration = e.generation;
+    sample.buildGeneration = e.dyn.buildGeneration + (op.kind == DynamicOp::Refit ? 0u : 1u);
+    sample.build = op.kind != DynamicOp::Refit;
+    sample.firstCluster = firstCluster;
+    sample.clusterCount = ClusterBoundsPass::clusterCount(e.mesh.desc.triangleCount);
+    s.clusterBounds.record(s.ctx, cmd, e.mesh.desc,
+                           sub.readback.address + VkDeviceAddress(firstCluster) * sizeof(float));
+    firstCluster += sample.clusterCount;
+    sub.samples.push_back(sample);
+  }
+  if (clusters > 0) {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    s.c.vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0,
+                                nullptr, 0, nullptr);
+  }
+}
+
+}  // namespace
+
+Status AccelerationStructureService::Impl::recordDynamicOps(VkCommandBuffer cmd, std::vector<DynamicOp>& ops,
+                                                            bool onAsyncQueue, DynamicSubmission& sub,
+                                                            std::vector<GpuBuffer>& transientScratch) {
+  // Everything that can fail comes first, so that a failure leaves nothing recorded: the readback of the
+  // cluster measure, scratch, the timestamp queries.
+  uint32_t clusters = 0;
+  if (Status st = prepareMeasureReadback(*this, ops, sub, clusters); !st) return st;
+  DynamicBuildInfos builds;
+  fillDynamicBuildInfos(*this, ops, builds, sub);
+  Result<std::vector<ScratchBatch>> placed = placeDynamicScratch(*this, builds, onAsyncQueue, transientScratch);
+  if (!placed) return placed.error();
+  const std::vector<ScratchBatch>& batches = placed.value();
 
   // Timestamps: main-queue work is a BuildBatch (resolved with the others); async work times its submission.
   BuildBatch batchRecord;
@@ -273,34 +338,12 @@ Status AccelerationStructureService::Impl::recordDynamicOps(VkCommandBuffer cmd,
   if (timestamps) c.vk.vkCmdResetQueryPool(cmd, timestamps, 0, 2);
   recordDynamicStartBarrier(c.vk, cmd, onAsyncQueue);
   if (timestamps) c.vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps, 0);
-  // The measure reads the same vertices as the builds, before them.
-  uint32_t firstCluster = 0;
-  for (const DynamicOp& op : ops) {
-    if (!op.measure) continue;
-    const BlasEntry& e = entries[op.entry];
-    ClusterSample sample;
-    sample.entry = op.entry;
-    sample.entryGeneration = e.generation;
-    sample.buildGeneration = e.dyn.buildGeneration + (op.kind == DynamicOp::Refit ? 0u : 1u);
-    sample.build = op.kind != DynamicOp::Refit;
-    sample.firstCluster = firstCluster;
-    sample.clusterCount = ClusterBoundsPass::clusterCount(e.mesh.desc.triangleCount);
-    clusterBounds.record(ctx, cmd, e.mesh.desc, sub.readback.address + VkDeviceAddress(firstCluster) * sizeof(float));
-    firstCluster += sample.clusterCount;
-    sub.samples.push_back(sample);
-  }
-  if (clusters > 0) {
-    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-    b.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    c.vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0,
-                              nullptr, 0, nullptr);
-  }
+  recordClusterMeasures(*this, cmd, ops, clusters, sub);
   for (size_t b = 0, begin = 0; b < batches.size(); begin = batches[b++].end) {
     // Consecutive batches share the scratch memory.
     if (b > 0) recordAsBarrier(c.vk, cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
-    c.vk.vkCmdBuildAccelerationStructuresKHR(cmd, static_cast<uint32_t>(batches[b].end - begin), infos.data() + begin,
-                                             rangePtrs.data() + begin);
+    c.vk.vkCmdBuildAccelerationStructuresKHR(cmd, static_cast<uint32_t>(batches[b].end - begin),
+                                             builds.infos.data() + begin, builds.rangePtrs.data() + begin);
   }
   if (timestamps) c.vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps, 1);
   if (!onAsyncQueue) {

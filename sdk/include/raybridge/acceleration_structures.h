@@ -1,6 +1,6 @@
 // Acceleration structures as a service: one BLAS per distinct mesh (content-hash dedup), batched builds
 // under a scratch budget, compaction, suballocated storage, a TLAS per frame, LRU eviction under a memory
-// budget, statistics.
+// budget, explicit eviction for streaming (evictMesh), a queryable state per mesh (MeshState), statistics.
 //
 // Frame flow, all recorded into the engine's command buffers:
 //   ctx.beginFrame();                       // after waiting for the frame slot's fence
@@ -21,8 +21,9 @@
 // while their mesh is registered (a dynamic mesh may change between updateMesh() calls).
 //
 // Thread safety
-//   - registerMesh() and releaseMesh() may run concurrently with any other call of this service, from any
-//     number of threads (e.g. a streaming thread registering while the render thread records).
+//   - registerMesh(), releaseMesh(), evictMesh() and meshState() may run concurrently with any other call of this
+//     service, from any number of threads (e.g. a streaming thread registering, or evicting under memory pressure,
+//     while the render thread records).
 //   - Everything else (updateMesh, submitDynamicWork, fillTlasWait, fillVertexReuseWait, recordPendingWork,
 //     recordTlasBuild, isBuilt, blasAddress, stats, create and the destructor), and Context::beginFrame() and
 //     Context::releaseAfterIdle() of the Context it was created from, stays on one thread at a time: the
@@ -30,7 +31,7 @@
 //   - One internal mutex per service makes this so; the recording calls hold it for their whole duration,
 //     so a registration waits for at most one of them (registerMesh validates, hashes the host copies and
 //     queries build sizes before taking it).
-//   - registerMesh/releaseMesh never touch the Context's deferred-release queue or its frame counter, which
+//   - registerMesh/releaseMesh/evictMesh never touch the Context's deferred-release queue or its frame counter, which
 //     beginFrame uses without the lock: the BLASes they evict or free are handed to the Context by the next
 //     recording call of this service (so they live until framesInFlight frames after that call), and eviction
 //     takes a BLAS as no longer in flight once the Context has released the frame that last traced it.
@@ -160,6 +161,47 @@ struct MeshDesc {
   uint32_t texcoordStride = 0;          // 0 = 8
 };
 
+// The state of a registered mesh's BLAS (meshState()), like sokol_gfx's resource states. It belongs to the BLAS, so
+// registrations that share one (dedup) share its state. Static meshes go through all four:
+//
+//   registerMesh -> Queued -> (recordPendingWork records its build) -> Built -> (evictMesh) -> Evicted
+//   Evicted -> (a TLAS build, or a registration of equal geometry, references it) -> Queued
+//   Queued -> (its build fails) -> Failed -> (a later recordPendingWork retries it) -> Built, or Failed again
+//   Queued and Failed go to Evicted by evictMesh too (the build is cancelled, the retries stop).
+//
+// Dynamic meshes (MeshRole::Dynamic) are only Queued or Built: their builds keep today's behaviour (a failure is
+// returned by the call that recorded it and the build stays queued), and evictMesh refuses them.
+enum class MeshState : uint8_t {
+  // Registered, or re-queued after eviction; the build is not recorded yet. TLAS builds skip its instances
+  // (TlasInfo::skippedInstances) until it is Built.
+  Queued = 0,
+  // Its build is recorded: TLAS builds recorded after it (in the same command buffer or later) reference it.
+  Built,
+  // Its latest build attempt failed; MeshStatus::error says why: ErrorCode::VulkanError when its BLAS storage or
+  // acceleration structure could not be created (the device or host ran out of memory), ErrorCode::OutOfBudget
+  // when re-queuing it after eviction found AsServiceDesc::blasBudgetBytes full of registered meshes. Other meshes
+  // are not affected: their builds are recorded as if it were not there. The recordPendingWork() call of the
+  // attempt returns the error, and every later recordPendingWork() retries it after the builds queued before it
+  // (reporting a failed retry the same way) until it is Built; evictMesh() stops the retries, releaseMesh() ends
+  // them. TLAS builds skip its instances and count them in TlasInfo::failedInstances.
+  Failed,
+  // evictMesh() freed its BLAS (the memory returns framesInFlight frames later, when no frame in flight can read
+  // it). The registration and its handle stay valid. A TLAS build that references it re-queues its build (Queued;
+  // the instance is skipped in that TLAS), or marks it Failed with ErrorCode::OutOfBudget when the budget cannot
+  // hold it. A registration of equal geometry (a dedup hit) re-queues it too; when the budget cannot hold it, that
+  // registerMesh fails with ErrorCode::OutOfBudget and the mesh stays Evicted.
+  Evicted,
+};
+
+// What meshState() reports. Plain value; thread-safe to copy.
+struct MeshStatus {
+  MeshState state = MeshState::Queued;
+  // MeshState::Failed: the error of the latest failed attempt (its code, the failing VkResult for
+  // ErrorCode::VulkanError, and a message naming the mesh, the failed call and what to do). Otherwise
+  // ErrorCode::Ok with an empty message.
+  Error error;
+};
+
 // One TLAS instance. Instance{} is the identity transform, visible to every ray mask.
 struct Instance {
   MeshHandle mesh{};  // required
@@ -239,7 +281,8 @@ struct TlasInfo {
   VkAccelerationStructureKHR tlas = VK_NULL_HANDLE;
   VkDeviceAddress address = 0;
   uint32_t instanceCount = 0;     // instances written into the TLAS
-  uint32_t skippedInstances = 0;  // instances whose mesh has no built BLAS yet (queued beyond the budget)
+  uint32_t skippedInstances = 0;  // instances whose mesh has no built BLAS yet (MeshState::Queued, Evicted)
+  uint32_t failedInstances = 0;   // instances left out because their mesh is MeshState::Failed (see meshState())
   // Instances written whose geometry runs any-hit shaders (MeshDesc::nonOpaque, or forced by
   // VK_GEOMETRY_INSTANCE_FORCE_NO_OPAQUE_BIT_KHR). 0 = the passes keep the opaque fast path.
   uint32_t nonOpaqueInstances = 0;
@@ -308,16 +351,21 @@ struct BuildBatchTiming {
 };
 
 struct AsStats {
-  uint32_t meshHandles = 0;         // live handles (registered and not released)
-  uint32_t nonOpaqueMeshes = 0;     // live handles registered with MeshDesc::nonOpaque
-  uint32_t registrations = 0;       // registerMesh calls that succeeded
-  uint32_t dedupHits = 0;           // registrations that reused an existing BLAS
-  uint32_t blasCount = 0;           // BLASes that exist (built, building or queued)
-  uint32_t blasQueued = 0;          // waiting for a build
-  uint32_t blasCompacted = 0;       // BLASes whose storage was replaced by a compacted copy
-  uint32_t compactionsSkipped = 0;  // compaction saved < 2% (lavapipe) so no copy was made
-  uint32_t evictions = 0;
-  uint64_t triangles = 0;                      // triangles over all BLASes
+  uint32_t meshHandles = 0;           // live handles (registered and not released)
+  uint32_t nonOpaqueMeshes = 0;       // live handles registered with MeshDesc::nonOpaque
+  uint32_t registrations = 0;         // registerMesh calls that succeeded
+  uint32_t dedupHits = 0;             // registrations that reused an existing BLAS
+  uint32_t blasCount = 0;             // BLASes that exist (built, building or queued; not Failed or Evicted)
+  uint32_t blasQueued = 0;            // waiting for a build
+  uint32_t blasFailed = 0;            // BLASes in MeshState::Failed (waiting for their retry; hold no storage)
+  uint32_t blasEvicted = 0;           // BLASes in MeshState::Evicted (registered, hold no storage nor budget)
+  uint32_t blasCompacted = 0;         // BLASes whose storage was replaced by a compacted copy
+  uint32_t compactionsSkipped = 0;    // compaction saved < 2% (lavapipe) so no copy was made
+  uint32_t evictions = 0;             // cached BLASes (no registration left) freed by the budget, least recent first
+  uint32_t meshEvictions = 0;         // BLASes freed by evictMesh() (cumulative)
+  VkDeviceSize evictedBlasBytes = 0;  // their sizes then (cumulative); no longer in blasBytes, and out of
+                                      // storageUsedBytes once the frames in flight are done
+  uint64_t triangles = 0;             // triangles over all BLASes
   VkDeviceSize blasBytesBeforeCompaction = 0;  // sum of built sizes of all BLASes
   VkDeviceSize blasBytes = 0;                  // sum of current sizes (after compaction where it happened;
                                                // every copy of a dynamic BLAS)
@@ -401,15 +449,33 @@ class AccelerationStructureService {
   // dynamic work (first builds, refits, rebuilds and their measure, once per frame), which binds a compute
   // pipeline and push constants in `cmd`. Returns how many builds are still queued. On an error the builds it could
   // not record stay queued for the next call; a failed read of earlier builds' queries (a lost device) is returned
-  // too, naming vkGetQueryPoolResults.
+  // too, naming vkGetQueryPoolResults. A build that fails for its own mesh (its storage or acceleration structure
+  // could not be created) makes that mesh MeshState::Failed and does not stop the others: the call records them and
+  // then returns the first such error, naming the mesh. Either way, submit `cmd`: what it holds is valid.
   Result<uint32_t> recordPendingWork(VkCommandBuffer cmd);
   // Writes this frame slot's instance buffer and records the TLAS build, followed by a barrier that makes the
-  // TLAS readable by ray tracing shaders. Instances of meshes not built yet are skipped (counted). Once per
-  // frame (between Context::beginFrame calls); a second call in the same frame is refused.
+  // TLAS readable by ray tracing shaders. Instances of meshes not built yet are skipped (counted): Queued ones in
+  // TlasInfo::skippedInstances, Failed ones in TlasInfo::failedInstances (the frame renders without them rather
+  // than fail; recordPendingWork returned their error, meshState() still has it). An Evicted mesh is re-queued
+  // (skipped in this TLAS, built by the next recordPendingWork) or, when the budget cannot hold it, made Failed. Once
+  // per frame (between Context::beginFrame calls); a second call in the same frame is refused.
   Result<TlasInfo> recordTlasBuild(VkCommandBuffer cmd, std::span<const Instance> instances,
                                    const TlasBuildOptions& options = {});
 
-  // State of a mesh's BLAS: true once its build has been recorded (it may then appear in a TLAS).
+  // Frees the BLAS of a static mesh to make room (streaming under memory pressure) and keeps its registration:
+  // MeshState::Evicted. Its storage is handed to the Context's deferred release by the next recording call and
+  // returns framesInFlight frames after it, so frames in flight that trace it stay valid; it leaves the budget
+  // (AsServiceDesc::blasBudgetBytes) and AsStats::blasBytes at once.
+  // Every registration that shares the BLAS (dedup) is evicted with it. A queued or failed build is cancelled.
+  // Evicting an Evicted mesh does nothing. A TLAS build that references an Evicted mesh re-queues its build (see
+  // MeshState::Evicted). Errors: a stale or null handle (StaleHandle, InvalidArgument), a dynamic mesh
+  // (InvalidArgument: release it instead). Thread safety: as registerMesh.
+  Status evictMesh(MeshHandle mesh);
+  // The state of a mesh's BLAS and, when Failed, the error of the failed build (see MeshState). A stale handle is
+  // ErrorCode::StaleHandle, the null handle InvalidArgument. Thread safety: as registerMesh (any thread); the state
+  // can change as soon as it returns, by the recording thread's calls or by evictMesh.
+  Result<MeshStatus> meshState(MeshHandle mesh) const;
+  // meshState(mesh) == MeshState::Built: its build has been recorded (it may then appear in a TLAS).
   Result<bool> isBuilt(MeshHandle mesh) const;
   // For a dynamic mesh: the newest copy (see DynamicBuildMode), which changes with every update.
   Result<VkDeviceAddress> blasAddress(MeshHandle mesh) const;
