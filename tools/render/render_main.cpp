@@ -11,7 +11,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -274,53 +278,86 @@ std::vector<float> distances(const CapturedFrame& f, const glm::mat4& viewProj) 
   return out;
 }
 
-}  // namespace
+// What one run of the command carries from step to step. The members are declared in the order the steps create
+// them, so they are destroyed in reverse: the capture and the adapter before the engine whose device they use.
+struct RenderRun {
+  explicit RenderRun(const RenderOptions& options)
+      : o(options),
+        hybrid(o.mode == Mode::Hybrid),
+        rayTraced(o.mode == Mode::RayTraced),
+        modeName(hybrid      ? "hybrid"
+                 : rayTraced ? "raytraced"
+                             : "raster") {}
 
-int main(int argc, char** argv) {
-  RenderOptions o;
-  if (std::string e = parseRenderOptions(argc, argv, o); !e.empty()) {
-    std::fprintf(stderr, "%s", renderUsage());
-    return fail(e, 2);
-  }
-  if (o.help) return std::printf("%s", renderUsage()), 0;
-  if (const char* v = std::getenv("RAYBRIDGE_VALIDATION"); v && std::string(v) == "1") o.validation = true;
-  const bool hybrid = o.mode == Mode::Hybrid, rayTraced = o.mode == Mode::RayTraced;
-  const char* modeName = hybrid ? "hybrid" : rayTraced ? "raytraced" : "raster";
+  const RenderOptions& o;
+  const bool hybrid, rayTraced;
+  const char* const modeName;
 
-  // Everything the options name is checked before any Vulkan work, so bad input fails fast: the output folder,
-  // the scene, the camera path and the animation.
-  if (std::string e = prepareOutputFolder(o.out); !e.empty()) return fail(e);
+  se::Scene scene;
+  rbCameraPath::CameraPath cameraPath;
+  int animation = -1;  // the animation that plays (index into Scene::animations), -1 = the scene has none
+  se::FrameParams params;
+
+  std::unique_ptr<se::Engine> engine;
+  std::string cameraSource;
+
+  ResolvedEffects fx;
+  size_t lightCount = 0;
+  rb::EffectSet effects = 0;
+  bool wantShadows = false, wantAo = false, wantReflections = false, wantLights = false;
+  std::unique_ptr<rbAdapter::Adapter> adapter;
+  std::unique_ptr<FrameCapture> capture;
+
+  // Set for the last frame with --dump; the hook records the copies and keeps that frame's camera-relative viewProj.
+  bool captureNext = false;
+  std::string captureError;
+  glm::mat4 capturedViewProj{1.0f};
+
+  FrameSeries series;
+  double capturedPathTime = 0.0;
+  se::PassTimings timings;  // of the last frame without capture copies
+  se::ImageRGBA8 ldr;
+  se::ImageRGBA32F hdr;
+};
+
+// Everything the options name is checked before any Vulkan work, so bad input fails fast: the output folder,
+// the scene, the camera path and the animation. Returns "" or the error.
+std::string loadInputs(RenderRun& run) {
+  const RenderOptions& o = run.o;
+  if (std::string e = prepareOutputFolder(o.out); !e.empty()) return e;
   std::vector<se::AnimationPlayback> characterPlaybacks;  // --characters: one animation per character
   auto scene = loadScene(o, characterPlaybacks);
-  if (!scene) return fail(scene.error);
-  rbCameraPath::CameraPath cameraPath;
+  if (!scene) return scene.error;
+  run.scene = std::move(scene.value);
   if (!o.cameraPath.empty()) {
-    if (std::string e = rbCameraPath::loadCameraPath(o.cameraPath, cameraPath); !e.empty())
-      return fail("--camera-path: " + e);
-    if (std::string e = checkPathCameras(o, cameraPath); !e.empty()) return fail(e);
+    if (std::string e = rbCameraPath::loadCameraPath(o.cameraPath, run.cameraPath); !e.empty())
+      return "--camera-path: " + e;
+    if (std::string e = checkPathCameras(o, run.cameraPath); !e.empty()) return e;
   }
-  se::FrameParams params;
-  int animation = -1;  // the animation that plays (index into Scene::animations), -1 = the scene has none
   if (!characterPlaybacks.empty()) {
-    params.animations = characterPlaybacks;
-    animation = int(characterPlaybacks[0].animation);
-  } else if (!scene.value.animations.empty()) {
+    run.params.animations = characterPlaybacks;
+    run.animation = int(characterPlaybacks[0].animation);
+  } else if (!run.scene.animations.empty()) {
     std::optional<uint32_t> index = o.animation.empty() ? std::optional<uint32_t>(0)
-                                                        : scene.value.animationIndex(o.animation);
+                                                        : run.scene.animationIndex(o.animation);
     if (!index) {
       std::string names;
-      for (size_t i = 0; i < scene.value.animations.size(); ++i)
-        names += (i ? ", " : "") + std::to_string(i) + " '" + scene.value.animations[i].name + "'";
-      return fail("--animation: the scene has no animation " + o.animation + "; its animations are " + names);
+      for (size_t i = 0; i < run.scene.animations.size(); ++i)
+        names += (i ? ", " : "") + std::to_string(i) + " '" + run.scene.animations[i].name + "'";
+      return "--animation: the scene has no animation " + o.animation + "; its animations are " + names;
     }
-    animation = int(*index);
-    params.animations = {{*index, 0.0}};
+    run.animation = int(*index);
+    run.params.animations = {{*index, 0.0}};
   } else if (!o.animation.empty()) {
-    return fail("--animation " + o.animation + ": the scene has no animations");
+    return "--animation " + o.animation + ": the scene has no animations";
   }
+  return {};
+}
 
-  // The same device in every mode (Raybridge's extensions enabled, the optional ones where the device has them), so
-  // the modes, and --reorder, compare like for like.
+// The same device in every mode (Raybridge's extensions enabled, the optional ones where the device has them), so
+// the modes, and --reorder, compare like for like. Loads the scene and places the camera and the sun.
+std::string createEngine(RenderRun& run) {
+  const RenderOptions& o = run.o;
   rb::RequiredFeatures features;
   rb::OptionalFeatures optionalFeatures;
   se::EngineConfig config;
@@ -328,39 +365,49 @@ int main(int argc, char** argv) {
   config.deviceNameFilter = o.device;
   rbAdapter::configureEngine(config, features, &optionalFeatures);
   auto created = se::Engine::create(config);
-  if (!created) return fail("engine: " + created.error);
-  se::Engine& engine = *created.value;
-  if (se::Status s = engine.loadScene(scene.value); !s) return fail(s.error);
-  if (se::Status s = engine.setRenderSize(o.width, o.height); !s) return fail(s.error);
+  if (!created) return "engine: " + created.error;
+  run.engine = std::move(created.value);
+  se::Engine& engine = *run.engine;
+  if (se::Status s = engine.loadScene(run.scene); !s) return s.error;
+  if (se::Status s = engine.setRenderSize(o.width, o.height); !s) return s.error;
 
-  std::string cameraSource;
-  params.camera = chooseCamera(o, engine.scene(), engine.sceneBounds(), cameraSource);
-  if (!o.cameraPath.empty()) cameraSource = "path";
+  se::FrameParams& params = run.params;
+  params.camera = chooseCamera(o, engine.scene(), engine.sceneBounds(), run.cameraSource);
+  if (!o.cameraPath.empty()) run.cameraSource = "path";
   if (o.sun) params.sun.direction = glm::normalize(*o.sun);
   else if (engine.scene().sun)
     params.sun = *engine.scene().sun;
   params.sun.direction = glm::normalize(params.sun.direction);
+  return {};
+}
 
-  ResolvedEffects fx = resolve(o);
+// The effects of the mode: Raybridge's through the adapter (hybrid, ray-traced), or the engine's own
+// counterparts (raster); plus the frame capture of --dump.
+std::string setUpEffects(RenderRun& run) {
+  const RenderOptions& o = run.o;
+  se::Engine& engine = *run.engine;
+  se::FrameParams& params = run.params;
+  run.fx = resolve(o);
+  ResolvedEffects& fx = run.fx;
   // The scene's punctual lights are shadowed by Raybridge with any preset but none, unless --effects leaves them out
   // (no light, no pass).
-  const size_t lightCount = engine.scene().lights.size();
-  if (!o.effects && lightCount && o.preset != rb::Preset::None) fx.hybrid.effects |= rb::kEffectLocalLights;
-  if (rayTraced) fx.hybrid.effects = 0;  // no G-buffer effect: the primary rays' hits are lit by sun, sky and lights
-  const rb::EffectSet effects = fx.hybrid.effects;
-  const bool wantShadows = effects & rb::kEffectShadows, wantAo = effects & rb::kEffectAo,
-             wantReflections = effects & rb::kEffectReflections, wantLights = effects & rb::kEffectLocalLights;
-  std::unique_ptr<rbAdapter::Adapter> adapter;
-  if (hybrid || rayTraced) {
+  run.lightCount = engine.scene().lights.size();
+  if (!o.effects && run.lightCount && o.preset != rb::Preset::None) fx.hybrid.effects |= rb::kEffectLocalLights;
+  if (run.rayTraced)
+    fx.hybrid.effects = 0;  // no G-buffer effect: the primary rays' hits are lit by sun, sky and lights
+  run.effects = fx.hybrid.effects;
+  run.wantShadows = run.effects & rb::kEffectShadows, run.wantAo = run.effects & rb::kEffectAo;
+  run.wantReflections = run.effects & rb::kEffectReflections, run.wantLights = run.effects & rb::kEffectLocalLights;
+  if (run.hybrid || run.rayTraced) {
     rbAdapter::AdapterConfig ac;
     ac.effects = fx.hybrid;
-    ac.rayTraced = rayTraced;
-    params.externalColor = rayTraced;  // the hook shades the frame; the engine draws no G-buffer or lighting
+    ac.rayTraced = run.rayTraced;
+    params.externalColor = run.rayTraced;  // the hook shades the frame; the engine draws no G-buffer or lighting
     ac.geometricNormals = o.geometricNormals;
     ac.accelerationStructures.dynamicMode = o.dynamicMode;
     auto a = rbAdapter::Adapter::create(engine, ac);
-    if (!a) return fail("adapter: " + a.error);
-    adapter = std::move(a.value);
+    if (!a) return "adapter: " + a.error;
+    run.adapter = std::move(a.value);
     // Traced shadows replace the shadow map, and a preset without shadows has none in either mode: nothing
     // samples the map, so the engine draws none.
     params.shadow.enabled = false;
@@ -369,138 +416,151 @@ int main(int argc, char** argv) {
     params.shadow.enabled = fx.raster.mapSize > 0;
     if (fx.raster.mapSize) params.shadow.mapSize = fx.raster.mapSize;
     params.shadow.pcfKernelSize = fx.raster.pcfKernel ? fx.raster.pcfKernel : 1u;  // 0 = one hardware 2x2 tap
-    params.ssao.enabled = wantAo;
+    params.ssao.enabled = run.wantAo;
     params.ssao.radius = fx.hybrid.ao.range ? fx.hybrid.ao.range : rb::kDefaultAoRange;
-    params.reflectionProbe.enabled = wantReflections;
+    params.reflectionProbe.enabled = run.wantReflections;
     params.outputShadowVisibility = o.dump;
   }
   // The engine's own shadowed irradiance of the punctual lights (shadow maps for the strongest few), for lights.exr
   // wherever Raybridge does not compute it.
-  params.outputLocalLightIrradiance = o.dump && lightCount && !(hybrid && wantLights) && !rayTraced;
-  std::unique_ptr<FrameCapture> capture;
+  params.outputLocalLightIrradiance = o.dump && run.lightCount && !(run.hybrid && run.wantLights) && !run.rayTraced;
   if (o.dump) {
     auto c = FrameCapture::create(engine);
-    if (!c) return fail(c.error);
-    capture = std::move(c.value);
+    if (!c) return c.error;
+    run.capture = std::move(c.value);
   }
-  bool captureNext = false;
-  std::string captureError;
-  glm::mat4 capturedViewProj{1.0f};
-  engine.setPrepassHook([&](const se::PrepassHookInfo& info, se::LightingInputs& inputs) {
-    if (adapter) adapter->recordFrame(info, inputs);
-    if (!captureNext) return;
-    captureNext = false;
-    capturedViewProj = info.viewProj;
-    const bool geometric = o.geometricNormals;
-    std::vector<CaptureImage> images;
-    if (const rb::PrimaryShadingPass* shading = adapter ? adapter->primaryShading() : nullptr) {
-      images = {{"distance", shading->outputs().distance, 1, true}};  // the pre-pass images are only cleared
-    } else if (adapter) {
-      const rb::HybridOutputs& fo = adapter->effects().outputs();
-      // An effect that is off names a 1x1 neutral image: nothing to dump.
-      const rb::EffectSet on = adapter->effects().desc().effects;
-      auto of = [&](rb::EffectSet effect, const rb::EffectImage& e) {
-        return (on & effect) ? e.image : VK_NULL_HANDLE;
-      };
-      images = {{"shadow", of(rb::kEffectShadows, fo.shadow), 1},
-                {"ao", of(rb::kEffectAo, fo.ao), 1},
-                {"ao_raw", of(rb::kEffectAo, fo.aoRaw), 1},
-                {"reflection", of(rb::kEffectReflections, fo.reflection), 4},
-                {"lights", of(rb::kEffectLocalLights, fo.localLights), 4}};
-      if (fo.shadowRaw.image != fo.shadow.image) images.push_back({"shadow_raw", fo.shadowRaw.image, 1});  // denoised
-      if (fo.localLightsRaw.image != fo.localLights.image) images.push_back({"lights_raw", fo.localLightsRaw.image, 4});
-    }
-    if (se::Status s = capture->record(info, geometric ? info.geometricNormal : info.normalRoughness, images); !s)
-      captureError = s.error;
-  });
+  return {};
+}
 
-  // Frame k of N shows time - (N-1-k)/fps (every frame at `time` without --fps), so the last, captured frame is
-  // always at `time`; a time before 0 is clamped to 0.
-  auto frameTime = [&](uint32_t k) {
-    return o.fps ? std::max(0.0, o.time - double(o.frames - 1 - k) / *o.fps) : o.time;
-  };
-  // --camera-path: frame k at k/(N-1) of the path (the last frame at its end), or k/fps clamped to the end.
-  const double pathDuration = cameraPath.totalDuration();
-  double capturedPathTime = 0.0;
-  auto placeCamera = [&](uint32_t k) -> se::Status {
-    if (o.cameraPath.empty()) return se::Status::success();
-    capturedPathTime = pathTime(o, cameraPath, k);
-    auto camera = pathCamera(cameraPath, capturedPathTime, engine.sceneBounds());
-    if (!camera) return se::Status::failure(camera.error);
-    params.camera = camera.value;
-    return se::Status::success();
-  };
-  // Every frame's GPU times as they resolve (the engine's after its fence, the SDK's kFramesInFlight later), for
-  // the percentiles of stats.json's frame_series.
-  FrameSeries series;
-  auto collectTimings = [&] {
-    const se::PassTimings t = engine.lastTimings();
-    if (t.valid) {
-      series.add("frame_gpu_ms", t.frameNumber, frameTotalMs(t));
-      series.add("hook_gpu_ms", t.frameNumber, t.hookMs);
-    }
-    if (!adapter) return;
-    if (const rb::PrimaryShadingPass* shading = adapter->primaryShading(); shading && shading->stats().frame)
-      series.add("primary_shading_gpu_ms", shading->stats().frame, shading->stats().gpuMs);
-    const rb::HybridStats es = adapter->effects().stats();
-    for (const auto& [name, p] : namedPassStats(es))
-      if (p->frame) series.add(std::string(name) + "_gpu_ms", p->frame, p->gpuMs);
-  };
-  // With --dump the last frame also copies its pre-pass and effect images; the timings reported are those of
-  // the frame before it, which has no capture copies.
-  const uint32_t plain = capture && o.frames > 1 ? o.frames - 1 : o.frames;
-  for (uint32_t f = 0; f < plain; ++f) {
-    params.time = frameTime(f);
-    if (se::Status s = placeCamera(f); !s) return fail(s.error);
-    if (se::Status s = engine.renderFrame(params); !s) return fail(s.error);
-    collectTimings();
+// The images --dump copies in the hook: the primary rays' distances (ray-traced mode; the pre-pass images are only
+// cleared), or Raybridge's effect images (hybrid; an effect that is off names a 1x1 neutral image: nothing to dump).
+std::vector<CaptureImage> imagesToCapture(const rbAdapter::Adapter* adapter) {
+  if (!adapter) return {};
+  if (const rb::PrimaryShadingPass* shading = adapter->primaryShading())
+    return {{"distance", shading->outputs().distance, 1, true}};
+  const rb::HybridOutputs& fo = adapter->effects().outputs();
+  const rb::EffectSet on = adapter->effects().desc().effects;
+  auto of = [&](rb::EffectSet effect, const rb::EffectImage& e) { return (on & effect) ? e.image : VK_NULL_HANDLE; };
+  std::vector<CaptureImage> images = {{"shadow", of(rb::kEffectShadows, fo.shadow), 1},
+                                      {"ao", of(rb::kEffectAo, fo.ao), 1},
+                                      {"ao_raw", of(rb::kEffectAo, fo.aoRaw), 1},
+                                      {"reflection", of(rb::kEffectReflections, fo.reflection), 4},
+                                      {"lights", of(rb::kEffectLocalLights, fo.localLights), 4}};
+  if (fo.shadowRaw.image != fo.shadow.image) images.push_back({"shadow_raw", fo.shadowRaw.image, 1});  // denoised
+  if (fo.localLightsRaw.image != fo.localLights.image) images.push_back({"lights_raw", fo.localLightsRaw.image, 4});
+  return images;
+}
+
+// The adapter records its frame in the engine's pre-pass hook; the frame --dump captures also copies its images
+// there, while they are in the state the passes left them.
+void installPrepassHook(RenderRun& run) {
+  run.engine->setPrepassHook([&run](const se::PrepassHookInfo& info, se::LightingInputs& inputs) {
+    if (run.adapter) run.adapter->recordFrame(info, inputs);
+    if (!run.captureNext) return;
+    run.captureNext = false;
+    run.capturedViewProj = info.viewProj;
+    const std::vector<CaptureImage> images = imagesToCapture(run.adapter.get());
+    const se::PassImage& normal = run.o.geometricNormals ? info.geometricNormal : info.normalRoughness;
+    if (se::Status s = run.capture->record(info, normal, images); !s) run.captureError = s.error;
+  });
+}
+
+// Every frame's GPU times as they resolve (the engine's after its fence, the SDK's kFramesInFlight later), for
+// the percentiles of stats.json's frame_series.
+void collectTimings(RenderRun& run) {
+  const se::PassTimings t = run.engine->lastTimings();
+  if (t.valid) {
+    run.series.add("frame_gpu_ms", t.frameNumber, frameTotalMs(t));
+    run.series.add("hook_gpu_ms", t.frameNumber, t.hookMs);
   }
-  if (se::Status s = engine.waitIdle(); !s) return fail(s.error);
-  collectTimings();
-  const se::PassTimings timings = engine.lastTimings();  // without capture copies
-  if (capture) {
-    captureNext = true;
-    params.time = frameTime(o.frames - 1);
-    if (se::Status s = placeCamera(o.frames - 1); !s) return fail(s.error);
-    if (se::Status s = engine.renderFrame(params); !s) return fail(s.error);
+  if (!run.adapter) return;
+  if (const rb::PrimaryShadingPass* shading = run.adapter->primaryShading(); shading && shading->stats().frame)
+    run.series.add("primary_shading_gpu_ms", shading->stats().frame, shading->stats().gpuMs);
+  const rb::HybridStats es = run.adapter->effects().stats();
+  for (const auto& [name, p] : namedPassStats(es))
+    if (p->frame) run.series.add(std::string(name) + "_gpu_ms", p->frame, p->gpuMs);
+}
+
+// Frame k of N: its animation time and, with --camera-path, its camera. Frame k shows time - (N-1-k)/fps (every
+// frame at `time` without --fps), so the last, captured frame is always at `time`; a time before 0 is clamped to 0.
+// On the path, frame k is at k/(N-1) of the path (the last frame at its end), or k/fps clamped to the end.
+se::Status renderFrame(RenderRun& run, uint32_t k) {
+  const RenderOptions& o = run.o;
+  run.params.time = o.fps ? std::max(0.0, o.time - double(o.frames - 1 - k) / *o.fps) : o.time;
+  if (!o.cameraPath.empty()) {
+    run.capturedPathTime = pathTime(o, run.cameraPath, k);
+    auto camera = pathCamera(run.cameraPath, run.capturedPathTime, run.engine->sceneBounds());
+    if (!camera) return se::Status::failure(camera.error);
+    run.params.camera = camera.value;
+  }
+  return run.engine->renderFrame(run.params);
+}
+
+// Renders the frames and reads the final images back. With --dump the last frame also copies its pre-pass and
+// effect images; the timings reported are those of the frame before it, which has no capture copies.
+std::string renderFrames(RenderRun& run) {
+  const RenderOptions& o = run.o;
+  se::Engine& engine = *run.engine;
+  const uint32_t plain = run.capture && o.frames > 1 ? o.frames - 1 : o.frames;
+  for (uint32_t f = 0; f < plain; ++f) {
+    if (se::Status s = renderFrame(run, f); !s) return s.error;
+    collectTimings(run);
+  }
+  if (se::Status s = engine.waitIdle(); !s) return s.error;
+  collectTimings(run);
+  run.timings = engine.lastTimings();
+  if (run.capture) {
+    run.captureNext = true;
+    if (se::Status s = renderFrame(run, o.frames - 1); !s) return s.error;
   }
   auto ldr = engine.readbackLdr();  // waits for the GPU
-  if (!ldr) return fail(ldr.error);
+  if (!ldr) return ldr.error;
   auto hdr = engine.readbackHdr();
-  if (!hdr) return fail(hdr.error);
-  if (adapter && !adapter->lastError().empty()) return fail("Raybridge: " + adapter->lastError());
-  if (!captureError.empty()) return fail(captureError);
+  if (!hdr) return hdr.error;
+  if (run.adapter && !run.adapter->lastError().empty()) return "Raybridge: " + run.adapter->lastError();
+  if (!run.captureError.empty()) return run.captureError;
+  run.ldr = std::move(ldr.value);
+  run.hdr = std::move(hdr.value);
+  return {};
+}
 
+// final.png and final.exr, and the summary lines of the run.
+std::string writeFinalImages(const RenderRun& run) {
+  const RenderOptions& o = run.o;
   // The folder was checked at the start; it is created again in case it went away during the render.
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
-  if (ec) return fail("--out: the folder '" + o.out + "' cannot be created: " + ec.message());
+  if (ec) return "--out: the folder '" + o.out + "' cannot be created: " + ec.message();
   const std::filesystem::path out(o.out);
-  if (se::Status s = se::writePng((out / "final.png").string(), ldr.value); !s) return fail(s.error);
-  if (se::Status s = se::writeExr((out / "final.exr").string(), hdr.value); !s) return fail(s.error);
+  if (se::Status s = se::writePng((out / "final.png").string(), run.ldr); !s) return s.error;
+  if (se::Status s = se::writeExr((out / "final.exr").string(), run.hdr); !s) return s.error;
   std::printf("wrote %s and %s (%ux%u, %s)\n", (out / "final.png").c_str(), (out / "final.exr").c_str(), o.width,
-              o.height, modeName);
-  if (const nlohmann::json fs = series.summary(); fs.contains("frame_gpu_ms"))
+              o.height, run.modeName);
+  if (const nlohmann::json fs = run.series.summary(); fs.contains("frame_gpu_ms"))
     std::printf("over %d frames after %u warm-up frames: frame GPU ms p50 %.2f p99 %.2f; hook p50 %.2f p99 %.2f\n",
                 fs["frames"].get<int>(), kFrameSeriesWarmupFrames, fs["frame_gpu_ms"]["p50"].get<double>(),
                 fs["frame_gpu_ms"]["p99"].get<double>(), fs["hook_gpu_ms"]["p50"].get<double>(),
                 fs["hook_gpu_ms"]["p99"].get<double>());
   if (!o.cameraPath.empty())
     std::printf("camera path %s: %zu keyframes, %.3f s; the captured frame is at %.3f s\n", o.cameraPath.c_str(),
-                cameraPath.keys.size(), pathDuration, capturedPathTime);
+                run.cameraPath.keys.size(), run.cameraPath.totalDuration(), run.capturedPathTime);
+  return {};
+}
 
-  // Statistics. The SDK resolves a pass's GPU time kFramesInFlight frames after recording it.
-  nlohmann::json stats;
-  const double engineTotal = frameTotalMs(timings);
-  stats["mode"] = modeName;
+// stats.json: what was rendered (size, frames, animation, scene, camera, camera path).
+void addSceneStats(const RenderRun& run, nlohmann::json& stats) {
+  const RenderOptions& o = run.o;
+  se::Engine& engine = *run.engine;
+  const se::FrameParams& params = run.params;
+  stats["mode"] = run.modeName;
   stats["width"] = o.width;
   stats["height"] = o.height;
   stats["frames"] = o.frames;
-  stats["frame_series"] = series.summary();
+  stats["frame_series"] = run.series.summary();
   stats["animation"] = {{"time", o.time},
                         {"fps", o.fps ? nlohmann::json(*o.fps) : nlohmann::json(nullptr)},
-                        {"index", animation},
-                        {"name", animation >= 0 ? engine.scene().animations[size_t(animation)].name : ""},
+                        {"index", run.animation},
+                        {"name", run.animation >= 0 ? engine.scene().animations[size_t(run.animation)].name : ""},
                         {"deformed_instances", engine.deformedInstances().size()}};
   stats["gbuffer_normals"] = o.geometricNormals ? "geometric" : "shading";
   stats["scene"] = o.characters      ? "procedural demo scene with " + std::to_string(o.characters) + " characters"
@@ -513,23 +573,28 @@ int main(int argc, char** argv) {
                      {"fovy_degrees", params.camera.fovYDegrees},
                      {"z_near", params.camera.zNear},
                      {"z_far", params.camera.zFar},
-                     {"source", cameraSource}};
+                     {"source", run.cameraSource}};
   if (!o.cameraPath.empty())
     stats["camera_path"] = {{"file", o.cameraPath},
-                            {"keyframes", cameraPath.keys.size()},
-                            {"duration_s", pathDuration},
-                            {"time_s", capturedPathTime}};
-  const rb::HybridEffectsDesc& hd = fx.hybrid;
+                            {"keyframes", run.cameraPath.keys.size()},
+                            {"duration_s", run.cameraPath.totalDuration()},
+                            {"time_s", run.capturedPathTime}};
+}
+
+// stats.json: the sun, the preset and each effect's settings as the passes ran them (defaults filled in).
+void addEffectStats(const RenderRun& run, nlohmann::json& stats) {
+  const rb::HybridEffectsDesc& hd = run.fx.hybrid;
+  const bool hybrid = run.hybrid, wantAo = run.wantAo, wantReflections = run.wantReflections;
   const uint32_t shadowRays = hd.shadows.raysPerPixel ? hd.shadows.raysPerPixel : 1u;  // the engine's sun has no size
-  stats["sun"] = {{"direction", vec(params.sun.direction)},
-                  {"angular_radius_degrees", hybrid && wantShadows ? fx.sunRadiusDegrees : 0.0f},
-                  {"rays_per_pixel", rayTraced               ? 1u
-                                     : hybrid && wantShadows ? shadowRays
-                                                             : 0u}};  // raytraced: hard
-  stats["preset"] = rb::toString(o.preset);
+  stats["sun"] = {{"direction", vec(run.params.sun.direction)},
+                  {"angular_radius_degrees", hybrid && run.wantShadows ? run.fx.sunRadiusDegrees : 0.0f},
+                  {"rays_per_pixel", run.rayTraced               ? 1u
+                                     : hybrid && run.wantShadows ? shadowRays
+                                                                 : 0u}};  // raytraced: hard
+  stats["preset"] = rb::toString(run.o.preset);
   stats["effects"] = {
-      {"enabled", effectSetToString(effects)},
-      {"denoise", o.denoise},
+      {"enabled", effectSetToString(run.effects)},
+      {"denoise", run.o.denoise},
       {"ao_rays_per_pixel", wantAo ? (hd.ao.raysPerPixel ? hd.ao.raysPerPixel : rb::kDefaultAoRays) : 0u},
       {"ao_range", hd.ao.range ? hd.ao.range : rb::kDefaultAoRange},
       {"ao_estimator", hd.ao.estimator == rb::AoEstimator::Binary ? "binary" : "distance"},
@@ -552,37 +617,46 @@ int main(int argc, char** argv) {
       stats["effects"]["adaptive"][name] = {{"time_budget_ms", a->timeBudgetMs}, {"granularity", granularity}};
     }
   }
-  {
-    const se::LocalShadowStats ls = engine.lastLocalShadowStats();
-    uint32_t byType[3] = {0, 0, 0};
-    for (const se::PunctualLight& l : engine.scene().lights) ++byType[uint32_t(l.type)];
-    const bool traced = (hybrid && wantLights) || rayTraced;
-    const rb::LocalLightEffectSettings& ll = fx.hybrid.localLights;
-    stats["lights"] = {{"count", lightCount},
-                       {"directional", byType[0]},
-                       {"point", byType[1]},
-                       {"spot", byType[2]},
-                       {"shadowed_by", !lightCount ? "none"
-                                       : traced    ? "raybridge"
-                                                   : "engine shadow maps for the strongest lights"},
-                       {"mode", rayTraced                             ? "one resampled light per hit"
-                                : !traced                             ? "raster"
-                                : ll.mode == rb::ManyLightMode::Exact ? "exact"
-                                                                      : "stochastic"},
-                       {"rays_per_pixel",
-                        hybrid && traced && ll.mode == rb::ManyLightMode::Stochastic ? ll.raysPerPixel : 0u},
-                       {"denoised", traced && adapter && adapter->effects().localLightDenoiser() != nullptr},
-                       {"shadow_mapped_lights", traced ? 0u : ls.shadowedLights},
-                       {"shadow_map_views", traced ? 0u : ls.shadowViews}};
-  }
-  if (o.mode == Mode::Raster) {
+}
+
+// stats.json: the scene's punctual lights and who shadows them; in raster mode, the engine's counterparts drawn.
+void addLightAndRasterStats(const RenderRun& run, nlohmann::json& stats) {
+  se::Engine& engine = *run.engine;
+  const se::LocalShadowStats ls = engine.lastLocalShadowStats();
+  uint32_t byType[3] = {0, 0, 0};
+  for (const se::PunctualLight& l : engine.scene().lights) ++byType[uint32_t(l.type)];
+  const bool traced = (run.hybrid && run.wantLights) || run.rayTraced;
+  const rb::LocalLightEffectSettings& ll = run.fx.hybrid.localLights;
+  stats["lights"] = {{"count", run.lightCount},
+                     {"directional", byType[0]},
+                     {"point", byType[1]},
+                     {"spot", byType[2]},
+                     {"shadowed_by", !run.lightCount ? "none"
+                                     : traced        ? "raybridge"
+                                                     : "engine shadow maps for the strongest lights"},
+                     {"mode", run.rayTraced                         ? "one resampled light per hit"
+                              : !traced                             ? "raster"
+                              : ll.mode == rb::ManyLightMode::Exact ? "exact"
+                                                                    : "stochastic"},
+                     {"rays_per_pixel",
+                      run.hybrid && traced && ll.mode == rb::ManyLightMode::Stochastic ? ll.raysPerPixel : 0u},
+                     {"denoised", traced && run.adapter && run.adapter->effects().localLightDenoiser() != nullptr},
+                     {"shadow_mapped_lights", traced ? 0u : ls.shadowedLights},
+                     {"shadow_map_views", traced ? 0u : ls.shadowViews}};
+  if (run.o.mode == Mode::Raster) {
     const se::ShadowMapStats sm = engine.lastShadowMapStats();
     stats["effects"]["raster_counterparts"] = {{"shadows", sm.enabled ? "shadow map" : "none (unshadowed sun)"},
                                                {"shadow_map_size", sm.enabled ? sm.mapSize : 0u},
                                                {"pcf_kernel", sm.enabled ? sm.pcfKernel : 0u},
-                                               {"ao", wantAo ? "SSAO" : "off"},
-                                               {"reflections", wantReflections ? "reflection probe" : "constant sky"}};
+                                               {"ao", run.wantAo ? "SSAO" : "off"},
+                                               {"reflections",
+                                                run.wantReflections ? "reflection probe" : "constant sky"}};
   }
+}
+
+// stats.json: the engine's GPU times of the reported frame and the scene's size.
+void addEngineStats(const RenderRun& run, nlohmann::json& stats) {
+  const se::PassTimings& timings = run.timings;
   stats["engine_gpu_ms"] = {{"valid", timings.valid},
                             {"shadow_map", timings.shadowMs},
                             {"probe", timings.probeMs},
@@ -594,161 +668,228 @@ int main(int argc, char** argv) {
                             {"tonemap", timings.tonemapMs},
                             {"local_shadow_maps", timings.localShadowMs},
                             {"local_irradiance_output", timings.localIrradianceMs},
-                            {"frame_total", engineTotal}};
+                            {"frame_total", frameTotalMs(timings)}};
+  const se::Scene& scene = run.engine->scene();
   uint64_t sceneTriangles = 0;
-  for (const se::Instance& inst : engine.scene().instances)
-    sceneTriangles += engine.scene().meshes[inst.mesh].triangleCount();
+  for (const se::Instance& inst : scene.instances) sceneTriangles += scene.meshes[inst.mesh].triangleCount();
   stats["triangles"] = sceneTriangles;
-  stats["instances"] = engine.scene().instances.size();
+  stats["instances"] = scene.instances.size();
   stats["rays_traced"] = 0;
-  if (adapter) {
-    const rb::DeviceInfo& di = adapter->context().deviceInfo();
-    stats["device"]["driver"] = di.driverName;
-    stats["device"]["driver_info"] = di.driverInfo;
-    // Shader execution reordering: enabled on the device, whether the driver says it reorders, and whether the
-    // reflections of the reported frame used it (only with --reorder).
-    stats["device"]["invocation_reorder"] = di.invocationReorder;
-    stats["device"]["invocation_reorder_reorders"] = di.invocationReorderReorders;
-    const rb::ReflectionPass* reflectionPass = adapter->effects().reflectionPass();
-    stats["effects"]["reflection_invocation_reorder"] = reflectionPass && reflectionPass->reordered();
-    const rb::HybridEffects& fxo = adapter->effects();
-    const rb::HybridStats es = fxo.stats();
-    const rb::AsStats as = adapter->accelerationStructures().stats();
-    double buildMs = 0.0;
-    for (const rb::BuildBatchTiming& b : as.batches) buildMs += b.gpuMs;
-    const rb::MemoryStats mem = adapter->context().memoryStats();
-    nlohmann::json memory;
-    for (size_t c = 0; c < size_t(rb::MemoryCategory::Count); ++c)
-      memory[rb::toString(rb::MemoryCategory(c))] = mem.bytes[c];
-    memory["total"] = mem.total();
-    nlohmann::json passes = nlohmann::json::object();
-    uint64_t rays = 0;
-    std::printf("Raybridge (%s):", rayTraced ? "raytraced" : effectSetToString(effects).c_str());
-    std::vector<std::pair<const char*, const rb::PassStats*>> named = namedPassStats(es, &fxo);
-    const rb::PassStats shadingStats = adapter->primaryShading() ? adapter->primaryShading()->stats() : rb::PassStats{};
-    if (rayTraced) named.push_back({"primary_shading", &shadingStats});
-    for (const auto& [name, p] : named) {
-      passes[name] = {
-          {"gpu_ms", p->gpuMs}, {"rays", p->rays}, {"rays_per_second", p->raysPerSecond()}, {"frame", p->frame}};
-      if (p->tilesTotal()) {
-        passes[name]["tiles"] = {{"traced", p->tilesTraced},
-                                 {"skipped", p->tilesSkipped},
-                                 {"converged", p->tilesConverged},
-                                 {"rays_saved", p->raysSaved}};
-      }
-      rays += p->rays;
-      std::printf(" %s %.1f ms", name, p->gpuMs);
-      if (p->rays) std::printf(" %.2f Mrays (%.1f Mrays/s)", p->rays * 1e-6, p->raysPerSecond() * 1e-6);
-      std::printf(";");
+}
+
+// Each pass's GPU time and rays for stats.json, printed on one "Raybridge (...):" line; returns the rays traced.
+uint64_t addPassStats(const RenderRun& run, nlohmann::json& passes) {
+  const rb::HybridEffects& fxo = run.adapter->effects();
+  const rb::HybridStats es = fxo.stats();
+  uint64_t rays = 0;
+  std::printf("Raybridge (%s):", run.rayTraced ? "raytraced" : effectSetToString(run.effects).c_str());
+  std::vector<std::pair<const char*, const rb::PassStats*>> named = namedPassStats(es, &fxo);
+  const rb::PassStats shadingStats = run.adapter->primaryShading() ? run.adapter->primaryShading()->stats()
+                                                                   : rb::PassStats{};
+  if (run.rayTraced) named.push_back({"primary_shading", &shadingStats});
+  for (const auto& [name, p] : named) {
+    passes[name] = {
+        {"gpu_ms", p->gpuMs}, {"rays", p->rays}, {"rays_per_second", p->raysPerSecond()}, {"frame", p->frame}};
+    if (p->tilesTotal()) {
+      passes[name]["tiles"] = {{"traced", p->tilesTraced},
+                               {"skipped", p->tilesSkipped},
+                               {"converged", p->tilesConverged},
+                               {"rays_saved", p->raysSaved}};
     }
-    std::printf(" BLAS build %.2f ms; memory %.1f MiB\n", buildMs, mem.total() / 1048576.0);
-    stats["rays_traced"] = rays;
-    stats["raybridge"] = {
-        {"passes", passes},
-        {"acceleration_structures",
-         {{"blas_build_gpu_ms", buildMs},
-          {"build_batches", as.batches.size()},
-          {"blas_count", as.blasCount},
-          {"blas_triangles", as.triangles},
-          {"blas_bytes", as.blasBytes},
-          {"tlas_bytes", as.tlasBytes},
-          {"scratch_bytes", as.scratchBytes},
-          {"storage_block_bytes", as.storageBlockBytes},
-          {"dedup_hits", as.dedupHits},
-          {"tlas_instances", adapter->lastTlas().instanceCount},
-          {"tlas_skipped_instances", adapter->lastTlas().skippedInstances},
-          {"tlas_mode", o.tlasMode == rb::TlasBuildMode::Rebuild            ? "rebuild"
-                        : o.tlasMode == rb::TlasBuildMode::UpdateIfPossible ? "refit"
-                                                                            : "adaptive"},
-          {"tlas_builds", as.tlasBuilds},
-          {"tlas_refits", as.tlasRefits},
-          {"dynamic_builds", o.dynamicMode == rb::DynamicBuildMode::InFrame          ? "in-frame"
-                             : o.dynamicMode == rb::DynamicBuildMode::AsyncSameFrame ? "async"
-                                                                                     : "async-late"},
-          {"refits", as.refits},
-          {"rebuilds", as.rebuilds},
-          {"async", as.async},
-          {"async_queue_family", as.async ? nlohmann::json(as.asyncQueueFamily) : nlohmann::json(nullptr)},
-          {"async_fallback_reason", as.asyncFallbackReason},
-          {"stale_blas", as.staleBlas},
-          {"async_gpu_ms", as.lastAsyncGpuMs},
-          {"dynamic_blas_bytes", as.dynamicBlasBytes}}},
-        {"memory_bytes", memory}};
+    rays += p->rays;
+    std::printf(" %s %.1f ms", name, p->gpuMs);
+    if (p->rays) std::printf(" %.2f Mrays (%.1f Mrays/s)", p->rays * 1e-6, p->raysPerSecond() * 1e-6);
+    std::printf(";");
   }
+  return rays;
+}
+
+// stats.json's "raybridge": the passes, the acceleration structures and the SDK's memory by category; the device's
+// driver and shader execution reordering. Only with the adapter (hybrid and ray-traced modes).
+void addRaybridgeStats(const RenderRun& run, nlohmann::json& stats) {
+  const RenderOptions& o = run.o;
+  rbAdapter::Adapter& adapter = *run.adapter;
+  const rb::DeviceInfo& di = adapter.context().deviceInfo();
+  stats["device"]["driver"] = di.driverName;
+  stats["device"]["driver_info"] = di.driverInfo;
+  // Shader execution reordering: enabled on the device, whether the driver says it reorders, and whether the
+  // reflections of the reported frame used it (only with --reorder).
+  stats["device"]["invocation_reorder"] = di.invocationReorder;
+  stats["device"]["invocation_reorder_reorders"] = di.invocationReorderReorders;
+  const rb::ReflectionPass* reflectionPass = run.adapter->effects().reflectionPass();
+  stats["effects"]["reflection_invocation_reorder"] = reflectionPass && reflectionPass->reordered();
+  const rb::AsStats as = run.adapter->accelerationStructures().stats();
+  double buildMs = 0.0;
+  for (const rb::BuildBatchTiming& b : as.batches) buildMs += b.gpuMs;
+  const rb::MemoryStats mem = adapter.context().memoryStats();
+  nlohmann::json memory;
+  for (size_t c = 0; c < size_t(rb::MemoryCategory::Count); ++c)
+    memory[rb::toString(rb::MemoryCategory(c))] = mem.bytes[c];
+  memory["total"] = mem.total();
+  nlohmann::json passes = nlohmann::json::object();
+  const uint64_t rays = addPassStats(run, passes);
+  std::printf(" BLAS build %.2f ms; memory %.1f MiB\n", buildMs, mem.total() / 1048576.0);
+  stats["rays_traced"] = rays;
+  stats["raybridge"] = {
+      {"passes", passes},
+      {"acceleration_structures",
+       {{"blas_build_gpu_ms", buildMs},
+        {"build_batches", as.batches.size()},
+        {"blas_count", as.blasCount},
+        {"blas_triangles", as.triangles},
+        {"blas_bytes", as.blasBytes},
+        {"tlas_bytes", as.tlasBytes},
+        {"scratch_bytes", as.scratchBytes},
+        {"storage_block_bytes", as.storageBlockBytes},
+        {"dedup_hits", as.dedupHits},
+        {"tlas_instances", adapter.lastTlas().instanceCount},
+        {"tlas_skipped_instances", adapter.lastTlas().skippedInstances},
+        {"tlas_mode", o.tlasMode == rb::TlasBuildMode::Rebuild            ? "rebuild"
+                      : o.tlasMode == rb::TlasBuildMode::UpdateIfPossible ? "refit"
+                                                                          : "adaptive"},
+        {"tlas_builds", as.tlasBuilds},
+        {"tlas_refits", as.tlasRefits},
+        {"dynamic_builds", o.dynamicMode == rb::DynamicBuildMode::InFrame          ? "in-frame"
+                           : o.dynamicMode == rb::DynamicBuildMode::AsyncSameFrame ? "async"
+                                                                                   : "async-late"},
+        {"refits", as.refits},
+        {"rebuilds", as.rebuilds},
+        {"async", as.async},
+        {"async_queue_family", as.async ? nlohmann::json(as.asyncQueueFamily) : nlohmann::json(nullptr)},
+        {"async_fallback_reason", as.asyncFallbackReason},
+        {"stale_blas", as.staleBlas},
+        {"async_gpu_ms", as.lastAsyncGpuMs},
+        {"dynamic_blas_bytes", as.dynamicBlasBytes}}},
+      {"memory_bytes", memory}};
+}
+
+// The statistics of the run (written as stats.json with --dump), printing the SDK's and the engine's GPU times.
+// The SDK resolves a pass's GPU time kFramesInFlight frames after recording it.
+nlohmann::json collectStats(const RenderRun& run) {
+  nlohmann::json stats;
+  addSceneStats(run, stats);
+  addEffectStats(run, stats);
+  addLightAndRasterStats(run, stats);
+  addEngineStats(run, stats);
+  if (run.adapter) addRaybridgeStats(run, stats);
+  const se::PassTimings& timings = run.timings;
   std::printf("engine GPU ms: shadow map %.2f  probe %.2f  prepass %.2f  ssao %.2f  hook %.2f  lighting %.2f  tonemap "
               "%.2f  total %.2f\n",
               timings.shadowMs, timings.probeMs, timings.prepassMs, timings.ssaoMs, timings.hookMs, timings.lightingMs,
-              timings.tonemapMs, engineTotal);
-  stats["validation"] = {{"enabled", o.validation}, {"errors", engine.validationErrorCount()}};
+              timings.tonemapMs, frameTotalMs(timings));
+  stats["validation"] = {{"enabled", run.o.validation}, {"errors", run.engine->validationErrorCount()}};
+  return stats;
+}
 
-  if (o.dump) {
-    const CapturedFrame f = capture->read();
-    auto write = [&](const char* name, const se::ImageRGBA32F& img) -> std::string {
-      se::Status s = se::writeExr((out / name).string(), img, /*halfFloat=*/false);
-      return s ? std::string() : s.error;
-    };
-    // The hook's viewProj is camera-relative: the eye is at the origin of the positions it reconstructs.
-    // Ray-traced: the primary rays' own distances (the same convention); the engine drew no G-buffer normals.
-    std::string e = write("depth.exr",
-                          toExr(f, rayTraced ? f.images.at("distance") : distances(f, capturedViewProj), 1));
-    std::vector<std::string> written = {"depth.exr"};
-    if (e.empty() && !rayTraced) e = write("normal.exr", toExr(f, f.normal, 4)), written.push_back("normal.exr");
-    // Hybrid: Raybridge's images as captured in the hook (raw only where a denoiser ran).
-    auto writeCaptured = [&](const std::string& name, int channels) {
-      auto it = f.images.find(name);
-      if (!e.empty() || it == f.images.end()) return;
-      e = write((name + ".exr").c_str(), toExr(f, it->second, channels));
-      written.push_back(name + ".exr");
-    };
-    writeCaptured("shadow", 1);
-    writeCaptured("shadow_raw", 1);
-    writeCaptured("ao", 1);
-    writeCaptured("ao_raw", 1);
-    writeCaptured("reflection", 4);
-    // The shadowed irradiance of the punctual lights: the EXR and, beside it, its fixed-mapping picture.
-    auto writeLights = [&](const std::string& name, const se::ImageRGBA32F& img) {
-      if (!e.empty()) return;
-      e = write((name + ".exr").c_str(), img);
-      if (!e.empty()) return;
-      se::Status s = se::writePng((out / (name + ".png")).string(), irradiancePicture(img));
-      e = s ? std::string() : s.error;
-      written.push_back(name + ".exr"), written.push_back(name + ".png");
-    };
-    // Hybrid: Raybridge's (and its raw image where denoised), as captured in the hook.
-    for (const char* name : {"lights", "lights_raw"})
-      if (auto it = f.images.find(name); it != f.images.end()) writeLights(name, toExr(f, it->second, 4));
-    // The engine's own irradiance of the punctual lights (raster mode, or hybrid without the lights effect).
-    if (e.empty() && params.outputLocalLightIrradiance) {
-      auto irradiance = engine.readbackLocalLightIrradiance();
-      if (!irradiance) e = irradiance.error;
-      std::vector<float> values;
-      for (const glm::vec4& v : irradiance.value) values.insert(values.end(), {v.r, v.g, v.b, v.a});
-      if (e.empty()) writeLights("lights", toExr(f, values, 4));
-    }
-    // Raster: the engine's shadow-map visibility and SSAO.
-    if (e.empty() && o.mode == Mode::Raster) {
-      auto visibility = engine.readbackShadowVisibility();
-      if (!visibility) e = visibility.error;
+// --dump's images, each as an EXR in the output folder, in the order they are written; the first error stops it.
+class DumpWriter {
+ public:
+  explicit DumpWriter(const std::filesystem::path& out) : out_(out) {}
+
+  void exr(const std::string& name, const se::ImageRGBA32F& img) {
+    if (!error_.empty()) return;
+    se::Status s = se::writeExr((out_ / name).string(), img, /*halfFloat=*/false);
+    error_ = s ? std::string() : s.error;
+    written_.push_back(name);
+  }
+  // The shadowed irradiance of the punctual lights: the EXR and, beside it, its fixed-mapping picture.
+  void lights(const std::string& name, const se::ImageRGBA32F& img) {
+    if (!error_.empty()) return;
+    se::Status s = se::writeExr((out_ / (name + ".exr")).string(), img, /*halfFloat=*/false);
+    error_ = s ? std::string() : s.error;
+    if (!error_.empty()) return;
+    s = se::writePng((out_ / (name + ".png")).string(), irradiancePicture(img));
+    error_ = s ? std::string() : s.error;
+    written_.push_back(name + ".exr"), written_.push_back(name + ".png");
+  }
+  void fail(const std::string& error) { error_ = error; }
+
+  const std::string& error() const { return error_; }
+  std::vector<std::string>& written() { return written_; }
+
+ private:
+  std::filesystem::path out_;
+  std::string error_;
+  std::vector<std::string> written_;
+};
+
+// The engine's own images of the frame: the punctual lights' irradiance where Raybridge did not compute it, and in
+// raster mode the shadow-map visibility and SSAO.
+void dumpEngineImages(RenderRun& run, const CapturedFrame& f, DumpWriter& w) {
+  se::Engine& engine = *run.engine;
+  if (w.error().empty() && run.params.outputLocalLightIrradiance) {
+    auto irradiance = engine.readbackLocalLightIrradiance();
+    if (!irradiance) w.fail(irradiance.error);
+    std::vector<float> values;
+    for (const glm::vec4& v : irradiance.value) values.insert(values.end(), {v.r, v.g, v.b, v.a});
+    if (w.error().empty()) w.lights("lights", toExr(f, values, 4));
+  }
+  if (w.error().empty() && run.o.mode == Mode::Raster) {
+    auto visibility = engine.readbackShadowVisibility();
+    if (!visibility) w.fail(visibility.error);
+    else
+      w.exr("shadow.exr", toExr(f, visibility.value, 1));
+    if (w.error().empty() && run.wantAo) {
+      auto ssao = engine.readbackSsao();
+      if (!ssao) w.fail(ssao.error);
       else
-        e = write("shadow.exr", toExr(f, visibility.value, 1)), written.push_back("shadow.exr");
-      if (e.empty() && wantAo) {
-        auto ssao = engine.readbackSsao();
-        if (!ssao) e = ssao.error;
-        else
-          e = write("ao.exr", toExr(f, ssao.value, 1)), written.push_back("ao.exr");
-      }
+        w.exr("ao.exr", toExr(f, ssao.value, 1));
     }
-    if (!e.empty()) return fail(e);
-    if (se::Status s = se::writeFile((out / "stats.json").string(), stats.dump(2) + "\n"); !s) return fail(s.error);
-    written.push_back("stats.json");
-    std::printf("wrote");
-    for (size_t i = 0; i < written.size(); ++i) std::printf("%s %s", i ? "," : "", written[i].c_str());
-    std::printf("\n");
+  }
+}
+
+// --dump: depth (distance from the eye), normals, the effect images and stats.json.
+std::string writeDump(RenderRun& run, const nlohmann::json& stats) {
+  const std::filesystem::path out(run.o.out);
+  const CapturedFrame f = run.capture->read();
+  DumpWriter w(out);
+  // The hook's viewProj is camera-relative: the eye is at the origin of the positions it reconstructs.
+  // Ray-traced: the primary rays' own distances (the same convention); the engine drew no G-buffer normals.
+  w.exr("depth.exr", toExr(f, run.rayTraced ? f.images.at("distance") : distances(f, run.capturedViewProj), 1));
+  if (!run.rayTraced) w.exr("normal.exr", toExr(f, f.normal, 4));
+  // Hybrid: Raybridge's images as captured in the hook (raw only where a denoiser ran).
+  for (const auto& [name, channels] : {std::pair{"shadow", 1}, std::pair{"shadow_raw", 1}, std::pair{"ao", 1},
+                                       std::pair{"ao_raw", 1}, std::pair{"reflection", 4}})
+    if (auto it = f.images.find(name); it != f.images.end())
+      w.exr(std::string(name) + ".exr", toExr(f, it->second, channels));
+  for (const char* name : {"lights", "lights_raw"})
+    if (auto it = f.images.find(name); it != f.images.end()) w.lights(name, toExr(f, it->second, 4));
+  dumpEngineImages(run, f, w);
+  if (!w.error().empty()) return w.error();
+  if (se::Status s = se::writeFile((out / "stats.json").string(), stats.dump(2) + "\n"); !s) return s.error;
+  w.written().push_back("stats.json");
+  std::printf("wrote");
+  for (size_t i = 0; i < w.written().size(); ++i) std::printf("%s %s", i ? "," : "", w.written()[i].c_str());
+  std::printf("\n");
+  return {};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  RenderOptions o;
+  if (std::string e = parseRenderOptions(argc, argv, o); !e.empty()) {
+    std::fprintf(stderr, "%s", renderUsage());
+    return fail(e, 2);
+  }
+  if (o.help) return std::printf("%s", renderUsage()), 0;
+  if (const char* v = std::getenv("RAYBRIDGE_VALIDATION"); v && std::string(v) == "1") o.validation = true;
+
+  RenderRun run(o);
+  if (std::string e = loadInputs(run); !e.empty()) return fail(e);
+  if (std::string e = createEngine(run); !e.empty()) return fail(e);
+  if (std::string e = setUpEffects(run); !e.empty()) return fail(e);
+  installPrepassHook(run);
+  if (std::string e = renderFrames(run); !e.empty()) return fail(e);
+  if (std::string e = writeFinalImages(run); !e.empty()) return fail(e);
+  const nlohmann::json stats = collectStats(run);
+  if (o.dump) {
+    if (std::string e = writeDump(run, stats); !e.empty()) return fail(e);
   }
   if (o.validation) {
-    std::printf("validation errors: %u\n", engine.validationErrorCount());
-    if (engine.validationErrorCount() > 0) return fail("the validation layer reported errors", 3);
+    std::printf("validation errors: %u\n", run.engine->validationErrorCount());
+    if (run.engine->validationErrorCount() > 0) return fail("the validation layer reported errors", 3);
   }
-  engine.setPrepassHook({});
+  run.engine->setPrepassHook({});
   return 0;
 }
