@@ -3,8 +3,8 @@
 #   scripts/check_format.sh          check (what CI runs, from .ci/run)
 #   scripts/check_format.sh --fix    format the covered files in place
 #   scripts/check_format.sh --list   print the covered files
-# Covered: the .cpp and .h files under sdk/, adapters/, samples/ and tests/ that git tracks (plus new files not
-# yet added, unless .gitignore'd, so a --fix before a commit catches them). GLSL (shaders/,
+# Covered: the .cpp and .h files under sdk/, adapters/, tools/, samples/ and tests/ that git tracks (plus new files
+# not yet added, unless .gitignore'd, so a --fix before a commit catches them). GLSL (shaders/,
 # samples/*/shaders/) is not covered: clang-format reads it as C++ and splits a block's instance name ("} pc;").
 # Installs nothing: clang-format comes from scripts/setup.sh. CLANG_FORMAT=... picks another binary.
 set -euo pipefail
@@ -12,7 +12,8 @@ cd "$(dirname "$0")/.."
 
 covered_files() {
   git ls-files --cached --others --exclude-standard -- \
-    'sdk/*.cpp' 'sdk/*.h' 'adapters/*.cpp' 'adapters/*.h' 'samples/*.cpp' 'samples/*.h' 'tests/*.cpp' 'tests/*.h' |
+    'sdk/*.cpp' 'sdk/*.h' 'adapters/*.cpp' 'adapters/*.h' 'tools/*.cpp' 'tools/*.h' 'samples/*.cpp' 'samples/*.h' \
+    'tests/*.cpp' 'tests/*.h' |
     sort -u | while IFS= read -r f; do [ -f "$f" ] && printf '%s\n' "$f"; done
 }
 

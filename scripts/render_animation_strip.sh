@@ -14,7 +14,7 @@ times=("$@")
 dir="$(mktemp -d)"
 frames=()
 for t in "${times[@]}"; do
-  ./build/adapters/render/raybridge-render --characters 3 --time "$t" --fps 30 --frames 4 --preset high \
+  ./build/tools/render/raybridge-render --characters 3 --time "$t" --fps 30 --frames 4 --preset high \
     --width 360 --height 300 --camera 0.3,1.7,10.6,0,0.75,5.4,32 --out "$dir/$t" >/dev/null
   frames+=("$dir/$t/final.png")
 done

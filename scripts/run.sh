@@ -7,4 +7,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 bash scripts/build.sh
-./build/adapters/render/raybridge-render "$@"
+./build/tools/render/raybridge-render "$@"

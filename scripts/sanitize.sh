@@ -5,7 +5,8 @@
 #   scripts/sanitize.sh [asan|tsan|all]     (default all)
 #   asan: AddressSanitizer + UndefinedBehaviorSanitizer + LeakSanitizer, in ./build-asan: every test program
 #         that ctest runs (raybridge_tests, sample_engine_tests, pose_reference_tests, minimal_integration_test,
-#         the adapter tests, which start the sanitized raybridge-render) and the three benchmark smoke runs.
+#         the adapter's and the tools' tests, which start the sanitized raybridge-render) and the three benchmark
+#         smoke runs.
 #   tsan: ThreadSanitizer, in ./build-tsan: the calls documented as callable from several threads
 #         (raybridge_tests "[threads]": registerMesh/releaseMesh on streaming threads, validation messages).
 # What runs and why, the timings and the suppressions: docs/reliability.md, "Sanitizers".
@@ -90,7 +91,7 @@ if [ "$what" = asan ] || [ "$what" = all ]; then
   start=$(date +%s)
   configure build-asan address,undefined
   cmake --build build-asan -j "$jobs" --target raybridge_tests sample_engine_tests pose_reference_tests \
-    minimal_integration_test raybridge_adapter_tests raybridge_render_conformance_tests \
+    minimal_integration_test raybridge_adapter_tests raybridge_render_command_tests raybridge_render_conformance_tests \
     raybridge_animated_conformance_tests raybridge_far_origin_tests raybridge_lights_conformance_tests \
     raybridge_camera_path_tests raybridge_flythrough_tests raybridge_render_malformed_input_tests \
     raybridge-bench raybridge-effects-bench raybridge-animated-bench
@@ -112,14 +113,15 @@ if [ "$what" = asan ] || [ "$what" = all ]; then
     run sample_engine_tests $b/samples/engine/sample_engine_tests
     run pose_reference_tests $b/samples/engine/tests/reference/pose_reference_tests
     run minimal_integration_test $b/samples/minimal_integration/tests/minimal_integration_test
-    for t in adapter render_conformance animated_conformance far_origin lights_conformance camera_path flythrough \
-      render_malformed_input; do
-      run "raybridge_${t}_tests" "$b/adapters/tests/raybridge_${t}_tests"
+    run raybridge_adapter_tests $b/adapters/tests/raybridge_adapter_tests
+    for t in render_command render_conformance animated_conformance far_origin lights_conformance camera_path \
+      flythrough render_malformed_input; do
+      run "raybridge_${t}_tests" "$b/tools/tests/raybridge_${t}_tests"
     done
     # The smoke runs of ctest (bench_smoke, effects_bench_smoke, animated_bench_smoke), with the same arguments.
     run bench_smoke $b/samples/bench/raybridge-bench --quick --scenario all --out $b/bench_smoke.json
-    run effects_bench_smoke $b/adapters/effects_bench/raybridge-effects-bench --quick --out $b/effects_smoke.json
-    run animated_bench_smoke $b/adapters/animated_bench/raybridge-animated-bench --quick --out $b/animated_smoke.json
+    run effects_bench_smoke $b/tools/effects_bench/raybridge-effects-bench --quick --out $b/effects_smoke.json
+    run animated_bench_smoke $b/tools/animated_bench/raybridge-animated-bench --quick --out $b/animated_smoke.json
   )
   echo "sanitize: asan runs took $(($(date +%s) - start)) s"
 fi

@@ -29,7 +29,7 @@ $SUDO apt-get install -y -q --no-install-recommends $PKGS_BASE
 $SUDO apt-get install -y -q --no-install-recommends -t bookworm-backports $PKGS_BACKPORTS
 # The viewer builds Dear ImGui's GLFW and Vulkan backends from the sources libimgui-dev ships under
 # /usr/share/doc. Minimal images (Docker's debian:bookworm-slim) tell dpkg to skip /usr/share/doc; then unpack
-# the package's copy into /var/tmp/raybridge-imgui, where adapters/viewer/CMakeLists.txt looks next.
+# the package's copy into /var/tmp/raybridge-imgui, where tools/viewer/CMakeLists.txt looks next.
 if [ ! -f /usr/share/doc/libimgui-dev/examples/backends/imgui_impl_vulkan.cpp ]; then
   $SUDO mkdir -p /var/tmp/raybridge-imgui
   (cd /var/tmp/raybridge-imgui && $SUDO apt-get download -q libimgui-dev && $SUDO dpkg-deb -x libimgui-dev_*.deb root)

@@ -81,9 +81,9 @@ rm -rf "$CARRY"
 mkdir -p "$CARRY/bin" "$CARRY/lib" "$CARRY/layers" "$CARRY/debs" "$CARRY/data"
 BENCH="$BUILD/samples/bench/raybridge-bench"
 [ -x "$BENCH" ] || die "$BENCH was not built"
-# Executables of the project: everything executable under tests/, samples/ and adapters/ of the build, outside
-# CMake's own folders, that is an ELF program (not a library or script).
-mapfile -t EXES < <(for d in tests samples adapters; do
+# Executables of the project: everything executable under tests/, samples/, adapters/ and tools/ of the build,
+# outside CMake's own folders, that is an ELF program (not a library or script).
+mapfile -t EXES < <(for d in tests samples adapters tools; do
     [ -d "$BUILD/$d" ] && find "$BUILD/$d" -path '*/CMakeFiles' -prune -o -type f -perm -u+x -print
   done | while read -r f; do
     case "$f" in *.so|*.so.*|*.a|*.sh|*.cmake) continue ;; esac

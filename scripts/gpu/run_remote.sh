@@ -135,7 +135,7 @@ if [ -n "$need_c" ] && [ -n "$sys_c" ] && ! grep -aq "$need_c" "$sys_c"; then
 fi
 export LD_LIBRARY_PATH="$LIBPATH${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export VK_LAYER_PATH="$RT/layers"
-export RAYBRIDGE_RENDER="$RT/bin/raybridge-render"  # the adapter tests run the carried render command
+export RAYBRIDGE_RENDER="$RT/bin/raybridge-render"  # the tools' tests run the carried render command
 export RAYBRIDGE_MINIMAL_INTEGRATION="$RT/bin/minimal_integration"  # and the carried minimal integration
 # NVIDIA's ICD needs a static TLS block; dlopen'ed after Embree/TBB (the tests) it finds none left, so the
 # driver's TLS library is loaded at start-up instead.

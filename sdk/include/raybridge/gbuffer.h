@@ -9,7 +9,7 @@
 // pass GBufferDesc::cameraPosition in double. A world-space `viewProj * world` in float loses about
 // |eye| * 2^-24 of position per operation (1 mm at 20 km), which the perspective divide turns into depth errors
 // growing with the distance: the sample engine measured 1.3% median relative depth error at 5 km and hard
-// shadows differing on 30% of the pixels at 20 km before it did this (adapters/tests/far_origin_test.cpp).
+// shadows differing on 30% of the pixels at 20 km before it did this (tools/tests/far_origin_test.cpp).
 // Instance transforms given to the TLAS stay world-space: TlasBuildOptions::originOffset is subtracted in double.
 //
 // Sides: the normals (shading and geometric) must face the viewer, as rasterised: for a double-sided surface

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 
 #include <GLFW/glfw3.h>
@@ -145,23 +146,33 @@ uint32_t shadowRays(const rb::HybridEffectsDesc& d) { return d.shadows.raysPerPi
 uint32_t aoRays(const rb::HybridEffectsDesc& d) { return d.ao.raysPerPixel ? d.ao.raysPerPixel : rb::kDefaultAoRays; }
 bool denoiseOn(const rb::HybridEffectsDesc& d) { return !d.shadows.disableDenoiser || !d.ao.disableDenoiser; }
 
-}  // namespace
+// The window, the engine presenting to it, the adapter and the overlay, created in that order and destroyed in
+// reverse. Once the overlay is attached, whatever way main() ends, the engine stops calling it and is idle before
+// the overlay goes.
+struct Viewer {
+  std::unique_ptr<se::Window> window;
+  std::unique_ptr<se::Engine> engine;
+  std::unique_ptr<rbAdapter::Adapter> adapter;
+  std::unique_ptr<rbViewer::ImGuiOverlay> overlay;
+  bool overlayAttached = false;
 
-int main(int argc, char** argv) {
-  Options o;
-  bool exitNow = false;
-  if (int code = parse(argc, argv, o, exitNow); exitNow) return code;
-  if (const char* v = std::getenv("RAYBRIDGE_VALIDATION"); v && std::string(v) == "1") o.validation = true;
-
-  se::Scene scene = se::makeDefaultDemoScene();
-  if (!o.scene.empty()) {
-    se::SceneLoadResult r = se::loadGltf(o.scene);
-    if (!r.ok()) return fail("--scene: cannot load glTF '" + o.scene + "': " + r.error);
-    scene = std::move(r.scene);
+  Viewer() = default;
+  Viewer(const Viewer&) = delete;
+  Viewer& operator=(const Viewer&) = delete;
+  ~Viewer() {
+    if (!overlayAttached) return;
+    engine->setOverlayHook({});
+    (void)engine->waitIdle();
   }
+};
+
+// Builds the viewer on `scene`: Raybridge's effects of the preset, plus the scene's punctual lights shadowed by
+// Raybridge on top of any preset (L toggles them). Returns "" or the error.
+std::string createViewer(const Options& o, const se::Scene& scene, Viewer& v) {
   auto win = se::Window::create("Raybridge viewer", int(o.width), int(o.height));
-  if (!win) return fail(win.error);
-  se::Window& window = *win.value;
+  if (!win) return win.error;
+  v.window = std::move(win.value);
+  se::Window& window = *v.window;
 
   rb::RequiredFeatures features;
   se::EngineConfig config;
@@ -170,103 +181,119 @@ int main(int argc, char** argv) {
   config.instanceExtensions = window.requiredInstanceExtensions();
   rbAdapter::configureEngine(config, features);
   auto created = se::Engine::create(config);
-  if (!created) return fail("engine: " + created.error);
-  se::Engine& engine = *created.value;
-  if (se::Status s = engine.loadScene(scene); !s) return fail(s.error);
+  if (!created) return "engine: " + created.error;
+  v.engine = std::move(created.value);
+  se::Engine& engine = *v.engine;
+  if (se::Status s = engine.loadScene(scene); !s) return s.error;
   auto surface = window.createSurface(engine.instance());
-  if (!surface) return fail(surface.error);
+  if (!surface) return surface.error;
   int fbw = 0, fbh = 0;
   window.framebufferSize(fbw, fbh);
-  if (se::Status s = engine.attachSurface(surface.value, uint32_t(fbw), uint32_t(fbh)); !s) return fail(s.error);
+  if (se::Status s = engine.attachSurface(surface.value, uint32_t(fbw), uint32_t(fbh)); !s) return s.error;
 
   rbAdapter::AdapterConfig adapterConfig;
   adapterConfig.preset = o.preset;
-  // The scene's punctual lights are shadowed by Raybridge on top of any preset (L toggles them).
-  bool localLights = !engine.scene().lights.empty();
-  if (localLights) adapterConfig.effects.effects = rb::kEffectLocalLights;
+  if (!engine.scene().lights.empty()) adapterConfig.effects.effects = rb::kEffectLocalLights;
   auto adapter = rbAdapter::Adapter::create(engine, adapterConfig);
-  if (!adapter) return fail("adapter: " + adapter.error);
-  rbAdapter::Adapter& rt = *adapter.value;
-  rb::HybridEffects& fx = rt.effects();
-  rb::Preset preset = o.preset;
-  engine.setPrepassHook(rt.prepassHook());
+  if (!adapter) return "adapter: " + adapter.error;
+  v.adapter = std::move(adapter.value);
+  engine.setPrepassHook(v.adapter->prepassHook());
 
-  GLFWwindow* glfwWindow = static_cast<GLFWwindow*>(window.glfwHandle());
-  auto overlayCreated = rbViewer::ImGuiOverlay::create(glfwWindow);
-  if (!overlayCreated) return fail("overlay: " + overlayCreated.error);
-  rbViewer::ImGuiOverlay& overlay = *overlayCreated.value;
-  engine.setOverlayHook(overlay.hook());
-  // Whatever way main() ends: the engine stops calling the overlay and is idle before the overlay goes.
-  struct OverlayDetach {
-    se::Engine& engine;
-    ~OverlayDetach() {
-      engine.setOverlayHook({});
-      (void)engine.waitIdle();
-    }
-  } overlayDetach{engine};
-  bool showOverlay = o.overlay;
+  auto overlay = rbViewer::ImGuiOverlay::create(static_cast<GLFWwindow*>(window.glfwHandle()));
+  if (!overlay) return "overlay: " + overlay.error;
+  v.overlay = std::move(overlay.value);
+  engine.setOverlayHook(v.overlay->hook());
+  v.overlayAttached = true;
+  return {};
+}
 
+// What the user changes while the viewer runs (the effects through the front end, the mode, the camera, the sun,
+// the animation clock) and the frame that shows it. The keys and the overlay's panel make the same changes.
+struct Session {
+  Session(const Options& options, Viewer& v)
+      : o(options),
+        window(*v.window),
+        engine(*v.engine),
+        rt(*v.adapter),
+        fx(rt.effects()),
+        overlay(*v.overlay),
+        keys{static_cast<GLFWwindow*>(window.glfwHandle())},
+        preset(o.preset),
+        localLights(!engine.scene().lights.empty()),
+        showOverlay(o.overlay) {
+    params.camera = engine.scene().camera ? *engine.scene().camera : se::defaultCameraFor(engine.sceneBounds());
+    if (engine.scene().sun) params.sun = *engine.scene().sun;
+    sunAzimuth = std::atan2(params.sun.direction.x, params.sun.direction.z);
+    sunElevation = std::asin(std::clamp(glm::normalize(params.sun.direction).y, -1.0f, 1.0f));
+    orbit = Orbit::from(params.camera);
+    sceneSize = std::max(engine.sceneBounds().radius(), 1.0f);
+  }
+
+  const Options& o;
+  se::Window& window;
+  se::Engine& engine;
+  rbAdapter::Adapter& rt;
+  rb::HybridEffects& fx;
+  rbViewer::ImGuiOverlay& overlay;
+  Keys keys;
+
+  rb::Preset preset;
+  bool localLights;  // the scene's punctual lights are on; kept across presets, which never name them
+  bool showOverlay;
   se::FrameParams params;
-  params.camera = engine.scene().camera ? *engine.scene().camera : se::defaultCameraFor(engine.sceneBounds());
-  if (engine.scene().sun) params.sun = *engine.scene().sun;
-  float sunAzimuth = std::atan2(params.sun.direction.x, params.sun.direction.z);
-  float sunElevation = std::asin(std::clamp(glm::normalize(params.sun.direction).y, -1.0f, 1.0f));
-
-  std::printf("device: %s\n%s", engine.deviceInfo().name.c_str(), kKeys);
-  Orbit orbit = Orbit::from(params.camera);
-  Keys keys{glfwWindow};
-  const float sceneSize = std::max(engine.sceneBounds().radius(), 1.0f);
+  float sunAzimuth = 0.0f, sunElevation = 0.0f;
+  Orbit orbit{};
+  float sceneSize = 1.0f;
   double lastX = 0, lastY = 0;
-  window.cursorPosition(lastX, lastY);
-  auto last = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
   double frameMs = 0.0;
   uint32_t frames = 0;
   bool paused = false;        // the animation clock (real time) stops while paused
   bool overlayDrawn = false;  // the last rendered frame has the overlay in it
 
-  auto printState = [&] {
+  void printState() const {
     const rb::HybridEffectsDesc& d = fx.desc();
     std::printf("mode %s, preset %s, effects [%s], shadows %s (%u rays), AO %u rays, denoise %s, sun azimuth %.0f "
                 "elevation %.0f deg\n",
                 rt.settings().enabled ? "hybrid" : "raster", rb::toString(preset), effectsToString(d.effects).c_str(),
                 shadowRays(d) > 1 ? "soft" : "hard", shadowRays(d), aoRays(d), denoiseOn(d) ? "on" : "off",
                 glm::degrees(sunAzimuth), glm::degrees(sunElevation));
-  };
-  auto setDesc = [&](const rb::HybridEffectsDesc& d) {
+  }
+  void setDesc(const rb::HybridEffectsDesc& d) {
     if (rb::Status s = fx.setDesc(d); !s) std::fprintf(stderr, "raybridge-viewer: %s\n", s.error().message.c_str());
     printState();
-  };
-  auto applyPreset = [&](rb::Preset p) {
+  }
+  void applyPreset(rb::Preset p) {
     preset = p;
     rb::HybridEffectsDesc d = rb::withPreset(fx.desc(), p);
     if (localLights) d.effects |= rb::kEffectLocalLights;
     setDesc(d);
-  };
-  auto toggleEffects = [&](rb::EffectSet bits) {
+  }
+  void toggleEffects(rb::EffectSet bits) {
     rb::HybridEffectsDesc d = fx.desc();
     d.effects ^= bits;
     if (bits & rb::kEffectLocalLights) localLights = d.effects & rb::kEffectLocalLights;
     setDesc(d);
-  };
-  auto toggleSoftShadows = [&] {
+  }
+  void toggleSoftShadows() {
     rb::HybridEffectsDesc d = fx.desc();
     const uint32_t presetRays = rb::presetDesc(preset).shadowRaysPerPixel;
     d.shadows.raysPerPixel = shadowRays(d) > 1 ? 1u : (presetRays > 1 ? presetRays : rb::kDefaultSoftShadowRays);
     setDesc(d);
-  };
-  auto toggleDenoise = [&] {
+  }
+  void toggleDenoise() {
     rb::HybridEffectsDesc d = fx.desc();
     d.shadows.disableDenoiser = d.ao.disableDenoiser = denoiseOn(d);
     setDesc(d);
-  };
-  auto setHybrid = [&](bool hybrid) {
+  }
+  void setHybrid(bool hybrid) {
     rt.settings().enabled = hybrid;
     printState();
-  };
+  }
 
   // Raster mode: the engine's own counterparts of the enabled effects; its shadow map is the preset's (the
   // engine's default one when the preset has none). Hybrid mode: Raybridge's visibility replaces the map.
-  auto engineTerms = [&] {
+  void engineTerms() {
     const rb::EffectSet fxOn = fx.desc().effects;
     const bool raster = !rt.settings().enabled;
     const rb::RasterShadowDesc r = rb::presetDesc(preset).raster;
@@ -275,71 +302,64 @@ int main(int argc, char** argv) {
     if (r.mapSize) params.shadow.mapSize = r.mapSize, params.shadow.pcfKernelSize = r.pcfKernel;
     params.ssao.enabled = raster && (fxOn & rb::kEffectAo);
     params.reflectionProbe.enabled = raster && (fxOn & rb::kEffectReflections);
-  };
+  }
 
-  auto render = [&](bool withOverlay) -> se::Status {
+  // The overlay's panel, drawn into the frame about to render; what it asks for is applied before the frame, as
+  // the keys are.
+  void drawPanel() {
+    overlay.beginFrame();
+    const rb::HybridEffectsDesc& d = fx.desc();
+    rbViewer::PanelModel m;
+    m.device = engine.deviceInfo().name;
+    m.hybrid = rt.settings().enabled;
+    m.preset = preset;
+    m.effects = d.effects;
+    m.denoise = denoiseOn(d);
+    m.shadowRays = (d.effects & rb::kEffectShadows) ? shadowRays(d) : 0u;
+    m.aoRays = (d.effects & rb::kEffectAo) ? aoRays(d) : 0u;
+    m.paused = paused;
+    m.sunAzimuthDegrees = glm::degrees(sunAzimuth);
+    m.sunElevationDegrees = glm::degrees(sunElevation);
+    m.frameMs = frameMs;
+    m.engine = engine.lastTimings();
+    m.effectStats = fx.stats();
+    m.as = rt.accelerationStructures().stats();
+    m.memory = rt.context().memoryStats();
+    const rbViewer::PanelRequests req = rbViewer::drawPanel(m);
+    overlay.endFrame();
+    if (req.hybrid) setHybrid(*req.hybrid);
+    if (req.preset) applyPreset(*req.preset);
+    if (req.toggleEffects) toggleEffects(req.toggleEffects);
+    if (req.toggleSoftShadows) toggleSoftShadows();
+    if (req.toggleDenoise) toggleDenoise();
+    engineTerms();
+  }
+
+  se::Status render(bool withOverlay) {
     overlayDrawn = withOverlay;
-    if (withOverlay) {
-      overlay.beginFrame();
-      const rb::HybridEffectsDesc& d = fx.desc();
-      rbViewer::PanelModel m;
-      m.device = engine.deviceInfo().name;
-      m.hybrid = rt.settings().enabled;
-      m.preset = preset;
-      m.effects = d.effects;
-      m.denoise = denoiseOn(d);
-      m.shadowRays = (d.effects & rb::kEffectShadows) ? shadowRays(d) : 0u;
-      m.aoRays = (d.effects & rb::kEffectAo) ? aoRays(d) : 0u;
-      m.paused = paused;
-      m.sunAzimuthDegrees = glm::degrees(sunAzimuth);
-      m.sunElevationDegrees = glm::degrees(sunElevation);
-      m.frameMs = frameMs;
-      m.engine = engine.lastTimings();
-      m.effectStats = fx.stats();
-      m.as = rt.accelerationStructures().stats();
-      m.memory = rt.context().memoryStats();
-      const rbViewer::PanelRequests req = rbViewer::drawPanel(m);
-      overlay.endFrame();
-      // Applied before the frame, as the keys are.
-      if (req.hybrid) setHybrid(*req.hybrid);
-      if (req.preset) applyPreset(*req.preset);
-      if (req.toggleEffects) toggleEffects(req.toggleEffects);
-      if (req.toggleSoftShadows) toggleSoftShadows();
-      if (req.toggleDenoise) toggleDenoise();
-      engineTerms();
-    }
+    if (withOverlay) drawPanel();
     se::Status s = engine.renderFrame(params);
     if (s && !overlay.lastError().empty()) return se::Status::failure("overlay: " + overlay.lastError());
     return s;
-  };
+  }
 
-  printState();
-  while (!window.shouldClose()) {
-    window.pollEvents();
-    if (window.keyDown(se::Window::Key::Escape)) window.requestClose();
-    const auto now = std::chrono::steady_clock::now();
-    const float dt = std::min(std::chrono::duration<float>(now - last).count(), 0.1f);
-    frameMs = frameMs * 0.9 + 100.0 * double(std::chrono::duration<float>(now - last).count());
-    last = now;
-    const bool uiKeyboard = showOverlay && overlay.wantsKeyboard();
-    const bool uiMouse = showOverlay && overlay.wantsMouse();
-
-    if (keys.pressed(GLFW_KEY_F1)) showOverlay = !showOverlay;
-    if (!uiKeyboard) {
-      if (keys.pressed(GLFW_KEY_SPACE)) {
-        paused = !paused;
-        rt.settings().updateDeformedMeshes = !paused;  // a paused animation costs no BLAS work
-        std::printf("animation %s at %.2f s\n", paused ? "paused" : "playing", params.time);
-      }
-      if (keys.pressed(GLFW_KEY_M)) setHybrid(!rt.settings().enabled);
-      if (keys.pressed(GLFW_KEY_H)) toggleSoftShadows();
-      if (keys.pressed(GLFW_KEY_O)) toggleEffects(rb::kEffectAo);
-      if (keys.pressed(GLFW_KEY_R)) toggleEffects(rb::kEffectReflections);
-      if (keys.pressed(GLFW_KEY_L)) toggleEffects(rb::kEffectLocalLights);
-      if (keys.pressed(GLFW_KEY_N)) toggleDenoise();
-      if (keys.pressed(GLFW_KEY_P)) applyPreset(rb::Preset((uint32_t(preset) + 1) % rb::kPresetCount));
+  // The keys that switch the mode, the effects, the preset and the animation clock.
+  void handleSwitchKeys() {
+    if (keys.pressed(GLFW_KEY_SPACE)) {
+      paused = !paused;
+      rt.settings().updateDeformedMeshes = !paused;  // a paused animation costs no BLAS work
+      std::printf("animation %s at %.2f s\n", paused ? "paused" : "playing", params.time);
     }
-    if (!paused) params.time += dt;
+    if (keys.pressed(GLFW_KEY_M)) setHybrid(!rt.settings().enabled);
+    if (keys.pressed(GLFW_KEY_H)) toggleSoftShadows();
+    if (keys.pressed(GLFW_KEY_O)) toggleEffects(rb::kEffectAo);
+    if (keys.pressed(GLFW_KEY_R)) toggleEffects(rb::kEffectReflections);
+    if (keys.pressed(GLFW_KEY_L)) toggleEffects(rb::kEffectLocalLights);
+    if (keys.pressed(GLFW_KEY_N)) toggleDenoise();
+    if (keys.pressed(GLFW_KEY_P)) applyPreset(rb::Preset((uint32_t(preset) + 1) % rb::kPresetCount));
+  }
+
+  void moveSun(float dt, bool uiKeyboard) {
     const float sunSpeed = 0.8f * dt;
     if (!uiKeyboard) {
       if (keys.down(GLFW_KEY_LEFT)) sunAzimuth -= sunSpeed;
@@ -349,8 +369,9 @@ int main(int argc, char** argv) {
     }
     params.sun.direction = {std::cos(sunElevation) * std::sin(sunAzimuth), std::sin(sunElevation),
                             std::cos(sunElevation) * std::cos(sunAzimuth)};
-    engineTerms();
+  }
 
+  void moveCamera(float dt, bool uiKeyboard, bool uiMouse) {
     double x, y;
     window.cursorPosition(x, y);
     if (window.mouseButtonDown(0) && !uiMouse) {
@@ -372,14 +393,36 @@ int main(int argc, char** argv) {
       if (window.keyDown(se::Window::Key::Q)) orbit.target.y -= speed;
     }
     orbit.apply(params.camera);
+  }
 
+  // Events, the clock and the input of one turn of the loop; keys and mouse go to the overlay when it wants them.
+  void readInput() {
+    window.pollEvents();
+    if (window.keyDown(se::Window::Key::Escape)) window.requestClose();
+    const auto now = std::chrono::steady_clock::now();
+    const float dt = std::min(std::chrono::duration<float>(now - last).count(), 0.1f);
+    frameMs = frameMs * 0.9 + 100.0 * double(std::chrono::duration<float>(now - last).count());
+    last = now;
+    const bool uiKeyboard = showOverlay && overlay.wantsKeyboard();
+    const bool uiMouse = showOverlay && overlay.wantsMouse();
+    if (keys.pressed(GLFW_KEY_F1)) showOverlay = !showOverlay;
+    if (!uiKeyboard) handleSwitchKeys();
+    if (!paused) params.time += dt;
+    moveSun(dt, uiKeyboard);
+    engineTerms();
+    moveCamera(dt, uiKeyboard, uiMouse);
+  }
+
+  // Renders a frame at the window's size (none while it is minimised), every 60th with its GPU times printed;
+  // closes the window after --frames. Returns "" or the error.
+  std::string drawFrame() {
     int w = 0, h = 0;
     window.framebufferSize(w, h);
-    if (w == 0 || h == 0) continue;  // minimised
+    if (w == 0 || h == 0) return {};
     const VkExtent2D size = engine.renderSize();
     if (uint32_t(w) != size.width || uint32_t(h) != size.height) (void)engine.resizeSwapchain(uint32_t(w), uint32_t(h));
-    if (se::Status s = render(showOverlay); !s) return fail(s.error);
-    if (!rt.lastError().empty()) return fail("Raybridge: " + rt.lastError());
+    if (se::Status s = render(showOverlay); !s) return s.error;
+    if (!rt.lastError().empty()) return "Raybridge: " + rt.lastError();
     if (++frames % 60 == 0) {
       const se::PassTimings t = engine.lastTimings();
       const rb::HybridStats es = fx.stats();
@@ -389,23 +432,57 @@ int main(int argc, char** argv) {
                   es.ao.gpuMs, es.aoDenoise.gpuMs, es.reflection.gpuMs, t.lightingMs, t.tonemapMs);
     }
     if (o.frames > 0 && frames >= o.frames) window.requestClose();
+    return {};
   }
-  if (!o.screenshot.empty()) {
-    // The last frame showed the overlay but the screenshot should not: one more frame without it.
+
+  // --screenshot: the last frame, without the overlay unless --screenshot-overlay asks for it.
+  std::string writeScreenshot() {
     if (overlayDrawn && !o.screenshotOverlay)
-      if (se::Status s = render(false); !s) return fail(s.error);
-    if (se::Status s = engine.waitIdle(); !s) return fail(s.error);
+      if (se::Status s = render(false); !s) return s.error;
+    if (se::Status s = engine.waitIdle(); !s) return s.error;
     auto ldr = engine.readbackLdr();
-    if (!ldr) return fail(ldr.error);
-    if (se::Status s = se::writePng(o.screenshot, ldr.value); !s) return fail(s.error);
+    if (!ldr) return ldr.error;
+    if (se::Status s = se::writePng(o.screenshot, ldr.value); !s) return s.error;
     std::printf("wrote %s\n", o.screenshot.c_str());
+    return {};
   }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  bool exitNow = false;
+  if (int code = parse(argc, argv, o, exitNow); exitNow) return code;
+  if (const char* v = std::getenv("RAYBRIDGE_VALIDATION"); v && std::string(v) == "1") o.validation = true;
+
+  se::Scene scene = se::makeDefaultDemoScene();
+  if (!o.scene.empty()) {
+    se::SceneLoadResult r = se::loadGltf(o.scene);
+    if (!r.ok()) return fail("--scene: cannot load glTF '" + o.scene + "': " + r.error);
+    scene = std::move(r.scene);
+  }
+  Viewer viewer;
+  if (std::string e = createViewer(o, scene, viewer); !e.empty()) return fail(e);
+  Session session(o, viewer);
+  se::Engine& engine = *viewer.engine;
+  std::printf("device: %s\n%s", engine.deviceInfo().name.c_str(), kKeys);
+  session.window.cursorPosition(session.lastX, session.lastY);
+  session.last = std::chrono::steady_clock::now();
+
+  session.printState();
+  while (!session.window.shouldClose()) {
+    session.readInput();
+    if (std::string e = session.drawFrame(); !e.empty()) return fail(e);
+  }
+  if (!o.screenshot.empty())
+    if (std::string e = session.writeScreenshot(); !e.empty()) return fail(e);
   if (se::Status s = engine.waitIdle(); !s) return fail(s.error);
-  std::printf("rendered %u frames\n", frames);
+  std::printf("rendered %u frames\n", session.frames);
   engine.setOverlayHook({});
-  overlayCreated.value.reset();
+  viewer.overlay.reset();
   engine.setPrepassHook({});
-  adapter.value.reset();
+  viewer.adapter.reset();
   if (o.validation) {
     std::printf("validation errors: %u\n", engine.validationErrorCount());
     if (engine.validationErrorCount() > 0) return 3;

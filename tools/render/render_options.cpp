@@ -177,7 +177,8 @@ std::optional<glm::vec3> sunDirection(const std::vector<float>& v) {
   return glm::normalize(d / largest);
 }
 
-void addOptions(CLI::App& app, RenderOptions& o) {
+// The help text's frame, then what is rendered from where: the scene, the image size, the camera and the sun.
+void addSceneAndCameraOptions(CLI::App& app, RenderOptions& o) {
   rbCli::prepare(app);
   app.description(
       "Renders one image headless with the sample engine and Raybridge (default: the procedural demo scene,\n"
@@ -232,7 +233,11 @@ void addOptions(CLI::App& app, RenderOptions& o) {
             return "the direction " + value + " has zero length; give a direction towards the sun, e.g. 0.3,1,0.2";
           },
           ""));
+}
 
+// The effects: the preset and the options that override its set and its quality, the TLAS builds, raster mode's
+// shadow map.
+void addEffectOptions(CLI::App& app, RenderOptions& o) {
   app.add_option_function<std::string>(
          "--preset", [&o](const std::string& value) { o.preset = *rb::parsePreset(value); },
          "effects and quality, one of the presets below (default high)")
@@ -322,7 +327,10 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "raster mode's PCF kernel, taps per axis (default: the preset's)")
       ->type_name("N")
       ->check(rbCli::wholeNumber(1, 9));
+}
 
+// The mode, the outputs and the frames: how many, at which animation time, which animation or characters.
+void addFrameOptions(CLI::App& app, RenderOptions& o) {
   rbCli::addEnum(app, "--mode", o.mode,
                  {{"raster", Mode::Raster}, {"hybrid", Mode::Hybrid}, {"raytraced", Mode::RayTraced}},
                  "hybrid: Raybridge's effects; raster: the engine's counterparts of the same\n"
@@ -362,6 +370,10 @@ void addOptions(CLI::App& app, RenderOptions& o) {
                  "each playing its first animation at its own offset")
       ->type_name("N")
       ->check(rbCli::wholeNumber(1, 1000));
+}
+
+// Where rays are spent: tile classification, converged tiles per effect, adaptive rays.
+void addScheduleOptions(CLI::App& app, RenderOptions& o) {
   app.add_flag("--tile-classifier", o.tileClassifier,
                "hybrid shadows: classify 8x8 tiles and trace only those with a pixel that needs\n"
                "a ray (same image; off by default, see docs/performance.md)");
@@ -398,6 +410,10 @@ void addOptions(CLI::App& app, RenderOptions& o) {
          "(sides 1, 2, 4 or 8), e.g. ao,tile=8x4")
       ->type_name("LIST")
       ->check(CLI::Validator([](std::string& v) { return parseAdaptive(v, nullptr); }, ""));
+}
+
+// The performance scene and where the shared models are, the dynamic BLAS builds, the device and validation.
+void addSceneSourceAndDeviceOptions(CLI::App& app, RenderOptions& o) {
   app.add_flag("--perf-scene", o.perfScene,
                "the performance scene instead of the demo: the shared static glTF models, each\n"
                "instanced on a ring around the centre, on a finely tessellated ground (about\n"
@@ -430,6 +446,15 @@ void addOptions(CLI::App& app, RenderOptions& o) {
   app.add_flag("--validation", o.validation,
                "enable VK_LAYER_KHRONOS_validation (also RAYBRIDGE_VALIDATION=1); exit status 3\n"
                "if it reported errors");
+}
+
+// The options in the order --help lists them.
+void addOptions(CLI::App& app, RenderOptions& o) {
+  addSceneAndCameraOptions(app, o);
+  addEffectOptions(app, o);
+  addFrameOptions(app, o);
+  addScheduleOptions(app, o);
+  addSceneSourceAndDeviceOptions(app, o);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
-// raybridge-render only: copies the pre-pass depth, the normal the passes used and the effect images (sun
-// visibility, AO, reflection; raw and denoised) of one frame into host memory, recorded from inside the pre-pass hook
-// (the engine reads back only its final images). Vulkan functions come from the engine's vkGetInstanceProcAddr, like
-// the SDK's.
+// raybridge-render --dump and raybridge-effects-bench: copies the pre-pass depth, the normal the passes used and
+// the effect images (sun visibility, AO, reflection; raw and denoised) of one frame into host memory, recorded from
+// inside the pre-pass hook (the engine reads back only its final images). Vulkan functions come from the engine's
+// vkGetInstanceProcAddr, like the SDK's.
 #pragma once
 
 #include <cstdint>

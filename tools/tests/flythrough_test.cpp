@@ -1,4 +1,4 @@
-// The fly-through measurement of docs/performance.md: per-frame GPU time percentiles (adapters/render/frame_series.h)
+// The fly-through measurement of docs/performance.md: per-frame GPU time percentiles (tools/common/frame_series.h)
 // against a hand-computed nearest rank, raybridge-render's frame_series in stats.json along a camera path, and the
 // performance scene (--perf-scene), with its bad uses.
 #include <catch2/catch_test_macros.hpp>

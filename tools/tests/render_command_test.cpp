@@ -1,0 +1,331 @@
+// raybridge-render as a subprocess: bad input, half-resolution and reordered reflections, a dumped hybrid render
+// with every effect (files, statistics, AO contact darkening), every preset in both modes, raster mode's
+// counterparts. The validation layer is on; any error fails.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <ImfRgbaFile.h>
+#include <catch2/catch_test_macros.hpp>
+#include <nlohmann/json.hpp>
+
+#include "raybridge_sample_engine_adapter.h"
+#include "render_command_support.h"
+#include "sample_engine/procedural.h"
+
+namespace fs = std::filesystem;
+namespace se = sample_engine;
+
+namespace {
+
+struct RunResult {
+  int exitCode = -1;
+  std::string output;  // stdout and stderr
+};
+
+// The render command built with these tests; RAYBRIDGE_RENDER overrides it where the binaries were moved
+// (the GPU machine runs a carried copy).
+std::string renderExecutable() {
+  const char* overridden = std::getenv("RAYBRIDGE_RENDER");
+  return overridden && *overridden ? overridden : RAYBRIDGE_RENDER_EXE;
+}
+
+RunResult runRender(const std::string& args) {
+  std::string command = "\"";
+  command += renderExecutable();
+  command += "\" --validation ";
+  command += args;
+  command += " 2>&1";
+  RunResult r;
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  char buffer[4096];
+  while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) r.output.append(buffer, n);
+  const int status = pclose(pipe);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+fs::path tempDir(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("raybridge_adapter_tests_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST_CASE("raybridge-render rejects bad input with a message naming the problem", "[render][bad-input]") {
+  const fs::path dir = tempDir("bad_input");
+  struct Case {
+    std::string args, expected;
+  };
+  const fs::path malformed = dir / "malformed.gltf";
+  std::ofstream(malformed) << "{ \"asset\": { \"version\": \"2.0\" }, \"meshes\": [ { \"primitives\": ";
+  // Each message names the option and the bad value, and the valid range or names.
+  const std::vector<Case> cases = {
+      {"--scene " + (dir / "missing.gltf").string(), "missing.gltf' does not exist"},
+      {"--scene " + malformed.string(), "cannot load glTF"},
+      {"--camera 1,2,3,1,2,3,45", "--camera: eye equals target"},
+      {"--camera 1,2,3,0,0,0,180", "--camera: fovy 180 is outside [0.01, 180) degrees"},
+      {"--width 0", "--width: 0 is outside 1..16384"},
+      {"--height 100000", "--height: 100000 is outside 1..16384"},
+      {"--width abc", "--width: 'abc' is not a whole number in 1..16384"},
+      {"--sun 1,x,0", "--sun: 'x' in '1,x,0' is not a number"},
+      {"--frobnicate", "unknown option '--frobnicate'"},
+      {"stray", "unexpected argument 'stray'"},
+      {"--preset nonsense", "--preset: 'nonsense' is not a preset (none, hard-shadows, ao, ao16, reflections, "
+                            "soft-shadows, soft-shadows8, low, medium, high, ultra)"},
+      {"--effects shadows,bogus",
+       "--effects: 'bogus' in 'shadows,bogus' is not an effect (shadows, ao, reflections, lights)"},
+      {"--light-rays 65", "--light-rays: 65 is outside 1..64 (or 0 = exact)"},
+      {"--ao-rays 0", "--ao-rays: 0 is outside 1..4096"},
+      {"--ao-range -1", "--ao-range: -1 must be greater than 0"},
+      {"--ao-range abc", "--ao-range: 'abc' is not a number"},
+      {"--ao-estimator cosine", "--ao-estimator: 'cosine' is not binary or distance"},
+      {"--reflection-roughness 1.5", "--reflection-roughness: 1.5 is outside (0, 1]"},
+      {"--reflection-rays 0", "--reflection-rays: 0 is outside 1..64"},
+      {"--sun-radius 45", "--sun-radius: 45 is outside [0, 45) degrees"},
+      {"--shadow-map-size 5", "--shadow-map-size: 5 is outside 1024..8192 (or 0 = no shadow map)"},
+      {"--pcf 0", "--pcf: 0 is outside 1..9"},
+      {"--mode fast", "--mode: 'fast' is not raster, hybrid or raytraced"},
+      {"--mode raytraced --effects ao", "--effects: --mode raytraced shades every primary ray"},
+      {"--mode raytraced --gbuffer-normals geometric", "--gbuffer-normals: --mode raytraced draws no G-buffer"},
+      {"--adaptive reflections", "--adaptive: 'reflections' in 'reflections' is not an effect with adaptive rays"},
+      {"--adaptive ao=-1", "--adaptive: '-1' in 'ao=-1' is not a time in ms greater than 0"},
+      {"--adaptive ao=fast", "--adaptive: 'fast' in 'ao=fast' is not a time in ms"},
+      {"--adaptive ao --no-denoise", "--adaptive: adaptive rays plan from the denoiser's history"},
+      {"--adaptive ao,tile=3x4", "--adaptive: '3x4' in 'tile=3x4' is not a tile WxH with sides 1, 2, 4 or 8"},
+      {"--adaptive ao,pixel=8x4", "--adaptive: '8x4' in 'pixel=8x4' is not allowed (pixel takes no size)"},
+      {"--adaptive pixel", "--adaptive: 'pixel' names no effect with adaptive rays (shadows, ao)"},
+      {"--converged-tiles 0", "--converged-tiles: 0 is outside 1..65535"},
+      {"--converged-tiles 8 --no-denoise", "--converged-tiles: converged tiles are read from the shadow denoiser's"},
+      {"--converged-reflections 0", "--converged-reflections: 0 is outside 1..65535"},
+      {"--converged-lights 8 --light-rays 0", "--converged-lights: --light-rays 0 traces every light exactly"},
+      {"--converged-reflections 8 --no-denoise",
+       "--converged-reflections: converged tiles are read from the reflection"},
+      {"--converged-reflections 8 --half-res ao,reflections",
+       "--converged-reflections: it skips tiles of full-resolution reflections: drop reflections from --half-res"},
+      {"--half-res ao,shadows",
+       "--half-res: 'shadows' in 'ao,shadows' is not an effect with half-resolution tracing (ao, reflections)"},
+  };
+  for (const Case& c : cases) {
+    const RunResult r = runRender(c.args + " --out " + (dir / "out").string());
+    INFO(c.args << "\n" << r.output);
+    CHECK(r.exitCode != 0);
+    CHECK(contains(r.output, c.expected));
+  }
+  {
+    const RunResult r = runRender("--out " + (dir / "out").string() + " --width");  // the value is missing
+    INFO(r.output);
+    CHECK(r.exitCode != 0);
+    CHECK(contains(r.output, "--width needs a value"));
+  }
+  CHECK_FALSE(fs::exists(dir / "out" / "final.png"));
+
+  // --help (and -h) print the generated help, with every option and the presets, and exit 0 without rendering.
+  for (const char* help : {"--help", "-h"}) {
+    const RunResult r = runRender(std::string(help) + " --out " + (dir / "out").string());
+    INFO(help << "\n" << r.output);
+    CHECK(r.exitCode == 0);
+    for (const char* part : {"Usage: raybridge-render", "--preset", "--effects", "--shadow-map-size", "--pcf",
+                             "--dynamic-builds", "soft-shadows8"})
+      CHECK(contains(r.output, part));
+  }
+  CHECK_FALSE(fs::exists(dir / "out" / "final.png"));
+}
+
+// Reads the R channel of an EXR written by raybridge-render.
+using rbRenderTest::readExrRed;
+
+TEST_CASE("raybridge-render --half-res traces AO and reflections at half resolution", "[render][halfres]") {
+  // The same frames at full and at half resolution: the option reaches the SDK (the stats say so, and the passes
+  // count about a quarter of the rays), and the images keep their size.
+  auto render = [](const std::string& name, const std::string& halfRes) {
+    const fs::path dir = tempDir(name);
+    const RunResult r = runRender("--effects ao,reflections --width 96 --height 64 --dump --half-res " + halfRes +
+                                  " --out " + dir.string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    int w = 0, h = 0;
+    CHECK(readExrRed(dir / "ao.exr", w, h).size() == 96u * 64u);
+    return nlohmann::json::parse(std::ifstream(dir / "stats.json"));
+  };
+  const nlohmann::json full = render("half_res_none", "none");
+  const nlohmann::json half = render("half_res_both", "ao,reflections");
+  CHECK(full["effects"]["ao_half_resolution"] == false);
+  CHECK(full["effects"]["reflection_half_resolution"] == false);
+  CHECK(half["effects"]["ao_half_resolution"] == true);
+  CHECK(half["effects"]["reflection_half_resolution"] == true);
+  CHECK(half["validation"]["errors"] == 0);
+  for (const char* pass : {"ao", "reflection"}) {
+    const double ratio = half["raybridge"]["passes"][pass]["rays"].get<double>() /
+                         full["raybridge"]["passes"][pass]["rays"].get<double>();
+    INFO(pass << ": half / full rays " << ratio);
+    CHECK((ratio > 0.2 && ratio < 0.3));
+  }
+}
+
+TEST_CASE("raybridge-render --reorder: stats.json says whether reflections reordered", "[render][reorder]") {
+  auto render = [](const std::string& name, const std::string& extra) {
+    const fs::path dir = tempDir(name);
+    const RunResult r = runRender("--effects reflections --width 64 --height 48 --dump " + extra + " --out " +
+                                  dir.string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    return nlohmann::json::parse(std::ifstream(dir / "stats.json"));
+  };
+  const nlohmann::json on = render("reorder_on", "--reorder");
+  const nlohmann::json byDefault = render("reorder_default", "");
+  // Reordered with --reorder exactly where the device enabled it (never on lavapipe); never by default.
+  CHECK(on["effects"]["reflection_invocation_reorder"] == on["device"]["invocation_reorder"]);
+  CHECK(byDefault["effects"]["reflection_invocation_reorder"] == false);
+  CHECK(byDefault["device"]["invocation_reorder"] == on["device"]["invocation_reorder"]);  // the same device
+  CHECK(on["validation"]["errors"] == 0);
+}
+
+TEST_CASE("raybridge-render: --preset high --dump writes every effect image and counts rays per pass", "[render]") {
+  const fs::path dir = tempDir("dump");
+  const int w = 160, h = 96;
+  const RunResult r = runRender("--preset high --width 160 --height 96 --dump --out " + dir.string());
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  for (const char* name : {"final.png", "final.exr", "depth.exr", "normal.exr", "shadow.exr", "shadow_raw.exr",
+                           "ao.exr", "ao_raw.exr", "reflection.exr", "lights.exr", "stats.json"}) {
+    INFO(name);
+    CHECK(fs::file_size(dir / name) > 0);
+  }
+  const nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir / "stats.json"));
+  CHECK(stats["mode"] == "hybrid");
+  CHECK(stats["preset"] == "high");
+  // The demo scene's punctual lights add the local lights effect to the preset's.
+  CHECK(stats["effects"]["enabled"] == "shadows,ao,reflections,lights");
+  CHECK(stats["lights"]["count"].get<uint32_t>() >= 4);
+  CHECK(stats["lights"]["shadowed_by"] == "raybridge");
+  CHECK(stats["width"] == w);
+  CHECK(stats["rays_traced"].get<uint64_t>() > 0);
+  const nlohmann::json& passes = stats["raybridge"]["passes"];
+  for (const char* pass : {"shadow", "ao", "reflection", "local_lights"}) {
+    INFO(pass);
+    REQUIRE(passes.contains(pass));
+    CHECK(passes[pass]["rays"].get<uint64_t>() > 0);
+    CHECK(passes[pass]["gpu_ms"].get<double>() > 0.0);
+    CHECK(passes[pass]["rays_per_second"].get<double>() > 0.0);
+  }
+  for (const char* pass : {"shadow_denoise", "ao_denoise"}) {  // soft shadows and AO are denoised by default
+    INFO(pass);
+    REQUIRE(passes.contains(pass));
+    CHECK(passes[pass]["gpu_ms"].get<double>() > 0.0);
+  }
+  const nlohmann::json& memory = stats["raybridge"]["memory_bytes"];
+  CHECK(memory["pass_images"].get<uint64_t>() > 0);
+  CHECK(memory["total"].get<uint64_t>() > 0);
+  CHECK(stats["raybridge"]["acceleration_structures"]["tlas_instances"] == stats["instances"]);
+  CHECK(stats["validation"]["errors"] == 0);
+
+  const se::Camera camera = *se::makeDefaultDemoScene().camera;
+  const glm::mat4 viewProj = se::projectionMatrix(camera, float(w) / float(h)) * se::viewMatrix(camera);
+
+  // depth.exr holds the distance from the eye along the pixel-centre ray: check a ground pixel analytically.
+  int dw = 0, dh = 0;
+  const std::vector<float> depth = readExrRed(dir / "depth.exr", dw, dh);
+  REQUIRE(dw == w);
+  REQUIRE(dh == h);
+  const glm::mat4 inv = glm::inverse(viewProj);
+  const uint32_t px = 66, py = 94;  // bottom of the image: the ground plane y = 0
+  const glm::vec2 ndc((px + 0.5f) / float(w) * 2.0f - 1.0f, (py + 0.5f) / float(h) * 2.0f - 1.0f);
+  const glm::vec4 far = inv * glm::vec4(ndc, 1.0f, 1.0f);
+  const glm::vec3 ray = glm::normalize(glm::vec3(far) / far.w - camera.eye);
+  const float expected = -camera.eye.y / ray.y;
+  CHECK(std::abs(depth[py * w + px] - expected) < 0.01f * expected);
+  CHECK(depth[0] == 0.0f);  // top-left: sky
+
+  // AO: the ground right in front of the gold sphere (radius 1 at (-1.6, 1, 0)) is darker than open ground.
+  int aw = 0, ah = 0;
+  const std::vector<float> ao = readExrRed(dir / "ao.exr", aw, ah);
+  REQUIRE(aw == w);
+  auto meanAround = [&](glm::vec3 world) {
+    const glm::vec4 clip = viewProj * glm::vec4(world, 1.0f);
+    const int x = int((clip.x / clip.w * 0.5f + 0.5f) * float(w)), y = int((clip.y / clip.w * 0.5f + 0.5f) * float(h));
+    REQUIRE((x >= 1 && y >= 1 && x + 1 < w && y + 1 < h));
+    float sum = 0.0f;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) sum += ao[size_t(y + dy) * w + size_t(x + dx)];
+    return sum / 9.0f;
+  };
+  const float base = meanAround({-1.6f, 0.0f, 1.05f});
+  const float open = meanAround({-2.5f, 0.0f, 6.0f});
+  INFO("AO at the sphere's base " << base << ", on open ground " << open);
+  CHECK(open > 0.9f);
+  CHECK(base < open - 0.15f);
+}
+
+TEST_CASE("all eleven presets render in both modes; raster mode follows the preset's shadow map and PCF",
+          "[render][presets]") {
+  REQUIRE(rb::kPresetCount == 11);
+  for (uint32_t i = 0; i < rb::kPresetCount; ++i) {
+    const rb::Preset preset = rb::Preset(i);
+    const rb::PresetDesc want = rb::presetDesc(preset);
+    for (const char* mode : {"raster", "hybrid"}) {
+      const fs::path dir = tempDir(std::string("preset_") + rb::toString(preset) + "_" + mode);
+      const RunResult r = runRender(std::string("--mode ") + mode + " --preset " + rb::toString(preset) +
+                                    " --width 64 --height 40 --frames 4 --dump --out " + dir.string());
+      INFO(rb::toString(preset) << " " << mode << "\n" << r.output);
+      REQUIRE(r.exitCode == 0);
+      const nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir / "stats.json"));
+      CHECK(stats["preset"] == rb::toString(preset));
+      CHECK(stats["validation"]["errors"] == 0);
+      if (std::string(mode) == "raster") {
+        // What the engine reports it drew (after its own clamping), not what was asked for.
+        const nlohmann::json& raster = stats["effects"]["raster_counterparts"];
+        CHECK(raster["shadow_map_size"] == want.raster.mapSize);
+        CHECK(raster["pcf_kernel"] == (want.raster.mapSize ? std::max(1u, want.raster.pcfKernel) : 0u));
+        CHECK(stats["rays_traced"] == 0);
+        continue;
+      }
+      const nlohmann::json& passes = stats["raybridge"]["passes"];
+      CHECK(passes.contains("shadow") == bool(want.effects & rb::kEffectShadows));
+      CHECK(passes.contains("ao") == bool(want.effects & rb::kEffectAo));
+      CHECK(passes.contains("reflection") == bool(want.effects & rb::kEffectReflections));
+      CHECK(passes.contains("local_lights") == (preset != rb::Preset::None));  // the demo's punctual lights
+      // Soft shadows (more than one ray) are denoised, hard ones never; the reported rays per pixel are the table's.
+      CHECK(passes.contains("shadow_denoise") == (want.shadowRaysPerPixel > 1));
+      if (want.effects & rb::kEffectShadows) CHECK(stats["sun"]["rays_per_pixel"] == want.shadowRaysPerPixel);
+      if (want.effects & rb::kEffectAo) {
+        CHECK(stats["effects"]["ao_rays_per_pixel"] == want.aoRaysPerPixel);
+        CHECK(stats["effects"]["ao_half_resolution"] == want.aoHalfResolution);
+      }
+      if (want.effects == 0) CHECK(stats["rays_traced"] == 0);
+      else
+        CHECK(stats["rays_traced"].get<uint64_t>() > 0);
+    }
+  }
+}
+
+TEST_CASE("raybridge-render --mode raster uses the engine's shadow map, SSAO and reflection probe",
+          "[render][raster]") {
+  const fs::path dir = tempDir("raster");
+  const RunResult r = runRender("--mode raster --preset high --width 96 --height 64 --dump --out " + dir.string());
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  for (const char* name : {"final.png", "shadow.exr", "ao.exr", "stats.json"}) {
+    INFO(name);
+    CHECK(fs::file_size(dir / name) > 0);
+  }
+  CHECK_FALSE(fs::exists(dir / "reflection.exr"));  // the probe is a cubemap, not a screen image
+  const nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir / "stats.json"));
+  CHECK(stats["mode"] == "raster");
+  CHECK(stats["effects"]["raster_counterparts"]["ao"] == "SSAO");
+  CHECK(stats["effects"]["raster_counterparts"]["reflections"] == "reflection probe");
+  CHECK(stats["rays_traced"] == 0);
+  int w = 0, h = 0;
+  const std::vector<float> shadow = readExrRed(dir / "shadow.exr", w, h);
+  float minimum = 1.0f;
+  for (float v : shadow) minimum = std::min(minimum, v);
+  CHECK(minimum < 0.1f);  // the shadow map shadows something
+}
