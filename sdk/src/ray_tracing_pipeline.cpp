@@ -21,6 +21,45 @@ Result<VkShaderModule> makeModule(Context::Impl& c, const SpirvModule& m, const 
   return module;
 }
 
+// The shader binding table of `p` (created): raygen | misses | hit groups, each region starting at the base
+// alignment, in a host-visible buffer; the caller destroys `p` on an error.
+Status writeShaderBindingTable(Context& ctx, RayTracingPipeline& p, uint32_t groupCount, uint32_t missCount,
+                               uint32_t hitCount) {
+  Context::Impl& c = internal::contextImpl(ctx);
+  const uint32_t handleSize = c.info.shaderGroupHandleSize;
+  const VkDeviceSize stride = alignUp(handleSize, c.info.shaderGroupHandleAlignment);
+  const VkDeviceSize base = c.info.shaderGroupBaseAlignment;
+  std::vector<uint8_t> handles(size_t(groupCount) * handleSize);
+  VkResult r = c.vk.vkGetRayTracingShaderGroupHandlesKHR(c.desc.device, p.pipeline, 0, groupCount,
+                                                handles.size(), handles.data());
+  if (r != VK_SUCCESS) return vulkanError(r, "vkGetRayTracingShaderGroupHandlesKHR");
+  VkDeviceSize raygenSize = alignUp(stride, base);
+  VkDeviceSize missSize = alignUp(stride * missCount, base);
+  VkDeviceSize hitSize = alignUp(stride * hitCount, base);
+  Result<GpuBuffer> sbt =
+      createBuffer(ctx, raygenSize + missSize + hitSize + base,
+                   VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                   MemoryLocation::HostVisibleDeviceLocal, MemoryCategory::ShaderTables, "shader binding table");
+  if (!sbt) return sbt.error();
+  p.sbt = sbt.value();
+  VkDeviceAddress start = alignUp(p.sbt.address, base);
+  auto* bytes = static_cast<uint8_t*>(p.sbt.mapped) + (start - p.sbt.address);
+  std::memcpy(bytes, handles.data(), handleSize);
+  for (uint32_t i = 0; i < missCount; ++i) {
+    std::memcpy(bytes + raygenSize + i * stride, handles.data() + (1 + i) * handleSize, handleSize);
+  }
+  for (uint32_t i = 0; i < hitCount; ++i) {
+    std::memcpy(bytes + raygenSize + missSize + i * stride, handles.data() + (1 + missCount + i) * handleSize,
+                handleSize);
+  }
+  p.raygenRegion = {start, raygenSize, raygenSize};
+  p.missRegion = {start + raygenSize, stride, stride * missCount};
+  p.hitRegion = {start + raygenSize + missSize, stride, stride * hitCount};
+  if (missCount == 0) p.missRegion = {};
+  if (hitCount == 0) p.hitRegion = {};
+  return {};
+}
+
 }  // namespace
 
 Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTracingPipelineDesc& desc) {
@@ -132,46 +171,12 @@ Result<RayTracingPipeline> RayTracingPipeline::create(Context& ctx, const RayTra
     return vulkanError(r, std::string("vkCreateRayTracingPipelinesKHR for ") + desc.name);
   }
 
-  // Shader binding table: raygen | misses | hit groups, each region starting at the base alignment.
-  const uint32_t handleSize = c.info.shaderGroupHandleSize;
-  const VkDeviceSize stride = alignUp(handleSize, c.info.shaderGroupHandleAlignment);
-  const VkDeviceSize base = c.info.shaderGroupBaseAlignment;
-  const uint32_t missCount = static_cast<uint32_t>(desc.misses.size());
-  const uint32_t hitCount = static_cast<uint32_t>(desc.hitGroups.size());
-  std::vector<uint8_t> handles(size_t(groups.size()) * handleSize);
-  r = c.vk.vkGetRayTracingShaderGroupHandlesKHR(c.desc.device, p.pipeline, 0, static_cast<uint32_t>(groups.size()),
-                                                handles.size(), handles.data());
-  if (r != VK_SUCCESS) {
+  if (Status st = writeShaderBindingTable(ctx, p, uint32_t(groups.size()), uint32_t(desc.misses.size()),
+                                          uint32_t(desc.hitGroups.size()));
+      !st) {
     p.destroy(ctx);
-    return vulkanError(r, "vkGetRayTracingShaderGroupHandlesKHR");
+    return st.error();
   }
-  VkDeviceSize raygenSize = alignUp(stride, base);
-  VkDeviceSize missSize = alignUp(stride * missCount, base);
-  VkDeviceSize hitSize = alignUp(stride * hitCount, base);
-  Result<GpuBuffer> sbt =
-      createBuffer(ctx, raygenSize + missSize + hitSize + base,
-                   VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                   MemoryLocation::HostVisibleDeviceLocal, MemoryCategory::ShaderTables, "shader binding table");
-  if (!sbt) {
-    p.destroy(ctx);
-    return sbt.error();
-  }
-  p.sbt = sbt.value();
-  VkDeviceAddress start = alignUp(p.sbt.address, base);
-  auto* bytes = static_cast<uint8_t*>(p.sbt.mapped) + (start - p.sbt.address);
-  std::memcpy(bytes, handles.data(), handleSize);
-  for (uint32_t i = 0; i < missCount; ++i) {
-    std::memcpy(bytes + raygenSize + i * stride, handles.data() + (1 + i) * handleSize, handleSize);
-  }
-  for (uint32_t i = 0; i < hitCount; ++i) {
-    std::memcpy(bytes + raygenSize + missSize + i * stride, handles.data() + (1 + missCount + i) * handleSize,
-                handleSize);
-  }
-  p.raygenRegion = {start, raygenSize, raygenSize};
-  p.missRegion = {start + raygenSize, stride, stride * missCount};
-  p.hitRegion = {start + raygenSize + missSize, stride, stride * hitCount};
-  if (missCount == 0) p.missRegion = {};
-  if (hitCount == 0) p.hitRegion = {};
   return p;
 }
 
