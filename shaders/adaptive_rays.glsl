@@ -1,4 +1,4 @@
-// Adaptive rays per pixel (sdk/src/adaptive_rays.h): the counters the two planning dispatches share, and the plan
+// Adaptive rays per pixel (sdk/src/schedule/adaptive_rays.h): the counters the two planning dispatches share, and the plan
 // the ray generation shaders read.
 #ifndef RAYBRIDGE_ADAPTIVE_RAYS_GLSL
 #define RAYBRIDGE_ADAPTIVE_RAYS_GLSL

@@ -1,4 +1,4 @@
-// The numbers the RGB denoiser's C++ (sdk/src/denoiser.cpp) and its shaders must agree on: descriptor bindings
+// The numbers the RGB denoiser's C++ (sdk/src/denoise/denoiser.cpp) and its shaders must agree on: descriptor bindings
 // and the flag bits it adds to DenoiseConstants::flags (above the RB_DN_* of raybridge_shader_interface.glsl).
 // Only #defines, so the one file is included by both.
 #ifndef RAYBRIDGE_DENOISE_RGB_INTERFACE_GLSL

@@ -6,7 +6,7 @@
 
 #include "raybridge_shader_interface.glsl"
 
-// Mirrors GpuLight in sdk/src/many_light_pass_impl.h (std430, 64 bytes). Filled on the host.
+// Mirrors GpuLight in sdk/src/trace/many_light_pass_impl.h (std430, 64 bytes). Filled on the host.
 struct GpuLight {
   vec3 position;   // point, spot: TLAS space
   float range;     // point, spot: 0 = unlimited

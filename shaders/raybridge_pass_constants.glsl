@@ -1,5 +1,5 @@
 // The push constants of every SDK pass, one struct per pass. Each is mirrored field by field by the struct of the
-// same name in sdk/src/pass_constants.h, which static_asserts the size and every offset written here (std430,
+// same name in sdk/src/trace/pass_constants.h, which static_asserts the size and every offset written here (std430,
 // the layout of push constants). A shader declares its pass's block as
 //   layout(push_constant) uniform ShadowPushConstants { ShadowConstants pc; };
 // All fit the 256 bytes every device allows.

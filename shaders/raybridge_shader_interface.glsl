@@ -1,5 +1,5 @@
 // The numbers the SDK's C++ and its GLSL must agree on: descriptor bindings, flag bits, enumerations and the ray
-// counters. Only #defines, so the one file is included by both (sdk/src/pass_constants.h and the shaders); the
+// counters. Only #defines, so the one file is included by both (sdk/src/trace/pass_constants.h and the shaders); the
 // C++ side static_asserts the enumerations against the public enums.
 #ifndef RAYBRIDGE_SHADER_INTERFACE_GLSL
 #define RAYBRIDGE_SHADER_INTERFACE_GLSL

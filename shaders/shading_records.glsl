@@ -9,7 +9,7 @@
 
 #include "raybridge_shader_interface.glsl"
 
-// Mirrors rb::ShadingRecord (sdk/src/as_service_impl.h): where an instance's vertex data is.
+// Mirrors rb::ShadingRecord (sdk/src/accel/as_service_impl.h): where an instance's vertex data is.
 struct ShadingRecord {
   uvec2 positions;
   uvec2 indices;
@@ -25,7 +25,7 @@ struct ShadingRecord {
   uint pad1;
 };
 
-// Mirrors rb::GpuMaterial (sdk/src/material_table_impl.h). Defaults are resolved on the host.
+// Mirrors rb::GpuMaterial (sdk/src/trace/material_table_impl.h). Defaults are resolved on the host.
 struct GpuMaterial {
   vec4 baseColor;
   float metallic;

@@ -10,7 +10,7 @@ set(raybridge_shader_variants
 
   # Ambient occlusion with pc.raysPerPixel rays in every surface pixel.
   ao.rgen                              ao_raygen.glsl              -
-  # Ambient occlusion with each pixel's rays from the adaptive plan (sdk/src/adaptive_rays.h).
+  # Ambient occlusion with each pixel's rays from the adaptive plan (sdk/src/schedule/adaptive_rays.h).
   ao_adaptive.rgen                     ao_raygen.glsl              RB_ADAPTIVE_RAYS
   # Ambient occlusion over the tile classifier's list (AoSettings::convergedTiles).
   ao_tiles.rgen                        ao_raygen.glsl              RB_AO_TILE_LIST
@@ -22,7 +22,7 @@ set(raybridge_shader_variants
   shadow.rgen                          shadow_raygen.glsl          -
   # The same, plus the occluder-distance image (ShadowPassDesc::outputHitDistance).
   shadow_distance.rgen                 shadow_raygen.glsl          RB_WRITE_HIT_DISTANCE=1
-  # Soft shadows with each pixel's rays from the adaptive plan (sdk/src/adaptive_rays.h).
+  # Soft shadows with each pixel's rays from the adaptive plan (sdk/src/schedule/adaptive_rays.h).
   shadow_adaptive.rgen                 shadow_raygen.glsl          RB_ADAPTIVE_RAYS
   # The shadow pass's tile classifier, without and with the occluder-distance image.
   shadow_classify.comp                 shadow_classify.glsl        -

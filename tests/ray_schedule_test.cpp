@@ -1,4 +1,4 @@
-// One RaySchedule validator (sdk/src/ray_schedule_stage.h) for every effect: each pass and the HybridEffects front
+// One RaySchedule validator (sdk/src/schedule/ray_schedule_stage.h) for every effect: each pass and the HybridEffects front
 // end refuse a stage the effect does not have, and a bad member of a stage it has, with one message that names the
 // field once (the pass's settings, or HybridEffectsDesc's effect), before anything is recorded.
 #include <raybridge/ray_schedule.h>

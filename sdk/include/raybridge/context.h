@@ -30,7 +30,7 @@
 namespace rb {
 
 namespace internal {
-struct ContextAccess;  // the SDK's own way in (sdk/src/context_access.h); not part of the API
+struct ContextAccess;  // the SDK's own way in (sdk/src/core/context_access.h); not part of the API
 }
 
 // The Vulkan API version Raybridge needs: the engine's VkApplicationInfo::apiVersion and the device's.

@@ -128,7 +128,7 @@ class Denoiser {
   struct Impl;
 
  private:
-  friend struct internal::DenoiserAccess;  // adaptive rays read the history (sdk/src/denoiser_history.h)
+  friend struct internal::DenoiserAccess;  // adaptive rays read the history (sdk/src/denoise/denoiser_history.h)
   explicit Denoiser(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

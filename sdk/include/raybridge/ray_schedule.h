@@ -18,7 +18,7 @@
 // rays (AoPass, soft shadows of ShadowPass): rays go where the denoiser's reprojected history says the estimate is
 // still uncertain, within a ray budget that can follow a GPU time budget from frame to frame.
 //
-// Each frame, before tracing, two compute dispatches plan the rays (sdk/src/adaptive_rays.h):
+// Each frame, before tracing, two compute dispatches plan the rays (sdk/src/schedule/adaptive_rays.h):
 //   1. every pixel reprojects the history of the Denoiser that filters the pass's output (its running mean p over
 //      f frames, as the denoiser's temporal pass will) and weighs itself by the variance its mean still has,
 //      (p (1 - p) + 0.01) / f; a pixel without history counts as half a frame of p = 0.5;
