@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// The AO pass's tile classifier (AoSettings::convergedTiles), one workgroup per 8x8-pixel tile, after
+// The AO pass's tile classifier (AoSettings::schedule.convergedTiles), one workgroup per 8x8-pixel tile, after
 // shadow_converged.comp marked the converged tiles: a tile of sky alone gets its outputs here (1, as the ray
 // generation shader writes for sky); a tile that shadow_converged.comp marked converged is skipped (its outputs, the
 // kept-history marks, are already written); any other tile is appended to the tile list, whose trace arguments grow

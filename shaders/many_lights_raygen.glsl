@@ -11,7 +11,7 @@
 //                                                  from n listed lights)
 // which is unbiased wherever p > 0 covers f > 0 (it does: p is f's luminance before the shadow ray).
 // Exact, or a tile with no more lights than rays: one ray per light.
-// With RB_ML_CONVERGED_TILES (ManyLightSettings::convergedTiles) the pixels of the 8x8 tiles that rgb_converged.comp
+// With RB_ML_CONVERGED_TILES (ManyLightSettings::schedule.convergedTiles) the pixels of the 8x8 tiles that rgb_converged.comp
 // marked converged return at once: they already hold their outputs.
 #include "raybridge_pass_constants.glsl"
 layout(push_constant) uniform ManyLightPushConstants { ManyLightConstants pc; };

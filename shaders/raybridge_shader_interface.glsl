@@ -16,14 +16,14 @@
 #define RB_SHADOW_BINDING_TILES 9         // the tile classifier's list and trace arguments (shadow_tiles.glsl)
 #define RB_SHADOW_BINDING_TILE_STATE 12   // classifier only: per tile, the converged-tile state (shadow_converged.glsl)
 #define RB_AO_BINDING_OUTPUT 5
-// AoSettings::convergedTiles: the AO pass's tile list and tile state, at the shadow pass's bindings (the same
+// AoSettings::schedule.convergedTiles: the AO pass's tile list and tile state, at the shadow pass's bindings (the same
 // layouts: shadow_tiles.glsl, shadow_converged.glsl).
 #define RB_AO_BINDING_TILES RB_SHADOW_BINDING_TILES
 #define RB_AO_BINDING_TILE_STATE RB_SHADOW_BINDING_TILE_STATE
 #define RB_REFLECTION_BINDING_ROUGHNESS_METALNESS 5  // the normal image again when roughness is in normal.w
 #define RB_REFLECTION_BINDING_RADIANCE 6
 #define RB_REFLECTION_BINDING_LIGHTS 10  // the ManyLightPass's light list (GpuLight[]), read by the hits
-// ReflectionSettings::convergedTiles: the tile state (rgb_converged.glsl), at the shadow pass's binding.
+// ReflectionSettings::schedule.convergedTiles: the tile state (rgb_converged.glsl), at the shadow pass's binding.
 #define RB_REFLECTION_BINDING_TILE_STATE RB_SHADOW_BINDING_TILE_STATE
 // Adaptive rays (the AO and shadow passes' adaptive ray generation modules): the plan of adaptive_rays.glsl.
 #define RB_BINDING_RAY_PLAN 11
@@ -37,7 +37,7 @@
 #define RB_ML_BINDING_LIGHTS 5      // GpuLight[], TLAS space
 #define RB_ML_BINDING_TILES 6       // per tile: count (RB_ML_TILE_OVERFLOW = all lights), packed 16-bit indices
 #define RB_ML_BINDING_IRRADIANCE 9  // rgba16f output
-#define RB_ML_BINDING_TILE_STATE RB_SHADOW_BINDING_TILE_STATE  // ManyLightSettings::convergedTiles (rgb_converged.glsl)
+#define RB_ML_BINDING_TILE_STATE RB_SHADOW_BINDING_TILE_STATE  // ManyLightSettings::schedule.convergedTiles (rgb_converged.glsl)
 #define RB_ML_CULL_BINDING_DEPTH 0
 #define RB_ML_CULL_BINDING_LIGHTS 1
 #define RB_ML_CULL_BINDING_TILES 2
@@ -110,7 +110,7 @@
 // before the tile list (a VkTraceRaysIndirectCommandKHR, padded to 16 bytes).
 #define RB_SHADOW_TILE_SIZE 8
 #define RB_SHADOW_TILE_HEADER_UINTS 4
-// Converged-tile skipping (ShadowSettings::convergedTiles): one uint of state per tile. Bits 0-15: frames left
+// Converged-tile skipping (ShadowSettings::schedule.convergedTiles): one uint of state per tile. Bits 0-15: frames left
 // before the tile may be skipped again (set when a refresh found a change); then what this frame does with it.
 #define RB_TILE_HOLD_MASK 0xFFFFu
 #define RB_TILE_SKIP_CONVERGED 0x10000u  // converged: not traced, its pixels already hold their kept-history marks

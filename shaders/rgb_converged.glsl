@@ -1,5 +1,5 @@
-// Converged-tile skipping for the passes with an RGB signal: reflections (ReflectionSettings::convergedTiles,
-// pc.flags has RB_DN_RGB_REFLECTION) and local lights (ManyLightSettings::convergedTiles), shared by their two
+// Converged-tile skipping for the passes with an RGB signal: reflections (ReflectionSettings::schedule.convergedTiles,
+// pc.flags has RB_DN_RGB_REFLECTION) and local lights (ManyLightSettings::schedule.convergedTiles), shared by their two
 // dispatches, one workgroup per 8x8-pixel tile: rgb_converged.comp before the trace decides which tiles have
 // converged and writes their outputs (the ray generation shader then skips them), rgb_converged_check.comp after the
 // trace checks the tiles refreshed this frame against their history. Both read the RGB denoiser's latest history

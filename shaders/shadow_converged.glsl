@@ -1,4 +1,4 @@
-// Converged-tile skipping for the shadow pass (ShadowSettings::convergedTiles), shared by its two dispatches, one
+// Converged-tile skipping for the shadow pass (ShadowSettings::schedule.convergedTiles), shared by its two dispatches, one
 // workgroup per 8x8-pixel tile of the classifier: shadow_converged.comp before the classifier decides which tiles
 // have converged and writes their outputs, shadow_converged_check.comp after the trace checks the tiles refreshed
 // this frame against their history. Both read the denoiser's latest history through its own reprojection

@@ -12,10 +12,10 @@ set(raybridge_shader_variants
   ao.rgen                              ao_raygen.glsl              -
   # Ambient occlusion with each pixel's rays from the adaptive plan (sdk/src/schedule/adaptive_rays.h).
   ao_adaptive.rgen                     ao_raygen.glsl              RB_ADAPTIVE_RAYS
-  # Ambient occlusion over the tile classifier's list (AoSettings::convergedTiles).
+  # Ambient occlusion over the tile classifier's list (AoSettings::schedule.convergedTiles).
   ao_tiles.rgen                        ao_raygen.glsl              RB_AO_TILE_LIST
   # Ambient occlusion over the tile classifier's list with each pixel's rays from the adaptive plan
-  # (AoSettings::convergedTiles and AoSettings::adaptive).
+  # (AoSettings::schedule.convergedTiles and AoSettings::schedule.adaptive).
   ao_adaptive_tiles.rgen               ao_raygen.glsl              RB_ADAPTIVE_RAYS,RB_AO_TILE_LIST
 
   # Shadow rays towards the light.
@@ -30,19 +30,19 @@ set(raybridge_shader_variants
 
   # The reflection pass's ray generation: rays traced and shaded in place.
   reflect.rgen                         reflection_raygen.glsl      -
-  # Reflections that skip the converged tiles (ReflectionSettings::convergedTiles).
+  # Reflections that skip the converged tiles (ReflectionSettings::schedule.convergedTiles).
   reflect_converged.rgen               reflection_raygen.glsl      RB_REFLECTION_CONVERGED_TILES
   # The reflection pass's ray generation with shader execution reordering (VK_NV_ray_tracing_invocation_reorder):
   # the same rays as reflect.rgen, the hits regrouped by instance before shading. Built into a pipeline only on a
   # Context with DeviceInfo::invocationReorder.
   reflect_reorder.rgen                 reflection_raygen.glsl      RB_REFLECTION_REORDER=1
-  # Reflections that skip the converged tiles (ReflectionSettings::convergedTiles), with shader execution
+  # Reflections that skip the converged tiles (ReflectionSettings::schedule.convergedTiles), with shader execution
   # reordering (reflect_reorder.rgen).
   reflect_reorder_converged.rgen       reflection_raygen.glsl      RB_REFLECTION_REORDER=1,RB_REFLECTION_CONVERGED_TILES
 
   # ManyLightPass, step 2: the shadowed irradiance of every pixel.
   many_lights.rgen                     many_lights_raygen.glsl     -
-  # ManyLightPass, step 2, skipping the converged tiles (ManyLightSettings::convergedTiles).
+  # ManyLightPass, step 2, skipping the converged tiles (ManyLightSettings::schedule.convergedTiles).
   many_lights_converged.rgen           many_lights_raygen.glsl     RB_ML_CONVERGED_TILES
 
   # An a-trous step of the scalar denoiser that another step follows.

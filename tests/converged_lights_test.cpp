@@ -1,8 +1,8 @@
-// Converged-tile skipping for denoised local lights (ManyLightSettings::convergedTiles, through HybridEffects), on
-// lavapipe at 64x48 in the many-light room: a still scene converges and then skips tiles, and the denoised output
-// stays within a tolerance of the one without skipping; a light moved while the tiles are converged is traced again
-// within the refresh period; bad settings are named. Two HybridEffects run side by side in the same frames (the same
-// rays), one skipping and one not.
+// Converged-tile skipping for denoised local lights (ManyLightSettings::schedule.convergedTiles, through
+// HybridEffects), on lavapipe at 64x48 in the many-light room: a still scene converges and then skips tiles, and the
+// denoised output stays within a tolerance of the one without skipping; a light moved while the tiles are converged is
+// traced again within the refresh period; bad settings are named. Two HybridEffects run side by side in the same frames
+// (the same rays), one skipping and one not.
 #include <raybridge/raybridge.h>
 
 #include <catch2/catch_test_macros.hpp>

@@ -1,5 +1,5 @@
-// Converged-tile skipping for denoised reflections (ReflectionSettings::convergedTiles), on lavapipe at 64x48: a
-// static scene converges and then skips tiles, and the denoised output stays within a tolerance of the one without
+// Converged-tile skipping for denoised reflections (ReflectionSettings::schedule.convergedTiles), on lavapipe at 64x48:
+// a static scene converges and then skips tiles, and the denoised output stays within a tolerance of the one without
 // skipping; a camera that moves turns the view of the reflections, so their tiles are traced again, however slowly
 // it moves, while a camera that only rotates keeps them; an object moved in the TLAS alone is re-traced in its
 // reflection within the refresh period; bad settings are named. Each case runs two HybridEffects side by side in the

@@ -1,7 +1,7 @@
-// Converged-tile skipping for denoised soft shadows (ShadowSettings::convergedTiles) and AO
-// (AoSettings::convergedTiles), on lavapipe at 64x48: a static scene converges and then skips tiles (the rays saved
-// are the rays missing); the denoised output stays within a tolerance of the one without skipping; a moved light is
-// traced again within the refresh period; a camera move re-traces the tiles it disoccluded. Each case runs two
+// Converged-tile skipping for denoised soft shadows (ShadowSettings::schedule.convergedTiles) and AO
+// (AoSettings::schedule.convergedTiles), on lavapipe at 64x48: a static scene converges and then skips tiles (the rays
+// saved are the rays missing); the denoised output stays within a tolerance of the one without skipping; a moved light
+// is traced again within the refresh period; a camera move re-traces the tiles it disoccluded. Each case runs two
 // HybridEffects side by side in the same frames (the same noise), one skipping and one not.
 #include <raybridge/raybridge.h>
 

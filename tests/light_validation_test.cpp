@@ -1,5 +1,5 @@
-// One rb::Light validator (sdk/src/trace/light_validation.h): every effect that takes a light refuses the same bad light
-// with the same message naming the field, before anything is recorded. The shadow pass once accepted a non-finite
+// One rb::Light validator (sdk/src/trace/light_validation.h): every effect that takes a light refuses the same bad
+// light with the same message naming the field, before anything is recorded. The shadow pass once accepted a non-finite
 // point-light position that the many-light pass refused.
 #include <catch2/catch_test_macros.hpp>
 

@@ -1,6 +1,6 @@
-// One RaySchedule validator (sdk/src/schedule/ray_schedule_stage.h) for every effect: each pass and the HybridEffects front
-// end refuse a stage the effect does not have, and a bad member of a stage it has, with one message that names the
-// field once (the pass's settings, or HybridEffectsDesc's effect), before anything is recorded.
+// One RaySchedule validator (sdk/src/schedule/ray_schedule_stage.h) for every effect: each pass and the HybridEffects
+// front end refuse a stage the effect does not have, and a bad member of a stage it has, with one message that names
+// the field once (the pass's settings, or HybridEffectsDesc's effect), before anything is recorded.
 #include <raybridge/ray_schedule.h>
 
 #include <catch2/catch_test_macros.hpp>

@@ -307,7 +307,8 @@ class AdaptiveSweep {
     longUniform.params = {{"rays_per_pixel", n}, {"adaptive", false}};
     if (std::string err = runOnce(d, longUniform, kConvergedFrames); !err.empty()) return err;
     const Row lu = result_.rows.back();
-    rb::ConvergedTileSettings& c = fx_.flag == rb::kEffectAo ? d.ao.schedule.convergedTiles : d.shadows.schedule.convergedTiles;
+    rb::ConvergedTileSettings& c = fx_.flag == rb::kEffectAo ? d.ao.schedule.convergedTiles
+                                                             : d.shadows.schedule.convergedTiles;
     c.enabled = true;
     Row converged;
     converged.method = "converged_tiles";

@@ -1,7 +1,7 @@
 // Reflections: compared on the final HDR image, because the raster counterparts (constant sky, reflection probe)
 // only exist inside the lighting pass. Shadows come from the engine's shadow map in every row (the same map),
 // AO is off, so the reflected term is the only difference between rows. Then converged tiles
-// (ReflectionSettings::convergedTiles, default settings) against uniform rays, denoised, over kConvergedFrames
+// (ReflectionSettings::schedule.convergedTiles, default settings) against uniform rays, denoised, over kConvergedFrames
 // frames of the still camera at the most rays of the plan:
 //   uniform_long           n rays in every pixel;
 //   converged_tiles        the same with converged tiles skipped: the rays saved, the time, and the error.

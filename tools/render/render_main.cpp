@@ -606,7 +606,8 @@ void addEffectStats(const RenderRun& run, nlohmann::json& stats) {
       {"reflection_half_resolution", hybrid && wantReflections && hd.reflections.schedule.halfResolution}};
   // Adaptive rays (--adaptive): per effect, the time target (0 = the uniform rays, redistributed) and the
   // granularity ("pixel", or the tile in launch cells, "8x8").
-  for (auto [name, a] : {std::pair{"shadows", &hd.shadows.schedule.adaptive}, std::pair{"ao", &hd.ao.schedule.adaptive}}) {
+  for (auto [name, a] :
+       {std::pair{"shadows", &hd.shadows.schedule.adaptive}, std::pair{"ao", &hd.ao.schedule.adaptive}}) {
     std::string granularity = "pixel";
     if (a->granularity == rb::AdaptiveRayGranularity::Tile) {
       const uint32_t tw = a->tileWidth ? a->tileWidth : rb::kDefaultAdaptiveTileWidth;

@@ -1,7 +1,7 @@
 // The G-buffer contract: what the engine's rasterizer hands to the effect passes instead of primary rays.
 // Positions are reconstructed camera-relative from depth and the inverse projection, and the passes trace a
 // TLAS built with TlasBuildOptions::originOffset = the camera position, so precision does not degrade far
-// from the world origin. GLSL helpers that write exactly what Raybridge reads: shaders/raybridge_gbuffer.glsl.
+// from the world origin. GLSL helpers that write exactly what Raybridge reads: shaders/public/raybridge_gbuffer.glsl.
 //
 // Far from the origin (open worlds reach 10-20 km) the engine's raster must be camera-relative as well, or the
 // depth the passes read is already wrong: rebase each model matrix to the camera on the host in double

@@ -56,13 +56,11 @@ class PrimaryRayPass {
   // Retires its pipeline to the context, without waiting for the frames that traced with it.
   ~PrimaryRayPass();
 
-  // Records the trace. The TLAS must have been built by recordTlasBuild() earlier in submission order; the
-  // images stay in VK_IMAGE_LAYOUT_GENERAL and the caller orders their reads after
+  // Records the trace of `tlas` (recordTlasBuild()'s, earlier in submission order; an engine's own TLAS as
+  // TlasInfo{.tlas = handle}), alpha-testing through `settings.materials`. The camera is in world space; the pass
+  // subtracts TlasInfo::originOffset from eye and target (in double) to trace a camera-relative TLAS. The images
+  // stay in VK_IMAGE_LAYOUT_GENERAL and the caller orders their reads after
   // VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR / VK_ACCESS_SHADER_WRITE_BIT.
-  Status record(VkCommandBuffer cmd, VkAccelerationStructureKHR tlas, const PrimaryRayCamera& camera,
-                const PrimaryRayTargets& targets);
-  // The same through a TlasInfo, with alpha testing. The camera is in world space; the pass subtracts
-  // TlasInfo::originOffset from eye and target (in double) to trace a camera-relative TLAS.
   Status record(VkCommandBuffer cmd, const TlasInfo& tlas, const PrimaryRayCamera& camera,
                 const PrimaryRayTargets& targets, const PrimaryRaySettings& settings = {});
   // The latest measurement whose frame has finished (rays, any-hit invocations, GPU time).

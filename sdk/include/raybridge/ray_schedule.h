@@ -58,15 +58,15 @@
 //
 // ---- Converged tiles (RaySchedule::convergedTiles) ----
 //
-// Converged-tile skipping, for the passes whose denoised signal is a mean of rays (ShadowSettings::convergedTiles
-// for soft shadows, AoSettings::convergedTiles for ambient occlusion, ReflectionSettings::convergedTiles for
-// reflections, whose differences are in reflection_pass.h): a tile of 8x8 pixels whose every surface
-// pixel has a reprojected history in the pass's denoiser of at least minFrames frames, with the noise the denoiser
-// measured there under maxNoise, traces no ray. Its pixels are not a sample: they hold kept-history marks,
-// -1 - (the reprojected history mean), in [-2, -1], which that denoiser's next record() reads as "no new frame":
-// it carries the history to the pixel's new position unchanged (the reprojection, and its disocclusion test, are
-// the denoiser's own, so a disoccluded pixel is never skipped). Read the denoised output, not the raw output, or
-// decode a value v < -0.5 as -1 - v. A converged tile is still traced once in refreshPeriod frames (a rotating
+// Converged-tile skipping, for the passes whose denoised signal is a mean of rays
+// (ShadowSettings::schedule.convergedTiles for soft shadows, AoSettings::schedule.convergedTiles for ambient occlusion,
+// ReflectionSettings::schedule.convergedTiles for reflections, whose differences are in reflection_pass.h): a tile of
+// 8x8 pixels whose every surface pixel has a reprojected history in the pass's denoiser of at least minFrames frames,
+// with the noise the denoiser measured there under maxNoise, traces no ray. Its pixels are not a sample: they hold
+// kept-history marks, -1 - (the reprojected history mean), in [-2, -1], which that denoiser's next record() reads as
+// "no new frame": it carries the history to the pixel's new position unchanged (the reprojection, and its disocclusion
+// test, are the denoiser's own, so a disoccluded pixel is never skipped). Read the denoised output, not the raw output,
+// or decode a value v < -0.5 as -1 - v. A converged tile is still traced once in refreshPeriod frames (a rotating
 // subset of the tiles each frame); when its new rays disagree with its history beyond their noise (a moved light or
 // occluder, which the history cannot see) it is traced every frame for the next minFrames frames. Two compute
 // dispatches over the tiles (before the pass's tile classifier and after the trace), within the pass's GPU time.

@@ -30,8 +30,8 @@ Status writeShaderBindingTable(Context& ctx, RayTracingPipeline& p, uint32_t gro
   const VkDeviceSize stride = alignUp(handleSize, c.info.shaderGroupHandleAlignment);
   const VkDeviceSize base = c.info.shaderGroupBaseAlignment;
   std::vector<uint8_t> handles(size_t(groupCount) * handleSize);
-  VkResult r = c.vk.vkGetRayTracingShaderGroupHandlesKHR(c.desc.device, p.pipeline, 0, groupCount,
-                                                handles.size(), handles.data());
+  VkResult r = c.vk.vkGetRayTracingShaderGroupHandlesKHR(c.desc.device, p.pipeline, 0, groupCount, handles.size(),
+                                                         handles.data());
   if (r != VK_SUCCESS) return vulkanError(r, "vkGetRayTracingShaderGroupHandlesKHR");
   VkDeviceSize raygenSize = alignUp(stride, base);
   VkDeviceSize missSize = alignUp(stride * missCount, base);

@@ -1,10 +1,10 @@
-// Converged-tile skipping (raybridge/ray_schedule.h) for the shadow pass (ShadowSettings::convergedTiles), the
-// AO pass (AoSettings::convergedTiles), the reflection pass (ReflectionSettings::convergedTiles) and the many-light
-// pass (ManyLightSettings::convergedTiles): the two compute dispatches around the pass's trace that decide, from its
-// denoiser's history, which tiles have converged and write their kept-history marks into the pass's output, and
-// after the trace check the refreshed tiles for a change the history could not see. Shadows and AO (a Scalar
-// denoiser): shadow_converged.comp and shadow_converged_check.comp, which serve both, as both signals are in [0, 1]
-// with sky at 1, around the pass's tile classifier. Reflections and local lights (a Reflection or Rgb denoiser):
+// Converged-tile skipping (raybridge/ray_schedule.h) for the shadow pass (ShadowSettings::schedule.convergedTiles), the
+// AO pass (AoSettings::schedule.convergedTiles), the reflection pass (ReflectionSettings::schedule.convergedTiles) and
+// the many-light pass (ManyLightSettings::schedule.convergedTiles): the two compute dispatches around the pass's trace
+// that decide, from its denoiser's history, which tiles have converged and write their kept-history marks into the
+// pass's output, and after the trace check the refreshed tiles for a change the history could not see. Shadows and AO
+// (a Scalar denoiser): shadow_converged.comp and shadow_converged_check.comp, which serve both, as both signals are in
+// [0, 1] with sky at 1, around the pass's tile classifier. Reflections and local lights (a Reflection or Rgb denoiser):
 // rgb_converged.comp and rgb_converged_check.comp, which for reflections also follow how far the view turned, and
 // which count the pass's tiles (those passes have no classifier: their ray generation shader skips the converged
 // tiles). The tile state lives in the TileClassifier. Owns the two pipelines, created on first use.

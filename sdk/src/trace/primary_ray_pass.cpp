@@ -95,13 +95,6 @@ Result<std::unique_ptr<PrimaryRayPass>> PrimaryRayPass::create(Context& context)
   return std::unique_ptr<PrimaryRayPass>(new PrimaryRayPass(std::move(impl)));
 }
 
-Status PrimaryRayPass::record(VkCommandBuffer cmd, VkAccelerationStructureKHR tlas, const PrimaryRayCamera& camera,
-                              const PrimaryRayTargets& targets) {
-  TlasInfo info;
-  info.tlas = tlas;
-  return record(cmd, info, camera, targets, {});
-}
-
 Status PrimaryRayPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, const PrimaryRayCamera& worldCamera,
                               const PrimaryRayTargets& targets, const PrimaryRaySettings& settings) {
   auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, m}; };
