@@ -112,7 +112,18 @@ ScheduleStage::ScheduleStage(ScheduledEffect effect)
 
 Status ScheduleStage::init(Context& ctx) {
   if (!effect_.classifierAlwaysBound) return {};
-  if (Status st = classifier_.init(ctx, effect_.classifierShader, effect_.classifierBindings, effect_.constantBytes,
+  return initClassifier(ctx);
+}
+
+Status ScheduleStage::initClassifier(Context& ctx) {
+  std::vector<VkDescriptorSetLayoutBinding> bindings;
+  for (const VkDescriptorSetLayoutBinding& b : effect_.classifierLaunchBindings) {
+    if (b.binding == RB_BINDING_TLAS) continue;
+    bindings.push_back({b.binding, b.descriptorType, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  }
+  bindings.push_back(
+      {effect_.tileStateBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  if (Status st = classifier_.init(ctx, effect_.classifierShader, bindings, effect_.constantBytes,
                                    effect_.classifierName);
       !st) {
     return st;
@@ -184,12 +195,7 @@ Status ScheduleStage::prepare(Context& ctx, const PassCore& core, const GBufferD
     return {};
   }
   if (scalar && !classifierReady_) {
-    if (Status st = classifier_.init(ctx, effect_.classifierShader, effect_.classifierBindings, effect_.constantBytes,
-                                     effect_.classifierName);
-        !st) {
-      return st;
-    }
-    classifierReady_ = true;
+    if (Status st = initClassifier(ctx); !st) return st;
   }
   // RGB signals skip converged tiles in their own launch: the tile state alone.
   return classifier_.ensure(ctx, g.width, g.height, scalar);

@@ -62,7 +62,9 @@ struct ScheduledEffect {
   VkShaderStageFlags recordStages = 0;
   // The tile classifier (Scalar signals with kScheduleTileClassifier or kScheduleConvergedTiles).
   SpirvModule classifierShader{};
-  std::vector<VkDescriptorSetLayoutBinding> classifierBindings;
+  // The bindings of the launch over the tile list (list binding included, material bindings not): the classifier
+  // reads the same set but the TLAS, in a compute stage, plus the tile state.
+  std::vector<VkDescriptorSetLayoutBinding> classifierLaunchBindings;
   uint32_t constantBytes = 0;
   const char* classifierName = "";
 };
@@ -116,6 +118,7 @@ class ScheduleStage {
   void setConstant(void* constants, uint32_t offset, uint32_t value) const;
   bool classifierOn(const RaySchedule& s) const;
   void retireTiles(Context& ctx);
+  Status initClassifier(Context& ctx);
   Result<bool> traceClassified(Context& ctx, PassCore& core, VkCommandBuffer cmd, ScheduleFrame& f, bool converged,
                                uint32_t variant);
 

@@ -33,8 +33,7 @@ RayTracingPipelineDesc aoPipelineDesc(uint32_t variant) {
 }
 
 // AO to the schedule stage: a Scalar signal with every stage but the classifier alone, whose classifier
-// (ao_classify.comp: the ray generation shader's bindings but the TLAS, and the tile state, in a compute stage)
-// runs on the frames whose converged tiles were marked.
+// (ao_classify.comp, over the tile launch's bindings) runs on the frames whose converged tiles were marked.
 ScheduledEffect aoSchedule() {
   ScheduledEffect e;
   e.passName = "AoPass";
@@ -48,12 +47,7 @@ ScheduledEffect aoSchedule() {
   e.pipelineDesc = aoPipelineDesc;
   e.alphaAnyHit = SpirvModule::of(spirv::ao_rahit);
   e.classifierShader = SpirvModule::of(spirv::ao_classify_comp);
-  for (const VkDescriptorSetLayoutBinding& c : aoPipelineDesc(kVariantTiles).bindings) {
-    if (c.binding == RB_BINDING_TLAS) continue;
-    e.classifierBindings.push_back({c.binding, c.descriptorType, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-  }
-  e.classifierBindings.push_back(
-      {RB_AO_BINDING_TILE_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  e.classifierLaunchBindings = aoPipelineDesc(kVariantTiles).bindings;
   e.constantBytes = sizeof(AoConstants);
   e.classifierName = "AO tile classifier";
   return e;

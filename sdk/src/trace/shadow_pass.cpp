@@ -72,9 +72,8 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
   p.pushConstantBytes = sizeof(ShadowConstants);
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::shadow_rahit)); !s) return s.error();
 
-  // To the schedule stage: a Scalar signal whose classifier is its own (the ray generation shader's bindings but
-  // the TLAS and the material bindings, and the tile state, in a compute stage), and whose adaptive variant adds
-  // the plan's binding (not with the occluder distance).
+  // To the schedule stage: a Scalar signal whose classifier is its own (it reads the launch's bindings, not the
+  // material ones), and whose adaptive variant adds the plan's binding (not with the occluder distance).
   ScheduledEffect e;
   e.passName = "ShadowPass";
   e.capabilities = kShadowScheduleCapabilities;
@@ -96,12 +95,7 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
   e.alphaAnyHit = SpirvModule::of(spirv::shadow_rahit);
   e.classifierShader = desc.outputHitDistance ? SpirvModule::of(spirv::shadow_classify_distance_comp)
                                               : SpirvModule::of(spirv::shadow_classify_comp);
-  for (const VkDescriptorSetLayoutBinding& b : p.bindings) {
-    if (b.binding == RB_BINDING_TLAS) continue;
-    e.classifierBindings.push_back({b.binding, b.descriptorType, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-  }
-  e.classifierBindings.push_back(
-      {RB_SHADOW_BINDING_TILE_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  e.classifierLaunchBindings = p.bindings;
   e.constantBytes = sizeof(ShadowConstants);
   e.classifierName = "shadow tile classifier";
   impl->schedule = std::make_unique<ScheduleStage>(std::move(e));
