@@ -175,4 +175,5 @@ TEST_CASE("every effect's RaySchedule is checked by one validator that names the
             std::string::npos);
     }
   });
+  destroyScene(fx, built);
 }

@@ -30,6 +30,9 @@ GpuFixture::~GpuFixture() {
     }
     CHECK(errors == 0);
   }
+  UNSCOPED_INFO(liveUploads_ << " mesh(es) from GpuFixture::upload were not destroyed: call destroyScene or "
+                                "GpuFixture::destroy before the test ends");
+  CHECK(liveUploads_ == 0);
 }
 
 UploadedMesh GpuFixture::upload(const rbsamples::CpuMesh& mesh, bool withHostCopies) {
@@ -43,6 +46,7 @@ UploadedMesh GpuFixture::upload(const rbsamples::CpuMesh& mesh, bool withHostCop
   RB_REQUIRE_OK(i);
   out.vertices = v.value();
   out.indices = i.value();
+  ++liveUploads_;
   out.desc.vertexAddress = out.vertices.address;
   out.desc.vertexBufferBytes = out.vertices.size;
   out.desc.vertexCount = mesh.vertexCount();
@@ -59,6 +63,7 @@ UploadedMesh GpuFixture::upload(const rbsamples::CpuMesh& mesh, bool withHostCop
 }
 
 void GpuFixture::destroy(UploadedMesh& mesh) {
+  if (mesh.vertices.buffer && liveUploads_) --liveUploads_;
   device_->destroyBuffer(mesh.vertices);
   device_->destroyBuffer(mesh.indices);
 }

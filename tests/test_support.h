@@ -30,7 +30,9 @@ class GpuFixture {
  public:
   // requestAsyncComputeQueue: see HeadlessDeviceDesc (a second, compute-only queue when the device has one).
   explicit GpuFixture(uint32_t framesInFlight = 2, bool requestAsyncComputeQueue = false);
-  // Fails the running test if the validation layer reported any error.
+  // Fails the running test if the validation layer reported any error, or if a mesh from upload() was not
+  // destroyed (the device would be destroyed with its buffers alive: LeakSanitizer's report in CI, and a
+  // validation message that comes too late to fail the test).
   ~GpuFixture();
 
   rb::HeadlessDevice& device() { return *device_; }
@@ -55,6 +57,7 @@ class GpuFixture {
  private:
   std::unique_ptr<rb::HeadlessDevice> device_;
   std::unique_ptr<rb::Context> ctx_;
+  uint32_t liveUploads_ = 0;  // upload() minus destroy()
 };
 
 // Asserts a result is ok and prints its message otherwise.
