@@ -353,9 +353,9 @@ TEST_CASE("half-resolution reflections of a mirror floor match full resolution a
   const uint32_t w = view.width, h = view.height;
   const CpuGBuffer cpu = traceGBuffer(embree, view, {0.0f, 1.0f});  // floor a mirror, box rough
   rb::ReflectionSettings settings;
-  settings.sunDirection[0] = 0.3f;
-  settings.sunDirection[1] = 1.0f;
-  settings.sunDirection[2] = 0.6f;
+  settings.lighting.sunDirection[0] = 0.3f;
+  settings.lighting.sunDirection[1] = 1.0f;
+  settings.lighting.sunDirection[2] = 0.6f;
   ReflectionRun full, half;
   {
     GpuFixture fx;

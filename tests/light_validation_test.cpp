@@ -27,6 +27,8 @@ TEST_CASE("every effect that takes a light refuses the same bad light with the s
   RB_REQUIRE_OK(shadowPass);
   auto manyLights = rb::ManyLightPass::create(fx.ctx());
   RB_REQUIRE_OK(manyLights);
+  auto lightList = rb::LightList::create(fx.ctx());
+  RB_REQUIRE_OK(lightList);
   auto effects = rb::HybridEffects::create(fx.ctx(), service.value().get(),
                                            {.effects = rb::kEffectShadows | rb::kEffectLocalLights});
   RB_REQUIRE_OK(effects);
@@ -58,12 +60,13 @@ TEST_CASE("every effect that takes a light refuses the same bad light with the s
       std::vector<rb::LightSource> list(1);
       list[0].light = light;
       const rb::Status many = manyLights.value()->record(cmd, gbuffer.desc(), built.tlas, list);
+      const rb::Status shared = lightList.value()->record(cmd, built.tlas, list);
       rb::HybridFrame frame;
       frame.gbuffer = gbuffer.desc();
       frame.instances = built.instances;
       frame.light = light;
       const rb::Status front = effects.value()->record(cmd, frame);
-      for (const rb::Status* st : {&shadow, &many, &front}) {
+      for (const rb::Status* st : {&shadow, &many, &shared, &front}) {
         INFO(st->what());
         REQUIRE_FALSE(st->ok());
         CHECK(st->error().code == rb::ErrorCode::InvalidArgument);
@@ -71,6 +74,7 @@ TEST_CASE("every effect that takes a light refuses the same bad light with the s
       }
       CHECK(std::string(shadow.what()).rfind("ShadowPass: ", 0) == 0);
       CHECK(std::string(many.what()).find("lights[0]: ") != std::string::npos);
+      CHECK(std::string(shared.what()).rfind("LightList::record: lights[0]: ", 0) == 0);
       CHECK(std::string(front.what()).find("HybridFrame::light: ") != std::string::npos);
     }
   });
@@ -83,6 +87,7 @@ TEST_CASE("every effect that takes a light refuses the same bad light with the s
   });
   shadowPass.value().reset();
   manyLights.value().reset();
+  lightList.value().reset();
   effects.value().reset();
   destroyScene(fx, built);
 }

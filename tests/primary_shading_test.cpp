@@ -53,7 +53,8 @@ TEST_CASE("primary shading: distances match Embree, misses see the sky, hits are
   TestScene scene = makeConformanceScene();
   const rb::PrimaryRayCamera camera = conformanceCamera();
   rb::PrimaryShadingSettings settings;  // zero: the default sun, sky and ambient; every surface white
-  settings.sunDirection[0] = 0.3f, settings.sunDirection[1] = 1.0f, settings.sunDirection[2] = 0.2f;
+  settings.lighting.sunDirection[0] = 0.3f, settings.lighting.sunDirection[1] = 1.0f,
+  settings.lighting.sunDirection[2] = 0.2f;
   ShadingRun run = runShading(fx, scene, camera, W, H, settings);
 
   EmbreeScene embree;
@@ -134,11 +135,12 @@ TEST_CASE("primary shading rejects bad input with a message naming it", "[primar
     rb::PrimaryRayCamera same = camera;
     for (int i = 0; i < 3; ++i) same.target[i] = same.eye[i];
     expect(pass.value()->record(cmd, built.tlas, same, {8, 8}), "camera: camera eye equals target");
-    auto lights = rb::ManyLightPass::create(fx.ctx());
+    auto lights = rb::LightList::create(fx.ctx());
     RB_REQUIRE_OK(lights);
     rb::PrimaryShadingSettings unrecorded;
     unrecorded.lights = lights.value().get();
-    expect(pass.value()->record(cmd, built.tlas, camera, {8, 8}, unrecorded), "uploaded no light list this frame");
+    expect(pass.value()->record(cmd, built.tlas, camera, {8, 8}, unrecorded),
+           "PrimaryShadingSettings::lights: that LightList was not recorded this frame");
   });
   destroyScene(fx, built);
 }

@@ -72,13 +72,14 @@ TEST_CASE("a mirror reflects a coloured box where Embree says it should", "[refl
   view.width = 96;
   view.height = 72;
   rb::ReflectionSettings settings;
-  settings.sunDirection[0] = 0.3f;
-  settings.sunDirection[1] = 1.0f;
-  settings.sunDirection[2] = 0.6f;
+  settings.lighting.sunDirection[0] = 0.3f;
+  settings.lighting.sunDirection[1] = 1.0f;
+  settings.lighting.sunDirection[2] = 0.6f;
   // Explicit lighting, so the reference below reads the same values the pass shades with.
   for (int i = 0; i < 3; ++i)
-    settings.sunRadiance[i] = rb::kDefaultSunRadiance, settings.skyRadiance[i] = rb::kDefaultSkyRadiance[i];
-  settings.ambientIntensity = rb::kDefaultAmbientIntensity;
+    settings.lighting.sunRadiance[i] = rb::kDefaultSunRadiance,
+    settings.lighting.skyRadiance[i] = rb::kDefaultSkyRadiance[i];
+  settings.lighting.ambientIntensity = rb::kDefaultAmbientIntensity;
 
   SECTION("mirror floor") {
     CpuGBuffer cpu = traceGBuffer(embree, view, {0.0f, 1.0f});  // floor a mirror, box rough
@@ -119,8 +120,9 @@ TEST_CASE("a mirror reflects a coloured box where Embree says it should", "[refl
           red += c.r > 3.0f * c.g && c.r > 3.0f * c.b && c.r > 0.05f;
         } else if (target < 0) {
           ++skyInMirror;
-          sky += std::fabs(c.r - settings.skyRadiance[0]) < 2e-3f && std::fabs(c.g - settings.skyRadiance[1]) < 2e-3f &&
-                 std::fabs(c.b - settings.skyRadiance[2]) < 2e-3f;
+          sky += std::fabs(c.r - settings.lighting.skyRadiance[0]) < 2e-3f &&
+                 std::fabs(c.g - settings.lighting.skyRadiance[1]) < 2e-3f &&
+                 std::fabs(c.b - settings.lighting.skyRadiance[2]) < 2e-3f;
         }
       }
     }
@@ -133,8 +135,8 @@ TEST_CASE("a mirror reflects a coloured box where Embree says it should", "[refl
     // Rays are counted: one reflection ray per mirror pixel (every floor pixel, no box pixel), plus a shadow
     // ray where a reflection ray hits a box face that faces the sun.
     uint64_t tracedPixels = 0, allFloor = 0, shadowRays = 0;
-    const glm::dvec3 toSun = glm::normalize(
-        glm::dvec3(settings.sunDirection[0], settings.sunDirection[1], settings.sunDirection[2]));
+    const glm::dvec3 toSun = glm::normalize(glm::dvec3(
+        settings.lighting.sunDirection[0], settings.lighting.sunDirection[1], settings.lighting.sunDirection[2]));
     for (size_t i = 0; i < run.radiance.size(); ++i) {
       tracedPixels += run.radiance[i].a != 0.0f;
       if (!cpu.hit[i] || cpu.instance[i] != 0) continue;
@@ -200,13 +202,14 @@ TEST_CASE("reflection hits are lit by the many-light pass's light list", "[refle
   CpuGBuffer cpu = traceGBuffer(embree, view, {0.0f, 1.0f});  // floor a mirror
   // No sun, a black sky, no ambient: the point light in front of the box is the only light.
   rb::ReflectionSettings settings;
-  settings.flags = rb::kReflectionExplicitLighting | rb::kReflectionNoSun;
+  settings.lighting.explicitValues = true;
+  settings.lighting.noSun = true;
   rb::LightSource light;
   light.light.type = rb::LightType::Point;
   light.light.position[0] = 0.4, light.light.position[1] = 1.0, light.light.position[2] = 0.2;
   light.intensity = 5.0f;
   light.color[1] = 0.8f;
-  auto lights = rb::ManyLightPass::create(fx.ctx());
+  auto lights = rb::LightList::create(fx.ctx());
   RB_REQUIRE_OK(lights);
   auto pass = rb::ReflectionPass::create(fx.ctx());
   RB_REQUIRE_OK(pass);
@@ -223,7 +226,7 @@ TEST_CASE("reflection hits are lit by the many-light pass's light list", "[refle
         [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
           rb::ReflectionSettings s = settings;
           if (withLights) {
-            RB_REQUIRE_OK(lights.value()->record(cmd, desc, tlas, std::span(&light, 1)));
+            RB_REQUIRE_OK(lights.value()->record(cmd, tlas, std::span(&light, 1)));
             s.lights = lights.value().get();
           }
           RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, s));
@@ -306,7 +309,8 @@ TEST_CASE("reflections with and without invocation reorder agree", "[reflection]
   CpuGBuffer cpu = traceGBuffer(embree, view, {0.2f, 0.0f, 0.0f});
   rb::ReflectionSettings settings;
   settings.raysPerPixel = 4;
-  settings.sunDirection[0] = 0.3f, settings.sunDirection[1] = 1.0f, settings.sunDirection[2] = 0.6f;
+  settings.lighting.sunDirection[0] = 0.3f, settings.lighting.sunDirection[1] = 1.0f,
+  settings.lighting.sunDirection[2] = 0.6f;
   rb::ReflectionSettings plainSettings = settings;
   settings.invocationReorder = true;  // opt-in
 

@@ -122,7 +122,7 @@ struct Adapter::Impl {
   // Ray-traced mode: the materials hits shade with, the pass, and the local lights' list (no G-buffer to cull).
   std::unique_ptr<rb::MaterialTable> materials;
   std::unique_ptr<rb::PrimaryShadingPass> shading;
-  std::unique_ptr<rb::ManyLightPass> lightList;
+  std::unique_ptr<rb::LightList> lightList;
   rb::TlasInfo tlas;                     // ray-traced mode's latest
   std::vector<rb::MeshHandle> meshes;    // parallel to engine.meshes(); null for empty meshes
   std::vector<rb::MeshHandle> deformed;  // parallel to engine.deformedInstances(): dynamic BLASes
@@ -266,10 +266,10 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   f.reflectionGBuffer = &shading;
   f.instances = a.instances;
   std::copy_n(&info.sunDirection[0], 3, f.light.direction);
-  std::copy_n(&info.sunRadiance[0], 3, f.lightRadiance);
-  std::copy_n(&info.skyColor[0], 3, f.skyRadiance);
-  f.ambientIntensity = info.ambientIntensity;
-  f.flags = rb::kFrameExplicitLighting;  // the engine's own values, zeros included
+  std::copy_n(&info.sunRadiance[0], 3, f.lighting.sunRadiance);
+  std::copy_n(&info.skyColor[0], 3, f.lighting.skyRadiance);
+  f.lighting.ambientIntensity = info.ambientIntensity;
+  f.lighting.explicitValues = true;  // the engine's own values, zeros included
   if (a.fx->desc().effects & rb::kEffectLocalLights) convertLights(info.lights, a.lights), f.localLights = a.lights;
   if (rb::Status s = a.fx->record(info.commandBuffer, f); !s)
     return keepFirst(a.error, message("HybridEffects::record", s.error()));
@@ -300,15 +300,15 @@ void Adapter::recordRayTraced(const se::PrepassHookInfo& info) {
   if (!tlas) return keepFirst(a.error, message("recordTlasBuild", tlas.error()));
   a.tlas = tlas.value();
   rb::PrimaryShadingSettings s;
-  if (!info.lights.empty() && !a.lightList) {  // made by the first frame with lights; it only uploads the list
-    auto lights = rb::ManyLightPass::create(*a.ctx);
-    if (!lights) return keepFirst(a.error, message("rb::ManyLightPass::create", lights.error()));
+  if (!info.lights.empty() && !a.lightList) {  // made by the first frame with lights
+    auto lights = rb::LightList::create(*a.ctx);
+    if (!lights) return keepFirst(a.error, message("rb::LightList::create", lights.error()));
     a.lightList = std::move(lights.value());
   }
   if (a.lightList) {
     convertLights(info.lights, a.lights);
-    if (rb::Status st = a.lightList->recordLightList(info.commandBuffer, a.tlas, a.lights); !st)
-      return keepFirst(a.error, message("ManyLightPass::recordLightList", st.error()));
+    if (rb::Status st = a.lightList->record(info.commandBuffer, a.tlas, a.lights); !st)
+      return keepFirst(a.error, message("LightList::record", st.error()));
     s.lights = a.lightList.get();
   }
   // The engine's camera: eye, its view direction and up (rotation-only view), and the field of view of its
@@ -324,11 +324,11 @@ void Adapter::recordRayTraced(const se::PrepassHookInfo& info) {
     camera.upHint[i] = up[i];
   }
   camera.verticalFovDegrees = glm::degrees(2.0f * std::atan(1.0f / std::abs(info.proj[1][1])));
-  std::copy_n(&info.sunDirection[0], 3, s.sunDirection);
-  std::copy_n(&info.sunRadiance[0], 3, s.sunRadiance);
-  std::copy_n(&info.skyColor[0], 3, s.skyRadiance);
-  s.ambientIntensity = info.ambientIntensity;
-  s.flags = rb::kPrimaryShadingExplicitLighting;  // the engine's own values, zeros included
+  std::copy_n(&info.sunDirection[0], 3, s.lighting.sunDirection);
+  std::copy_n(&info.sunRadiance[0], 3, s.lighting.sunRadiance);
+  std::copy_n(&info.skyColor[0], 3, s.lighting.skyRadiance);
+  s.lighting.ambientIntensity = info.ambientIntensity;
+  s.lighting.explicitValues = true;  // the engine's own values, zeros included
   s.materials = a.materials.get();
   rb::PrimaryShadingTargets targets;
   targets.width = info.extent.width, targets.height = info.extent.height;

@@ -47,6 +47,7 @@
 #include <raybridge/many_light_pass.h>
 #include <raybridge/presets.h>
 #include <raybridge/reflection_pass.h>
+#include <raybridge/scene_lighting.h>
 #include <raybridge/shadow_pass.h>
 
 #include <memory>
@@ -149,13 +150,6 @@ struct HybridEffectsDesc {
 // `base` with the preset's effect set, ray counts and AO resolution (every other field is kept).
 HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset);
 
-// Flags of HybridFrame::flags.
-enum HybridFrameFlags : uint32_t {
-  // Take lightRadiance, skyRadiance and ambientIntensity as given, zeros included (a black sky, no ambient).
-  // Without it a zero field means its default constant.
-  kFrameExplicitLighting = 1u << 0,
-};
-
 // One frame's inputs. gbuffer is required; the scene comes from `tlas` or `instances`.
 struct HybridFrame {
   GBufferDesc gbuffer{};
@@ -167,16 +161,14 @@ struct HybridFrame {
   const TlasInfo* tlas = nullptr;
   std::span<const Instance> instances{};
   Light light{};  // the light the shadow effect shadows and reflection hits are lit by (default: the sun, up)
-  // The engine's light list for the local lights effect (many_light_pass.h; at most kMaxLights), this frame's
-  // positions. Copied during record(). Empty = black, no rays.
+  // The engine's light list for the local lights effect (light_list.h; at most kMaxLights), this frame's
+  // positions, also lighting reflection hits. Copied during record(). Empty = black, no rays.
   std::span<const LightSource> localLights{};
-  // Lighting of reflection hits: the light's radiance (colour * intensity), the sky's radiance returned by
-  // escaping rays, and the sky light on hit surfaces (ambientIntensity * skyRadiance). Zero = the default
-  // constants above unless kFrameExplicitLighting.
-  float lightRadiance[3] = {0.0f, 0.0f, 0.0f};
-  float skyRadiance[3] = {0.0f, 0.0f, 0.0f};
-  float ambientIntensity = 0.0f;
-  uint32_t flags = 0;  // HybridFrameFlags
+  // Lighting of reflection hits (scene_lighting.h): sunRadiance is `light`'s radiance (colour * intensity),
+  // skyRadiance what escaping rays return, ambientIntensity the sky light on hit surfaces; zeros mean the defaults
+  // unless explicitValues. The sun's direction is `light`'s: lighting.sunDirection and lighting.noSun are not read
+  // (a point or spot `light` leaves the hits to the sky).
+  SceneLighting lighting{};
 };
 
 // An image the front end owns: left in `layout` after record(), readable by fragment, compute and ray tracing

@@ -24,8 +24,9 @@
 // A tile reached by more than kMaxTileLights lights draws its candidates from the whole list instead (still
 // unbiased, noisier).
 //
-// The lights are copied into a per-frame ring (one slot per frame in flight) and from there into a device
-// buffer by commands record() adds, so the caller's array may change right after the call.
+// The lights come as a LightList the engine recorded this frame (shared with reflection hits and the pure
+// ray-traced mode: light_list.h), or as the array itself, which record() then uploads into a list of the pass's own
+// (copied, so the caller's array may change right after the call).
 //
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipelines, buffers, output
 // image and measurement objects are handed to the Context's deferred release (see context.h). Destroy it
@@ -37,6 +38,7 @@
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
+#include <raybridge/light_list.h>
 #include <raybridge/material_table.h>
 #include <raybridge/ray_schedule.h>
 
@@ -45,29 +47,12 @@
 
 namespace rb {
 
-namespace internal {
-struct ManyLightPassAccess;
-}
-
-inline constexpr uint32_t kMaxLights = 65536;
 inline constexpr uint32_t kMaxTileLights = 256;     // lights one tile lists; more = candidates from all
 inline constexpr uint32_t kManyLightTileSize = 16;  // pixels per tile side
 inline constexpr uint32_t kDefaultLightRays = 1;    // shadow rays per pixel in Stochastic mode
 // Lights weighed per pixel: up to this many in a tile, selection is exactly proportional to the unshadowed
 // contribution; each costs a few ALU operations and no ray.
 inline constexpr uint32_t kDefaultLightCandidates = 32;
-
-// One light of the engine's list: the geometry and softness of rb::Light, with colour and intensity in
-// KHR_lights_punctual's units. Defaults are glTF's (colour white, intensity 1, inner cone angle 0).
-struct LightSource {
-  // type, direction (directional: towards the light; spot: the direction it shines), position, range (0 =
-  // unlimited: no range window), spotOuterAngleDegrees (0 = 45), and the softness: radius (point, spot) or
-  // angularRadiusDegrees (directional), 0 = hard shadows.
-  Light light{};
-  float color[3] = {1.0f, 1.0f, 1.0f};  // linear RGB, >= 0
-  float intensity = 1.0f;               // candela (point, spot) or lux (directional), finite and >= 0
-  float spotInnerAngleDegrees = 0.0f;   // spot: full intensity inside it; in [0, outer]
-};
 
 enum class ManyLightMode : uint32_t {
   Stochastic = 0,  // default: ManyLightSettings::raysPerPixel rays whatever the light count
@@ -108,26 +93,27 @@ class ManyLightPass {
   // Retires its Vulkan objects to the context, without waiting.
   ~ManyLightPass();
 
-  // Records the light upload, the tile culling and the shadow rays. `lights` may be empty (the output is then
-  // black and no ray is traced). Every light is checked first; on error nothing is recorded and the message
-  // names the light's index and field.
+  // Records the tile culling and the shadow rays over `lights`, a LightList recorded this frame for the same TLAS
+  // space (refused with a named error otherwise). An empty list makes the output black and traces no ray.
+  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas, const LightList& lights,
+                const ManyLightSettings& settings = {});
+  // The same, given the lights themselves: records their upload into the pass's own list first (inside the
+  // pass's time). Every light is checked first; on error nothing is recorded and the message names the light's
+  // index and field.
   Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas,
                 std::span<const LightSource> lights, const ManyLightSettings& settings = {});
-  // Records the light upload alone (no culling, no rays, no output image), for passes lit by the list without a
-  // G-buffer (PrimaryShadingSettings::lights); checked as record() checks it. stats() does not measure it.
-  Status recordLightList(VkCommandBuffer cmd, const TlasInfo& tlas, std::span<const LightSource> lights);
   // Creates the output images at width x height now, so that outputs() names them before the first record()
   // (HybridEffects hands out views that stay valid this way); record() at the same size keeps them, at another
   // size it recreates them. Written by the first record().
   Status prepare(uint32_t width, uint32_t height);
   const ManyLightOutputs& outputs() const;
-  // GPU time (upload, culling and tracing) and rays of the latest recording whose frame has finished.
+  // GPU time (culling and tracing, and the upload of lights given as an array) and rays of the latest recording
+  // whose frame has finished.
   PassStats stats() const;
 
   struct Impl;
 
  private:
-  friend struct internal::ManyLightPassAccess;
   explicit ManyLightPass(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

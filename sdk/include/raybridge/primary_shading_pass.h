@@ -1,7 +1,7 @@
 // Pure ray tracing: one primary ray per pixel from a pinhole camera (PrimaryRayCamera), shaded where it hits
 // with the engine's materials exactly as reflection hits are (reflection_pass.h): base colour, metallic and
 // emissive factors and textures, the sun with a shadow ray, the sky's ambient light, and the local lights of a
-// ManyLightPass when given (one resampled light per hit, with its shadow ray). A ray that misses returns the sky.
+// LightList when given (one resampled light per hit, with its shadow ray). A ray that misses returns the sky.
 // No G-buffer is read: the pass replaces an engine's rasterized shading (the thesis's "ray-traced" mode).
 //
 // Alpha: primary and shadow rays alpha-test non-opaque geometry with the material table (material_table.h):
@@ -23,39 +23,27 @@
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/context.h>
 #include <raybridge/effects.h>
-#include <raybridge/many_light_pass.h>
+#include <raybridge/light_list.h>
 #include <raybridge/material_table.h>
 #include <raybridge/primary_ray_pass.h>
 #include <raybridge/reflection_pass.h>
+#include <raybridge/scene_lighting.h>
 
 #include <memory>
 
 namespace rb {
 
-// Defaults of PrimaryShadingSettings: the lighting defaults of reflection hits (reflection_pass.h).
+// Defaults of PrimaryShadingSettings (the lighting's are SceneLighting's, shared with reflection hits).
 inline constexpr uint32_t kDefaultPrimaryShadingLightCandidates = kDefaultReflectionLightCandidates;
 inline constexpr uint32_t kMaxPrimaryShadingLightCandidates = 64;
 
-enum PrimaryShadingFlags : uint32_t {
-  // Take sunRadiance, skyRadiance and ambientIntensity as given, zeros included (a black sky, no sky light).
-  // Without it an all-zero colour or a zero intensity means its default constant.
-  kPrimaryShadingExplicitLighting = 1u << 0,
-  // No directional light: hits are lit by the sky alone (no sun shadow rays).
-  kPrimaryShadingNoSun = 1u << 1,
-};
-
 // A zero-initialised PrimaryShadingSettings is valid: every zero field means the default named on its line.
 struct PrimaryShadingSettings {
-  float sunDirection[3] = {0.0f, 0.0f, 0.0f};  // towards the sun; all zero = straight up (0, 1, 0)
-  float sunRadiance[3] = {0.0f, 0.0f, 0.0f};   // linear, the sun's colour times intensity; 0 = kDefaultSunRadiance
-  float skyRadiance[3] = {0.0f, 0.0f, 0.0f};   // linear, what missing rays see; 0 = kDefaultSkyRadiance
-  float ambientIntensity = 0.0f;  // sky light on hit surfaces, times skyRadiance; 0 = kDefaultAmbientIntensity
-  uint32_t flags = 0;             // PrimaryShadingFlags
+  SceneLighting lighting{};  // the sun with its shadow ray, what missing rays see, the sky light on hits
   // The table hits shade with and alpha-test with; nullptr = every surface white and opaque.
   const MaterialTable* materials = nullptr;
-  // Local lights: the light list this ManyLightPass uploaded earlier this frame (record() or recordLightList(),
-  // same TLAS). nullptr = sun and sky only.
-  const ManyLightPass* lights = nullptr;
+  // Local lights: this LightList, recorded earlier this frame for the same TLAS space. nullptr = sun and sky only.
+  const LightList* lights = nullptr;
   uint32_t lightCandidates = 0;  // 0 = kDefaultPrimaryShadingLightCandidates; at most 64
 };
 

@@ -10,6 +10,7 @@
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
 #include <raybridge/hybrid_effects.h>
+#include <raybridge/light_list.h>
 #include <raybridge/many_light_pass.h>
 #include <raybridge/material_table.h>
 #include <raybridge/presets.h>
@@ -18,4 +19,5 @@
 #include <raybridge/ray_schedule.h>
 #include <raybridge/reflection_pass.h>
 #include <raybridge/result.h>
+#include <raybridge/scene_lighting.h>
 #include <raybridge/shadow_pass.h>

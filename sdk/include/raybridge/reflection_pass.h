@@ -54,9 +54,10 @@
 #include <raybridge/acceleration_structures.h>
 #include <raybridge/effects.h>
 #include <raybridge/gbuffer.h>
-#include <raybridge/many_light_pass.h>
+#include <raybridge/light_list.h>
 #include <raybridge/material_table.h>
 #include <raybridge/ray_schedule.h>
+#include <raybridge/scene_lighting.h>
 
 #include <memory>
 #include <span>
@@ -66,35 +67,19 @@ namespace rb {
 // Defaults of ReflectionSettings (what a zero field means).
 inline constexpr float kDefaultReflectionRoughnessThreshold = 0.3f;
 inline constexpr uint32_t kDefaultReflectionRays = 1;
-inline constexpr float kDefaultSunRadiance = 3.0f;  // per channel
-inline constexpr float kDefaultSkyRadiance[3] = {0.45f, 0.62f, 0.9f};
-inline constexpr float kDefaultAmbientIntensity = 0.4f;
 inline constexpr uint32_t kDefaultReflectionLightCandidates = 4;  // local lights weighed per hit
-
-enum ReflectionFlags : uint32_t {
-  // Take sunRadiance, skyRadiance and ambientIntensity as given, zeros included (a black sky, no sky light).
-  // Without it an all-zero colour or a zero intensity means its default constant.
-  kReflectionExplicitLighting = 1u << 0,
-  // No directional light: hits are lit by the sky alone (sunRadiance is taken as zero), while sky and ambient
-  // keep their zero-means-default rule.
-  kReflectionNoSun = 1u << 1,
-};
 
 // A zero-initialised ReflectionSettings is valid: every zero field means the default constant above.
 struct ReflectionSettings {
   float roughnessThreshold = 0.0f;  // 0 = kDefaultReflectionRoughnessThreshold: rougher surfaces trace nothing
   uint32_t raysPerPixel = 0;        // glossy pixels; 0 = kDefaultReflectionRays (noisy: denoise or accumulate)
-  float sunDirection[3] = {0.0f, 0.0f, 0.0f};  // towards the sun; all zero = straight up (0, 1, 0)
-  float sunRadiance[3] = {0.0f, 0.0f, 0.0f};   // linear, the sun's colour times intensity; 0 = kDefaultSunRadiance
-  float skyRadiance[3] = {0.0f, 0.0f, 0.0f};   // linear, returned by rays that escape; 0 = kDefaultSkyRadiance
-  float ambientIntensity = 0.0f;  // sky light on hit surfaces, times skyRadiance; 0 = kDefaultAmbientIntensity
-  uint32_t flags = 0;             // ReflectionFlags
+  SceneLighting lighting{};         // the sun with its shadow ray, what escaping rays return, the sky light on hits
   // The table hits shade with and alpha-test with; nullptr = the pass's own table (setMaterials()).
   const MaterialTable* materials = nullptr;
-  // Local lights: hits are also lit by the light list this ManyLightPass uploaded in its record() earlier this
-  // frame (same TLAS), one light per hit chosen among lightCandidates in proportion to its unshadowed
-  // contribution there, with a shadow ray (unbiased, noisy like glossy rays). nullptr = sun and sky only.
-  const ManyLightPass* lights = nullptr;
+  // Local lights: hits are also lit by this LightList, recorded earlier this frame for the same TLAS space, one
+  // light per hit chosen among lightCandidates in proportion to its unshadowed contribution there, with a shadow
+  // ray (unbiased, noisy like glossy rays). nullptr = sun and sky only.
+  const LightList* lights = nullptr;
   uint32_t lightCandidates = 0;  // 0 = kDefaultReflectionLightCandidates; at most 64
   // false (default) = trace as usual; true = reorder the hits before shading them (shader execution reordering)
   // where the Context has it (DeviceInfo::invocationReorder), else trace as usual. Same rays and shading either

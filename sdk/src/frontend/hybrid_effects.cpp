@@ -9,6 +9,7 @@
 #include "neutral_images.h"
 #include "pass_constants.h"
 #include "ray_schedule_stage.h"
+#include "scene_lighting_resolve.h"
 
 namespace rb {
 
@@ -106,6 +107,15 @@ RaySchedule effectSchedule(const RaySchedule& wanted, const Denoiser* history, b
   return s;
 }
 
+// The frame's lighting as reflection hits see it: the pass lights hits by one directional light, the frame's; a
+// local one leaves them to the sky.
+SceneLighting reflectionLighting(const HybridFrame& f) {
+  SceneLighting l = f.lighting;
+  l.noSun = f.light.type != LightType::Directional;
+  for (int i = 0; i < 3; ++i) l.sunDirection[i] = l.noSun ? 0.0f : f.light.direction[i];
+  return l;
+}
+
 bool hasSize(const Light& l) {
   return l.type == LightType::Directional ? l.angularRadiusDegrees > 0.0f : l.radius > 0.0f;
 }
@@ -194,6 +204,8 @@ struct HybridEffects::Impl {
   std::unique_ptr<Denoiser> aoDenoiser;
   std::unique_ptr<ReflectionPass> reflection;
   std::unique_ptr<ManyLightPass> localLights;
+  // The frame's local lights, uploaded once and read by the many-light pass and the reflection hits.
+  std::unique_ptr<LightList> lightList;
   std::unique_ptr<Denoiser> localLightDenoiser;
   std::unique_ptr<Denoiser> reflectionDenoiser;
   // The engine's materials, shared by every pass: reflection hits shade with them, and shadow, AO and
@@ -342,6 +354,10 @@ struct HybridEffects::Impl {
                           [&] { return ManyLightPass::create(ctx); });
         !s)
       return s;
+    if (Status s = ensure(lightList, e & kEffectLocalLights, "LightList::create",
+                          [&] { return LightList::create(ctx); });
+        !s)
+      return s;
     if (!shadow || desc.shadows.disableDenoiser) shadowDenoiser.reset();
     if (!ao || desc.ao.disableDenoiser) aoDenoiser.reset();
     if (!localLightsDenoised()) localLightDenoiser.reset();
@@ -382,7 +398,8 @@ Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridF
   s.candidates = desc.localLights.candidates;
   s.materials = materials.get();
   s.schedule = effectSchedule(desc.localLights.schedule, localLightDenoiser.get());
-  if (Status st = localLights->record(cmd, f.gbuffer, tlas, f.localLights, s); !st)
+  if (Status st = lightList->record(cmd, tlas, f.localLights); !st) return wrap("HybridFrame::localLights", st.error());
+  if (Status st = localLights->record(cmd, f.gbuffer, tlas, *lightList, s); !st)
     return wrap("ManyLightPass::record", st.error());
   const ManyLightOutputs& o = localLights->outputs();
   return denoise(localLightDenoiser, localLightsDenoised(), "Denoiser (local lights)", cmd, f.gbuffer, o.irradianceView,
@@ -429,18 +446,8 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.raysPerPixel = desc.reflections.raysPerPixel;
   s.invocationReorder = desc.reflections.invocationReorder;
   s.schedule = effectSchedule(desc.reflections.schedule, reflectionDenoiser.get());
-  s.flags = (f.flags & kFrameExplicitLighting) ? kReflectionExplicitLighting : 0u;
-  for (int i = 0; i < 3; ++i) {
-    s.sunRadiance[i] = f.lightRadiance[i];
-    s.skyRadiance[i] = f.skyRadiance[i];
-  }
-  s.ambientIntensity = f.ambientIntensity;
-  if (localLights && !f.localLights.empty()) s.lights = localLights.get();  // recorded earlier this frame
-  if (f.light.type == LightType::Directional) {
-    for (int i = 0; i < 3; ++i) s.sunDirection[i] = f.light.direction[i];
-  } else {
-    s.flags |= kReflectionNoSun;  // the pass lights hits by one directional light: a local one leaves the sky
-  }
+  s.lighting = reflectionLighting(f);
+  if (lightList && !f.localLights.empty()) s.lights = lightList.get();  // recorded earlier this frame
   const GBufferDesc& g = f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer;
   if (Status st = reflection->record(cmd, g, tlas, s); !st) return wrap("ReflectionPass::record", st.error());
   const ReflectionOutputs& o = reflection->outputs();
@@ -516,6 +523,12 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
   // The light shadows and lights reflection hits: checked as every effect checks a light.
   if (a.shadow || a.reflection) {
     if (Status st = validateLight(frame.light, "HybridEffects: record: HybridFrame::light: "); !st) return st;
+  }
+  // Sun, sky and ambient of reflection hits: by the one resolver the pass uses, before anything is recorded.
+  if (a.reflection) {
+    Result<ResolvedLighting> lit = resolveSceneLighting(reflectionLighting(frame),
+                                                        "HybridEffects: record: HybridFrame::lighting");
+    if (!lit) return lit.error();
   }
   a.neutral.recordInit(a.ctx, cmd);
   if (frame.tlas && frame.tlas->tlas) {

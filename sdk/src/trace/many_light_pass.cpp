@@ -7,8 +7,7 @@
 
 #include "compute_pipeline.h"
 #include "context_impl.h"
-#include "light_validation.h"
-#include "many_light_pass_impl.h"
+#include "light_list_buffer.h"
 #include "pass_core.h"
 #include "ray_schedule_stage.h"
 #include "raybridge_shaders.h"
@@ -23,43 +22,6 @@ static_assert(RB_ML_MAX_TILE_LIGHTS == kMaxTileLights && RB_ML_TILE_SIZE == kMan
 static_assert(kMaxLights <= 65536, "tile lists hold 16-bit light indices");
 constexpr uint32_t kMaxRaysOrCandidates = 64;
 
-
-bool finite3(const float v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
-
-// Checks one light (validateLight, then what a LightSource adds) and converts it to the GPU's form in the TLAS's
-// space; the error names the light and field.
-Status convertLight(const LightSource& s, uint32_t index, const double originOffset[3], GpuLight& out) {
-  const std::string who = "ManyLightPass: lights[" + std::to_string(index) + "]: ";
-  auto invalid = [&](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, who + m}; };
-  const Light& l = s.light;
-  if (Status st = validateLight(l, who); !st) return st;
-  if (!(std::isfinite(s.intensity) && s.intensity >= 0.0f))
-    return invalid("intensity " + std::to_string(s.intensity) + " must be finite and >= 0");
-  if (!finite3(s.color) || s.color[0] < 0.0f || s.color[1] < 0.0f || s.color[2] < 0.0f)
-    return invalid("color must be finite and >= 0");
-  out = {};
-  for (int i = 0; i < 3; ++i) out.intensity[i] = s.color[i] * s.intensity;
-  lightDirection(l, out.direction);
-  out.type = uint32_t(l.type);
-  if (l.type == LightType::Directional) {
-    out.softness = std::tan(l.angularRadiusDegrees * kRadiansPerDegree);
-    return {};
-  }
-  for (int i = 0; i < 3; ++i) out.position[i] = float(l.position[i] - originOffset[i]);
-  out.range = l.range;
-  out.softness = l.radius;
-  if (l.type == LightType::Point) return {};
-  const float outer = spotOuterAngleDegrees(l);
-  if (!(s.spotInnerAngleDegrees >= 0.0f && s.spotInnerAngleDegrees <= outer))
-    return invalid("spotInnerAngleDegrees " + std::to_string(s.spotInnerAngleDegrees) +
-                   " must be in [0, the outer angle " + std::to_string(outer) + "]");
-  const float cosOuter = std::cos(outer * kRadiansPerDegree);
-  const float cosInner = std::cos(s.spotInnerAngleDegrees * kRadiansPerDegree);
-  out.cosOuter = cosOuter;
-  out.coneScale = 1.0f / std::max(1e-3f, cosInner - cosOuter);  // KHR_lights_punctual's formula
-  out.coneOffset = -cosOuter * out.coneScale;
-  return {};
-}
 
 VkBufferMemoryBarrier bufferBarrier(VkBuffer buffer, VkAccessFlags src, VkAccessFlags dst) {
   VkBufferMemoryBarrier b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
@@ -77,13 +39,9 @@ struct ManyLightPass::Impl {
   Context& ctx;
   PassCore core;
   ComputePipeline cull;
-  // The light ring (host-visible, one slot of `capacity` lights per frame in flight), its device copy and the
-  // tile lists; grown on demand, retired when replaced.
-  GpuBuffer ring, lights, tiles;
-  uint32_t capacity = 0;
-  std::vector<GpuLight> staging;
+  GpuBuffer tiles;            // the per-tile light lists; grown on demand, retired when replaced
+  LightListBuffer ownLights;  // record() given the lights themselves uploads them here
   ManyLightOutputs outputs;
-  internal::LightListView recorded;  // what the latest record() uploaded, for reflection hits
   // Converged tiles (ManyLightSettings::schedule), created on first use: the launch that skips them
   // (many_lights_converged.rgen), the tile state and the dispatches. Set by create().
   std::unique_ptr<ScheduleStage> schedule;
@@ -91,42 +49,16 @@ struct ManyLightPass::Impl {
   ~Impl() {  // frames in flight may still use them
     core.retire(ctx);
     cull.retire(ctx);
-    retireBuffer(ctx, ring);
-    retireBuffer(ctx, lights);
+    ownLights.retire(ctx);
     retireBuffer(ctx, tiles);
     if (schedule) schedule->retire(ctx);
   }
-  Status ensureLightBuffers(uint32_t lightCount);
   Status ensureTiles(VkDeviceSize tileBytes);
-  // Checks and converts the lights, then records their upload into `lights` (the list the rays read).
-  Status uploadLights(VkCommandBuffer cmd, const TlasInfo& tlas, std::span<const LightSource> lightList);
-  // Copies `staging` into this frame's ring slot and records its copy into `lights`.
-  void recordUpload(VkCommandBuffer cmd, uint32_t count);
-  // What other passes read (internal::lightList) after an upload of `count` lights this frame.
-  void remember(const TlasInfo& tlas, uint32_t count);
+  // What both record()s share once the settings and the G-buffer are checked: the culling and the rays over
+  // `list` (nullptr = ownLights, staged and not yet uploaded: its upload is recorded inside the pass's time).
+  Status trace(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const ManyLightSettings& settings,
+               ManyLightConstants& pc, const LightListInfo* list);
 };
-
-Status ManyLightPass::Impl::ensureLightBuffers(uint32_t lightCount) {
-  if (lightCount > capacity) {
-    uint32_t grown = std::max(64u, capacity);
-    while (grown < lightCount) grown *= 2;
-    grown = std::min(grown, kMaxLights);
-    retireBuffer(ctx, ring);
-    retireBuffer(ctx, lights);
-    capacity = 0;
-    const VkDeviceSize slot = VkDeviceSize(grown) * sizeof(GpuLight);
-    Result<GpuBuffer> r = createBuffer(ctx, slot * ctx.framesInFlight(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                       MemoryLocation::HostVisible, MemoryCategory::PassBuffers, "many-light ring");
-    if (!r) return r.error();
-    ring = r.value();
-    Result<GpuBuffer> d = createBuffer(ctx, slot, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                       MemoryLocation::DeviceLocal, MemoryCategory::PassBuffers, "many-light list");
-    if (!d) return d.error();
-    lights = d.value();
-    capacity = grown;
-  }
-  return {};
-}
 
 Status ManyLightPass::Impl::ensureTiles(VkDeviceSize tileBytes) {
   if (tiles.size != tileBytes) {
@@ -136,42 +68,6 @@ Status ManyLightPass::Impl::ensureTiles(VkDeviceSize tileBytes) {
     if (!t) return t.error();
     tiles = t.value();
   }
-  return {};
-}
-
-void ManyLightPass::Impl::recordUpload(VkCommandBuffer cmd, uint32_t count) {
-  if (count == 0) return;
-  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
-  // This frame's ring slot, copied to the device list once last frame's readers are done with it.
-  const uint32_t slot = uint32_t(ctx.frameIndex() % ctx.framesInFlight());
-  const VkDeviceSize slotBytes = VkDeviceSize(capacity) * sizeof(GpuLight);
-  const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
-                                       VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
-  std::memcpy(static_cast<uint8_t*>(ring.mapped) + slot * slotBytes, staging.data(), count * sizeof(GpuLight));
-  VkBufferMemoryBarrier before = bufferBarrier(lights.buffer, VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-  vk.vkCmdPipelineBarrier(cmd, readers, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 1, &before, 0, nullptr);
-  VkBufferCopy region{slot * slotBytes, 0, count * sizeof(GpuLight)};
-  vk.vkCmdCopyBuffer(cmd, ring.buffer, lights.buffer, 1, &region);
-  VkBufferMemoryBarrier after = bufferBarrier(lights.buffer, VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
-  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, readers, 0, 0, nullptr, 1, &after, 0, nullptr);
-}
-
-void ManyLightPass::Impl::remember(const TlasInfo& tlas, uint32_t count) {
-  recorded.buffer = lights.buffer;
-  recorded.count = count;
-  recorded.frame = ctx.frameIndex();
-  for (int i = 0; i < 3; ++i) recorded.originOffset[i] = tlas.originOffset[i];
-}
-
-Status ManyLightPass::Impl::uploadLights(VkCommandBuffer cmd, const TlasInfo& tlas,
-                                         std::span<const LightSource> lightList) {
-  const uint32_t count = uint32_t(lightList.size());
-  staging.resize(count);
-  for (uint32_t i = 0; i < count; ++i)
-    if (Status st = convertLight(lightList[i], i, tlas.originOffset, staging[i]); !st) return st;
-  if (Status st = ensureLightBuffers(std::max(count, 1u)); !st) return st;
-  recordUpload(cmd, count);
-  remember(tlas, count);
   return {};
 }
 
@@ -244,16 +140,13 @@ Result<std::unique_ptr<ManyLightPass>> ManyLightPass::create(Context& context) {
   return std::unique_ptr<ManyLightPass>(new ManyLightPass(std::move(impl)));
 }
 
-Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,
-                             std::span<const LightSource> lightList, const ManyLightSettings& settings) {
-  Impl& s = *impl_;
+namespace {
+
+// The settings' checks both record()s share; the message names the field.
+Status validateSettings(const ManyLightSettings& settings) {
   auto invalid = [](const std::string& m) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: " + m};
   };
-  if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
-  if (lightList.size() > kMaxLights)
-    return invalid(std::to_string(lightList.size()) + " lights exceed kMaxLights (" + std::to_string(kMaxLights) +
-                   "); pass the strongest or nearest ones");
   if (settings.mode != ManyLightMode::Stochastic && settings.mode != ManyLightMode::Exact)
     return invalid("ManyLightSettings::mode has an unknown value");
   if (settings.raysPerPixel > kMaxRaysOrCandidates || settings.candidates > kMaxRaysOrCandidates)
@@ -268,68 +161,75 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
     return invalid("ManyLightSettings::schedule.convergedTiles skips converged noise: ManyLightMode::Exact has none "
                    "to skip (and no denoiser); use Stochastic or disable convergedTiles");
   }
+  return {};
+}
+
+}  // namespace
+
+Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,
+                             std::span<const LightSource> lightList, const ManyLightSettings& settings) {
+  Impl& s = *impl_;
+  if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: cmd is VK_NULL_HANDLE"};
+  if (Status st = validateSettings(settings); !st) return st;
   ManyLightConstants pc{};
   if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ManyLightPass", pc.gbuffer); !st) return st;
-  const uint32_t count = uint32_t(lightList.size());
-  s.staging.resize(count);
-  for (uint32_t i = 0; i < count; ++i)
-    if (Status st = convertLight(lightList[i], i, tlas.originOffset, s.staging[i]); !st) return st;
-  pc.lightCount = count;
+  if (Status st = s.ownLights.stage(s.ctx, lightList, tlas, "ManyLightPass: "); !st) return st;
+  return s.trace(cmd, g, tlas, settings, pc, nullptr);
+}
+
+Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const LightList& lights,
+                             const ManyLightSettings& settings) {
+  Impl& s = *impl_;
+  if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: cmd is VK_NULL_HANDLE"};
+  if (Status st = validateSettings(settings); !st) return st;
+  ManyLightConstants pc{};
+  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ManyLightPass", pc.gbuffer); !st) return st;
+  Result<LightListInfo> list = readLightList(lights, tlas, s.ctx.frameIndex(), "ManyLightPass: lights");
+  if (!list) return list.error();
+  return s.trace(cmd, g, tlas, settings, pc, &list.value());
+}
+
+Status ManyLightPass::Impl::trace(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,
+                                  const ManyLightSettings& settings, ManyLightConstants& pc,
+                                  const LightListInfo* list) {
+  pc.lightCount = list ? list->count : ownLights.stagedCount();
   pc.mode = uint32_t(settings.mode);
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultLightRays;
   pc.candidates = settings.candidates ? settings.candidates : kDefaultLightCandidates;
   pc.tiles[0] = (g.width + kManyLightTileSize - 1) / kManyLightTileSize;
   pc.tiles[1] = (g.height + kManyLightTileSize - 1) / kManyLightTileSize;
   const VkDeviceSize tileBytes = VkDeviceSize(pc.tiles[0]) * pc.tiles[1] * RB_ML_TILE_UINTS * sizeof(uint32_t);
-  if (Status st = s.ensureLightBuffers(std::max(count, 1u)); !st) return st;
-  if (Status st = s.ensureTiles(tileBytes); !st) return st;
-  if (Status st = s.schedule->prepare(s.ctx, s.core, g, settings.schedule); !st) return st;
+  if (Status st = ensureTiles(tileBytes); !st) return st;
+  if (Status st = schedule->prepare(ctx, core, g, settings.schedule); !st) return st;
 
   DescriptorWrites w;
-  if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ManyLightPass", pc.gbuffer.flags); !st) return st;
-  if (Status st = s.core.begin(s.ctx, cmd, g, kManyLightOutputs); !st) return st;
-  const DeviceFunctions& vk = internal::deviceFunctions(s.ctx);
-  s.recordUpload(cmd, count);
+  if (Status st = core.writeMaterials(w, tlas, settings.materials, "ManyLightPass", pc.gbuffer.flags); !st) return st;
+  if (Status st = core.begin(ctx, cmd, g, kManyLightOutputs); !st) return st;
+  const DeviceFunctions& vk = internal::deviceFunctions(ctx);
+  if (!list) ownLights.recordUpload(ctx, cmd);
+  const VkBuffer lightBuffer = list ? list->buffer : ownLights.info().buffer;
   // Tile culling: last frame's rays read the lists this overwrites.
-  VkBufferMemoryBarrier tilesFree = bufferBarrier(s.tiles.buffer, VK_ACCESS_SHADER_READ_BIT,
-                                                  VK_ACCESS_SHADER_WRITE_BIT);
+  VkBufferMemoryBarrier tilesFree = bufferBarrier(tiles.buffer, VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_SHADER_WRITE_BIT);
   vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
                           nullptr, 1, &tilesFree, 0, nullptr);
   DescriptorWrites cw;
-  cw.sampledImage(RB_ML_CULL_BINDING_DEPTH, g.depth.view, s.core.sampler, readLayout(g.depth));
-  cw.storageBuffer(RB_ML_CULL_BINDING_LIGHTS, s.lights.buffer);
-  cw.storageBuffer(RB_ML_CULL_BINDING_TILES, s.tiles.buffer);
-  s.cull.dispatch(s.ctx, cmd, cw.writes, &pc, sizeof(pc), pc.tiles[0] * 8, pc.tiles[1] * 8);  // a group per tile
-  VkBufferMemoryBarrier tilesReady = bufferBarrier(s.tiles.buffer, VK_ACCESS_SHADER_WRITE_BIT,
-                                                   VK_ACCESS_SHADER_READ_BIT);
+  cw.sampledImage(RB_ML_CULL_BINDING_DEPTH, g.depth.view, core.sampler, readLayout(g.depth));
+  cw.storageBuffer(RB_ML_CULL_BINDING_LIGHTS, lightBuffer);
+  cw.storageBuffer(RB_ML_CULL_BINDING_TILES, tiles.buffer);
+  cull.dispatch(ctx, cmd, cw.writes, &pc, sizeof(pc), pc.tiles[0] * 8, pc.tiles[1] * 8);  // a group per tile
+  VkBufferMemoryBarrier tilesReady = bufferBarrier(tiles.buffer, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
   vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, 0, 0,
                           nullptr, 1, &tilesReady, 0, nullptr);
 
-  s.core.writeCommon(s.ctx, w, g, tlas);
-  w.storageBuffer(RB_ML_BINDING_LIGHTS, s.lights.buffer);
-  w.storageBuffer(RB_ML_BINDING_TILES, s.tiles.buffer);
+  core.writeCommon(ctx, w, g, tlas);
+  w.storageBuffer(RB_ML_BINDING_LIGHTS, lightBuffer);
+  w.storageBuffer(RB_ML_BINDING_TILES, tiles.buffer);
   // The rays saved count raysPerPixel per skipped surface pixel: at most what it would have traced (a tile with
   // fewer lights than rays traces one per light).
   ScheduleFrame frame{g, settings.schedule, w, &pc, &pc.gbuffer, pc.raysPerPixel};
-  if (Result<bool> traced = s.schedule->trace(s.ctx, s.core, cmd, frame); !traced) return traced.error();
-
-  s.remember(tlas, count);
-  nameOutputs(s);
+  if (Result<bool> traced = schedule->trace(ctx, core, cmd, frame); !traced) return traced.error();
+  nameOutputs(*this);
   return {};
-}
-
-Status ManyLightPass::recordLightList(VkCommandBuffer cmd, const TlasInfo& tlas, std::span<const LightSource> lights) {
-  if (!cmd)
-    return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass::recordLightList: cmd is VK_NULL_HANDLE"};
-  if (lights.size() > kMaxLights)
-    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
-                 "ManyLightPass::recordLightList: " + std::to_string(lights.size()) + " lights exceed kMaxLights (" +
-                     std::to_string(kMaxLights) + "); pass the strongest or nearest ones"};
-  return impl_->uploadLights(cmd, tlas, lights);
-}
-
-internal::LightListView internal::ManyLightPassAccess::lightList(const ManyLightPass& pass) {
-  return pass.impl_->recorded;
 }
 
 const ManyLightOutputs& ManyLightPass::outputs() const { return impl_->outputs; }

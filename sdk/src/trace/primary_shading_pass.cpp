@@ -4,10 +4,11 @@
 #include <string>
 
 #include "context_impl.h"
-#include "many_light_pass_impl.h"
+#include "light_list_buffer.h"
 #include "material_table_impl.h"
 #include "pass_core.h"
 #include "raybridge_shaders.h"
+#include "scene_lighting_resolve.h"
 
 namespace rb {
 
@@ -72,13 +73,9 @@ Status PrimaryShadingPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, con
   }
   Result<CameraBasis> basis = computeCameraBasis(camera, targets.width, targets.height);
   if (!basis) return invalid("camera: " + basis.error().message);
-  const bool sunUnset = settings.sunDirection[0] == 0.0f && settings.sunDirection[1] == 0.0f &&
-                        settings.sunDirection[2] == 0.0f;
-  const float sunDirection[3] = {settings.sunDirection[0], sunUnset ? 1.0f : settings.sunDirection[1],
-                                 settings.sunDirection[2]};
-  const float sunLength = std::sqrt(sunDirection[0] * sunDirection[0] + sunDirection[1] * sunDirection[1] +
-                                    sunDirection[2] * sunDirection[2]);
-  if (!std::isfinite(sunLength)) return invalid("PrimaryShadingSettings::sunDirection must be finite");
+  Result<ResolvedLighting> lighting = resolveSceneLighting(settings.lighting,
+                                                           "PrimaryShadingPass: PrimaryShadingSettings::lighting");
+  if (!lighting) return lighting.error();
   if (settings.lightCandidates > kMaxPrimaryShadingLightCandidates)
     return invalid("PrimaryShadingSettings::lightCandidates " + std::to_string(settings.lightCandidates) +
                    " exceeds 64");
@@ -95,29 +92,13 @@ Status PrimaryShadingPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, con
   pc.camera.tMin = camera.tMin;
   pc.camera.tMax = camera.tMax > 0.0f ? camera.tMax : 1e30f;
   pc.camera.frameIndex = uint32_t(s.ctx.frameIndex());
-  // Zero means the default, unless the engine says its zeros are meant (a black sky, no sky light).
-  const bool explicitLighting = (settings.flags & kPrimaryShadingExplicitLighting) != 0;
-  auto isZero = [](const float c[3]) { return c[0] == 0.0f && c[1] == 0.0f && c[2] == 0.0f; };
-  const bool defaultSun = !explicitLighting && isZero(settings.sunRadiance);
-  const bool defaultSky = !explicitLighting && isZero(settings.skyRadiance);
-  for (int i = 0; i < 3; ++i) {
-    pc.sunDirection[i] = sunDirection[i] / sunLength;
-    pc.sunRadiance[i] = (settings.flags & kPrimaryShadingNoSun) ? 0.0f
-                        : defaultSun                            ? kDefaultSunRadiance
-                                                                : settings.sunRadiance[i];
-    pc.skyRadiance[i] = defaultSky ? kDefaultSkyRadiance[i] : settings.skyRadiance[i];
-  }
-  pc.ambientIntensity = settings.ambientIntensity == 0.0f && !explicitLighting ? kDefaultAmbientIntensity
-                                                                               : settings.ambientIntensity;
-  internal::LightListView lights;
+  fillLighting(lighting.value(), pc);
+  LightListInfo lights;
   if (settings.lights) {
-    lights = internal::lightList(*settings.lights);
-    if (lights.frame != s.ctx.frameIndex())
-      return invalid("PrimaryShadingSettings::lights: that ManyLightPass uploaded no light list this frame; record "
-                     "it (or its recordLightList()) before this pass");
-    for (int i = 0; i < 3; ++i)
-      if (lights.originOffset[i] != tlas.originOffset[i])
-        return invalid("PrimaryShadingSettings::lights: that ManyLightPass used another TLAS space (originOffset)");
+    Result<LightListInfo> read = readLightList(*settings.lights, tlas, s.ctx.frameIndex(),
+                                               "PrimaryShadingPass: PrimaryShadingSettings::lights");
+    if (!read) return read.error();
+    lights = read.value();
     pc.lightCount = lights.count;
     pc.lightCandidates = settings.lightCandidates ? settings.lightCandidates : kDefaultPrimaryShadingLightCandidates;
   }

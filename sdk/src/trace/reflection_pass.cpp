@@ -5,11 +5,12 @@
 #include <string>
 
 #include "context_impl.h"
-#include "many_light_pass_impl.h"
+#include "light_list_buffer.h"
 #include "material_table_impl.h"
 #include "pass_core.h"
 #include "ray_schedule_stage.h"
 #include "raybridge_shaders.h"
+#include "scene_lighting_resolve.h"
 
 namespace rb {
 
@@ -155,42 +156,22 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
     return invalid("ReflectionSettings::roughnessThreshold " + std::to_string(threshold) + " is outside (0, 1]");
   }
   if (settings.raysPerPixel > 64) return invalid("ReflectionSettings::raysPerPixel exceeds 64");
-  const bool sunUnset = settings.sunDirection[0] == 0.0f && settings.sunDirection[1] == 0.0f &&
-                        settings.sunDirection[2] == 0.0f;
-  const float sunDirection[3] = {settings.sunDirection[0], sunUnset ? 1.0f : settings.sunDirection[1],
-                                 settings.sunDirection[2]};
-  float sunLen = std::sqrt(sunDirection[0] * sunDirection[0] + sunDirection[1] * sunDirection[1] +
-                           sunDirection[2] * sunDirection[2]);
-  if (!std::isfinite(sunLen)) return invalid("ReflectionSettings::sunDirection must be finite");
-  // Zero means the default, unless the engine says its zeros are meant (a black sky, no sky light).
-  const bool explicitLighting = (settings.flags & kReflectionExplicitLighting) != 0;
-  auto isZero = [](const float c[3]) { return c[0] == 0.0f && c[1] == 0.0f && c[2] == 0.0f; };
-  const bool defaultSun = !explicitLighting && isZero(settings.sunRadiance);
-  const bool defaultSky = !explicitLighting && isZero(settings.skyRadiance);
+  Result<ResolvedLighting> lighting = resolveSceneLighting(settings.lighting,
+                                                           "ReflectionPass: ReflectionSettings::lighting");
+  if (!lighting) return lighting.error();
   ReflectionConstants pc{};
   if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ReflectionPass", pc.gbuffer); !st) return st;
-  for (int i = 0; i < 3; ++i) {
-    pc.sunDirection[i] = sunDirection[i] / sunLen;
-    pc.sunRadiance[i] = (settings.flags & kReflectionNoSun) ? 0.0f
-                        : defaultSun                        ? kDefaultSunRadiance
-                                                            : settings.sunRadiance[i];
-    pc.skyRadiance[i] = defaultSky ? kDefaultSkyRadiance[i] : settings.skyRadiance[i];
-  }
+  fillLighting(lighting.value(), pc);
   pc.roughnessThreshold = threshold;
-  pc.ambientIntensity = settings.ambientIntensity == 0.0f && !explicitLighting ? kDefaultAmbientIntensity
-                                                                               : settings.ambientIntensity;
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultReflectionRays;
   pc.halfResolution = settings.schedule.halfResolution ? 1u : 0u;
 
-  internal::LightListView lights;
+  LightListInfo lights;
   if (settings.lights) {
-    lights = internal::lightList(*settings.lights);
-    if (lights.frame != s.ctx.frameIndex())
-      return invalid("ReflectionSettings::lights: that ManyLightPass was not recorded this frame; record it before "
-                     "the reflection pass");
-    for (int i = 0; i < 3; ++i)
-      if (lights.originOffset[i] != tlas.originOffset[i])
-        return invalid("ReflectionSettings::lights: that ManyLightPass traced another TLAS space (originOffset)");
+    Result<LightListInfo> read = readLightList(*settings.lights, tlas, s.ctx.frameIndex(),
+                                               "ReflectionPass: ReflectionSettings::lights");
+    if (!read) return read.error();
+    lights = read.value();
     if (settings.lightCandidates > 64)
       return invalid("ReflectionSettings::lightCandidates " + std::to_string(settings.lightCandidates) + " exceeds 64");
     pc.lightCount = lights.count;
