@@ -28,10 +28,6 @@
 
 namespace rb {
 
-namespace internal {
-struct MaterialTableAccess;
-}
-
 inline constexpr uint32_t kNoTexture = 0xFFFFFFFFu;
 
 enum class AlphaMode : uint32_t {
@@ -62,6 +58,15 @@ struct Material {
   float textureTransform[6] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
 };
 
+// What the passes bind of a MaterialTable's current table (MaterialTable::info()), in the SDK's own layouts (not
+// part of the API): the material buffer and the bindless texture set.
+struct MaterialTableInfo {
+  VkBuffer materials = VK_NULL_HANDLE;  // GPU materials, readable by ray tracing shaders
+  VkDeviceSize materialBytes = 0;
+  VkDescriptorSet textures = VK_NULL_HANDLE;  // the texture set every pass binds as its texture set
+  uint32_t materialCount = 0;
+};
+
 class MaterialTable {
  public:
   // Starts with one default Material (white, opaque) and no textures.
@@ -74,11 +79,12 @@ class MaterialTable {
   // afterwards see the new table; the previous one is released once frames in flight are done with it.
   Status setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures);
   uint32_t materialCount() const;
+  // The current table, valid until the next setMaterials() (the replaced one lives on for the frames in flight).
+  MaterialTableInfo info() const;
 
   struct Impl;
 
  private:
-  friend struct internal::MaterialTableAccess;
   explicit MaterialTable(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

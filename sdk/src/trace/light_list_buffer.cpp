@@ -6,6 +6,7 @@
 
 #include "context_impl.h"
 #include "light_validation.h"
+#include "memory_barrier.h"
 
 namespace rb {
 
@@ -45,16 +46,6 @@ Status convertLight(const LightSource& s, const std::string& who, const double o
   out.coneScale = 1.0f / std::max(1e-3f, cosInner - cosOuter);  // KHR_lights_punctual's formula
   out.coneOffset = -cosOuter * out.coneScale;
   return {};
-}
-
-VkBufferMemoryBarrier bufferBarrier(VkBuffer buffer, VkAccessFlags src, VkAccessFlags dst) {
-  VkBufferMemoryBarrier b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-  b.srcAccessMask = src;
-  b.dstAccessMask = dst;
-  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.buffer = buffer;
-  b.size = VK_WHOLE_SIZE;
-  return b;
 }
 
 }  // namespace
@@ -110,12 +101,12 @@ void LightListBuffer::recordUpload(Context& ctx, VkCommandBuffer cmd) {
   const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
                                        VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
   std::memcpy(static_cast<uint8_t*>(ring_.mapped) + slot * slotBytes, staging_.data(), count * sizeof(GpuLight));
-  VkBufferMemoryBarrier before = bufferBarrier(lights_.buffer, VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-  vk.vkCmdPipelineBarrier(cmd, readers, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 1, &before, 0, nullptr);
+  recordBufferBarrier(vk, cmd, lights_.buffer, readers, VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                      VK_ACCESS_TRANSFER_WRITE_BIT);
   VkBufferCopy region{slot * slotBytes, 0, count * sizeof(GpuLight)};
   vk.vkCmdCopyBuffer(cmd, ring_.buffer, lights_.buffer, 1, &region);
-  VkBufferMemoryBarrier after = bufferBarrier(lights_.buffer, VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
-  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, readers, 0, 0, nullptr, 1, &after, 0, nullptr);
+  recordBufferBarrier(vk, cmd, lights_.buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, readers,
+                      VK_ACCESS_SHADER_READ_BIT);
 }
 
 void LightListBuffer::retire(Context& ctx) {

@@ -8,6 +8,7 @@
 #include "compute_pipeline.h"
 #include "context_impl.h"
 #include "light_list_buffer.h"
+#include "memory_barrier.h"
 #include "pass_core.h"
 #include "ray_schedule_stage.h"
 #include "raybridge_shaders.h"
@@ -21,17 +22,6 @@ static_assert(RB_ML_EXACT == uint32_t(ManyLightMode::Exact));
 static_assert(RB_ML_MAX_TILE_LIGHTS == kMaxTileLights && RB_ML_TILE_SIZE == kManyLightTileSize);
 static_assert(kMaxLights <= 65536, "tile lists hold 16-bit light indices");
 constexpr uint32_t kMaxRaysOrCandidates = 64;
-
-
-VkBufferMemoryBarrier bufferBarrier(VkBuffer buffer, VkAccessFlags src, VkAccessFlags dst) {
-  VkBufferMemoryBarrier b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-  b.srcAccessMask = src;
-  b.dstAccessMask = dst;
-  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.buffer = buffer;
-  b.size = VK_WHOLE_SIZE;
-  return b;
-}
 
 }  // namespace
 
@@ -209,17 +199,15 @@ Status ManyLightPass::Impl::trace(VkCommandBuffer cmd, const GBufferDesc& g, con
   if (!list) ownLights.recordUpload(ctx, cmd);
   const VkBuffer lightBuffer = list ? list->buffer : ownLights.info().buffer;
   // Tile culling: last frame's rays read the lists this overwrites.
-  VkBufferMemoryBarrier tilesFree = bufferBarrier(tiles.buffer, VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_SHADER_WRITE_BIT);
-  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
-                          nullptr, 1, &tilesFree, 0, nullptr);
+  recordBufferBarrier(vk, cmd, tiles.buffer, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, VK_ACCESS_SHADER_READ_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
   DescriptorWrites cw;
   cw.sampledImage(RB_ML_CULL_BINDING_DEPTH, g.depth.view, core.sampler, readLayout(g.depth));
   cw.storageBuffer(RB_ML_CULL_BINDING_LIGHTS, lightBuffer);
   cw.storageBuffer(RB_ML_CULL_BINDING_TILES, tiles.buffer);
   cull.dispatch(ctx, cmd, cw.writes, &pc, sizeof(pc), pc.tiles[0] * 8, pc.tiles[1] * 8);  // a group per tile
-  VkBufferMemoryBarrier tilesReady = bufferBarrier(tiles.buffer, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
-  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, 0, 0,
-                          nullptr, 1, &tilesReady, 0, nullptr);
+  recordBufferBarrier(vk, cmd, tiles.buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, VK_ACCESS_SHADER_READ_BIT);
 
   core.writeCommon(ctx, w, g, tlas);
   w.storageBuffer(RB_ML_BINDING_LIGHTS, lightBuffer);

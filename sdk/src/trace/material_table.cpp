@@ -70,6 +70,11 @@ Result<std::unique_ptr<MaterialTable>> MaterialTable::create(Context& context) {
 
 uint32_t MaterialTable::materialCount() const { return impl_->materialCount; }
 
+MaterialTableInfo MaterialTable::info() const {
+  const Impl& s = *impl_;
+  return {s.materials.buffer, s.materials.size, s.textureSet, s.materialCount};
+}
+
 Status MaterialTable::setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures) {
   Impl& s = *impl_;
   Context::Impl& c = internal::contextImpl(s.ctx);

@@ -1,5 +1,6 @@
-// What the passes bind of a MaterialTable: the GPU material buffer and the bindless texture set, with the
-// set layout every pass's pipeline declares for it (identically defined layouts are compatible).
+// A MaterialTable's state: the GPU material buffer and the bindless texture set (passes read them through the
+// public MaterialTable::info()), and the set layout every pass's pipeline declares for it (identically defined
+// layouts are compatible).
 #pragma once
 
 #include <raybridge/material_table.h>
@@ -41,12 +42,5 @@ struct MaterialTable::Impl {
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl();
 };
-
-namespace internal {
-struct MaterialTableAccess {
-  static const MaterialTable::Impl& impl(const MaterialTable& t) { return *t.impl_; }
-};
-inline const MaterialTable::Impl& materialTableImpl(const MaterialTable& t) { return MaterialTableAccess::impl(t); }
-}  // namespace internal
 
 }  // namespace rb

@@ -83,7 +83,7 @@ void PassCore::writeGBuffer(Context& ctx, DescriptorWrites& w, const GBufferDesc
 
 Status PassCore::writeMaterials(DescriptorWrites& w, const TlasInfo& tlas, const MaterialTable* materials,
                                 const char* passName, uint32_t& gbufferFlags) {
-  const MaterialTable::Impl& table = internal::materialTableImpl(materials ? *materials : *fallbackMaterials);
+  const MaterialTableInfo table = (materials ? materials : fallbackMaterials.get())->info();
   const bool alphaTest = materials && tlas.nonOpaqueInstances > 0;
   if (alphaTest && !tlas.shadingRecords) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
@@ -96,10 +96,10 @@ Status PassCore::writeMaterials(DescriptorWrites& w, const TlasInfo& tlas, const
     w.storageBuffer(RB_BINDING_SHADING_RECORDS, tlas.shadingRecords, 0, tlas.shadingRecordsBytes);
   } else {
     // Never read (no RB_GB_ALPHA_TEST, so rays are opaque), but the binding must be valid.
-    w.storageBuffer(RB_BINDING_SHADING_RECORDS, table.materials.buffer, 0, table.materials.size);
+    w.storageBuffer(RB_BINDING_SHADING_RECORDS, table.materials, 0, table.materialBytes);
   }
-  w.storageBuffer(RB_BINDING_MATERIALS, table.materials.buffer, 0, table.materials.size);
-  boundTextures = table.textureSet;
+  w.storageBuffer(RB_BINDING_MATERIALS, table.materials, 0, table.materialBytes);
+  boundTextures = table.textures;
   return {};
 }
 

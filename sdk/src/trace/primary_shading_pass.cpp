@@ -120,9 +120,8 @@ Status PrimaryShadingPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, con
   w.storageBuffer(RB_BINDING_RAY_COUNTERS, s.core.metrics.counterBuffer(), s.core.metrics.counterOffset(s.ctx),
                   s.core.metrics.counterBytes());
   // The local lights' list when given, else any valid buffer (never read: lightCount is 0).
-  const MaterialTable::Impl* table = settings.materials ? &internal::materialTableImpl(*settings.materials)
-                                                        : &internal::materialTableImpl(*s.core.fallbackMaterials);
-  w.storageBuffer(RB_PRIMARY_SHADING_BINDING_LIGHTS, pc.lightCount ? lights.buffer : table->materials.buffer);
+  const MaterialTable& table = settings.materials ? *settings.materials : *s.core.fallbackMaterials;
+  w.storageBuffer(RB_PRIMARY_SHADING_BINDING_LIGHTS, pc.lightCount ? lights.buffer : table.info().materials);
   s.core.traceAndEnd(s.ctx, cmd, w, pc, size);
 
   PrimaryShadingOutputs& o = s.outputs;

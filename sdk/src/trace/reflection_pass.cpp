@@ -188,8 +188,7 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const T
   const GBufferImage& rm = g.roughnessMetalness.view ? g.roughnessMetalness : g.normal;
   w.sampledImage(RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, rm.view, s.core.sampler, readLayout(rm));
   // The local lights' list when given, else any valid buffer (never read: lightCount is 0).
-  w.storageBuffer(RB_REFLECTION_BINDING_LIGHTS,
-                  pc.lightCount ? lights.buffer : internal::materialTableImpl(*table).materials.buffer);
+  w.storageBuffer(RB_REFLECTION_BINDING_LIGHTS, pc.lightCount ? lights.buffer : table->info().materials);
   ScheduleFrame frame{g, settings.schedule, w, &pc, &pc.gbuffer, pc.raysPerPixel, {}, threshold, variant};
   if (Result<bool> traced = s.schedule.trace(s.ctx, s.core, cmd, frame); !traced) return traced.error();
   nameOutputs(s);
