@@ -12,8 +12,6 @@ namespace rb {
 
 namespace {
 
-bool finite3(const float v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
-
 // Checks one light (validateLight, then what a LightSource adds) and converts it to the GPU's form in the TLAS's
 // space; the error names the light and field.
 Status convertLight(const LightSource& s, const std::string& who, const double originOffset[3], GpuLight& out) {
@@ -22,8 +20,7 @@ Status convertLight(const LightSource& s, const std::string& who, const double o
   if (Status st = validateLight(l, who); !st) return st;
   if (!(std::isfinite(s.intensity) && s.intensity >= 0.0f))
     return invalid("intensity " + std::to_string(s.intensity) + " must be finite and >= 0");
-  if (!finite3(s.color) || s.color[0] < 0.0f || s.color[1] < 0.0f || s.color[2] < 0.0f)
-    return invalid("color must be finite and >= 0");
+  if (!finiteNonNegative3(s.color)) return invalid("color must be finite and >= 0");
   out = {};
   for (int i = 0; i < 3; ++i) out.intensity[i] = s.color[i] * s.intensity;
   lightDirection(l, out.direction);

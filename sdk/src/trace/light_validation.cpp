@@ -4,10 +4,6 @@
 
 namespace rb {
 
-namespace {
-bool finite3(const float v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
-}  // namespace
-
 Status validateLight(const Light& l, const std::string& who) {
   auto invalid = [&](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, who + m}; };
   if (l.type != LightType::Directional && l.type != LightType::Point && l.type != LightType::Spot)

@@ -5,11 +5,16 @@
 #include <raybridge/effects.h>
 #include <raybridge/result.h>
 
+#include <cmath>
 #include <string>
 
 namespace rb {
 
 inline constexpr float kRadiansPerDegree = 3.14159265358979f / 180.0f;
+
+// The vector checks of lights and lighting (rb::Light, rb::LightSource's colour, rb::SceneLighting's radiances).
+inline bool finite3(const float v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+inline bool finiteNonNegative3(const float v[3]) { return finite3(v) && v[0] >= 0.0f && v[1] >= 0.0f && v[2] >= 0.0f; }
 
 // ErrorCode::InvalidArgument naming `who` + the field ("ShadowPass: Light::position ..."), or ok. Checks: a known
 // type, a finite direction, for directional lights an angular radius in [0, kMaxLightAngularRadiusDegrees), for

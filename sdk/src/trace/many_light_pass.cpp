@@ -154,15 +154,21 @@ Status validateSettings(const ManyLightSettings& settings) {
   return {};
 }
 
+// The checks both record()s make before their lights: the command buffer, the settings, the G-buffer (into `pc`).
+Status checkRecord(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const ManyLightSettings& settings,
+                   uint64_t frameIndex, ManyLightConstants& pc) {
+  if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: cmd is VK_NULL_HANDLE"};
+  if (Status st = validateSettings(settings); !st) return st;
+  return fillGBufferConstants(g, tlas, frameIndex, "ManyLightPass", pc.gbuffer);
+}
+
 }  // namespace
 
 Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,
                              std::span<const LightSource> lightList, const ManyLightSettings& settings) {
   Impl& s = *impl_;
-  if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: cmd is VK_NULL_HANDLE"};
-  if (Status st = validateSettings(settings); !st) return st;
   ManyLightConstants pc{};
-  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ManyLightPass", pc.gbuffer); !st) return st;
+  if (Status st = checkRecord(cmd, g, tlas, settings, s.ctx.frameIndex(), pc); !st) return st;
   if (Status st = s.ownLights.stage(s.ctx, lightList, tlas, "ManyLightPass: "); !st) return st;
   return s.trace(cmd, g, tlas, settings, pc, nullptr);
 }
@@ -170,10 +176,8 @@ Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const Tl
 Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const LightList& lights,
                              const ManyLightSettings& settings) {
   Impl& s = *impl_;
-  if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: cmd is VK_NULL_HANDLE"};
-  if (Status st = validateSettings(settings); !st) return st;
   ManyLightConstants pc{};
-  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ManyLightPass", pc.gbuffer); !st) return st;
+  if (Status st = checkRecord(cmd, g, tlas, settings, s.ctx.frameIndex(), pc); !st) return st;
   Result<LightListInfo> list = readLightList(lights, tlas, s.ctx.frameIndex(), "ManyLightPass: lights");
   if (!list) return list.error();
   return s.trace(cmd, g, tlas, settings, pc, &list.value());

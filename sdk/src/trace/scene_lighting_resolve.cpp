@@ -2,16 +2,13 @@
 
 #include <cmath>
 
+#include "light_validation.h"
+
 namespace rb {
 
 namespace {
 
 bool isZero(const float c[3]) { return c[0] == 0.0f && c[1] == 0.0f && c[2] == 0.0f; }
-bool finiteNonNegative(const float c[3]) {
-  for (int i = 0; i < 3; ++i)
-    if (!(std::isfinite(c[i]) && c[i] >= 0.0f)) return false;
-  return true;
-}
 
 }  // namespace
 
@@ -22,8 +19,8 @@ Result<ResolvedLighting> resolveSceneLighting(const SceneLighting& l, const std:
   const float length = std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] +
                                  direction[2] * direction[2]);
   if (!std::isfinite(length)) return invalid("sunDirection must be finite");
-  if (!finiteNonNegative(l.sunRadiance)) return invalid("sunRadiance must be finite and >= 0");
-  if (!finiteNonNegative(l.skyRadiance)) return invalid("skyRadiance must be finite and >= 0");
+  if (!finiteNonNegative3(l.sunRadiance)) return invalid("sunRadiance must be finite and >= 0");
+  if (!finiteNonNegative3(l.skyRadiance)) return invalid("skyRadiance must be finite and >= 0");
   if (!(std::isfinite(l.ambientIntensity) && l.ambientIntensity >= 0.0f)) {
     return invalid("ambientIntensity " + std::to_string(l.ambientIntensity) + " must be finite and >= 0");
   }
