@@ -516,7 +516,8 @@ TEST_CASE("bad adaptive ray settings are named", "[adaptive][bad_input]") {
   RB_REQUIRE_OK(ao);
   auto expectError = [&](const rb::AoSettings& settings, const char* needle) {
     fx.runFrame([&](VkCommandBuffer cmd) {
-      rb::Status st = ao.value()->record(cmd, s.gbuffer->desc(), s.built.tlas, settings);
+      rb::Status st = ao.value()->record(cmd,
+                                         {.gbuffer = s.gbuffer->desc(), .tlas = s.built.tlas, .settings = settings});
       REQUIRE_FALSE(st.ok());
       INFO(st.error().message);
       CHECK(st.error().code == rb::ErrorCode::InvalidArgument);
@@ -568,7 +569,8 @@ TEST_CASE("bad adaptive ray settings are named", "[adaptive][bad_input]") {
     ss.schedule.history = scalar.value().get();
     rb::Light soft;
     soft.angularRadiusDegrees = 2.0f;
-    rb::Status st = shadow.value()->record(cmd, s.gbuffer->desc(), s.built.tlas, soft, ss);
+    rb::Status st = shadow.value()->record(
+        cmd, {.gbuffer = s.gbuffer->desc(), .tlas = s.built.tlas, .light = soft, .settings = ss});
     REQUIRE_FALSE(st.ok());
     CHECK(st.error().message.find("outputHitDistance") != std::string::npos);
   });

@@ -273,7 +273,7 @@ ShadowResult runShadows(GpuFixture& fx, const AlphaScene& s, const CpuGBuffer& c
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas, const rb::MaterialTable& m) {
         rb::ShadowSettings settings;
         settings.materials = &m;
-        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, light, settings));
+        RB_REQUIRE_OK(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .light = light, .settings = settings}));
       },
       [&](const rb::GBufferDesc& desc) {
         out.visibility = readR16f(fx, pass.value()->outputs().visibility, desc.width, desc.height);
@@ -394,7 +394,7 @@ TEST_CASE("AO through MASK cut-outs matches Embree's filtered AO", "[alpha][ao][
         settings.raysPerPixel = 512;
         settings.range = range;
         settings.materials = &m;
-        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, settings));
+        RB_REQUIRE_OK(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = settings}));
       },
       [&](const rb::GBufferDesc& desc) { ao = readR16f(fx, pass.value()->outputs().ao, desc.width, desc.height); });
   // Embree: cosine-weighted directions around the normal, binary within range, through the cut-outs.
@@ -477,7 +477,10 @@ PrimaryResult runPrimary(GpuFixture& fx, const AlphaScene& s, const SyntheticVie
         fx.toGeneral(cmd, ids);
         rb::PrimaryRaySettings settings;
         settings.materials = &m;
-        RB_REQUIRE_OK(pass.value()->record(cmd, tlas, primaryCamera(view), {dist.view, ids.view, w, h}, settings));
+        RB_REQUIRE_OK(pass.value()->record(cmd, {.tlas = tlas,
+                                                 .camera = primaryCamera(view),
+                                                 .targets = {dist.view, ids.view, w, h},
+                                                 .settings = settings}));
       },
       [&](const rb::GBufferDesc&) {
         std::vector<uint8_t> d = fx.readImage(dist, 4), i = fx.readImage(ids, 8);

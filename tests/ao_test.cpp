@@ -20,7 +20,7 @@ std::vector<float> runAo(GpuFixture& fx, const TestScene& scene, const CpuGBuffe
   runPassFrame(
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
-        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, settings));
+        RB_REQUIRE_OK(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = settings}));
       },
       [&](const rb::GBufferDesc& desc) { ao = readR16f(fx, pass.value()->outputs().ao, desc.width, desc.height); });
   if (stats) *stats = pass.value()->stats();

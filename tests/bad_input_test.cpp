@@ -233,7 +233,7 @@ TEST_CASE("NaN vertices make their triangles inactive, as Vulkan specifies", "[a
   fx.runFrame([&](VkCommandBuffer cmd) {
     fx.toGeneral(cmd, dist);
     fx.toGeneral(cmd, ids);
-    RB_REQUIRE_OK(pass.value()->record(cmd, tlas, cam, {dist.view, ids.view, W, H}));
+    RB_REQUIRE_OK(pass.value()->record(cmd, {.tlas = tlas, .camera = cam, .targets = {dist.view, ids.view, W, H}}));
   });
   auto d = fx.readImage(dist, 4);
   const float* t = reinterpret_cast<const float*>(d.data());

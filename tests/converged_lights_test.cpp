@@ -159,11 +159,11 @@ TEST_CASE("bad local-light converged-tile settings are named", "[many_lights][co
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
         rb::ManyLightSettings s;
         s.schedule.convergedTiles.enabled = true;  // without the denoiser whose history it reads
-        rb::Status st = pass.value()->record(cmd, desc, tlas, lights, s);
+        rb::Status st = pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .lights = lights, .settings = s});
         REQUIRE(!st);
         CHECK(st.error().message.find("ManyLightSettings::schedule.history is nullptr") != std::string::npos);
         s.schedule.history = scalar.value().get();  // the wrong kind of history
-        st = pass.value()->record(cmd, desc, tlas, lights, s);
+        st = pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .lights = lights, .settings = s});
         REQUIRE(!st);
         CHECK(st.error().message.find("history must be a DenoiseSignal::Rgb Denoiser") != std::string::npos);
       },

@@ -325,21 +325,21 @@ TEST_CASE("bad reflection converged-tile settings are named", "[reflection][conv
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
         rb::ReflectionSettings s;
         s.schedule.convergedTiles.enabled = true;  // without the denoiser whose history it reads
-        rb::Status st = pass.value()->record(cmd, desc, tlas, s);
+        rb::Status st = pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = s});
         REQUIRE(!st);
         CHECK(st.error().message.find("ReflectionSettings::schedule.history is nullptr") != std::string::npos);
         s.schedule.history = scalar.value().get();  // the wrong kind of history
-        st = pass.value()->record(cmd, desc, tlas, s);
+        st = pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = s});
         REQUIRE(!st);
         CHECK(st.error().message.find("history must be a DenoiseSignal::Reflection Denoiser") != std::string::npos);
         s.schedule.history = reflection.value().get();
         s.schedule.halfResolution = true;  // the tiles are of full-resolution pixels
-        st = pass.value()->record(cmd, desc, tlas, s);
+        st = pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = s});
         REQUIRE(!st);
         CHECK(st.error().message.find("disable halfResolution or convergedTiles") != std::string::npos);
         s.schedule.halfResolution = false;
         s.schedule.convergedTiles.maxNoise = -1.0f;
-        st = pass.value()->record(cmd, desc, tlas, s);
+        st = pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = s});
         REQUIRE(!st);
         CHECK(st.error().message.find("maxNoise") != std::string::npos);
       },

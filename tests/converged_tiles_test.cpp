@@ -372,7 +372,8 @@ TEST_CASE("bad converged-tile settings are named", "[shadow][converged][bad_inpu
   runPassFrame(
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
-        const rb::Status st = shadow.value()->record(cmd, desc, tlas, rb::Light{}, s);
+        const rb::Status st =
+            shadow.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .light = rb::Light{}, .settings = s});
         REQUIRE(!st);
         CHECK(st.error().message.find("ShadowSettings::schedule.history is nullptr") != std::string::npos);
       },
@@ -394,12 +395,12 @@ TEST_CASE("bad AO converged-tile settings are named", "[ao][converged][bad_input
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
         rb::AoSettings s;
         s.schedule.convergedTiles.enabled = true;  // without the denoiser whose history it reads
-        rb::Status st = ao.value()->record(cmd, desc, tlas, s);
+        rb::Status st = ao.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = s});
         REQUIRE(!st);
         CHECK(st.error().message.find("AoSettings::schedule.history is nullptr") != std::string::npos);
         s.schedule.history = denoiser.value().get();
         s.schedule.halfResolution = true;  // the tiles are of full-resolution pixels
-        st = ao.value()->record(cmd, desc, tlas, s);
+        st = ao.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = s});
         REQUIRE(!st);
         CHECK(st.error().message.find("disable halfResolution or convergedTiles") != std::string::npos);
       },

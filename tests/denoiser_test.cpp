@@ -52,8 +52,10 @@ std::vector<float> runFrames(GpuFixture& fx, const AoScene& s, const std::vector
     fx.runFrame([&](VkCommandBuffer cmd) {
       auto tlas = service.value()->recordTlasBuild(cmd, built.instances, gbuffer.cameraRelativeTlas());
       RB_REQUIRE_OK(tlas);
-      RB_REQUIRE_OK(ao.value()->record(cmd, desc, tlas.value(), settings));
-      if (denoise) RB_REQUIRE_OK(denoiser.value()->record(cmd, desc, ao.value()->outputs().aoView, dn));
+      RB_REQUIRE_OK(ao.value()->record(cmd, {.gbuffer = desc, .tlas = tlas.value(), .settings = settings}));
+      if (denoise)
+        RB_REQUIRE_OK(
+            denoiser.value()->record(cmd, {.gbuffer = desc, .signal = ao.value()->outputs().aoView, .settings = dn}));
     });
     VkImage image = denoise ? denoiser.value()->outputs().denoised : ao.value()->outputs().ao;
     out = readR16f(fx, image, desc.width, desc.height);
@@ -187,7 +189,8 @@ std::vector<float> denoiseOnce(GpuFixture& fx, const CpuGBuffer& cpu, const std:
     auto denoiser = rb::Denoiser::create(fx.ctx(), dd);
     RB_REQUIRE_OK(denoiser);
     fx.runFrame([&](VkCommandBuffer cmd) {
-      RB_REQUIRE_OK(denoiser.value()->record(cmd, gbuffer.desc(), input.view, settings));
+      RB_REQUIRE_OK(
+          denoiser.value()->record(cmd, {.gbuffer = gbuffer.desc(), .signal = input.view, .settings = settings}));
     });
     VkImage image = denoiser.value()->outputs().denoised;
     out = scalar ? readR16f(fx, image, w, h) : readRgba16f(fx, image, w, h);
@@ -420,7 +423,7 @@ TEST_CASE("reflections: mirrors keep their edges, glossy noise is filtered, unco
     auto denoiser = rb::Denoiser::create(fx.ctx(), dd);
     RB_REQUIRE_OK(denoiser);
     fx.runFrame([&](VkCommandBuffer cmd) {
-      rb::Status st = denoiser.value()->record(cmd, desc, desc.normal.view, {});
+      rb::Status st = denoiser.value()->record(cmd, {.gbuffer = desc, .signal = desc.normal.view});
       REQUIRE(!st);
       CHECK(st.error().message.find("roughness") != std::string::npos);
     });

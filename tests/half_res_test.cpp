@@ -49,7 +49,7 @@ AoRun runAo(GpuFixture& fx, const TestScene& scene, const CpuGBuffer& cpu, const
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
         run.frame = fx.ctx().frameIndex();
-        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, settings));
+        RB_REQUIRE_OK(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = settings}));
       },
       [&](const rb::GBufferDesc& desc) { run.ao = readR16f(fx, pass.value()->outputs().ao, desc.width, desc.height); });
   run.stats = pass.value()->stats();
@@ -72,7 +72,7 @@ ReflectionRun runReflections(GpuFixture& fx, const TestScene& scene, const CpuGB
       fx, scene, cpu, true,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
         run.frame = fx.ctx().frameIndex();
-        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, settings));
+        RB_REQUIRE_OK(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = settings}));
       },
       [&](const rb::GBufferDesc& desc) {
         std::vector<float> v = readRgba16f(fx, pass.value()->outputs().radiance, desc.width, desc.height);
@@ -307,7 +307,8 @@ TEST_CASE("half-resolution AO at odd sizes writes every pixel in every frame of 
     for (const Staged* s : {&room, &open}) {
       fx.runFrame([&](VkCommandBuffer cmd) {
         lastFrame = fx.ctx().frameIndex();
-        RB_REQUIRE_OK(pass.value()->record(cmd, s->gbuffer->desc(), s->built.tlas, settings));
+        RB_REQUIRE_OK(
+            pass.value()->record(cmd, {.gbuffer = s->gbuffer->desc(), .tlas = s->built.tlas, .settings = settings}));
       });
       const std::vector<float> ao = readR16f(fx, pass.value()->outputs().ao, w, h);
       const float expected = s == &room ? 0.0f : 1.0f;

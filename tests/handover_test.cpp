@@ -339,7 +339,8 @@ TEST_CASE("bad G-buffer hand-overs are named by field before anything is recorde
     CHECK(st.error().code == rb::ErrorCode::InvalidArgument);
     CHECK(std::string(st.what()).find(c.expect) != std::string::npos);
     // The passes check the same contract (one validator).
-    rb::Status pass = shadowPass.value()->record(notRecording, frame.gbuffer, built.tlas, rb::Light{});
+    rb::Status pass = shadowPass.value()->record(notRecording,
+                                                 {.gbuffer = frame.gbuffer, .tlas = built.tlas, .light = rb::Light{}});
     REQUIRE_FALSE(pass.ok());
     CHECK(std::string(pass.what()).find(c.expect) != std::string::npos);
   }

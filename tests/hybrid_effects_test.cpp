@@ -138,11 +138,11 @@ TEST_CASE("the front end's hard shadows and AO equal the passes recorded one by 
   RB_REQUIRE_OK(effects.value()->record(cmd.value(), frame));
   rb::Light hard = frame.light;
   hard.angularRadiusDegrees = 0.0f;
-  RB_REQUIRE_OK(shadowPass.value()->record(cmd.value(), frame.gbuffer, built.tlas, hard));
+  RB_REQUIRE_OK(shadowPass.value()->record(cmd.value(), {.gbuffer = frame.gbuffer, .tlas = built.tlas, .light = hard}));
   rb::AoSettings ao;
   ao.raysPerPixel = 4;
   ao.range = 2.0f;
-  RB_REQUIRE_OK(aoPass.value()->record(cmd.value(), frame.gbuffer, built.tlas, ao));
+  RB_REQUIRE_OK(aoPass.value()->record(cmd.value(), {.gbuffer = frame.gbuffer, .tlas = built.tlas, .settings = ao}));
   RB_REQUIRE_OK(fx.device().submitAndWait(cmd.value()));
 
   const rb::HybridOutputs& out = effects.value()->outputs();

@@ -144,9 +144,9 @@ TEST_CASE("passes and denoisers destroyed while their frame is in flight are rel
       RB_REQUIRE_OK(aoPass);
       auto denoiser = rb::Denoiser::create(fx.ctx());
       RB_REQUIRE_OK(denoiser);
-      RB_REQUIRE_OK(shadowPass.value()->record(cmd, desc, built.tlas, sun));
-      RB_REQUIRE_OK(aoPass.value()->record(cmd, desc, built.tlas, ao));
-      RB_REQUIRE_OK(denoiser.value()->record(cmd, desc, aoPass.value()->outputs().aoView));
+      RB_REQUIRE_OK(shadowPass.value()->record(cmd, {.gbuffer = desc, .tlas = built.tlas, .light = sun}));
+      RB_REQUIRE_OK(aoPass.value()->record(cmd, {.gbuffer = desc, .tlas = built.tlas, .settings = ao}));
+      RB_REQUIRE_OK(denoiser.value()->record(cmd, {.gbuffer = desc, .signal = aoPass.value()->outputs().aoView}));
       ring.submit(slot);
       if (frame == 0) perFrame = passBytes(fx.ctx().memoryStats()) - passBytes(start);
     }  // destroyed here, before the GPU has finished the frame, with no wait
@@ -272,7 +272,8 @@ TEST_CASE("primary shading passes destroyed while their frame is in flight are r
     {
       auto pass = rb::PrimaryShadingPass::create(fx.ctx());
       RB_REQUIRE_OK(pass);
-      RB_REQUIRE_OK(pass.value()->record(cmd, built.tlas, camera, {48, 32, VK_NULL_HANDLE}));
+      RB_REQUIRE_OK(
+          pass.value()->record(cmd, {.tlas = built.tlas, .camera = camera, .targets = {48, 32, VK_NULL_HANDLE}}));
       ring.submit(slot);
       if (frame == 0) perFrame = passBytes(fx.ctx().memoryStats()) - passBytes(start);
     }  // destroyed before the GPU has finished the frame, with no wait

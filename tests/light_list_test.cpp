@@ -49,8 +49,10 @@ TEST_CASE("the many-light pass lights the same from a shared LightList as from t
           CHECK(info.count == lights.size());
           CHECK(info.frame == fx.ctx().frameIndex());
           CHECK(info.buffer != VK_NULL_HANDLE);
-          RB_REQUIRE_OK(fromArray.value()->record(cmd, desc, tlas, lights, settings));
-          RB_REQUIRE_OK(fromList.value()->record(cmd, desc, tlas, *list.value(), settings));
+          RB_REQUIRE_OK(
+              fromArray.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .lights = lights, .settings = settings}));
+          RB_REQUIRE_OK(fromList.value()->record(
+              cmd, {.gbuffer = desc, .tlas = tlas, .lightList = list.value().get(), .settings = settings}));
         },
         [&](const rb::GBufferDesc& desc) {
           a = readRgba16f(fx, fromArray.value()->outputs().irradiance, desc.width, desc.height);
@@ -86,8 +88,8 @@ TEST_CASE("a LightList is refused when stale, recorded twice or in another TLAS 
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
         // Never recorded yet.
-        CHECK(contains(pass.value()->record(cmd, desc, tlas, *list.value()),
-                       "ManyLightPass: lights: that LightList was not recorded this frame"));
+        CHECK(contains(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .lightList = list.value().get()}),
+                       "ManyLightPass: ManyLightFrame::lightList: that LightList was not recorded this frame"));
         CHECK(contains(list.value()->record(VK_NULL_HANDLE, tlas, lights), "LightList::record: cmd is VK_NULL_HANDLE"));
         // Bad lights: the index and field, and the list stays unrecorded.
         std::vector<rb::LightSource> bad = lights;
@@ -106,8 +108,9 @@ TEST_CASE("a LightList is refused when stale, recorded twice or in another TLAS 
         CHECK(contains(list.value()->record(cmd, tlas, lights), "already recorded in frame"));
         rb::TlasInfo moved = tlas;
         moved.originOffset[0] += 4.0;
-        CHECK(contains(pass.value()->record(cmd, desc, moved, *list.value()), "recorded for another TLAS space"));
-        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, *list.value()));
+        CHECK(contains(pass.value()->record(cmd, {.gbuffer = desc, .tlas = moved, .lightList = list.value().get()}),
+                       "recorded for another TLAS space"));
+        RB_REQUIRE_OK(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .lightList = list.value().get()}));
       },
       [](const rb::GBufferDesc&) {});
   CHECK(list.value()->info().frame == recordedIn);
@@ -115,7 +118,8 @@ TEST_CASE("a LightList is refused when stale, recorded twice or in another TLAS 
   runPassFrame(
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
-        CHECK(contains(pass.value()->record(cmd, desc, tlas, *list.value()), "not recorded this frame"));
+        CHECK(contains(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .lightList = list.value().get()}),
+                       "not recorded this frame"));
       },
       [](const rb::GBufferDesc&) {});
 }

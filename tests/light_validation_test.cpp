@@ -56,10 +56,12 @@ TEST_CASE("every effect that takes a light refuses the same bad light with the s
       light.position[0] = 1.0;
       light.position[1] = 2.0;
       c.damage(light);
-      const rb::Status shadow = shadowPass.value()->record(cmd, gbuffer.desc(), built.tlas, light);
+      const rb::Status shadow =
+          shadowPass.value()->record(cmd, {.gbuffer = gbuffer.desc(), .tlas = built.tlas, .light = light});
       std::vector<rb::LightSource> list(1);
       list[0].light = light;
-      const rb::Status many = manyLights.value()->record(cmd, gbuffer.desc(), built.tlas, list);
+      const rb::Status many =
+          manyLights.value()->record(cmd, {.gbuffer = gbuffer.desc(), .tlas = built.tlas, .lights = list});
       const rb::Status shared = lightList.value()->record(cmd, built.tlas, list);
       rb::HybridFrame frame;
       frame.gbuffer = gbuffer.desc();
@@ -83,7 +85,7 @@ TEST_CASE("every effect that takes a light refuses the same bad light with the s
     rb::Light point;
     point.type = rb::LightType::Point;
     point.position[1] = 2.0;
-    RB_REQUIRE_OK(shadowPass.value()->record(cmd, gbuffer.desc(), built.tlas, point));
+    RB_REQUIRE_OK(shadowPass.value()->record(cmd, {.gbuffer = gbuffer.desc(), .tlas = built.tlas, .light = point}));
   });
   shadowPass.value().reset();
   manyLights.value().reset();

@@ -43,8 +43,11 @@ DenoisedFrames runViews(GpuFixture& fx, const TestScene& scene, const std::vecto
     fx.runFrame([&](VkCommandBuffer cmd) {
       auto tlas = service.value()->recordTlasBuild(cmd, built.instances, gbuffer.cameraRelativeTlas());
       RB_REQUIRE_OK(tlas);
-      RB_REQUIRE_OK(pass.value()->record(cmd, g, tlas.value(), lights, settings));
-      if (denoise) RB_REQUIRE_OK(denoiser.value()->record(cmd, g, pass.value()->outputs().irradianceView, dn));
+      RB_REQUIRE_OK(
+          pass.value()->record(cmd, {.gbuffer = g, .tlas = tlas.value(), .lights = lights, .settings = settings}));
+      if (denoise)
+        RB_REQUIRE_OK(denoiser.value()->record(
+            cmd, {.gbuffer = g, .signal = pass.value()->outputs().irradianceView, .settings = dn}));
     });
     if (std::find(readAt.begin(), readAt.end(), f) == readAt.end()) continue;
     out.raw.push_back(readRgba16f(fx, pass.value()->outputs().irradiance, g.width, g.height));

@@ -86,7 +86,8 @@ ManyLightRun runManyLights(GpuFixture& fx, const TestScene& scene, const CpuGBuf
   runPassFrame(
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
-        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, lights, settings));
+        RB_REQUIRE_OK(
+            pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .lights = lights, .settings = settings}));
       },
       [&](const rb::GBufferDesc& desc) {
         out.rgba = readRgba16f(fx, pass.value()->outputs().irradiance, desc.width, desc.height);
@@ -239,7 +240,7 @@ TEST_CASE("many-light bad lights fail naming the light and field; nothing is rec
     runPassFrame(
         fx, scene, cpu, false,
         [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
-          rb::Status s = pass.value()->record(cmd, desc, tlas, lights);
+          rb::Status s = pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .lights = lights});
           REQUIRE_FALSE(s);
           INFO(s.error().message);
           CHECK(s.error().code == rb::ErrorCode::InvalidArgument);

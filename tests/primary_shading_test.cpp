@@ -30,7 +30,8 @@ ShadingRun runShading(GpuFixture& fx, const TestScene& scene, const rb::PrimaryR
   auto pass = rb::PrimaryShadingPass::create(fx.ctx());
   RB_REQUIRE_OK(pass);
   fx.runFrame([&](VkCommandBuffer cmd) {
-    RB_REQUIRE_OK(pass.value()->record(cmd, built.tlas, camera, {W, H, VK_NULL_HANDLE}, settings));
+    RB_REQUIRE_OK(pass.value()->record(
+        cmd, {.tlas = built.tlas, .camera = camera, .targets = {W, H, VK_NULL_HANDLE}, .settings = settings}));
   });
   const rb::PrimaryShadingOutputs& o = pass.value()->outputs();
   REQUIRE(o.radiance != VK_NULL_HANDLE);
@@ -125,21 +126,26 @@ TEST_CASE("primary shading rejects bad input with a message naming it", "[primar
       CHECK(s.error().code == rb::ErrorCode::InvalidArgument);
       CHECK(contains(s.error().message, part));
     };
-    expect(pass.value()->record(VK_NULL_HANDLE, built.tlas, camera, {8, 8}), "cmd is VK_NULL_HANDLE");
-    expect(pass.value()->record(cmd, noRecords, camera, {8, 8}), "no shading records");
-    expect(pass.value()->record(cmd, rb::TlasInfo{}, camera, {8, 8}), "TLAS is VK_NULL_HANDLE");
-    expect(pass.value()->record(cmd, built.tlas, camera, {0, 8}), "PrimaryShadingTargets::width and height");
+    expect(pass.value()->record(VK_NULL_HANDLE, {.tlas = built.tlas, .camera = camera, .targets = {8, 8}}),
+           "cmd is VK_NULL_HANDLE");
+    expect(pass.value()->record(cmd, {.tlas = noRecords, .camera = camera, .targets = {8, 8}}), "no shading records");
+    expect(pass.value()->record(cmd, {.tlas = rb::TlasInfo{}, .camera = camera, .targets = {8, 8}}),
+           "TLAS is VK_NULL_HANDLE");
+    expect(pass.value()->record(cmd, {.tlas = built.tlas, .camera = camera, .targets = {0, 8}}),
+           "PrimaryShadingTargets::width and height");
     rb::PrimaryShadingSettings many;
     many.lightCandidates = 65;
-    expect(pass.value()->record(cmd, built.tlas, camera, {8, 8}, many), "lightCandidates 65 exceeds 64");
+    expect(pass.value()->record(cmd, {.tlas = built.tlas, .camera = camera, .targets = {8, 8}, .settings = many}),
+           "lightCandidates 65 exceeds 64");
     rb::PrimaryRayCamera same = camera;
     for (int i = 0; i < 3; ++i) same.target[i] = same.eye[i];
-    expect(pass.value()->record(cmd, built.tlas, same, {8, 8}), "camera: camera eye equals target");
+    expect(pass.value()->record(cmd, {.tlas = built.tlas, .camera = same, .targets = {8, 8}}),
+           "camera: camera eye equals target");
     auto lights = rb::LightList::create(fx.ctx());
     RB_REQUIRE_OK(lights);
     rb::PrimaryShadingSettings unrecorded;
     unrecorded.lights = lights.value().get();
-    expect(pass.value()->record(cmd, built.tlas, camera, {8, 8}, unrecorded),
+    expect(pass.value()->record(cmd, {.tlas = built.tlas, .camera = camera, .targets = {8, 8}, .settings = unrecorded}),
            "PrimaryShadingSettings::lights: that LightList was not recorded this frame");
   });
   destroyScene(fx, built);

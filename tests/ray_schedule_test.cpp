@@ -102,7 +102,8 @@ TEST_CASE("every effect's RaySchedule is checked by one validator that names the
        [&](VkCommandBuffer cmd, const rb::RaySchedule& s) {
          rb::ShadowSettings settings;
          settings.schedule = s;
-         return shadow.value()->record(cmd, gbuffer.desc(), built.tlas, soft, settings);
+         return shadow.value()->record(
+             cmd, {.gbuffer = gbuffer.desc(), .tlas = built.tlas, .light = soft, .settings = settings});
        },
        [](rb::HybridEffectsDesc& d, const rb::RaySchedule& s) {
          d.effects = rb::kEffectShadows;
@@ -113,7 +114,7 @@ TEST_CASE("every effect's RaySchedule is checked by one validator that names the
        [&](VkCommandBuffer cmd, const rb::RaySchedule& s) {
          rb::AoSettings settings;
          settings.schedule = s;
-         return ao.value()->record(cmd, gbuffer.desc(), built.tlas, settings);
+         return ao.value()->record(cmd, {.gbuffer = gbuffer.desc(), .tlas = built.tlas, .settings = settings});
        },
        [](rb::HybridEffectsDesc& d, const rb::RaySchedule& s) {
          d.effects = rb::kEffectAo;
@@ -124,7 +125,7 @@ TEST_CASE("every effect's RaySchedule is checked by one validator that names the
        [&](VkCommandBuffer cmd, const rb::RaySchedule& s) {
          rb::ReflectionSettings settings;
          settings.schedule = s;
-         return reflection.value()->record(cmd, gbuffer.desc(), built.tlas, settings);
+         return reflection.value()->record(cmd, {.gbuffer = gbuffer.desc(), .tlas = built.tlas, .settings = settings});
        },
        [](rb::HybridEffectsDesc& d, const rb::RaySchedule& s) {
          d.effects = rb::kEffectReflections;
@@ -135,7 +136,8 @@ TEST_CASE("every effect's RaySchedule is checked by one validator that names the
        [&](VkCommandBuffer cmd, const rb::RaySchedule& s) {
          rb::ManyLightSettings settings;
          settings.schedule = s;
-         return lights.value()->record(cmd, gbuffer.desc(), built.tlas, list, settings);
+         return lights.value()->record(
+             cmd, {.gbuffer = gbuffer.desc(), .tlas = built.tlas, .lights = list, .settings = settings});
        },
        [](rb::HybridEffectsDesc& d, const rb::RaySchedule& s) {
          d.effects = rb::kEffectLocalLights;

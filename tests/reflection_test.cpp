@@ -35,7 +35,7 @@ ReflectionRun runReflections(GpuFixture& fx, const TestScene& scene, const CpuGB
   runPassFrame(
       fx, scene, cpu, true,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
-        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, settings));
+        RB_REQUIRE_OK(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = settings}));
       },
       [&](const rb::GBufferDesc& desc) {
         std::vector<uint8_t> raw = readPassImage(fx, pass.value()->outputs().radiance, desc.width, desc.height, 8);
@@ -229,7 +229,7 @@ TEST_CASE("reflection hits are lit by the many-light pass's light list", "[refle
             RB_REQUIRE_OK(lights.value()->record(cmd, tlas, std::span(&light, 1)));
             s.lights = lights.value().get();
           }
-          RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, s));
+          RB_REQUIRE_OK(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = s}));
         },
         [&](const rb::GBufferDesc& desc) { read(desc, withLights ? lit : unlit); });
   }
@@ -279,7 +279,7 @@ TEST_CASE("reflection hits are lit by the many-light pass's light list", "[refle
         [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
           rb::ReflectionSettings s = settings;
           s.lights = lights.value().get();
-          rb::Status st = pass.value()->record(cmd, desc, tlas, s);
+          rb::Status st = pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = s});
           REQUIRE_FALSE(st);
           CHECK(st.error().message.find("not recorded this frame") != std::string::npos);
         },
@@ -366,7 +366,7 @@ TEST_CASE("the reflection pass says whether it reordered", "[reflection][invocat
     runPassFrame(
         fx, scene, cpu, true,
         [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
-          RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, settings));
+          RB_REQUIRE_OK(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .settings = settings}));
         },
         [](const rb::GBufferDesc&) {});
     // Requested on a device without it: the plain pipeline, no error (lavapipe); not requested: never.

@@ -79,10 +79,12 @@ TEST_CASE("reflections, primary shading and the front end refuse the same bad Sc
       INFO(c.message);
       rb::ReflectionSettings r;
       c.damage(r.lighting);
-      const rb::Status reflected = reflection.value()->record(cmd, gbuffer.desc(), built.tlas, r);
+      const rb::Status reflected =
+          reflection.value()->record(cmd, {.gbuffer = gbuffer.desc(), .tlas = built.tlas, .settings = r});
       rb::PrimaryShadingSettings p;
       c.damage(p.lighting);
-      const rb::Status shaded = shading.value()->record(cmd, built.tlas, camera, {8, 8}, p);
+      const rb::Status shaded =
+          shading.value()->record(cmd, {.tlas = built.tlas, .camera = camera, .targets = {8, 8}, .settings = p});
       rb::HybridFrame frame;
       frame.gbuffer = gbuffer.desc();
       frame.tlas = &built.tlas;

@@ -33,7 +33,7 @@ ShadowRun runShadowPass(GpuFixture& fx, const TestScene& scene, const CpuGBuffer
   runPassFrame(
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
-        RB_REQUIRE_OK(pass.value()->record(cmd, desc, tlas, light, settings));
+        RB_REQUIRE_OK(pass.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .light = light, .settings = settings}));
       },
       [&](const rb::GBufferDesc& desc) {
         run.visibility = readR16f(fx, pass.value()->outputs().visibility, desc.width, desc.height);

@@ -95,7 +95,8 @@ TraceComparison compareFirstTrace(GpuFixture& fx, const TestScene& scene, VkAcce
   fx.runFrame([&](VkCommandBuffer cmd) {
     fx.toGeneral(cmd, dist);
     fx.toGeneral(cmd, ids);
-    RB_REQUIRE_OK(pass.value()->record(cmd, rb::TlasInfo{.tlas = tlas}, cam, {dist.view, ids.view, W, H}));
+    RB_REQUIRE_OK(pass.value()->record(
+        cmd, {.tlas = rb::TlasInfo{.tlas = tlas}, .camera = cam, .targets = {dist.view, ids.view, W, H}}));
   });
   std::vector<uint8_t> distBytes = fx.readImage(dist, 4), idBytes = fx.readImage(ids, 8);
   fx.destroyImage(dist);

@@ -54,8 +54,10 @@ ClassifierComparison compareClassifier(GpuFixture& fx, const TestScene& scene, c
   runPassFrame(
       fx, scene, cpu, false,
       [&](VkCommandBuffer cmd, const rb::GBufferDesc& desc, const rb::TlasInfo& tlas) {
-        RB_REQUIRE_OK(classified.value()->record(cmd, desc, tlas, light, settings));
-        RB_REQUIRE_OK(plain.value()->record(cmd, desc, tlas, light, unclassified));
+        RB_REQUIRE_OK(
+            classified.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .light = light, .settings = settings}));
+        RB_REQUIRE_OK(
+            plain.value()->record(cmd, {.gbuffer = desc, .tlas = tlas, .light = light, .settings = unclassified}));
         c.passBufferBytes = fx.ctx().memoryStats().of(rb::MemoryCategory::PassBuffers) - created;
       },
       [&](const rb::GBufferDesc& desc) {

@@ -333,7 +333,9 @@ void Adapter::recordRayTraced(const se::PrepassHookInfo& info) {
   rb::PrimaryShadingTargets targets;
   targets.width = info.extent.width, targets.height = info.extent.height;
   targets.radiance = info.hdrColor.view;  // GENERAL, as the engine hands it over and wants it back
-  if (rb::Status st = a.shading->record(info.commandBuffer, a.tlas, camera, targets, s); !st)
+  if (rb::Status st = a.shading->record(info.commandBuffer,
+                                        {.tlas = a.tlas, .camera = camera, .targets = targets, .settings = s});
+      !st)
     return keepFirst(a.error, message("PrimaryShadingPass::record", st.error()));
 }
 

@@ -238,7 +238,9 @@ nlohmann::json runAlphaScenario(BenchEnv& env) {
     return tlas;
   };
   auto record = [&](VkCommandBuffer cmd, const rb::TlasInfo& tlas, size_t v, int k) {
-    check(kinds[k].pass->record(cmd, gbuffer, tlas, kinds[k].light, setups[v].settings[k]), "ShadowPass::record");
+    check(kinds[k].pass->record(
+              cmd, {.gbuffer = gbuffer, .tlas = tlas, .light = kinds[k].light, .settings = setups[v].settings[k]}),
+          "ShadowPass::record");
   };
 
   // Counting: a frame with one recording per pass gives its statistics (rays, any-hit invocations) and its

@@ -182,7 +182,9 @@ nlohmann::json runLightsScenario(BenchEnv& env) {
     env.runFrame([&](VkCommandBuffer cmd) {
       rb::TlasInfo tlas = buildTlas(cmd);
       env.recordTraceBarrier(cmd, targets);
-      check(primary->record(cmd, tlas, primaryCamera(camera), {targets.distance.view, targets.ids.view, w, h}),
+      check(primary->record(cmd, {.tlas = tlas,
+                                  .camera = primaryCamera(camera),
+                                  .targets = {targets.distance.view, targets.ids.view, w, h}}),
             "PrimaryRayPass::record");
     });
     const std::vector<uint8_t> d = readImage(env, targets.distance.image, VK_IMAGE_LAYOUT_GENERAL, w, h, 4,
@@ -266,9 +268,12 @@ nlohmann::json runLightsScenario(BenchEnv& env) {
         for (uint32_t i = 0; i < warmUp + z.repeats; ++i) {
           const bool timed = i >= warmUp;
           const uint32_t a = timed ? timer.mark(cmd) : 0;
-          check(pass->record(cmd, gbuffer, tlas, lights, settings), "ManyLightPass::record");
+          check(pass->record(cmd, {.gbuffer = gbuffer, .tlas = tlas, .lights = lights, .settings = settings}),
+                "ManyLightPass::record");
           const uint32_t b = timed ? timer.mark(cmd) : 0;
-          if (withDenoiser) check(denoiser->record(cmd, gbuffer, pass->outputs().irradianceView), "Denoiser::record");
+          if (withDenoiser)
+            check(denoiser->record(cmd, {.gbuffer = gbuffer, .signal = pass->outputs().irradianceView}),
+                  "Denoiser::record");
           if (timed) marks.push_back({a, b, withDenoiser ? timer.mark(cmd) : b});
         }
       });
@@ -320,7 +325,8 @@ nlohmann::json runLightsScenario(BenchEnv& env) {
     exact.mode = rb::ManyLightMode::Exact;
     env.runFrame([&](VkCommandBuffer cmd) {
       rb::TlasInfo tlas = buildTlas(cmd);
-      check(pass->record(cmd, gbuffer, tlas, field.lights, exact), "ManyLightPass::record (exact)");
+      check(pass->record(cmd, {.gbuffer = gbuffer, .tlas = tlas, .lights = field.lights, .settings = exact}),
+            "ManyLightPass::record (exact)");
     });
     const std::vector<float> reference = readRgba16f(env, pass->outputs().irradiance, outLayout, w, h, "exact");
     env.settle();
@@ -393,10 +399,12 @@ nlohmann::json runLightsScenario(BenchEnv& env) {
           timer.reset(cmd);
           rb::TlasInfo tlas = buildTlas(cmd);
           p0 = timer.mark(cmd);
-          check(pass->record(cmd, gbuffer, tlas, field.lights, stochastic), "ManyLightPass::record");
+          check(pass->record(cmd, {.gbuffer = gbuffer, .tlas = tlas, .lights = field.lights, .settings = stochastic}),
+                "ManyLightPass::record");
           p1 = timer.mark(cmd);
           if (denoiser) {
-            check(denoiser->record(cmd, gbuffer, pass->outputs().irradianceView), "Denoiser::record");
+            check(denoiser->record(cmd, {.gbuffer = gbuffer, .signal = pass->outputs().irradianceView}),
+                  "Denoiser::record");
             d1 = timer.mark(cmd);
           }
         });

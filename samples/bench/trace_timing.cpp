@@ -16,7 +16,9 @@ TraceTiming timeTraces(BenchEnv& env, rb::PrimaryRayPass& pass, VkAccelerationSt
     for (uint32_t i = 0; i <= repeats; ++i) {
       env.recordTraceBarrier(cmd, targets);
       uint32_t a = i ? timer.mark(cmd) : 0;
-      check(pass.record(cmd, rb::TlasInfo{.tlas = tlas}, camera, {targets.distance.view, targets.ids.view, w, h}),
+      check(pass.record(cmd, {.tlas = rb::TlasInfo{.tlas = tlas},
+                              .camera = camera,
+                              .targets = {targets.distance.view, targets.ids.view, w, h}}),
             "PrimaryRayPass::record");
       if (i) marks.emplace_back(a, timer.mark(cmd));
     }

@@ -58,6 +58,20 @@ struct AoSettings {
   RaySchedule schedule{};
 };
 
+// Fixed for the pass's life. Zero-initialised = images created at the first record().
+struct AoPassDesc {
+  // Create the output images at width x height now (as prepare()), so that outputs() names them and the first
+  // record() allocates nothing; 0 x 0 = at the first record(). Both or neither.
+  uint32_t width = 0, height = 0;
+};
+
+// What one record() traces. The G-buffer and TLAS have no defaults: a zero-initialised frame is refused by name.
+struct AoFrame {
+  GBufferDesc gbuffer{};  // the engine's G-buffer, its images in their declared layouts
+  TlasInfo tlas{};        // from recordTlasBuild() earlier in submission order
+  AoSettings settings{};
+};
+
 // Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record().
 struct AoOutputs {
   VkImage ao = VK_NULL_HANDLE;  // R16_SFLOAT open fraction; sky pixels are 1
@@ -73,12 +87,13 @@ struct AoOutputs {
 
 class AoPass {
  public:
-  static Result<std::unique_ptr<AoPass>> create(Context& context);
+  static Result<std::unique_ptr<AoPass>> create(Context& context, const AoPassDesc& desc = {});
   // Retires its Vulkan objects to the context, without waiting: the images of outputs() stay valid for
   // the frames already recorded.
   ~AoPass();
 
-  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas, const AoSettings& settings = {});
+  // Records the AO rays of `frame` into `cmd`. On an error (named field) nothing is recorded.
+  Status record(VkCommandBuffer cmd, const AoFrame& frame);
   // Creates the output images at width x height now, so that outputs() names them before the first record()
   // (HybridEffects hands out views that stay valid this way); record() at the same size keeps them, at another
   // size it recreates them. Written by the first record().

@@ -39,10 +39,6 @@
 
 namespace rb {
 
-namespace internal {
-struct DenoiserAccess;
-}
-
 // What a Denoiser filters.
 enum class DenoiseSignal : uint32_t {
   Scalar = 0,  // default: R16/R32 .r (shadow visibility, AO); output R16_SFLOAT
@@ -57,6 +53,9 @@ enum class DenoiseSignal : uint32_t {
 // Fixed for the denoiser's life (its history and images follow it). Zero-initialised = a scalar denoiser.
 struct DenoiserDesc {
   DenoiseSignal signal = DenoiseSignal::Scalar;
+  // Create the images at width x height now (as prepare()), so that outputs() names the output and the first
+  // record() allocates nothing; 0 x 0 = at the first record(). Both or neither.
+  uint32_t width = 0, height = 0;
 };
 
 // Default of DenoiseSettings::convergedNoise: a scalar pixel whose noise has a standard deviation under 0.1 passes
@@ -89,6 +88,19 @@ struct DenoiseSettings {
   float convergedNoise = 0.0f;
 };
 
+// What one record() filters. The G-buffer and signal have no defaults: a zero-initialised frame is refused by name.
+struct DenoiseFrame {
+  GBufferDesc gbuffer{};  // the one the signal was traced from
+  // In SHADER_READ_ONLY_OPTIMAL (the outputs of ShadowPass, AoPass, ManyLightPass and ReflectionPass are):
+  //   Scalar: an R16/R32 float image view with the noisy value in .r.
+  //   Rgb: an RGBA16F/RGBA32F image view with the noisy HDR value in .rgb (.a is ignored). A VkImageView does
+  //        not tell its format, so this cannot be checked: a one-channel view would read as red only.
+  //   Reflection: as Rgb, .a = coverage (0 = no reflection there); the G-buffer must carry roughness
+  //        (GBufferDesc::roughnessInNormalW or roughnessMetalness), that of the reflection rays.
+  VkImageView signal = VK_NULL_HANDLE;
+  DenoiseSettings settings{};
+};
+
 // Owned by the denoiser, left in SHADER_READ_ONLY_OPTIMAL after record().
 struct DenoiseOutputs {
   // DenoiseSignal::Scalar: R16_SFLOAT (.r). Rgb: R16G16B16A16_SFLOAT (.rgb, a = 1). Reflection: as Rgb, a = coverage.
@@ -98,23 +110,36 @@ struct DenoiseOutputs {
   uint32_t width = 0, height = 0;
 };
 
+// The history a Denoiser's latest record() left: what the ray schedule of the pass that traces this signal reads
+// (RaySchedule::history: adaptive rays and converged tiles), and what an engine may show in a debug view. Read-only:
+// the images belong to the denoiser and are rewritten by its next record(). All in SHADER_READ_ONLY_OPTIMAL.
+struct DenoiseHistory {
+  // Scalar: RG16F (mean, frames accumulated). Rgb and Reflection: RGBA16F (mean colour, frames accumulated).
+  VkImageView mean = VK_NULL_HANDLE;
+  // Scalar: R32F (view distance of each pixel's surface). Rgb and Reflection: RG32F (view distance, variance of one
+  // frame's colour).
+  VkImageView distance = VK_NULL_HANDLE;
+  // Scalar only: RG16F, the latest temporal result (value, variance of its noise). VK_NULL_HANDLE otherwise.
+  VkImageView noise = VK_NULL_HANDLE;
+  VkSampler sampler = VK_NULL_HANDLE;  // nearest, clamped: the one the denoiser reads its history with
+  uint32_t width = 0, height = 0;      // 0 before the first record() at the current size
+  // false = the images hold no usable history (never written at this size, resetHistory(), temporal off).
+  bool valid = false;
+  // The camera of the frame that wrote it, as the temporal pass reprojects from: the world-space camera position and
+  // projection * rotation-only view (column-major), both in double.
+  double cameraPosition[3] = {};
+  double viewProjection[16] = {};
+};
+
 class Denoiser {
  public:
-  static Result<std::unique_ptr<Denoiser>> create(Context& context, const DenoiserDesc& desc);
-  static Result<std::unique_ptr<Denoiser>> create(Context& context);  // = DenoiseSignal::Scalar
+  static Result<std::unique_ptr<Denoiser>> create(Context& context, const DenoiserDesc& desc = {});
   // Retires its Vulkan objects to the context, without waiting: the images of outputs() stay valid for
   // the frames already recorded.
   ~Denoiser();
 
-  // `signal`, in SHADER_READ_ONLY_OPTIMAL (the outputs of ShadowPass, AoPass and ManyLightPass are):
-  //   Scalar: an R16/R32 float image view with the noisy value in .r.
-  //   Rgb: an RGBA16F/RGBA32F image view with the noisy HDR value in .rgb (.a is ignored). A VkImageView does
-  //        not tell its format, so this cannot be checked: a one-channel view would read as red only.
-  //   Reflection: as Rgb, .a = coverage (0 = no reflection there); the G-buffer must carry roughness
-  //        (GBufferDesc::roughnessInNormalW or roughnessMetalness), that of the reflection rays.
-  // The G-buffer is the one the signal was traced from.
-  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, VkImageView signal,
-                const DenoiseSettings& settings = {});
+  // Records the filtering of frame.signal into `cmd`. On an error (named field) nothing is recorded.
+  Status record(VkCommandBuffer cmd, const DenoiseFrame& frame);
   // Creates the images at width x height now (the history starts empty), so that outputs() names the output
   // before the first record(); record() at the same size keeps them, at another size it recreates them. The output
   // image is the same whatever the DenoiseSettings, until the size changes. Written by the first record().
@@ -124,11 +149,13 @@ class Denoiser {
   const DenoiseOutputs& outputs() const;
   DenoiseSignal signal() const;  // the DenoiserDesc::signal it was created with
   PassStats stats() const;       // GPU time (rays are 0: the denoiser traces none)
+  // The history the latest record() left (see DenoiseHistory); mean is VK_NULL_HANDLE before the first record() or
+  // after prepare() at another size.
+  DenoiseHistory history() const;
 
   struct Impl;
 
  private:
-  friend struct internal::DenoiserAccess;  // adaptive rays read the history (sdk/src/denoise/denoiser_history.h)
   explicit Denoiser(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

@@ -76,6 +76,27 @@ struct ManyLightSettings {
   RaySchedule schedule{};
 };
 
+// Fixed for the pass's life. Zero-initialised = images created at the first record().
+struct ManyLightPassDesc {
+  // Create the output images at width x height now (as prepare()), so that outputs() names them and the first
+  // record() allocates nothing; 0 x 0 = at the first record(). Both or neither.
+  uint32_t width = 0, height = 0;
+};
+
+// What one record() traces. The G-buffer and TLAS have no defaults: a zero-initialised frame is refused by name.
+// The lights: a LightList or an array, not both (refused by name); neither = no light (a black output, no ray).
+struct ManyLightFrame {
+  GBufferDesc gbuffer{};  // the engine's G-buffer, its images in their declared layouts
+  TlasInfo tlas{};        // from recordTlasBuild() earlier in submission order
+  // A LightList recorded this frame for the same TLAS space (refused with a named error otherwise): shared with
+  // reflection hits and primary shading, uploaded once.
+  const LightList* lightList = nullptr;
+  // Or the lights themselves: record() checks every one (the error names its index and field) and uploads them into
+  // a list of the pass's own first, inside the pass's time (copied: the array may change right after the call).
+  std::span<const LightSource> lights{};
+  ManyLightSettings settings{};
+};
+
 // Owned by the pass, sized to the G-buffer, left in SHADER_READ_ONLY_OPTIMAL after record(), readable by
 // fragment, compute and ray tracing shaders.
 struct ManyLightOutputs {
@@ -89,19 +110,14 @@ struct ManyLightOutputs {
 
 class ManyLightPass {
  public:
-  static Result<std::unique_ptr<ManyLightPass>> create(Context& context);
+  static Result<std::unique_ptr<ManyLightPass>> create(Context& context, const ManyLightPassDesc& desc = {});
   // Retires its Vulkan objects to the context, without waiting.
   ~ManyLightPass();
 
-  // Records the tile culling and the shadow rays over `lights`, a LightList recorded this frame for the same TLAS
-  // space (refused with a named error otherwise). An empty list makes the output black and traces no ray.
-  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas, const LightList& lights,
-                const ManyLightSettings& settings = {});
-  // The same, given the lights themselves: records their upload into the pass's own list first (inside the
-  // pass's time). Every light is checked first; on error nothing is recorded and the message names the light's
-  // index and field.
-  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas,
-                std::span<const LightSource> lights, const ManyLightSettings& settings = {});
+  // Records the tile culling and the shadow rays over the frame's lights into `cmd` (first their upload, when
+  // given as an array). An empty list makes the output black and traces no ray. On an error (named field) nothing
+  // is recorded.
+  Status record(VkCommandBuffer cmd, const ManyLightFrame& frame);
   // Creates the output images at width x height now, so that outputs() names them before the first record()
   // (HybridEffects hands out views that stay valid this way); record() at the same size keeps them, at another
   // size it recreates them. Written by the first record().

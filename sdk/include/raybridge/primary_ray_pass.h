@@ -50,19 +50,34 @@ struct PrimaryRaySettings {
   const MaterialTable* materials = nullptr;
 };
 
+// Fixed for the pass's life. Zero-initialised = a pipeline that alpha-tests when given materials.
+struct PrimaryRayPassDesc {
+  // true = never alpha-test: the pipeline has no any-hit shader and the pass allocates no fallback material table
+  // (a buffer and a descriptor set it would otherwise hold); every hit counts, and record() refuses
+  // PrimaryRaySettings::materials by name. For conformance runs and scenes without cut-outs.
+  bool opaqueOnly = false;
+};
+
+// What one record() traces. The TLAS and targets have no defaults: a zero-initialised frame is refused by name.
+struct PrimaryRayFrame {
+  // recordTlasBuild()'s, earlier in submission order; an engine's own TLAS as TlasInfo{.tlas = handle}.
+  TlasInfo tlas{};
+  PrimaryRayCamera camera{};  // world space
+  PrimaryRayTargets targets{};
+  PrimaryRaySettings settings{};
+};
+
 class PrimaryRayPass {
  public:
-  static Result<std::unique_ptr<PrimaryRayPass>> create(Context& context);
+  static Result<std::unique_ptr<PrimaryRayPass>> create(Context& context, const PrimaryRayPassDesc& desc = {});
   // Retires its pipeline to the context, without waiting for the frames that traced with it.
   ~PrimaryRayPass();
 
-  // Records the trace of `tlas` (recordTlasBuild()'s, earlier in submission order; an engine's own TLAS as
-  // TlasInfo{.tlas = handle}), alpha-testing through `settings.materials`. The camera is in world space; the pass
-  // subtracts TlasInfo::originOffset from eye and target (in double) to trace a camera-relative TLAS. The images
+  // Records the trace of frame.tlas, alpha-testing through frame.settings.materials. The pass subtracts
+  // TlasInfo::originOffset from the camera's eye and target (in double) to trace a camera-relative TLAS. The images
   // stay in VK_IMAGE_LAYOUT_GENERAL and the caller orders their reads after
   // VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR / VK_ACCESS_SHADER_WRITE_BIT.
-  Status record(VkCommandBuffer cmd, const TlasInfo& tlas, const PrimaryRayCamera& camera,
-                const PrimaryRayTargets& targets, const PrimaryRaySettings& settings = {});
+  Status record(VkCommandBuffer cmd, const PrimaryRayFrame& frame);
   // The latest measurement whose frame has finished (rays, any-hit invocations, GPU time).
   PassStats stats() const;
 

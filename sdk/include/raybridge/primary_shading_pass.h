@@ -57,6 +57,21 @@ struct PrimaryShadingTargets {
   VkImageView radiance = VK_NULL_HANDLE;
 };
 
+// Fixed for the pass's life. Zero-initialised = images created at the first record().
+struct PrimaryShadingPassDesc {
+  // Create the output images at width x height now (as prepare()), so that outputs() names them and the first
+  // record() allocates nothing; 0 x 0 = at the first record(). Both or neither.
+  uint32_t width = 0, height = 0;
+};
+
+// What one record() traces. The TLAS and target size have no defaults: a zero-initialised frame is refused by name.
+struct PrimaryShadingFrame {
+  TlasInfo tlas{};            // recordTlasBuild()'s (with shading records), earlier in submission order
+  PrimaryRayCamera camera{};  // world space
+  PrimaryShadingTargets targets{};
+  PrimaryShadingSettings settings{};
+};
+
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
 struct PrimaryShadingOutputs {
   // R16G16B16A16_SFLOAT: rgb linear radiance towards the eye, a = 1. VK_NULL_HANDLE when the latest record()
@@ -73,7 +88,7 @@ struct PrimaryShadingOutputs {
 class PrimaryShadingPass {
  public:
   // Fails with ErrorCode::MissingFeature on a device whose ray recursion depth is below 2.
-  static Result<std::unique_ptr<PrimaryShadingPass>> create(Context& context);
+  static Result<std::unique_ptr<PrimaryShadingPass>> create(Context& context, const PrimaryShadingPassDesc& desc = {});
   // Retires its Vulkan objects to the context, without waiting: the images of outputs() stay valid for the
   // frames already recorded.
   ~PrimaryShadingPass();
@@ -81,8 +96,11 @@ class PrimaryShadingPass {
   // Records the trace. The camera is in world space; the pass subtracts TlasInfo::originOffset from eye and target
   // (in double) to trace a camera-relative TLAS. The TLAS must have been built by recordTlasBuild() earlier in
   // submission order. On an error (named field) nothing is recorded.
-  Status record(VkCommandBuffer cmd, const TlasInfo& tlas, const PrimaryRayCamera& camera,
-                const PrimaryShadingTargets& targets, const PrimaryShadingSettings& settings = {});
+  Status record(VkCommandBuffer cmd, const PrimaryShadingFrame& frame);
+  // Creates the pass's own images (radiance and distance) at width x height now, so that outputs() names them before
+  // the first record(); a record() at the same size that writes into its own radiance image keeps them, one at
+  // another size or into the caller's radiance image recreates them. Written by the first record().
+  Status prepare(uint32_t width, uint32_t height);
   const PrimaryShadingOutputs& outputs() const;
   // The latest measurement whose frame has finished: GPU time, and rays (primary plus shadow rays).
   PassStats stats() const;

@@ -94,6 +94,20 @@ struct ReflectionSettings {
   RaySchedule schedule{};
 };
 
+// Fixed for the pass's life. Zero-initialised = images created at the first record().
+struct ReflectionPassDesc {
+  // Create the output images at width x height now (as prepare()), so that outputs() names them and the first
+  // record() allocates nothing; 0 x 0 = at the first record(). Both or neither.
+  uint32_t width = 0, height = 0;
+};
+
+// What one record() traces. The G-buffer and TLAS have no defaults: a zero-initialised frame is refused by name.
+struct ReflectionFrame {
+  GBufferDesc gbuffer{};  // the engine's G-buffer (with roughness), its images in their declared layouts
+  TlasInfo tlas{};        // from recordTlasBuild() earlier in submission order
+  ReflectionSettings settings{};
+};
+
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().
 struct ReflectionOutputs {
   // R16G16B16A16_SFLOAT: rgb radiance, a = 1 where rays were traced. With schedule.convergedTiles also a = -1 where a
@@ -107,7 +121,7 @@ struct ReflectionOutputs {
 
 class ReflectionPass {
  public:
-  static Result<std::unique_ptr<ReflectionPass>> create(Context& context);
+  static Result<std::unique_ptr<ReflectionPass>> create(Context& context, const ReflectionPassDesc& desc = {});
   // Retires its Vulkan objects to the context, without waiting: the images of outputs() stay valid for
   // the frames already recorded.
   ~ReflectionPass();
@@ -115,8 +129,8 @@ class ReflectionPass {
   // Fills the pass's own MaterialTable (MaterialTable::setMaterials), used where ReflectionSettings::materials
   // is nullptr. Call when they change; the previous table is released once frames in flight are done with it.
   Status setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures);
-  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas,
-                const ReflectionSettings& settings = {});
+  // Records the reflection rays of `frame` into `cmd`. On an error (named field) nothing is recorded.
+  Status record(VkCommandBuffer cmd, const ReflectionFrame& frame);
   // Creates the output images at width x height now, so that outputs() names them before the first record()
   // (HybridEffects hands out views that stay valid this way); record() at the same size keeps them, at another
   // size it recreates them. Written by the first record().

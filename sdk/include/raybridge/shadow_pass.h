@@ -42,10 +42,14 @@
 
 namespace rb {
 
+// Fixed for the pass's life. Zero-initialised = visibility only, images created at the first record().
 struct ShadowPassDesc {
   // Allocate and write the occluder-distance image (for denoisers and contact hardening). false = the
   // visibility image only, and rays stop at the first occluder they find.
   bool outputHitDistance = false;
+  // Create the output images at width x height now (as prepare()), so that outputs() names them and the first
+  // record() allocates nothing; 0 x 0 = at the first record(). Both or neither.
+  uint32_t width = 0, height = 0;
 };
 
 inline constexpr uint32_t kDefaultSoftShadowRays = 4;
@@ -82,6 +86,15 @@ struct ShadowOutputs {
   VkImageView rayPlanView = VK_NULL_HANDLE;
 };
 
+// What one record() traces. The G-buffer and TLAS have no defaults: a zero-initialised frame is refused by name.
+struct ShadowFrame {
+  GBufferDesc gbuffer{};  // the engine's G-buffer, its images in their declared layouts
+  // From recordTlasBuild() earlier in submission order (ideally with originOffset = the camera position).
+  TlasInfo tlas{};
+  Light light{};  // checked by the one rb::Light validator (light_validation: the same limits for every pass)
+  ShadowSettings settings{};
+};
+
 class ShadowPass {
  public:
   static Result<std::unique_ptr<ShadowPass>> create(Context& context, const ShadowPassDesc& desc = {});
@@ -89,10 +102,8 @@ class ShadowPass {
   // the frames already recorded.
   ~ShadowPass();
 
-  // Records the shadow rays. `tlas` comes from recordTlasBuild() earlier in submission order (ideally with
-  // originOffset = the camera position); the G-buffer images must be in their declared layouts.
-  Status record(VkCommandBuffer cmd, const GBufferDesc& gbuffer, const TlasInfo& tlas, const Light& light,
-                const ShadowSettings& settings = {});
+  // Records the shadow rays of `frame` into `cmd`. On an error (named field) nothing is recorded.
+  Status record(VkCommandBuffer cmd, const ShadowFrame& frame);
   // Creates the output images at width x height now, so that outputs() names them before the first record()
   // (HybridEffects hands out views that stay valid this way); record() at the same size keeps them, at another
   // size it recreates them. Written by the first record().

@@ -52,6 +52,25 @@ struct Context::Impl {
   }
   int32_t findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
   const VkAllocationCallbacks* allocator() const { return desc.allocationCallbacks; }
+
+  // Signals that hold kept-history marks this frame: a pass that skipped converged tiles wrote them into its output
+  // (converged_tiles.cpp), and the Denoiser that filters that view reads them as "no new frame"
+  // (RB_DN_KEPT_MARKS). Keyed by the view, not by a denoiser, so no object reaches into another.
+  void markKeptHistory(VkImageView signal) {
+    std::erase_if(keptMarkSignals, [&](const KeptMarks& k) { return k.frame != frame || k.signal == signal; });
+    keptMarkSignals.push_back({signal, frame});
+  }
+  bool holdsKeptMarks(VkImageView signal) const {
+    for (const KeptMarks& k : keptMarkSignals) {
+      if (k.signal == signal && k.frame == frame) return true;
+    }
+    return false;
+  }
+  struct KeptMarks {
+    VkImageView signal;
+    uint64_t frame;
+  };
+  std::vector<KeptMarks> keptMarkSignals;
 };
 
 }  // namespace rb

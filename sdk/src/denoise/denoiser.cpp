@@ -10,6 +10,7 @@
 #include "denoiser_history.h"
 #include "gbuffer_sampler.h"
 #include "image_barriers.h"
+#include "initial_extent.h"
 #include "pass_constants.h"
 #include "pass_images.h"
 #include "pass_metrics.h"
@@ -73,9 +74,6 @@ struct Denoiser::Impl {
   // The images hold what a record() wrote, in the layouts it left them in (false from their creation until then:
   // adaptive rays read the history only when it is true).
   bool imagesWritten = false;
-  // The frame whose signal holds kept-history marks (internal::expectKeptMarks); set through a const Denoiser by
-  // the shadow pass that reads its history.
-  mutable uint64_t keptMarksFrame = UINT64_MAX;
   double previousViewProjection[16] = {};
   double previousCamera[3] = {};
   explicit Impl(Context& c) : ctx(c) {}
@@ -141,8 +139,6 @@ Status ensureImages(Denoiser::Impl& s, uint32_t width, uint32_t height) {
 Denoiser::Denoiser(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Denoiser::~Denoiser() = default;
 
-Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context) { return create(context, DenoiserDesc{}); }
-
 Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const DenoiserDesc& desc) {
   if (desc.signal != DenoiseSignal::Scalar && desc.signal != DenoiseSignal::Rgb &&
       desc.signal != DenoiseSignal::Reflection) {
@@ -207,7 +203,11 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
   if (!s) return s.error();
   impl->sampler = s.value();
   if (Status st = impl->metrics.init(context, "denoiser", /*countsRays=*/false); !st) return st.error();
-  return std::unique_ptr<Denoiser>(new Denoiser(std::move(impl)));
+  std::unique_ptr<Denoiser> denoiser(new Denoiser(std::move(impl)));
+  if (Status st = internal::prepareAtCreation(*denoiser, desc.width, desc.height, "DenoiserDesc"); !st) {
+    return st.error();
+  }
+  return denoiser;
 }
 
 Status Denoiser::prepare(uint32_t width, uint32_t height) {
@@ -436,12 +436,15 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
 // The constants every dispatch of a frame shares: the G-buffer's camera and layout (checked as the ray tracing
 // passes check them), and the reprojection from last frame's camera (previousViewProjection, cameraDelta). Also
 // returns this frame's camera position and rotation-only view-projection, which record() keeps for next frame.
-Status prepareConstants(const Denoiser::Impl& s, const GBufferDesc& g, const char* who, DenoiseConstants& pc,
-                        uint32_t& flags, double camera[3], double viewProjection[16]) {
+// The temporal pass's constants for `g`, reprojecting from the camera (`previousCamera`, `previousViewProjection`)
+// of the frame the history was written in; `camera` and `viewProjection` receive this frame's, kept for the next.
+Status prepareConstants(const GBufferDesc& g, uint64_t frame, const double previousCamera[3],
+                        const double previousViewProjection[16], const char* who, DenoiseConstants& pc, uint32_t& flags,
+                        double camera[3], double viewProjection[16]) {
   GBufferConstants pass{};
   TlasInfo noTlas;
   noTlas.tlas = reinterpret_cast<VkAccelerationStructureKHR>(uintptr_t(1));  // fillGBufferConstants wants one
-  if (Status st = fillGBufferConstants(g, noTlas, s.ctx.frameIndex(), who, pass); !st) return st;
+  if (Status st = fillGBufferConstants(g, noTlas, frame, who, pass); !st) return st;
   std::memcpy(pc.inverseProjection, pass.inverseProjection, sizeof pc.inverseProjection);
   std::memcpy(pc.viewToWorld, pass.viewToWorld, sizeof pc.viewToWorld);
   pc.wAtDepthOne = pass.wAtDepthOne;
@@ -460,19 +463,21 @@ Status prepareConstants(const Denoiser::Impl& s, const GBufferDesc& g, const cha
   }
   viewRot[15] = 1.0;
   multiply(proj, viewRot, viewProjection);
-  for (int i = 0; i < 16; ++i) pc.previousViewProjection[i] = static_cast<float>(s.previousViewProjection[i]);
-  for (int i = 0; i < 3; ++i) pc.cameraDelta[i] = static_cast<float>(camera[i] - s.previousCamera[i]);
+  for (int i = 0; i < 16; ++i) pc.previousViewProjection[i] = static_cast<float>(previousViewProjection[i]);
+  for (int i = 0; i < 3; ++i) pc.cameraDelta[i] = static_cast<float>(camera[i] - previousCamera[i]);
   return {};
 }
 
 }  // namespace
 
-Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
-                        const DenoiseSettings& settings) {
+Status Denoiser::record(VkCommandBuffer cmd, const DenoiseFrame& frame) {
+  const GBufferDesc& g = frame.gbuffer;
+  const VkImageView signal = frame.signal;
+  const DenoiseSettings& settings = frame.settings;
   Impl& s = *impl_;
   auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "Denoiser: " + m}; };
   if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
-  if (!signal) return invalid("signal is VK_NULL_HANDLE; pass the noisy image's view");
+  if (!signal) return invalid("DenoiseFrame::signal is VK_NULL_HANDLE; pass the noisy image's view");
   if (settings.spatialIterations > 6) return invalid("DenoiseSettings::spatialIterations exceeds 6");
   if (settings.disableTemporal && settings.disableSpatial) {
     return invalid("both temporal and spatial filtering are disabled; use the raw signal instead");
@@ -480,7 +485,11 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   DenoiseConstants pc{};
   uint32_t flags = 0;
   double camera[3], viewProjection[16];
-  if (Status st = prepareConstants(s, g, "Denoiser", pc, flags, camera, viewProjection); !st) return st;
+  if (Status st = prepareConstants(g, s.ctx.frameIndex(), s.previousCamera, s.previousViewProjection, "Denoiser", pc,
+                                   flags, camera, viewProjection);
+      !st) {
+    return st;
+  }
   pc.depthSigma = settings.depthSigma > 0.0f ? settings.depthSigma : 0.005f;
   pc.normalPower = settings.normalPower > 0.0f ? settings.normalPower : 32.0f;
   pc.signalRaysPerPixel = float(settings.raysPerPixel);
@@ -492,7 +501,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
     }
     flags |= RB_DN_RGB_REFLECTION | (roughnessInImage(g) ? RB_DN_RGB_ROUGHNESS_IMAGE : 0u);
   }
-  if (s.keptMarksFrame == s.ctx.frameIndex()) flags |= RB_DN_KEPT_MARKS;
+  if (internal::contextImpl(s.ctx).holdsKeptMarks(signal)) flags |= RB_DN_KEPT_MARKS;
   if (s.signal != DenoiseSignal::Scalar) {
     Status st = recordRgb(s, cmd, g, signal, settings, pc, flags);
     if (st) {
@@ -510,35 +519,43 @@ Status Denoiser::record(VkCommandBuffer cmd, const GBufferDesc& g, VkImageView s
   return st;
 }
 
-namespace internal {
-
-DenoiserHistory latestHistory(const Denoiser& denoiser, const GBufferDesc& g) {
-  const Denoiser::Impl& s = DenoiserAccess::impl(denoiser);
-  DenoiserHistory h;
+DenoiseHistory Denoiser::history() const {
+  const Impl& s = *impl_;
+  DenoiseHistory h;
   // Scalar images: 0,1 the history ping-pong, 2,3 the distances; RGB: 0,1 the colour history, 2,3 the surface
   // (distance, variance). The latest record() wrote 1 - parity.
-  if (!s.imagesWritten || s.images.size() < 5 || s.images[0].width != g.width || s.images[0].height != g.height) {
-    return h;
-  }
+  if (!s.imagesWritten || s.images.size() < 5) return h;
   const uint32_t last = 1 - s.parity;
   h.mean = s.images[last].view;
   h.distance = s.images[2 + last].view;
   h.noise = s.signal == DenoiseSignal::Scalar ? s.images[4].view : VK_NULL_HANDLE;
   h.sampler = s.sampler;
+  h.width = s.images[0].width;
+  h.height = s.images[0].height;
   h.valid = s.historyValid;
+  std::memcpy(h.cameraPosition, s.previousCamera, sizeof h.cameraPosition);
+  std::memcpy(h.viewProjection, s.previousViewProjection, sizeof h.viewProjection);
   return h;
 }
 
-void expectKeptMarks(const Denoiser& denoiser, uint64_t frame) {
-  DenoiserAccess::impl(denoiser).keptMarksFrame = frame;
+namespace internal {
+
+DenoiseHistory historyFor(const Denoiser& denoiser, const GBufferDesc& g) {
+  DenoiseHistory h = denoiser.history();
+  if (h.width != g.width || h.height != g.height) return {};
+  return h;
 }
 
-Status historyReprojection(const Denoiser& denoiser, const GBufferDesc& g, const char* who, DenoiseConstants& pc) {
-  const Denoiser::Impl& s = DenoiserAccess::impl(denoiser);
+Status historyReprojection(const DenoiseHistory& history, const GBufferDesc& g, uint64_t frame, const char* who,
+                           DenoiseConstants& pc) {
   uint32_t flags = 0;
   double camera[3], viewProjection[16];
-  if (Status st = prepareConstants(s, g, who, pc, flags, camera, viewProjection); !st) return st;
-  pc.flags = flags | (s.historyValid ? RB_DN_HISTORY : 0u);
+  if (Status st = prepareConstants(g, frame, history.cameraPosition, history.viewProjection, who, pc, flags, camera,
+                                   viewProjection);
+      !st) {
+    return st;
+  }
+  pc.flags = flags | (history.valid ? RB_DN_HISTORY : 0u);
   return {};
 }
 

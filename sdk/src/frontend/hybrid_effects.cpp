@@ -381,7 +381,8 @@ struct HybridEffects::Impl {
     if (!slot) return {};
     DenoiseSettings d = desc.denoiser;
     d.raysPerPixel = kind == DenoiseSignal::Scalar ? rays : 0u;
-    if (Status st = slot->record(cmd, gbuffer, signal, d); !st) return wrap(what, st.error());
+    if (Status st = slot->record(cmd, {.gbuffer = gbuffer, .signal = signal, .settings = d}); !st)
+      return wrap(what, st.error());
     return {};
   }
 
@@ -399,7 +400,9 @@ Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridF
   s.materials = materials.get();
   s.schedule = effectSchedule(desc.localLights.schedule, localLightDenoiser.get());
   if (Status st = lightList->record(cmd, tlas, f.localLights); !st) return wrap("HybridFrame::localLights", st.error());
-  if (Status st = localLights->record(cmd, f.gbuffer, tlas, *lightList, s); !st)
+  if (Status st =
+          localLights->record(cmd, {.gbuffer = f.gbuffer, .tlas = tlas, .lightList = lightList.get(), .settings = s});
+      !st)
     return wrap("ManyLightPass::record", st.error());
   const ManyLightOutputs& o = localLights->outputs();
   return denoise(localLightDenoiser, localLightsDenoised(), "Denoiser (local lights)", cmd, f.gbuffer, o.irradianceView,
@@ -413,7 +416,7 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   s.materials = materials.get();  // alpha tests non-opaque geometry
   // Adaptive rays and converged tiles: only for soft shadows, whose denoiser runs after the pass this frame.
   s.schedule = effectSchedule(desc.shadows.schedule, shadowDenoiser.get(), plan.soft);
-  if (Status st = shadow->record(cmd, f.gbuffer, tlas, plan.light, s); !st)
+  if (Status st = shadow->record(cmd, {.gbuffer = f.gbuffer, .tlas = tlas, .light = plan.light, .settings = s}); !st)
     return wrap("ShadowPass::record", st.error());
   const ShadowOutputs& o = shadow->outputs();
   // The visibility is a fraction of plan.rays binary rays; with adaptive rays the count varies per pixel, so the
@@ -429,7 +432,8 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   s.range = desc.ao.range;
   s.estimator = desc.ao.estimator;
   s.schedule = effectSchedule(desc.ao.schedule, aoDenoiser.get());
-  if (Status st = ao->record(cmd, f.gbuffer, tlas, s); !st) return wrap("AoPass::record", st.error());
+  if (Status st = ao->record(cmd, {.gbuffer = f.gbuffer, .tlas = tlas, .settings = s}); !st)
+    return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
   // Binary AO is a fraction of binary rays; distance-weighted AO is not, nor is adaptive AO (the count varies per
   // pixel), so their noise is estimated.
@@ -449,7 +453,8 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.lighting = reflectionLighting(f);
   if (lightList && !f.localLights.empty()) s.lights = lightList.get();  // recorded earlier this frame
   const GBufferDesc& g = f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer;
-  if (Status st = reflection->record(cmd, g, tlas, s); !st) return wrap("ReflectionPass::record", st.error());
+  if (Status st = reflection->record(cmd, {.gbuffer = g, .tlas = tlas, .settings = s}); !st)
+    return wrap("ReflectionPass::record", st.error());
   const ReflectionOutputs& o = reflection->outputs();
   // Guided by the roughness of the G-buffer the rays were traced from.
   return denoise(reflectionDenoiser, !desc.reflections.disableDenoiser, "Denoiser (reflections)", cmd, g,

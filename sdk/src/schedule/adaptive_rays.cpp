@@ -95,10 +95,10 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
                      std::to_string(ctx.deviceInfo().timestampValidBits) +
                      "): set timeBudgetMs = 0 and cap the rays with maxRaysPerFrame"};
   }
-  const internal::DenoiserHistory history = internal::latestHistory(*denoiser, g);
+  const DenoiseHistory history = internal::historyFor(*denoiser, g);
   if (!history.mean) return false;
   DenoiseConstants dn{};
-  if (Status st = internal::historyReprojection(*denoiser, g, who, dn); !st) return st.error();
+  if (Status st = internal::historyReprojection(history, g, ctx.frameIndex(), who, dn); !st) return st.error();
   if (Status st = init(ctx, s.granularity); !st) return st.error();
   if (Status st = images_.ensure(ctx, g.width, g.height,
                                  {{VK_FORMAT_R16G16_SFLOAT, "adaptive ray weights"},

@@ -58,10 +58,12 @@ Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBu
                                     const ConvergedTileSettings& s, const Denoiser* denoiser, uint32_t raysPerPixel,
                                     TileClassifier& classifier, VkImageView visibility, const char* who,
                                     float roughnessThreshold, VkDescriptorBufferInfo counters) {
-  const internal::DenoiserHistory history = internal::latestHistory(*denoiser, g);
+  const DenoiseHistory history = internal::historyFor(*denoiser, g);
   if (!history.mean || !history.valid) return false;
   ConvergedTileConstants pc{};
-  if (Status st = internal::historyReprojection(*denoiser, g, who, pc.denoise); !st) return st.error();
+  if (Status st = internal::historyReprojection(history, g, ctx.frameIndex(), who, pc.denoise); !st) {
+    return st.error();
+  }
   if (Status st = init(ctx, who); !st) return st.error();
   pc.denoise.signalRaysPerPixel = float(raysPerPixel);
   if (signal_ == DenoiseSignal::Reflection) {
@@ -102,7 +104,8 @@ Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBu
   // or for an RGB signal the ray generation shader (which reads the state and writes the traced tiles).
   recordMemoryBarrier(vk, cmd, cs, VK_ACCESS_SHADER_WRITE_BIT,
                       signal_ != DenoiseSignal::Scalar ? cs | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR : cs, rw);
-  internal::expectKeptMarks(*denoiser, ctx.frameIndex());
+  // The pass's output now holds kept-history marks: the denoiser that filters it this frame reads them as such.
+  internal::contextImpl(ctx).markKeptHistory(visibility);
   return true;
 }
 

@@ -64,7 +64,7 @@ class ConvergedTiles {
   DenoiseSignal signal_;
   ComputePipeline mark_, check_;
   ConvergedTileConstants constants_{};
-  internal::DenoiserHistory history_;
+  DenoiseHistory history_;
   uint32_t recordings_ = 0;  // record()s that found history: the refresh rotation
 };
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "context_impl.h"
+#include "initial_extent.h"
 #include "pass_core.h"
 #include "ray_schedule_stage.h"
 #include "raybridge_shaders.h"
@@ -89,15 +90,20 @@ Status AoPass::prepare(uint32_t width, uint32_t height) {
 AoPass::AoPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 AoPass::~AoPass() = default;
 
-Result<std::unique_ptr<AoPass>> AoPass::create(Context& context) {
+Result<std::unique_ptr<AoPass>> AoPass::create(Context& context, const AoPassDesc& desc) {
   auto impl = std::make_unique<Impl>(context);
   if (Status s = impl->core.init(context, aoPipelineDesc(0), SpirvModule::of(spirv::ao_rahit)); !s) {
     return s.error();
   }
-  return std::unique_ptr<AoPass>(new AoPass(std::move(impl)));
+  std::unique_ptr<AoPass> pass(new AoPass(std::move(impl)));
+  if (Status s = internal::prepareAtCreation(*pass, desc.width, desc.height, "AoPassDesc"); !s) return s.error();
+  return pass;
 }
 
-Status AoPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const AoSettings& settings) {
+Status AoPass::record(VkCommandBuffer cmd, const AoFrame& input) {
+  const GBufferDesc& g = input.gbuffer;
+  const TlasInfo& tlas = input.tlas;
+  const AoSettings& settings = input.settings;
   Impl& s = *impl_;
   auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "AoPass: " + m}; };
   if (!cmd) return invalid("cmd is VK_NULL_HANDLE");

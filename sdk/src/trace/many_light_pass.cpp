@@ -7,6 +7,7 @@
 
 #include "compute_pipeline.h"
 #include "context_impl.h"
+#include "initial_extent.h"
 #include "light_list_buffer.h"
 #include "memory_barrier.h"
 #include "pass_core.h"
@@ -84,7 +85,7 @@ Status ManyLightPass::prepare(uint32_t width, uint32_t height) {
 ManyLightPass::ManyLightPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 ManyLightPass::~ManyLightPass() = default;
 
-Result<std::unique_ptr<ManyLightPass>> ManyLightPass::create(Context& context) {
+Result<std::unique_ptr<ManyLightPass>> ManyLightPass::create(Context& context, const ManyLightPassDesc& desc) {
   auto impl = std::make_unique<Impl>(context);
   RayTracingPipelineDesc p;
   p.name = "many-light pass";
@@ -127,7 +128,11 @@ Result<std::unique_ptr<ManyLightPass>> ManyLightPass::create(Context& context) {
                               sizeof(ManyLightConstants), "many-light tile culling");
   if (!cull) return cull.error();
   impl->cull = cull.value();
-  return std::unique_ptr<ManyLightPass>(new ManyLightPass(std::move(impl)));
+  std::unique_ptr<ManyLightPass> pass(new ManyLightPass(std::move(impl)));
+  if (Status s = internal::prepareAtCreation(*pass, desc.width, desc.height, "ManyLightPassDesc"); !s) {
+    return s.error();
+  }
+  return pass;
 }
 
 namespace {
@@ -154,7 +159,7 @@ Status validateSettings(const ManyLightSettings& settings) {
   return {};
 }
 
-// The checks both record()s make before their lights: the command buffer, the settings, the G-buffer (into `pc`).
+// The checks record() makes before it reads the lights: the command buffer, the settings, the G-buffer (into `pc`).
 Status checkRecord(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const ManyLightSettings& settings,
                    uint64_t frameIndex, ManyLightConstants& pc) {
   if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: cmd is VK_NULL_HANDLE"};
@@ -164,23 +169,26 @@ Status checkRecord(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tl
 
 }  // namespace
 
-Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,
-                             std::span<const LightSource> lightList, const ManyLightSettings& settings) {
+Status ManyLightPass::record(VkCommandBuffer cmd, const ManyLightFrame& frame) {
   Impl& s = *impl_;
+  const GBufferDesc& g = frame.gbuffer;
+  const TlasInfo& tlas = frame.tlas;
+  if (frame.lightList && !frame.lights.empty()) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "ManyLightPass: ManyLightFrame has both lightList and " + std::to_string(frame.lights.size()) +
+                     " lights; give one of them (the list when reflections or primary shading read the same lights)"};
+  }
   ManyLightConstants pc{};
-  if (Status st = checkRecord(cmd, g, tlas, settings, s.ctx.frameIndex(), pc); !st) return st;
-  if (Status st = s.ownLights.stage(s.ctx, lightList, tlas, "ManyLightPass: "); !st) return st;
-  return s.trace(cmd, g, tlas, settings, pc, nullptr);
-}
-
-Status ManyLightPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const LightList& lights,
-                             const ManyLightSettings& settings) {
-  Impl& s = *impl_;
-  ManyLightConstants pc{};
-  if (Status st = checkRecord(cmd, g, tlas, settings, s.ctx.frameIndex(), pc); !st) return st;
-  Result<LightListInfo> list = readLightList(lights, tlas, s.ctx.frameIndex(), "ManyLightPass: lights");
+  if (Status st = checkRecord(cmd, g, tlas, frame.settings, s.ctx.frameIndex(), pc); !st) return st;
+  if (!frame.lightList) {
+    // The lights as an array (or none): uploaded into the pass's own list, inside its time.
+    if (Status st = s.ownLights.stage(s.ctx, frame.lights, tlas, "ManyLightPass: "); !st) return st;
+    return s.trace(cmd, g, tlas, frame.settings, pc, nullptr);
+  }
+  Result<LightListInfo> list = readLightList(*frame.lightList, tlas, s.ctx.frameIndex(),
+                                             "ManyLightPass: ManyLightFrame::lightList");
   if (!list) return list.error();
-  return s.trace(cmd, g, tlas, settings, pc, &list.value());
+  return s.trace(cmd, g, tlas, frame.settings, pc, &list.value());
 }
 
 Status ManyLightPass::Impl::trace(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,

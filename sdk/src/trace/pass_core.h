@@ -31,6 +31,8 @@ struct PassCore {
   // (shading records, materials, texture set); `recordStages` are the stages besides any-hit that read them.
   Status init(Context& ctx, RayTracingPipelineDesc desc, SpirvModule alphaAnyHit = {},
               VkShaderStageFlags recordStages = 0);
+  // Whether init() was given an any-hit shader (the material bindings exist, writeMaterials() fills them).
+  bool alphaTested() const { return textureLayout != VK_NULL_HANDLE; }
   // Another pipeline of the pass with the same alpha testing (a variant of its ray generation module, e.g. with
   // adaptive rays), sharing this core's texture set layout, images and measurements. The caller retires it.
   Result<RayTracingPipeline> createVariant(Context& ctx, RayTracingPipelineDesc desc, SpirvModule alphaAnyHit = {},

@@ -76,7 +76,7 @@ struct PrimaryRayPass::Impl {
 PrimaryRayPass::PrimaryRayPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 PrimaryRayPass::~PrimaryRayPass() = default;
 
-Result<std::unique_ptr<PrimaryRayPass>> PrimaryRayPass::create(Context& context) {
+Result<std::unique_ptr<PrimaryRayPass>> PrimaryRayPass::create(Context& context, const PrimaryRayPassDesc& passDesc) {
   RayTracingPipelineDesc desc;
   desc.name = "primary ray pass";
   desc.raygen = SpirvModule::of(spirv::primary_rgen);
@@ -91,12 +91,17 @@ Result<std::unique_ptr<PrimaryRayPass>> PrimaryRayPass::create(Context& context)
   };
   desc.pushConstantBytes = sizeof(PrimaryConstants);
   auto impl = std::make_unique<Impl>(context);
-  if (Status s = impl->core.init(context, desc, SpirvModule::of(spirv::primary_rahit)); !s) return s.error();
+  // Opaque only: no any-hit shader, so PassCore adds neither the material bindings nor its fallback table.
+  const SpirvModule alphaTest = passDesc.opaqueOnly ? SpirvModule{} : SpirvModule::of(spirv::primary_rahit);
+  if (Status s = impl->core.init(context, desc, alphaTest); !s) return s.error();
   return std::unique_ptr<PrimaryRayPass>(new PrimaryRayPass(std::move(impl)));
 }
 
-Status PrimaryRayPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, const PrimaryRayCamera& worldCamera,
-                              const PrimaryRayTargets& targets, const PrimaryRaySettings& settings) {
+Status PrimaryRayPass::record(VkCommandBuffer cmd, const PrimaryRayFrame& frame) {
+  const TlasInfo& tlas = frame.tlas;
+  const PrimaryRayCamera& worldCamera = frame.camera;
+  const PrimaryRayTargets& targets = frame.targets;
+  const PrimaryRaySettings& settings = frame.settings;
   auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, m}; };
   if (!cmd) return invalid("PrimaryRayPass::record: cmd is VK_NULL_HANDLE");
   if (!tlas.tlas) return invalid("PrimaryRayPass::record: tlas is VK_NULL_HANDLE; build one with recordTlasBuild()");
@@ -124,7 +129,12 @@ Status PrimaryRayPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, const P
   pc.frameIndex = uint32_t(impl_->ctx.frameIndex());
   Impl& s = *impl_;
   DescriptorWrites w;
-  if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "PrimaryRayPass", pc.flags); !st) return st;
+  if (s.core.alphaTested()) {
+    if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "PrimaryRayPass", pc.flags); !st) return st;
+  } else if (settings.materials) {
+    return invalid("PrimaryRayPass::record: PrimaryRaySettings::materials is set, but the pass was created with "
+                   "PrimaryRayPassDesc::opaqueOnly (no alpha test); create it without opaqueOnly to alpha-test");
+  }
   w.accelerationStructure(RB_PRIMARY_BINDING_TLAS, tlas.tlas);
   w.storageImage(RB_PRIMARY_BINDING_HIT_DISTANCE, targets.hitDistance);
   w.storageImage(RB_PRIMARY_BINDING_HIT_IDS, targets.hitIds);

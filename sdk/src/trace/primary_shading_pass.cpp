@@ -4,6 +4,7 @@
 #include <string>
 
 #include "context_impl.h"
+#include "initial_extent.h"
 #include "light_list_buffer.h"
 #include "material_table_impl.h"
 #include "pass_core.h"
@@ -20,10 +21,23 @@ struct PrimaryShadingPass::Impl {
   ~Impl() { core.retire(ctx); }  // frames in flight may still trace with it
 };
 
+namespace {
+
+// The pass's own images: the radiance unless the caller writes it into its own image, and the distance.
+std::vector<PassImages::Spec> ownImages(bool callerRadiance) {
+  std::vector<PassImages::Spec> specs;
+  if (!callerRadiance) specs.push_back({VK_FORMAT_R16G16B16A16_SFLOAT, "primary shading radiance"});
+  specs.push_back({VK_FORMAT_R32_SFLOAT, "primary shading distance"});
+  return specs;
+}
+
+}  // namespace
+
 PrimaryShadingPass::PrimaryShadingPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 PrimaryShadingPass::~PrimaryShadingPass() = default;
 
-Result<std::unique_ptr<PrimaryShadingPass>> PrimaryShadingPass::create(Context& context) {
+Result<std::unique_ptr<PrimaryShadingPass>> PrimaryShadingPass::create(Context& context,
+                                                                       const PrimaryShadingPassDesc& desc) {
   Context::Impl& c = internal::contextImpl(context);
   if (c.info.maxRayRecursionDepth < 2) {
     return Error{ErrorCode::MissingFeature, VK_SUCCESS,
@@ -50,11 +64,32 @@ Result<std::unique_ptr<PrimaryShadingPass>> PrimaryShadingPass::create(Context& 
   auto impl = std::make_unique<Impl>(context);
   // Shading records and materials: read by the hits (shading) and the any-hits (alpha).
   if (Status s = impl->core.init(context, p, SpirvModule::of(spirv::primary_shading_rahit), hit); !s) return s.error();
-  return std::unique_ptr<PrimaryShadingPass>(new PrimaryShadingPass(std::move(impl)));
+  std::unique_ptr<PrimaryShadingPass> pass(new PrimaryShadingPass(std::move(impl)));
+  if (Status s = internal::prepareAtCreation(*pass, desc.width, desc.height, "PrimaryShadingPassDesc"); !s) {
+    return s.error();
+  }
+  return pass;
 }
 
-Status PrimaryShadingPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, const PrimaryRayCamera& worldCamera,
-                                  const PrimaryShadingTargets& targets, const PrimaryShadingSettings& settings) {
+Status PrimaryShadingPass::prepare(uint32_t width, uint32_t height) {
+  Impl& s = *impl_;
+  if (Status st = s.core.prepare(s.ctx, width, height, ownImages(false), "PrimaryShadingPass"); !st) return st;
+  PrimaryShadingOutputs& o = s.outputs;
+  o = {};
+  o.radiance = s.core.images[0].image;
+  o.radianceView = s.core.images[0].view;
+  o.distance = s.core.images[1].image;
+  o.distanceView = s.core.images[1].view;
+  o.width = width;
+  o.height = height;
+  return {};
+}
+
+Status PrimaryShadingPass::record(VkCommandBuffer cmd, const PrimaryShadingFrame& frame) {
+  const TlasInfo& tlas = frame.tlas;
+  const PrimaryRayCamera& worldCamera = frame.camera;
+  const PrimaryShadingTargets& targets = frame.targets;
+  const PrimaryShadingSettings& settings = frame.settings;
   Impl& s = *impl_;
   auto invalid = [](const std::string& m) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "PrimaryShadingPass: " + m};
@@ -106,9 +141,7 @@ Status PrimaryShadingPass::record(VkCommandBuffer cmd, const TlasInfo& tlas, con
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "PrimaryShadingPass", pc.camera.flags); !st)
     return st;
-  std::vector<PassImages::Spec> specs;
-  if (!targets.radiance) specs.push_back({VK_FORMAT_R16G16B16A16_SFLOAT, "primary shading radiance"});
-  specs.push_back({VK_FORMAT_R32_SFLOAT, "primary shading distance"});
+  const std::vector<PassImages::Spec> specs = ownImages(targets.radiance != VK_NULL_HANDLE);
   GBufferDesc size;  // only the launch and image size
   size.width = targets.width;
   size.height = targets.height;

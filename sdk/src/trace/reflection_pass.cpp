@@ -5,6 +5,7 @@
 #include <string>
 
 #include "context_impl.h"
+#include "initial_extent.h"
 #include "light_list_buffer.h"
 #include "material_table_impl.h"
 #include "pass_core.h"
@@ -104,7 +105,7 @@ Status ReflectionPass::prepare(uint32_t width, uint32_t height) {
 ReflectionPass::ReflectionPass(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 ReflectionPass::~ReflectionPass() = default;
 
-Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context) {
+Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context, const ReflectionPassDesc& desc) {
   Context::Impl& c = internal::contextImpl(context);
   if (c.info.maxRayRecursionDepth < 2) {
     return Error{ErrorCode::MissingFeature, VK_SUCCESS,
@@ -122,7 +123,11 @@ Result<std::unique_ptr<ReflectionPass>> ReflectionPass::create(Context& context)
     if (Status s = impl->schedule.ensureVariant(context, impl->core, kVariantReorder); !s) return s.error();
   }
   // The own table holds one white material until the engine gives its own.
-  return std::unique_ptr<ReflectionPass>(new ReflectionPass(std::move(impl)));
+  std::unique_ptr<ReflectionPass> pass(new ReflectionPass(std::move(impl)));
+  if (Status s = internal::prepareAtCreation(*pass, desc.width, desc.height, "ReflectionPassDesc"); !s) {
+    return s.error();
+  }
+  return pass;
 }
 
 Status ReflectionPass::setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures) {
@@ -132,8 +137,10 @@ Status ReflectionPass::setMaterials(std::span<const Material> materials, std::sp
   return {};
 }
 
-Status ReflectionPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,
-                              const ReflectionSettings& settings) {
+Status ReflectionPass::record(VkCommandBuffer cmd, const ReflectionFrame& input) {
+  const GBufferDesc& g = input.gbuffer;
+  const TlasInfo& tlas = input.tlas;
+  const ReflectionSettings& settings = input.settings;
   Impl& s = *impl_;
   auto invalid = [](const std::string& m) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ReflectionPass: " + m};

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "context_impl.h"
+#include "initial_extent.h"
 #include "light_validation.h"
 #include "pass_core.h"
 #include "ray_schedule_stage.h"
@@ -100,11 +101,16 @@ Result<std::unique_ptr<ShadowPass>> ShadowPass::create(Context& context, const S
   e.classifierName = "shadow tile classifier";
   impl->schedule = std::make_unique<ScheduleStage>(std::move(e));
   if (Status s = impl->schedule->init(context); !s) return s.error();
-  return std::unique_ptr<ShadowPass>(new ShadowPass(std::move(impl)));
+  std::unique_ptr<ShadowPass> pass(new ShadowPass(std::move(impl)));
+  if (Status s = internal::prepareAtCreation(*pass, desc.width, desc.height, "ShadowPassDesc"); !s) return s.error();
+  return pass;
 }
 
-Status ShadowPass::record(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const Light& light,
-                          const ShadowSettings& settings) {
+Status ShadowPass::record(VkCommandBuffer cmd, const ShadowFrame& input) {
+  const GBufferDesc& g = input.gbuffer;
+  const TlasInfo& tlas = input.tlas;
+  const Light& light = input.light;
+  const ShadowSettings& settings = input.settings;
   Impl& s = *impl_;
   auto invalid = [](const std::string& m) { return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ShadowPass: " + m}; };
   if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
