@@ -255,6 +255,8 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   g.depth = {info.depth.view, info.depth.layout}, g.depthFormat = info.depth.format;  // DEPTH_READ_ONLY_OPTIMAL
   g.depthConvention = info.reversedZ ? rb::DepthConvention::ReversedZ : rb::DepthConvention::Standard;
   g.geometricNormal = {info.geometricNormal.view, info.geometricNormal.layout};  // w = metallic, unused
+  // Pixels, current - previous: the denoisers follow moving and skinned objects, not only the camera.
+  g.motionVectors = {info.motionVectors.view, info.motionVectors.layout};
   std::memcpy(g.view, &info.view[0][0], sizeof(g.view));
   std::memcpy(g.projection, &info.proj[0][0], sizeof(g.projection));
   for (int i = 0; i < 3; ++i) g.cameraPosition[i] = info.cameraPositionD[i];  // camera-relative TLAS and rays

@@ -15,4 +15,8 @@ layout(push_constant) uniform DrawConstants {
   uint alphaMode;     // SE_ALPHA_*
   float alphaCutoff;  // SE_ALPHA_MASK: covered where alpha >= alphaCutoff
   uint instance;      // Scene::instances index: seeds the hashed shadow-map test of SE_ALPHA_BLEND draws
+  // Device address of last frame's model matrices (mat4 per Scene::instances entry, rebased to this frame's eye),
+  // read by mesh.vert for the pre-pass's motion vectors; (0, 0) = none (the probe capture, no bufferDeviceAddress):
+  // the instance is taken as still.
+  uvec2 previousModels;
 } draw;

@@ -24,6 +24,10 @@ layout(set = 2, binding = 4) uniform samplerCube probeCube;
 layout(set = 2, binding = 8) uniform sampler2D externalLocalIrradiance;
 
 layout(location = 0) out vec4 outColor;
+// mesh.vert's clip positions for the pre-pass's motion vectors: declared so that the shared vertex shader's outputs
+// have a consumer here too (the lighting pass does not read them).
+layout(location = 4) in vec4 inCurrentClip;
+layout(location = 5) in vec4 inPreviousClip;
 
 const float PI = 3.14159265358979;
 

@@ -19,4 +19,8 @@ layout(set = 0, binding = 0) uniform FrameUniforms {
   // x: KHR lights in the light buffer (0 = none: LocalLightSettings::enabled off, the probe capture),
   // y: 1 = LightingInputs::localLightIrradiance bound
   uvec4 localLights;
+  // Last frame's camera-relative position -> clip, rebased to this frame's eye (its projection * rotation *
+  // translation by eye - previous eye): with last frame's vertex positions and model matrices, where a surface
+  // point was on screen (the pre-pass's motion vectors). The probe capture: its viewProj.
+  mat4 previousViewProj;
 } frame;

@@ -1,5 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
 // Vertex shader shared by the pre-pass and the lighting pass: one module and identical vertex input
 // guarantee bit-identical depth, which the lighting pass's EQUAL depth test relies on. draw.model is rebased
 // to the eye on the host, so positions are camera-relative (world axes) and keep float precision far from
@@ -10,11 +12,20 @@ layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec2 inUv;
 layout(location = 3) in vec4 inTangent;
+// Last frame's position of this vertex, instance-local: the deformed buffer of the previous frame for a skinned or
+// morphed instance, else the same buffer as inPosition.
+layout(location = 4) in vec3 inPreviousPosition;
 
 layout(location = 0) out vec3 outEyeRelativePos;  // world position - eye
 layout(location = 1) out vec3 outNormal;
 layout(location = 2) out vec2 outUv;
 layout(location = 3) out vec4 outTangent;
+// This frame's and last frame's clip positions of the vertex, for the pre-pass's motion vectors (prepass.frag).
+// Both are computed by the same expression, so a still vertex gets bit-identical pairs and a motion of exactly 0.
+layout(location = 4) out vec4 outCurrentClip;
+layout(location = 5) out vec4 outPreviousClip;
+
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer PreviousModels { mat4 models[]; };
 
 invariant gl_Position;
 
@@ -25,4 +36,8 @@ void main() {
   outTangent = vec4(mat3(draw.model) * inTangent.xyz, inTangent.w);
   outUv = inUv;
   gl_Position = frame.viewProj * position;
+  mat4 previousModel = draw.model;
+  if (draw.previousModels != uvec2(0)) previousModel = PreviousModels(draw.previousModels).models[draw.instance];
+  outCurrentClip = frame.viewProj * (draw.model * vec4(inPosition, 1.0));
+  outPreviousClip = frame.previousViewProj * (previousModel * vec4(inPreviousPosition, 1.0));
 }

@@ -10,6 +10,8 @@ namespace sample_engine::detail {
 namespace {
 
 constexpr VkDeviceSize align16(VkDeviceSize v) { return (v + 15) / 16 * 16; }
+// Buffers per deforming instance: positions, attributes, last frame's positions.
+constexpr size_t kOutputsPerInstance = 3;
 
 // Byte layout of one mesh's static deformation data: joints, weights, morph deltas.
 struct SourceLayout {
@@ -139,6 +141,8 @@ void Deformer::unload() {
   }
   instances_.clear();
   outputs_.clear();
+  previousPositions_.clear();
+  hasPreviousFrame_ = false;
   sources_.clear();
   pendingWaits_.clear();
   jointBytes_ = weightBytes_ = 0;
@@ -167,7 +171,7 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
   const VkBufferUsageFlags tableUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   sources_.resize(s.meshes.size());
-  outputs_.resize(deforming.size() * 2);
+  outputs_.resize(deforming.size() * kOutputsPerInstance);
   std::vector<SourceLayout> layouts(s.meshes.size());
   std::vector<bool> needsSource(s.meshes.size(), false);
   for (uint32_t i : deforming) needsSource[s.instances[i].mesh] = true;
@@ -182,8 +186,13 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
   }
   for (size_t k = 0; k < deforming.size(); ++k) {
     const VkDeviceSize n = s.meshes[s.instances[deforming[k]].mesh].positions.size();
-    requests.push_back({n * 12, outputUsage, &outputs_[2 * k], families});
-    requests.push_back({n * 36, outputUsage, &outputs_[2 * k + 1], families});
+    requests.push_back({n * 12, outputUsage, &outputs_[kOutputsPerInstance * k], families});
+    requests.push_back({n * 36, outputUsage, &outputs_[kOutputsPerInstance * k + 1], families});
+    // Read by vertex input only, on the engine's queue.
+    requests.push_back({n * 12,
+                        VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                        &outputs_[kOutputsPerInstance * k + 2],
+                        {}});
   }
   std::vector<DeformJob> jobs(deforming.size());
   std::vector<uint32_t> groupJobs;
@@ -214,19 +223,15 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
     job.weights = job.influences ? src.address + l.weights : 0;
     job.targetCount = uint32_t(mesh.morphTargets.size());
     job.morphDeltas = job.targetCount ? src.address + l.morph : 0;
-    job.outPositions = outputs_[2 * k].address;
-    job.outAttributes = outputs_[2 * k + 1].address;
+    const Buffer* out = &outputs_[kOutputsPerInstance * k];
+    job.outPositions = out[0].address;
+    job.outAttributes = out[1].address;
     job.vertexCount = uint32_t(mesh.positions.size());
     job.jointOffset = job.influences ? pose.jointOffset(i) : 0;
     job.weightOffset = job.targetCount ? pose.weightOffset(i) : 0;
-    instances_[k] = {i,
-                     inst.mesh,
-                     outputs_[2 * k].buffer,
-                     outputs_[2 * k].address,
-                     outputs_[2 * k + 1].buffer,
-                     outputs_[2 * k + 1].address,
-                     job.vertexCount};
-    scene.instanceVertices[i] = {outputs_[2 * k].buffer, outputs_[2 * k + 1].buffer};
+    instances_[k] = {i, inst.mesh, out[0].buffer, out[0].address, out[1].buffer, out[1].address, job.vertexCount};
+    scene.instanceVertices[i] = {out[0].buffer, out[1].buffer, out[2].buffer};
+    previousPositions_.push_back(out[2].buffer);
   }
   Buffer staging;
   if (std::string e = gpu_->createBuffer(stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -258,12 +263,14 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
       vkCmdCopyBuffer(cmd, staging.buffer, c.dst, 1, &region);
     }
     // The deformed buffers start as the bind pose, so they are valid before the first frame.
-    for (const DeformedInstance& d : instances_) {
+    for (size_t k = 0; k < instances_.size(); ++k) {
+      const DeformedInstance& d = instances_[k];
       const MeshBuffers& b = scene.buffers[d.mesh];
       VkBufferCopy positions{0, 0, VkDeviceSize(d.vertexCount) * 12},
           attributes{0, 0, VkDeviceSize(d.vertexCount) * 36};
       vkCmdCopyBuffer(cmd, b.positions.buffer, d.positionBuffer, 1, &positions);
       vkCmdCopyBuffer(cmd, b.attributes.buffer, d.attributeBuffer, 1, &attributes);
+      vkCmdCopyBuffer(cmd, b.positions.buffer, previousPositions_[k], 1, &positions);
     }
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
@@ -303,8 +310,16 @@ std::string Deformer::submit(uint32_t slot, uint64_t value, const ScenePose& pos
   // The previous frame's passes (vertex input, and whatever the hook recorded, e.g. BLAS builds) are done
   // with the deformed buffers before they are overwritten.
   memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+                VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+                    VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  // Last frame's positions, kept for the pre-pass's motion vectors before the dispatch overwrites them.
+  for (size_t k = 0; k < instances_.size(); ++k) {
+    const VkBufferCopy region{0, 0, VkDeviceSize(instances_[k].vertexCount) * 12};
+    vkCmdCopyBuffer(cmd, instances_[k].positionBuffer, previousPositions_[k], 1, &region);
+  }
+  memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
+                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   DeformConstants c{};
   c.jobs = jobs_.address;
@@ -316,6 +331,16 @@ std::string Deformer::submit(uint32_t slot, uint64_t value, const ScenePose& pos
   c.groupsPerRow = std::min(groupCount_, maxX);
   vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(c), &c);
   vkCmdDispatch(cmd, c.groupsPerRow, (groupCount_ + c.groupsPerRow - 1) / c.groupsPerRow, 1);
+  if (!hasPreviousFrame_) {
+    // The first frame of the scene has no previous one: last frame's positions are this frame's (no motion).
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    for (size_t k = 0; k < instances_.size(); ++k) {
+      const VkBufferCopy region{0, 0, VkDeviceSize(instances_[k].vertexCount) * 12};
+      vkCmdCopyBuffer(cmd, instances_[k].positionBuffer, previousPositions_[k], 1, &region);
+    }
+    hasPreviousFrame_ = true;
+  }
   if (sl.timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, sl.timestamps, 1);
   SE_VK_TRY(vkEndCommandBuffer(cmd));
 

@@ -96,8 +96,12 @@ class Deformer {
 
   // Per scene.
   std::vector<DeformedInstance> instances_;
-  std::vector<Buffer> outputs_;  // positions, attributes per instance
-  std::vector<Buffer> sources_;  // skin + morph data per mesh (empty Buffer for meshes that do not deform)
+  // Per instance: positions, attributes, last frame's positions (copied from the positions before each dispatch
+  // overwrites them: the pre-pass's motion vectors).
+  std::vector<Buffer> outputs_;
+  std::vector<VkBuffer> previousPositions_;  // outputs_' third buffer of each instance, in instances_ order
+  bool hasPreviousFrame_ = false;            // a submit() since load(): previousPositions_ hold a frame's pose
+  std::vector<Buffer> sources_;              // skin + morph data per mesh (empty Buffer for meshes that do not deform)
   Buffer jobs_, groupJobs_;
   std::vector<VkDeviceMemory> blocks_;
   VkDeviceSize jointBytes_ = 0, weightBytes_ = 0;

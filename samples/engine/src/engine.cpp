@@ -101,6 +101,7 @@ Engine::Impl::~Impl() {
     for (FrameResources& f : frames) {
       if (f.timestamps) vkDestroyQueryPool(ctx.device, f.timestamps, nullptr);
       gpu.destroy(f.uniforms);
+      gpu.destroy(f.previousModels);
       if (f.imageAcquired) vkDestroySemaphore(ctx.device, f.imageAcquired, nullptr);
       if (f.fence) vkDestroyFence(ctx.device, f.fence, nullptr);
       if (f.pool) vkDestroyCommandPool(ctx.device, f.pool, nullptr);
@@ -170,6 +171,8 @@ Status Engine::loadScene(const Scene& scene) {
     if (impl_->sceneLoaded) destroyScene(impl_->gpu, impl_->scene);
     impl_->sceneLoaded = true;  // partially uploaded resources are destroyed like a full scene
     impl_->frameLights.clear();
+    impl_->previousTransforms.clear();  // the first frame of a new scene has no motion
+    impl_->hasPreviousCamera = false;
     std::string e = checkLights(scene).error;
     if (e.empty())
       e = uploadScene(impl_->gpu, impl_->ctx, impl_->pipelines, impl_->defaults, scene, impl_->pose, impl_->scene);
@@ -206,6 +209,8 @@ std::string Engine::Impl::createTargets(VkExtent2D extent) {
   if (e.empty())
     e = gpu.createImage({kNormalFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | readable},
                         targets.geometricNormal);
+  if (e.empty())
+    e = gpu.createImage({kMotionFormat, extent, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | readable}, targets.motionVectors);
   // Storage and transfer destination too: a hook supplying the frame's colour (FrameParams::externalColor) writes it.
   if (e.empty())
     e = gpu.createImage({kHdrFormat, extent,
@@ -230,8 +235,9 @@ std::string Engine::Impl::createShadowMap(uint32_t size) {
 }
 
 void Engine::Impl::destroyTargets() {
-  for (Image* i : {&targets.depth, &targets.normalRoughness, &targets.geometricNormal, &targets.hdr, &targets.ldr,
-                   &targets.ssaoRaw, &targets.ssao, &targets.shadowVisibility, &targets.localIrradiance})
+  for (Image* i :
+       {&targets.depth, &targets.normalRoughness, &targets.geometricNormal, &targets.motionVectors, &targets.hdr,
+        &targets.ldr, &targets.ssaoRaw, &targets.ssao, &targets.shadowVisibility, &targets.localIrradiance})
     gpu.destroy(*i);
   destroyOverlayFramebuffer();
   ssaoRendered = shadowVisibilityRendered = localIrradianceRendered = false;
@@ -467,6 +473,26 @@ Result<std::vector<glm::vec4>> Engine::readbackLocalLightIrradiance() {
     for (int c = 0; c < 4; ++c) {
       uint16_t h;
       std::memcpy(&h, &raw[i * 8 + size_t(c) * 2], 2);
+      out[i][c] = halfToFloat(h);
+    }
+  return R::success(std::move(out));
+}
+
+Result<std::vector<glm::vec2>> Engine::readbackMotionVectors() {
+  using R = Result<std::vector<glm::vec2>>;
+  if (Status s = waitIdle(); !s) return R::failure(s.error);
+  if (!impl_->frameRendered || !impl_->prepassRendered)
+    return R::failure("readbackMotionVectors: the last frame drew no pre-pass (FrameParams::externalColor); render "
+                      "one without it");
+  std::vector<uint8_t> raw;
+  if (std::string e = readImage(*impl_, impl_->targets.motionVectors, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 4, raw);
+      !e.empty())
+    return R::failure("readbackMotionVectors: " + e);
+  std::vector<glm::vec2> out(raw.size() / 4);
+  for (size_t i = 0; i < out.size(); ++i)
+    for (int c = 0; c < 2; ++c) {
+      uint16_t h;
+      std::memcpy(&h, &raw[i * 4 + size_t(c) * 2], 2);
       out[i][c] = halfToFloat(h);
     }
   return R::success(std::move(out));

@@ -39,6 +39,9 @@ struct FrameResources {
   VkFence fence = VK_NULL_HANDLE;  // signaled when the frame's GPU work is done
   VkSemaphore imageAcquired = VK_NULL_HANDLE;
   detail::Buffer uniforms;  // FrameUniforms, host visible
+  // Last frame's model matrices rebased to this frame's eye (DrawConstants::previousModels), host visible, one
+  // glm::mat4 per scene instance; grown on demand.
+  detail::Buffer previousModels;
   VkDescriptorSet frameSet = VK_NULL_HANDLE;
   VkDescriptorSet lightingSet = VK_NULL_HANDLE;
   VkDescriptorSet tonemapSet = VK_NULL_HANDLE;
@@ -60,7 +63,7 @@ struct FrameResources {
 // Images rewritten every frame. One set is enough for two frames in flight: the frames run in
 // submission order on one queue and each frame's first barrier waits for the previous frame's use.
 struct RenderTargets {
-  detail::Image depth, normalRoughness, geometricNormal, hdr, ldr;
+  detail::Image depth, normalRoughness, geometricNormal, motionVectors, hdr, ldr;
   // The sun's depth map, targets.shadowMapSize texels square; a 1x1 placeholder (never rendered, only bound)
   // while the shadow map is disabled.
   detail::Image shadowMap;
@@ -96,6 +99,12 @@ struct Engine::Impl {
   std::vector<VkSemaphoreSubmitInfo> submitWaits;  // the hook's additions to this frame's main submission
   std::vector<VkSemaphoreSubmitInfo> mainWaits;    // reused: all waits of the main submission
   bool sceneLoaded = false;
+  // What the last rendered frame drew, for this frame's motion vectors: its instance transforms and camera (eye,
+  // rotation-only view, projection). Empty / unset after loadScene() and before the first frame: no motion.
+  std::vector<glm::mat4> previousTransforms;
+  bool hasPreviousCamera = false;
+  glm::dvec3 previousEye{0.0};
+  glm::mat4 previousView{1.0f}, previousProj{1.0f};
   uint64_t sceneVersion = 0;  // bumped by loadScene (the reflection probe recaptures)
   detail::ReflectionProbe probe;
   VkDescriptorPool framePool = VK_NULL_HANDLE;
@@ -118,6 +127,7 @@ struct Engine::Impl {
   std::vector<FrameLight> frameLights;
   LocalShadowStats localShadowStats;
   bool localIrradianceRendered = false;  // the last submitted frame wrote targets.localIrradiance
+  bool prepassRendered = false;          // the last submitted frame drew the pre-pass (no external colour)
   uint64_t timingsFrameNumber = 0;
   // A submit or a fence wait returned VK_ERROR_DEVICE_LOST: every later frame, wait and readback fails at once.
   bool deviceLost = false;
@@ -135,6 +145,9 @@ struct Engine::Impl {
 
   // frame_recorder.cpp
   std::string renderFrame(const FrameParams& params);
+  // Fills frame.previousModels with last frame's instance transforms rebased to `eye` (this frame's where an
+  // instance has none: the first frame, a new scene) and points scene.previousModels at it.
+  std::string writePreviousModels(FrameResources& frame, const glm::dvec3& eye);
   void recordFrame(FrameResources& frame, const FrameParams& params, const detail::FrameUniforms& uniforms,
                    std::optional<uint32_t> swapchainImage, bool captureProbe, const detail::ProbeKey& probeKey);
 

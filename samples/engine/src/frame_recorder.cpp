@@ -34,6 +34,26 @@ glm::mat4 lightViewProjection(const Bounds& bounds, const glm::vec3& towardsSun,
 
 }  // namespace
 
+std::string Engine::Impl::writePreviousModels(FrameResources& frame, const glm::dvec3& eye) {
+  scene.previousModels = 0;
+  if (!sceneLoaded || scene.instanceTransforms.empty() || !ctx.bufferDeviceAddressFeature) return {};
+  if (previousTransforms.size() != scene.instanceTransforms.size()) previousTransforms = scene.instanceTransforms;
+  const VkDeviceSize bytes = VkDeviceSize(previousTransforms.size()) * sizeof(glm::mat4);
+  if (frame.previousModels.size < bytes) {
+    gpu.destroy(frame.previousModels);  // this slot's previous frame is done (waitFrame)
+    if (std::string e = gpu.createBuffer(bytes,
+                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                                         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                                         frame.previousModels);
+        !e.empty())
+      return "previous model matrices: " + e;
+  }
+  auto* models = static_cast<glm::mat4*>(frame.previousModels.mapped);
+  for (size_t i = 0; i < previousTransforms.size(); ++i) models[i] = rebasedTransform(previousTransforms[i], eye);
+  scene.previousModels = frame.previousModels.address;
+  return {};
+}
+
 std::string Engine::Impl::renderFrame(const FrameParams& params) {
   if (deviceLost) return lostDeviceError("renderFrame");
   if (targets.extent.width == 0) return "renderFrame: no render size (call setRenderSize or attachSurface)";
@@ -121,6 +141,11 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   u.shadow = glm::vec4(1.0f / float(shadowSize), float(taps),
                        shadowsOn ? normalOffsetTexels * 2.0f * lightRadius / float(shadowSize) : 0.0f, 0.0f);
   u.invProj = glm::inverse(u.proj);
+  // Last frame's camera rebased to this eye (the motion vectors' camera part); none yet: this frame's, no motion.
+  u.previousViewProj = hasPreviousCamera
+                           ? previousProj * previousView * glm::translate(glm::mat4(1.0f), glm::vec3(eye - previousEye))
+                           : u.viewProj;
+  if (std::string e = writePreviousModels(frame, eye); !e.empty()) return "renderFrame: " + e;
   // inputs and probe are filled after the hook; the uniform buffer is written before submission.
 
   // The probe is static: captured again only when something it depends on changed.
@@ -191,9 +216,16 @@ std::string Engine::Impl::renderFrame(const FrameParams& params) {
   lastSubmittedSlot = slot;
   currentFrame = (currentFrame + 1) % kFramesInFlight;
   frameRendered = true;
+  // This frame is the next one's "previous" (motion vectors).
+  if (sceneLoaded) previousTransforms = scene.instanceTransforms;
+  hasPreviousCamera = true;
+  previousEye = eye;
+  previousView = u.view;
+  previousProj = u.proj;
   ssaoRendered = params.ssao.enabled && !params.externalColor;
   shadowVisibilityRendered = params.outputShadowVisibility;
   localIrradianceRendered = params.outputLocalLightIrradiance;
+  prepassRendered = !params.externalColor;
   const bool shadowMapDrawn = shadowsOn && !params.externalColor;
   shadowStats = ShadowMapStats{shadowMapDrawn, shadowMapDrawn ? shadowSize : 0u, shadowMapDrawn ? taps : 0u,
                                frame.frameNumber};
@@ -275,7 +307,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
                VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
                VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
-  for (const Image* img : {&targets.normalRoughness, &targets.geometricNormal})
+  for (const Image* img : {&targets.normalRoughness, &targets.geometricNormal, &targets.motionVectors})
     imageBarrier(cmd, img->image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                  VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
@@ -286,9 +318,10 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
     depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
     depth.clearValue.depthStencil = {1.0f, 0};
-    beginRendering(
-        cmd, extent,
-        {colorAttachment(targets.normalRoughness.view, {}), colorAttachment(targets.geometricNormal.view, {})}, &depth);
+    beginRendering(cmd, extent,
+                   {colorAttachment(targets.normalRoughness.view, {}),
+                    colorAttachment(targets.geometricNormal.view, {}), colorAttachment(targets.motionVectors.view, {})},
+                   &depth);
     // BLEND surfaces stay out: depth and normals (and what the hook computes from them) are the opaque scene's.
     if (haveScene && !external)
       drawScene(cmd, scene, pipelines, DrawPass::Prepass, {pipelines.prepass, pipelines.prepassMasked}, eye);
@@ -300,7 +333,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
                    VK_ACCESS_2_TRANSFER_READ_BIT);
-  for (const Image* img : {&targets.normalRoughness, &targets.geometricNormal})
+  for (const Image* img : {&targets.normalRoughness, &targets.geometricNormal, &targets.motionVectors})
     imageBarrier(cmd, img->image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, kReadLayout,
                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
                  VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -336,6 +369,7 @@ void Engine::Impl::recordFrame(FrameResources& frame, const FrameParams& params,
     info.depth = {targets.depth.image, targets.depth.view, kDepthFormat, kDepthReadLayout};
     info.normalRoughness = {targets.normalRoughness.image, targets.normalRoughness.view, kNormalFormat, kReadLayout};
     info.geometricNormal = {targets.geometricNormal.image, targets.geometricNormal.view, kNormalFormat, kReadLayout};
+    info.motionVectors = {targets.motionVectors.image, targets.motionVectors.view, kMotionFormat, kReadLayout};
     info.reversedZ = false;
     info.view = uniformsIn.view;
     info.proj = uniformsIn.proj;

@@ -256,7 +256,7 @@ std::string uploadScene(Gpu& gpu, const VulkanContext& ctx, const Pipelines& pip
   for (size_t i = 0; i < s.instances.size(); ++i) {
     out.instanceTransforms[i] = s.instances[i].transform;
     const MeshBuffers& b = out.buffers[s.instances[i].mesh];
-    out.instanceVertices[i] = {b.positions.buffer, b.attributes.buffer};
+    out.instanceVertices[i] = {b.positions.buffer, b.attributes.buffer, b.positions.buffer};
     const AlphaMode mode = s.materials[s.meshes[s.instances[i].mesh].material].alphaMode;
     out.instancesByAlpha[size_t(mode)].push_back(uint32_t(i));  // finalizeScene: Opaque, Mask or Blend
   }

@@ -42,10 +42,12 @@ struct GpuScene {
   std::array<std::vector<uint32_t>, 3> instancesByAlpha;
   std::vector<glm::vec3> meshCenters;  // per mesh: its bounding-box centre (local), for sorting BLEND draws
   std::vector<float> meshRadii;        // per mesh: half its bounding-box diagonal (local), for culling casters
-  // Per Scene instance, what the raster passes draw: this frame's world transform, and the position /
-  // attribute buffers (the mesh's, or the instance's deformed buffers).
+  // Per Scene instance, what the raster passes draw: this frame's world transform, and the position / attribute /
+  // last frame's position buffers (the mesh's, the positions twice; or the instance's deformed buffers).
   std::vector<glm::mat4> instanceTransforms;
-  std::vector<std::array<VkBuffer, 2>> instanceVertices;
+  std::vector<std::array<VkBuffer, 3>> instanceVertices;
+  // Device address of this frame's copy of last frame's model matrices (DrawConstants::previousModels); 0 = none.
+  uint64_t previousModels = 0;
 };
 
 // True for an instance the deformation pass writes own vertex buffers for: skinned and/or morphed.

@@ -53,7 +53,7 @@ enum class VertexInput {
   None,          // fullscreen passes
   Positions,     // binding 0 only
   PositionsUvs,  // binding 0 + the UV of binding 1 (location 2)
-  Full,          // positions (binding 0) + attributes (binding 1)
+  Full,          // positions (binding 0) + attributes (binding 1) + last frame's positions (binding 2)
 };
 
 struct PipelineDesc {
@@ -92,7 +92,11 @@ std::string makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out
   if (d.vertices == VertexInput::Full) attributes.push_back({1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0});
   if (d.vertices == VertexInput::PositionsUvs || d.vertices == VertexInput::Full)
     attributes.push_back({2, 1, VK_FORMAT_R32G32_SFLOAT, 12});
-  if (d.vertices == VertexInput::Full) attributes.push_back({3, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 20});
+  if (d.vertices == VertexInput::Full) {
+    attributes.push_back({3, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 20});
+    bindings.push_back({2, 12, VK_VERTEX_INPUT_RATE_VERTEX});
+    attributes.push_back({4, 2, VK_FORMAT_R32G32B32_SFLOAT, 0});
+  }
   VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
   vi.vertexBindingDescriptionCount = uint32_t(bindings.size());
   vi.pVertexBindingDescriptions = bindings.data();
@@ -278,7 +282,7 @@ std::string Pipelines::create(VkDevice device) {
     d = {};
     d.vert = meshVert;
     d.frag = prepassFrag;
-    d.colorFormats = {kNormalFormat, kNormalFormat};
+    d.colorFormats = {kNormalFormat, kNormalFormat, kMotionFormat};
     d.depthFormat = kDepthFormat;
     d.depthTest = d.depthWrite = true;
     d.depthCompare = VK_COMPARE_OP_LESS;

@@ -21,6 +21,8 @@ struct FrameUniforms {
   glm::vec4 probe;  // x: 1 = sample the reflection probe, y: its last mip level
   // x: KHR lights in the light buffer (0 = none: local lights off, the probe capture), y: 1 = external E bound
   glm::uvec4 localLights;
+  // Last frame's camera-relative position -> clip, rebased to this frame's eye (the pre-pass's motion vectors).
+  glm::mat4 previousViewProj;
 };
 
 // Mirror of DrawConstants in shaders/common.glsl (push constants, vertex + fragment; std430 layout).
@@ -32,6 +34,9 @@ struct DrawConstants {
   uint32_t alphaMode;  // Material::alphaMode (SE_ALPHA_* in common.glsl)
   float alphaCutoff;   // Material::alphaCutoff
   uint32_t instance;   // Scene::instances index, per draw (seeds the hashed shadow test of BLEND draws)
+  // Device address of last frame's model matrices (one glm::mat4 per instance, rebased to this frame's eye); 0 = none
+  // (the instance is taken as still: the probe capture, a device without bufferDeviceAddress).
+  uint64_t previousModels;
 };
 static_assert(offsetof(DrawConstants, baseColorFactor) == 64);
 static_assert(offsetof(DrawConstants, material) == 80);
@@ -39,13 +44,16 @@ static_assert(offsetof(DrawConstants, emissive) == 96);
 static_assert(offsetof(DrawConstants, alphaMode) == 108);
 static_assert(offsetof(DrawConstants, alphaCutoff) == 112);
 static_assert(offsetof(DrawConstants, instance) == 116);
-static_assert(sizeof(DrawConstants) == 120);
+static_assert(offsetof(DrawConstants, previousModels) == 120);
+static_assert(sizeof(DrawConstants) == 128);
 static_assert(sizeof(DrawConstants) <= 128, "Vulkan guarantees 128 bytes of push constants");
 // SE_ALPHA_OPAQUE / MASK / BLEND in shaders/common.glsl.
 static_assert(uint32_t(AlphaMode::Opaque) == 0 && uint32_t(AlphaMode::Mask) == 1 && uint32_t(AlphaMode::Blend) == 2);
 
 inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 inline constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+// Motion vectors in pixels: 16-bit float keeps 1/64 px up to 512 px of motion (the reprojection needs far less).
+inline constexpr VkFormat kMotionFormat = VK_FORMAT_R16G16_SFLOAT;
 inline constexpr VkFormat kHdrFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kLdrFormat = VK_FORMAT_R8G8B8A8_SRGB;
 // Single-channel effect images (SSAO, shadow visibility): 16-bit float keeps smooth gradients for readback.

@@ -54,8 +54,8 @@ void drawInstance(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p
   const GpuMesh& mesh = scene.meshes[scene.cpu.instances[i].mesh];
   // The instance's own deformed buffers when it deforms, else the mesh's.
   const VkBuffer* buffers = scene.instanceVertices[i].data();
-  VkDeviceSize offsets[2] = {0, 0};
-  vkCmdBindVertexBuffers(cmd, 0, positionsOnly ? 1 : 2, buffers, offsets);
+  VkDeviceSize offsets[3] = {0, 0, 0};
+  vkCmdBindVertexBuffers(cmd, 0, positionsOnly ? 1 : 3, buffers, offsets);
   if (!positionsOnly && boundMaterial != mesh.material) {
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.sceneLayout, 1, 1,
                             &scene.materialSets[mesh.material], 0, nullptr);
@@ -64,6 +64,7 @@ void drawInstance(VkCommandBuffer cmd, const GpuScene& scene, const Pipelines& p
   DrawConstants c = scene.materialConstants[mesh.material];
   c.model = model;
   c.instance = i;
+  c.previousModels = scene.previousModels;
   vkCmdPushConstants(cmd, p.sceneLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(c), &c);
   if (mesh.indexCount > 0) {
     vkCmdBindIndexBuffer(cmd, mesh.indexBuffer, 0, VK_INDEX_TYPE_UINT32);

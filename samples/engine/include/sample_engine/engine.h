@@ -351,6 +351,11 @@ struct PrepassHookInfo {
   // RGBA16F: xyz = geometric (triangle) normal in world space, facing the camera, w = metallic;
   // (0,0,0,0) for background. SHADER_READ_ONLY_OPTIMAL.
   PassImage geometricNormal;
+  // RG16F: screen-space motion in pixels, this frame's position of the surface point minus last rendered frame's
+  // (x right, y down; the camera, instance transforms and skinned / morphed deformation together); (0,0) for
+  // background and on the first frame after loadScene(); 32768 where the point was behind last frame's camera.
+  // SHADER_READ_ONLY_OPTIMAL.
+  PassImage motionVectors;
   bool reversedZ = false;
   // Camera-relative, as the engine rasterizes (precision far from the origin): `view` is rotation only, so
   // viewProj maps world position - cameraPosition to clip space. proj: Vulkan clip space, Y flipped, depth [0,1].
@@ -566,6 +571,10 @@ class Engine {
   // The last frame's engine KHR-light irradiance E (rgb, a = 1), row-major renderSize(), top row first (waits
   // for it). Fails naming FrameParams::outputLocalLightIrradiance when that frame did not produce it.
   Result<std::vector<glm::vec4>> readbackLocalLightIrradiance();
+  // The last frame's pre-pass motion vectors (PrepassHookInfo::motionVectors: pixels, this frame - last frame),
+  // row-major renderSize(), top row first (waits for it). Fails when that frame drew no pre-pass
+  // (FrameParams::externalColor).
+  Result<std::vector<glm::vec2>> readbackMotionVectors();
 
   // --- KHR lights ---
   // The last rendered frame's lights (rest pose before the first), Scene::lights order; empty after a frame
