@@ -20,8 +20,9 @@ layout(location = 0) out vec3 outEyeRelativePos;  // world position - eye
 layout(location = 1) out vec3 outNormal;
 layout(location = 2) out vec2 outUv;
 layout(location = 3) out vec4 outTangent;
-// This frame's and last frame's clip positions of the vertex, for the pre-pass's motion vectors (prepass.frag).
-// Both are computed by the same expression, so a still vertex gets bit-identical pairs and a motion of exactly 0.
+// This frame's and last frame's clip positions of the vertex, for the pre-pass's motion vectors (prepass.frag). A
+// vertex whose position, model matrix and camera did not change gets the same value twice, so its motion is exactly 0
+// (two evaluations of one expression may round differently: NVIDIA's compiler fuses them differently).
 layout(location = 4) out vec4 outCurrentClip;
 layout(location = 5) out vec4 outPreviousClip;
 
@@ -39,5 +40,7 @@ void main() {
   mat4 previousModel = draw.model;
   if (draw.previousModels != uvec2(0)) previousModel = PreviousModels(draw.previousModels).models[draw.instance];
   outCurrentClip = frame.viewProj * (draw.model * vec4(inPosition, 1.0));
-  outPreviousClip = frame.previousViewProj * (previousModel * vec4(inPreviousPosition, 1.0));
+  const bool still = inPreviousPosition == inPosition && previousModel == draw.model &&
+                     frame.previousViewProj == frame.viewProj;
+  outPreviousClip = still ? outCurrentClip : frame.previousViewProj * (previousModel * vec4(inPreviousPosition, 1.0));
 }

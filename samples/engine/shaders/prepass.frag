@@ -23,5 +23,6 @@ void main() {
   alphaTest(s);
   outNormalRoughness = vec4(s.n, s.roughness);
   outGeometricNormal = vec4(s.ng, s.metallic);
-  outMotion = inPreviousClip.w > 0.0 ? pixelOf(inCurrentClip) - pixelOf(inPreviousClip) : vec2(kNoPreviousPixel);
+  if (inPreviousClip == inCurrentClip) outMotion = vec2(0.0);  // still: exactly, whatever the divisions round to
+  else outMotion = inPreviousClip.w > 0.0 ? pixelOf(inCurrentClip) - pixelOf(inPreviousClip) : vec2(kNoPreviousPixel);
 }

@@ -232,7 +232,8 @@ std::string VulkanContext::create(const EngineConfig& config) {
   f12.timelineSemaphore = VK_TRUE;            // the deformation submission signals a timeline semaphore per frame
   f2.features.shaderStorageImageExtendedFormats = VK_TRUE;  // the SSAO compute passes write R16F storage images
   // Required by Vulkan 1.3, so always on: the deformation pass reads and writes vertex buffers through
-  // device addresses, and mesh.vert reads last frame's model matrices (motion vectors) through one. Scene buffers expose addresses only with enableRayTracingInputs (info.bufferDeviceAddress).
+  // device addresses, and mesh.vert reads last frame's model matrices (motion vectors) through one. Scene buffers
+  // expose addresses only with enableRayTracingInputs (info.bufferDeviceAddress).
   f12.bufferDeviceAddress = supported12.bufferDeviceAddress;
   mergeBools(f2.features, config.extraFeatures10, 0);
   mergeBools(f11, config.extraFeatures11, offsetof(VkPhysicalDeviceVulkan11Features, storageBuffer16BitAccess));
