@@ -13,6 +13,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_DEPTH) uniform sampler2D gDepth;
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_MOTION) uniform sampler2D gMotion;  // pixels, current - previous
+layout(set = 0, binding = RB_ADAPTIVE_BINDING_REACTIVE) uniform sampler2D gReactive;
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_HISTORY) uniform sampler2D historyIn;    // x: mean, y: frames
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_DISTANCE) uniform sampler2D distanceIn;  // last frame's distance
 layout(set = 0, binding = RB_ADAPTIVE_BINDING_WEIGHTS, rg16f) uniform writeonly image2D weightsOut;
@@ -39,7 +40,7 @@ void main() {
       float frames = kNoHistoryFrames;
       ivec2 pp;
       // The same reprojection and surface test as the denoiser's temporal pass.
-      if (rbDnFindHistory(pixel, rbDnCameraRelative(pixel, depth), gMotion, distanceIn, pp)) {
+      if (rbDnFindHistory(pixel, rbDnCameraRelative(pixel, depth), gMotion, gReactive, distanceIn, pp)) {
         vec2 h = texelFetch(historyIn, pp, 0).xy;
         mean = clamp(h.x, 0.0, 1.0);
         frames = max(h.y, 1.0);

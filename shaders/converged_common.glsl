@@ -13,6 +13,7 @@ layout(push_constant) uniform ConvergedPushConstants { ConvergedTileConstants tc
 layout(local_size_x = RB_SHADOW_TILE_SIZE, local_size_y = RB_SHADOW_TILE_SIZE) in;
 layout(set = 0, binding = RB_CONVERGED_BINDING_DEPTH) uniform sampler2D gDepth;
 layout(set = 0, binding = RB_CONVERGED_BINDING_MOTION) uniform sampler2D gMotion;  // pixels, current - previous
+layout(set = 0, binding = RB_CONVERGED_BINDING_REACTIVE) uniform sampler2D gReactive;
 layout(set = 0, binding = RB_CONVERGED_BINDING_STATE, std430) buffer TileState { uint tileState[]; };
 
 // The tile's index in the state buffer, row by row: the pass's classifier (shadows, AO) numbers its workgroups the

@@ -35,15 +35,23 @@ vec2 rbDnPreviousPixel(uvec2 pixel, vec3 rel, sampler2D motion, out vec3 prevRel
   return (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
 }
 
+// The engine's reactive mask drops this pixel's history (RB_DN_REACTIVE: .r > 0.5; particles, UI, anything the
+// SDK does not see change).
+bool rbDnReactive(uvec2 pixel, sampler2D reactive) {
+  return (pc.flags & RB_DN_REACTIVE) != 0u && texelFetch(reactive, ivec2(pixel), 0).r > 0.5;
+}
+
 // Where the surface at `pixel` (camera-relative position `rel`) was in the latest history: `pp`, that history's
-// texel, and whether the same surface is there (its distance from last frame's camera matches what was stored).
-// The temporal pass's test, shared with the readers of its history that must agree with it (converged shadow
-// tiles: a pixel they skip is one the temporal pass finds history for).
-bool rbDnFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D distanceIn, out ivec2 pp) {
+// texel, and whether the same surface is there (its distance from last frame's camera matches what was stored) and
+// the engine did not mark the pixel reactive. The temporal pass's test, shared with the readers of its history that
+// must agree with it (converged shadow tiles: a pixel they skip is one the temporal pass finds history for).
+bool rbDnFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D reactive, sampler2D distanceIn,
+                     out ivec2 pp) {
   vec3 prevRel;
   vec2 prevPixel = rbDnPreviousPixel(pixel, rel, motion, prevRel);
   pp = ivec2(floor(prevPixel));
-  if ((pc.flags & RB_DN_HISTORY) == 0u || any(lessThan(pp, ivec2(0))) || any(greaterThanEqual(pp, ivec2(pc.size)))) {
+  if ((pc.flags & RB_DN_HISTORY) == 0u || rbDnReactive(pixel, reactive) || any(lessThan(pp, ivec2(0))) ||
+      any(greaterThanEqual(pp, ivec2(pc.size)))) {
     return false;
   }
   float prevDist = texelFetch(distanceIn, pp, 0).r;

@@ -30,13 +30,13 @@ bool rbDnRgbStaleMark(float a) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && a
 // four history texels around the reprojected point, each kept only where it holds the same surface (its distance
 // from last frame's camera matches); nearest-texel reprojection would drift and blur the history by up to half a
 // pixel every frame the camera moves. Returns whether any did: then `h` is the history (rgb mean, a frames) and `v`
-// the variance of one frame's colour there. The temporal pass's test, shared with the converged reflection tiles,
-// which must find the history it finds.
-bool rbDnRgbFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D historyIn, sampler2D surfaceIn, out vec4 h,
-                        out float v) {
+// the variance of one frame's colour there; none where the engine's reactive mask is set (rbDnReactive). The temporal
+// pass's test, shared with the converged reflection tiles, which must find the history it finds.
+bool rbDnRgbFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D reactive, sampler2D historyIn,
+                        sampler2D surfaceIn, out vec4 h, out float v) {
   h = vec4(0.0);
   v = 0.0;
-  if ((pc.flags & RB_DN_HISTORY) == 0u) return false;
+  if ((pc.flags & RB_DN_HISTORY) == 0u || rbDnReactive(pixel, reactive)) return false;
   vec3 prevRel;
   vec2 f = rbDnPreviousPixel(pixel, rel, motion, prevRel) - 0.5;
   ivec2 base = ivec2(floor(f));

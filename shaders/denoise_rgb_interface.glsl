@@ -16,6 +16,7 @@
 #define RB_RGB_TEMPORAL_BINDING_GUIDE_OUT 8  // the a-trous steps' geometry (denoise_rgb_common.glsl)
 #define RB_RGB_TEMPORAL_BINDING_NORMAL 9
 #define RB_RGB_TEMPORAL_BINDING_ROUGHNESS 10  // with RB_DN_RGB_REFLECTION: .x, or the normal's .w
+#define RB_RGB_TEMPORAL_BINDING_REACTIVE 11   // the reactive mask, or the depth image again without one
 // A-trous pass (denoise_rgb_atrous.comp).
 #define RB_RGB_ATROUS_BINDING_GUIDE 0
 #define RB_RGB_ATROUS_BINDING_SIGNAL_IN 1

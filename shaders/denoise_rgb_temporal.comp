@@ -16,6 +16,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_DEPTH) uniform sampler2D gDepth;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_MOTION) uniform sampler2D gMotion;  // pixels, current - previous
+layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_REACTIVE) uniform sampler2D gReactive;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SIGNAL) uniform sampler2D signalIn;  // .rgb, this frame's
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_HISTORY_IN) uniform sampler2D historyIn;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SURFACE_IN) uniform sampler2D surfaceIn;
@@ -95,7 +96,7 @@ void main() {
   float frames = 1.0;
   vec4 h;
   float v;
-  if (!rbDnRgbStaleMark(texel.a) && rbDnRgbFindHistory(pixel, rel, gMotion, historyIn, surfaceIn, h, v)) {
+  if (!rbDnRgbStaleMark(texel.a) && rbDnRgbFindHistory(pixel, rel, gMotion, gReactive, historyIn, surfaceIn, h, v)) {
     if (kept) {
       // Not traced this frame: the history as it was, no frame added (the mark's rgb is this same mean).
       frames = clamp(floor(h.a + 0.5), 1.0, float(pc.maxHistoryFrames));

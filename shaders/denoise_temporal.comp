@@ -10,6 +10,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = RB_TEMPORAL_BINDING_DEPTH) uniform sampler2D gDepth;
 layout(set = 0, binding = RB_TEMPORAL_BINDING_MOTION) uniform sampler2D gMotion;  // pixels, current - previous
+layout(set = 0, binding = RB_TEMPORAL_BINDING_REACTIVE) uniform sampler2D gReactive;
 layout(set = 0, binding = RB_TEMPORAL_BINDING_SIGNAL) uniform sampler2D signalIn;        // this frame's noisy value
 layout(set = 0, binding = RB_TEMPORAL_BINDING_HISTORY_IN) uniform sampler2D historyIn;   // x: value, y: frames
 layout(set = 0, binding = RB_TEMPORAL_BINDING_DISTANCE_IN) uniform sampler2D distanceIn; // last frame's distance
@@ -43,7 +44,7 @@ void main() {
   float accumulated = value;
   float frames = 1.0;
   ivec2 pp;
-  if (rbDnFindHistory(pixel, rel, gMotion, distanceIn, pp)) {
+  if (rbDnFindHistory(pixel, rel, gMotion, gReactive, distanceIn, pp)) {
     vec2 h = texelFetch(historyIn, pp, 0).xy;
     frames = min(kept ? max(h.y, 1.0) : h.y + 1.0, float(pc.maxHistoryFrames));
     accumulated = kept ? h.x : mix(h.x, value, 1.0 / frames);

@@ -65,6 +65,7 @@
 #define RB_TEMPORAL_BINDING_DISTANCE_OUT 6
 #define RB_TEMPORAL_BINDING_VALUE_OUT 7  // rg: the value and the variance of its noise
 #define RB_TEMPORAL_BINDING_FINAL_OUT 8  // r: the denoiser's output, written with RB_DN_TEMPORAL_FINAL
+#define RB_TEMPORAL_BINDING_REACTIVE 9   // the reactive mask, or the depth image again without one
 // The denoiser's a-trous pass.
 #define RB_ATROUS_BINDING_DEPTH 0
 #define RB_ATROUS_BINDING_NORMAL 1
@@ -86,6 +87,7 @@
 #define RB_ADAPTIVE_BINDING_WEIGHTS 4   // rg16f: reprojected mean, weight
 #define RB_ADAPTIVE_BINDING_COUNTERS 5  // RbPlanCounters
 #define RB_ADAPTIVE_BINDING_PLAN 6      // rg16f: rays, reprojected mean
+#define RB_ADAPTIVE_BINDING_REACTIVE 7  // the reactive mask, or the depth image again without one
 
 // GBufferConstants::flags: what the G-buffer description says.
 #define RB_GB_REVERSED_Z 1u
@@ -134,6 +136,7 @@
 // pass's output, and:
 #define RB_CONVERGED_BINDING_ROUGHNESS 8  // the roughness image (.x), or the normal image (.w)
 #define RB_CONVERGED_BINDING_COUNTERS 9   // rgb_converged.comp: the pass's ray counters (tiles, rays saved)
+#define RB_CONVERGED_BINDING_REACTIVE 10  // the reactive mask, or the depth image again without one
 
 // ManyLightConstants::mode: the values of rb::ManyLightMode.
 #define RB_ML_STOCHASTIC 0u
@@ -152,6 +155,9 @@
 // Scalar temporal pass: the signal may hold kept-history marks, -1 - v for a pixel the shadow pass did not trace
 // because its tile had converged (denoise_noise.glsl): it keeps its history (v, the reprojected mean) unchanged.
 #define RB_DN_KEPT_MARKS 32u
+// The G-buffer has a reactive mask (GBufferDesc::reactiveMask): a pixel whose .r exceeds 0.5 finds no history
+// (rbDnFindHistory), in the temporal passes and in every reader that must agree with them.
+#define RB_DN_REACTIVE 0x40u
 
 // Half-resolution tracing (AoConstants/ReflectionConstants::halfResolution): sample (i, j) of frame f traces for
 // G-buffer pixel (2i + x, 2j + y), clamped to the image, with (x, y) = (0,0), (1,1), (1,0), (0,1) for f mod 4 = 0..3:

@@ -58,7 +58,7 @@ ConvergedRgb rbConvergedRgb(uvec2 pixel) {
   c.covered = true;
   vec3 rel = rbDnCameraRelative(pixel, depth);
   vec4 h;
-  c.history = rbDnRgbFindHistory(pixel, rel, gMotion, historyIn, surfaceIn, h, c.variance);
+  c.history = rbDnRgbFindHistory(pixel, rel, gMotion, gReactive, historyIn, surfaceIn, h, c.variance);
   if (c.history) {
     c.mean = h.rgb;
     c.frames = floor(h.a + 0.5);

@@ -33,7 +33,7 @@ ConvergedPixel rbConvergedPixel(uvec2 pixel) {
   float depth = texelFetch(gDepth, ivec2(pixel), 0).r;
   if (rbDnSky(depth)) return c;
   c.surface = true;
-  c.history = rbDnFindHistory(pixel, rbDnCameraRelative(pixel, depth), gMotion, distanceIn, c.texel);
+  c.history = rbDnFindHistory(pixel, rbDnCameraRelative(pixel, depth), gMotion, gReactive, distanceIn, c.texel);
   if (c.history) {
     vec2 h = texelFetch(historyIn, c.texel, 0).xy;
     c.mean = h.x;

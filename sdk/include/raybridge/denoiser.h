@@ -116,6 +116,7 @@ struct DenoiseOutputs {
 struct DenoiseHistory {
   // Scalar: RG16F (mean, frames accumulated). Rgb and Reflection: RGBA16F (mean colour, frames accumulated).
   VkImageView mean = VK_NULL_HANDLE;
+  VkImage meanImage = VK_NULL_HANDLE;  // the image of `mean`, for a copy or a debug view's readback
   // Scalar: R32F (view distance of each pixel's surface). Rgb and Reflection: RG32F (view distance, variance of one
   // frame's colour).
   VkImageView distance = VK_NULL_HANDLE;

@@ -111,6 +111,11 @@ struct GBufferDesc {
   bool roughnessInNormalW = false;  // true: roughness is in normal.w (WorldFloat encoding only)
   GBufferImage albedo{};            // optional: base colour in .rgb
   GBufferImage motionVectors{};     // optional: screen-space motion in pixels (current - previous) in .xy
+  // Optional reactive mask, .r in [0, 1] of any float or unorm format (R8_UNORM is enough): where it exceeds 0.5 the
+  // denoisers drop the pixel's history and start afresh, and the ray schedule treats the pixel as new (adaptive rays
+  // plan it from no history, converged tiles trace its tile). For what the SDK cannot see change: particles, UI,
+  // a screen-space effect drawn into the G-buffer, a teleport the engine knows of. Not given = no pixel is reactive.
+  GBufferImage reactiveMask{};
 
   // Camera, column-major 4x4 (GLM layout) as used to rasterize the G-buffer, Vulkan clip space (depth 0..1,
   // +Y down in NDC unless the projection flips it). Any projection works, including reversed-Z and infinite

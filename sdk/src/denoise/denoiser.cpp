@@ -163,7 +163,7 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
          sampled(RB_RGB_TEMPORAL_BINDING_SURFACE_IN), storage(RB_RGB_TEMPORAL_BINDING_HISTORY_OUT),
          storage(RB_RGB_TEMPORAL_BINDING_SURFACE_OUT), storage(RB_RGB_TEMPORAL_BINDING_VALUE_OUT),
          storage(RB_RGB_TEMPORAL_BINDING_GUIDE_OUT), sampled(RB_RGB_TEMPORAL_BINDING_NORMAL),
-         sampled(RB_RGB_TEMPORAL_BINDING_ROUGHNESS)},
+         sampled(RB_RGB_TEMPORAL_BINDING_ROUGHNESS), sampled(RB_RGB_TEMPORAL_BINDING_REACTIVE)},
         sizeof(DenoiseConstants), "denoiser RGB temporal");
     if (!t) return t.error();
     impl->temporal = t.value();
@@ -175,13 +175,14 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
     if (!a) return a.error();
     impl->atrous = a.value();
   } else {
-    Result<ComputePipeline> t = ComputePipeline::create(
-        context, SpirvModule::of(spirv::denoise_temporal_comp),
-        {sampled(RB_TEMPORAL_BINDING_DEPTH), sampled(RB_TEMPORAL_BINDING_MOTION), sampled(RB_TEMPORAL_BINDING_SIGNAL),
-         sampled(RB_TEMPORAL_BINDING_HISTORY_IN), sampled(RB_TEMPORAL_BINDING_DISTANCE_IN),
-         storage(RB_TEMPORAL_BINDING_HISTORY_OUT), storage(RB_TEMPORAL_BINDING_DISTANCE_OUT),
-         storage(RB_TEMPORAL_BINDING_VALUE_OUT), storage(RB_TEMPORAL_BINDING_FINAL_OUT)},
-        sizeof(DenoiseConstants), "denoiser temporal");
+    Result<ComputePipeline> t =
+        ComputePipeline::create(context, SpirvModule::of(spirv::denoise_temporal_comp),
+                                {sampled(RB_TEMPORAL_BINDING_DEPTH), sampled(RB_TEMPORAL_BINDING_MOTION),
+                                 sampled(RB_TEMPORAL_BINDING_SIGNAL), sampled(RB_TEMPORAL_BINDING_HISTORY_IN),
+                                 sampled(RB_TEMPORAL_BINDING_DISTANCE_IN), storage(RB_TEMPORAL_BINDING_HISTORY_OUT),
+                                 storage(RB_TEMPORAL_BINDING_DISTANCE_OUT), storage(RB_TEMPORAL_BINDING_VALUE_OUT),
+                                 storage(RB_TEMPORAL_BINDING_FINAL_OUT), sampled(RB_TEMPORAL_BINDING_REACTIVE)},
+                                sizeof(DenoiseConstants), "denoiser temporal");
     if (!t) return t.error();
     impl->temporal = t.value();
     Result<ComputePipeline> a =
@@ -277,8 +278,9 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   {
     DescriptorWrites w;
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
-    const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
+    const GBufferImage &motion = motionImage(g), &reactive = reactiveImage(g);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_MOTION, motion.view, s.sampler, readLayout(motion));
+    w.sampledImage(RB_RGB_TEMPORAL_BINDING_REACTIVE, reactive.view, s.sampler, readLayout(reactive));
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_SIGNAL, signal, s.sampler, ro);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_HISTORY_IN, im[prev].view, s.sampler, ro);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_SURFACE_IN, im[2 + prev].view, s.sampler, ro);
@@ -385,8 +387,9 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
   {
     DescriptorWrites w;
     w.sampledImage(RB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
-    const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
+    const GBufferImage &motion = motionImage(g), &reactive = reactiveImage(g);
     w.sampledImage(RB_TEMPORAL_BINDING_MOTION, motion.view, s.sampler, readLayout(motion));
+    w.sampledImage(RB_TEMPORAL_BINDING_REACTIVE, reactive.view, s.sampler, readLayout(reactive));
     w.sampledImage(RB_TEMPORAL_BINDING_SIGNAL, signal, s.sampler, ro);
     w.sampledImage(RB_TEMPORAL_BINDING_HISTORY_IN, im[prev].view, s.sampler, ro);
     w.sampledImage(RB_TEMPORAL_BINDING_DISTANCE_IN, im[2 + prev].view, s.sampler, ro);
@@ -452,6 +455,7 @@ Status prepareConstants(const GBufferDesc& g, uint64_t frame, const double previ
   if (g.depthConvention == DepthConvention::ReversedZ) flags |= RB_DN_REVERSED_Z;
   if (g.normalEncoding == NormalEncoding::Octahedral) flags |= RB_DN_OCTAHEDRAL;
   if (g.motionVectors.view) flags |= RB_DN_MOTION;
+  if (g.reactiveMask.view) flags |= RB_DN_REACTIVE;
   pc.size[0] = g.width;
   pc.size[1] = g.height;
   // This frame's camera: projection * rotation-only view, kept for next frame's reprojection.
@@ -527,6 +531,7 @@ DenoiseHistory Denoiser::history() const {
   if (!s.imagesWritten || s.images.size() < 5) return h;
   const uint32_t last = 1 - s.parity;
   h.mean = s.images[last].view;
+  h.meanImage = s.images[last].image;
   h.distance = s.images[2 + last].view;
   h.noise = s.signal == DenoiseSignal::Scalar ? s.images[4].view : VK_NULL_HANDLE;
   h.sampler = s.sampler;

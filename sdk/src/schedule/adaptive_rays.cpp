@@ -47,7 +47,8 @@ Status AdaptiveRayPlanner::init(Context& ctx, AdaptiveRayGranularity granularity
         ctx, SpirvModule::of(spirv::adaptive_estimate_comp),
         {sampled(RB_ADAPTIVE_BINDING_DEPTH), sampled(RB_ADAPTIVE_BINDING_MOTION), sampled(RB_ADAPTIVE_BINDING_HISTORY),
          sampled(RB_ADAPTIVE_BINDING_DISTANCE), storage(RB_ADAPTIVE_BINDING_WEIGHTS),
-         storage(RB_ADAPTIVE_BINDING_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER)},
+         storage(RB_ADAPTIVE_BINDING_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
+         sampled(RB_ADAPTIVE_BINDING_REACTIVE)},
         sizeof(DenoiseConstants), "adaptive rays: estimate");
     if (!e) return e.error();
     estimate_ = e.value();
@@ -167,8 +168,9 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
     DescriptorWrites w;
     const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     w.sampledImage(RB_ADAPTIVE_BINDING_DEPTH, g.depth.view, history.sampler, readLayout(g.depth));
-    const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
+    const GBufferImage &motion = motionImage(g), &reactive = reactiveImage(g);
     w.sampledImage(RB_ADAPTIVE_BINDING_MOTION, motion.view, history.sampler, readLayout(motion));
+    w.sampledImage(RB_ADAPTIVE_BINDING_REACTIVE, reactive.view, history.sampler, readLayout(reactive));
     w.sampledImage(RB_ADAPTIVE_BINDING_HISTORY, history.mean, history.sampler, ro);
     w.sampledImage(RB_ADAPTIVE_BINDING_DISTANCE, history.distance, history.sampler, ro);
     w.storageImage(RB_ADAPTIVE_BINDING_WEIGHTS, images_[0].view);

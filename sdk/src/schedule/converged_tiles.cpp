@@ -17,10 +17,13 @@ Status ConvergedTiles::init(Context& ctx, const char* who) {
   const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
   auto binding = [&](uint32_t b, VkDescriptorType t) { return VkDescriptorSetLayoutBinding{b, t, 1, cs, nullptr}; };
   const VkDescriptorType sampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-  std::vector<VkDescriptorSetLayoutBinding> common = {
-      binding(RB_CONVERGED_BINDING_DEPTH, sampled), binding(RB_CONVERGED_BINDING_MOTION, sampled),
-      binding(RB_CONVERGED_BINDING_HISTORY, sampled), binding(RB_CONVERGED_BINDING_DISTANCE, sampled),
-      binding(RB_CONVERGED_BINDING_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER)};
+  std::vector<VkDescriptorSetLayoutBinding> common = {binding(RB_CONVERGED_BINDING_DEPTH, sampled),
+                                                      binding(RB_CONVERGED_BINDING_MOTION, sampled),
+                                                      binding(RB_CONVERGED_BINDING_HISTORY, sampled),
+                                                      binding(RB_CONVERGED_BINDING_DISTANCE, sampled),
+                                                      binding(RB_CONVERGED_BINDING_STATE,
+                                                              VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
+                                                      binding(RB_CONVERGED_BINDING_REACTIVE, sampled)};
   const bool rgb = signal_ != DenoiseSignal::Scalar;
   if (rgb) common.push_back(binding(RB_CONVERGED_BINDING_ROUGHNESS, sampled));
   if (!mark_.pipeline) {
@@ -112,8 +115,9 @@ Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBu
 void ConvergedTiles::writeCommon(DescriptorWrites& w, const GBufferDesc& g, const TileClassifier& classifier) const {
   const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   w.sampledImage(RB_CONVERGED_BINDING_DEPTH, g.depth.view, history_.sampler, readLayout(g.depth));
-  const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
+  const GBufferImage &motion = motionImage(g), &reactive = reactiveImage(g);
   w.sampledImage(RB_CONVERGED_BINDING_MOTION, motion.view, history_.sampler, readLayout(motion));
+  w.sampledImage(RB_CONVERGED_BINDING_REACTIVE, reactive.view, history_.sampler, readLayout(reactive));
   w.sampledImage(RB_CONVERGED_BINDING_HISTORY, history_.mean, history_.sampler, ro);
   w.sampledImage(RB_CONVERGED_BINDING_DISTANCE, history_.distance, history_.sampler, ro);
   classifier.writeState(w, RB_CONVERGED_BINDING_STATE);

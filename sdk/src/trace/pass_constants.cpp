@@ -130,7 +130,8 @@ Status validateGBufferImages(const GBufferDesc& g, const char* passName) {
                                                                 {&g.geometricNormal, "geometricNormal"},
                                                                 {&g.roughnessMetalness, "roughnessMetalness"},
                                                                 {&g.albedo, "albedo"},
-                                                                {&g.motionVectors, "motionVectors"}};
+                                                                {&g.motionVectors, "motionVectors"},
+                                                                {&g.reactiveMask, "reactiveMask"}};
   for (const auto& [image, field] : images) {
     if (std::string m = checkImage(*image, field, image == &g.depth); !m.empty()) return invalid(m);
   }

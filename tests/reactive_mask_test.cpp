@@ -1,0 +1,114 @@
+// GBufferDesc::reactiveMask: the engine's per-pixel "this changed" for what the SDK cannot see. The denoiser drops
+// the history of exactly the masked pixels, and the readers of its history agree with it.
+#include <catch2/catch_test_macros.hpp>
+
+#include <glm/gtc/packing.hpp>
+
+#include <cstring>
+
+#include "synthetic_gbuffer.h"
+
+using namespace rbtest;
+
+namespace {
+
+constexpr uint32_t kW = 40, kH = 30;
+
+bool masked(uint32_t x, uint32_t y) { return x >= 10 && x < 22 && y >= 8 && y < 17; }
+
+// Frames accumulated per pixel: the .y of the scalar history (RG16F: mean, frames).
+std::vector<float> historyFrames(GpuFixture& fx, const rb::Denoiser& denoiser) {
+  const rb::DenoiseHistory h = denoiser.history();
+  REQUIRE(h.meanImage != VK_NULL_HANDLE);
+  std::vector<uint8_t> raw = readPassImage(fx, h.meanImage, kW, kH, 4);
+  std::vector<float> frames(size_t(kW) * kH);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    uint16_t half;
+    std::memcpy(&half, raw.data() + 4 * i + 2, 2);
+    frames[i] = glm::unpackHalf1x16(half);
+  }
+  return frames;
+}
+
+}  // namespace
+
+TEST_CASE("a reactive mask drops the history of exactly the masked pixels", "[denoise][reactive]") {
+  GpuFixture fx;
+  TestScene scene = makeConformanceScene();
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  CpuGBuffer cpu = traceGBuffer(embree, conformanceView(kW, kH));
+  std::vector<uint8_t> maskBytes(size_t(kW) * kH, 0);
+  for (uint32_t y = 0; y < kH; ++y)
+    for (uint32_t x = 0; x < kW; ++x) maskBytes[size_t(y) * kW + x] = masked(x, y) ? 255 : 0;
+  SampledImage mask = uploadSampledImage(fx, VK_FORMAT_R8_UNORM, VK_IMAGE_ASPECT_COLOR_BIT, kW, kH, maskBytes.data(),
+                                         maskBytes.size());
+  auto ao = rb::AoPass::create(fx.ctx());
+  RB_REQUIRE_OK(ao);
+  auto denoiser = rb::Denoiser::create(fx.ctx());
+  RB_REQUIRE_OK(denoiser);
+
+  auto frame = [&](bool withMask) {
+    runPassFrame(
+        fx, scene, cpu, false,
+        [&](VkCommandBuffer cmd, const rb::GBufferDesc& g, const rb::TlasInfo& tlas) {
+          rb::GBufferDesc gbuffer = g;
+          if (withMask) gbuffer.reactiveMask = {mask.view};
+          RB_REQUIRE_OK(ao.value()->record(cmd, {.gbuffer = gbuffer, .tlas = tlas}));
+          RB_REQUIRE_OK(denoiser.value()->record(cmd, {.gbuffer = gbuffer, .signal = ao.value()->outputs().aoView}));
+        },
+        [](const rb::GBufferDesc&) {});
+  };
+  for (int i = 0; i < 4; ++i) frame(false);
+  const std::vector<float> before = historyFrames(fx, *denoiser.value());
+  frame(true);
+  const std::vector<float> after = historyFrames(fx, *denoiser.value());
+
+  size_t maskedSurface = 0, otherSurface = 0, wrong = 0;
+  for (uint32_t y = 0; y < kH; ++y)
+    for (uint32_t x = 0; x < kW; ++x) {
+      const size_t i = size_t(y) * kW + x;
+      if (!cpu.hit[i]) continue;
+      const bool m = masked(x, y);
+      (m ? maskedSurface : otherSurface)++;
+      // A masked pixel starts afresh (one frame); every other surface pixel keeps its history and adds this frame.
+      const float expected = m ? 1.0f : before[i] + 1.0f;
+      if (after[i] != expected) {
+        if (wrong++ < 5)
+          UNSCOPED_INFO("pixel " << x << "," << y << (m ? " (masked)" : "") << ": " << after[i] << " frames, expected "
+                                 << expected);
+      }
+    }
+  INFO(maskedSurface << " masked and " << otherSurface << " other surface pixels");
+  REQUIRE(maskedSurface > 20);
+  REQUIRE(otherSurface > 100);
+  for (size_t i = 0; i < before.size(); ++i)
+    if (cpu.hit[i]) REQUIRE(before[i] == 4.0f);  // the history had grown before the mask
+  CHECK(wrong == 0);
+  destroySampledImage(fx, mask);
+}
+
+TEST_CASE("a reactive mask in a layout that cannot be sampled is refused by name", "[denoise][reactive][errors]") {
+  GpuFixture fx;
+  TestScene scene = makeConformanceScene();
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  CpuGBuffer cpu = traceGBuffer(embree, conformanceView(16, 12));
+  auto ao = rb::AoPass::create(fx.ctx());
+  RB_REQUIRE_OK(ao);
+  auto denoiser = rb::Denoiser::create(fx.ctx());
+  RB_REQUIRE_OK(denoiser);
+  runPassFrame(
+      fx, scene, cpu, false,
+      [&](VkCommandBuffer cmd, const rb::GBufferDesc& g, const rb::TlasInfo& tlas) {
+        rb::GBufferDesc gbuffer = g;
+        gbuffer.reactiveMask = {g.normal.view, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+        for (const rb::Status& st : {ao.value()->record(cmd, {.gbuffer = gbuffer, .tlas = tlas}),
+                                     denoiser.value()->record(cmd, {.gbuffer = gbuffer, .signal = g.normal.view})}) {
+          REQUIRE_FALSE(st);
+          INFO(st.error().message);
+          CHECK(st.error().message.find("reactiveMask") != std::string::npos);
+        }
+      },
+      [](const rb::GBufferDesc&) {});
+}
