@@ -389,6 +389,22 @@ std::string readImage(Engine::Impl& impl, const Image& image, VkImageLayout layo
   return e;
 }
 
+// Reads a 16-bit float image of N channels (in SHADER_READ_ONLY_OPTIMAL, left so) as floats, row-major.
+template <glm::length_t N>
+std::string readHalfImage(Engine::Impl& impl, const Image& image, std::vector<glm::vec<N, float>>& out) {
+  std::vector<uint8_t> raw;
+  if (std::string e = readImage(impl, image, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 2 * N, raw); !e.empty())
+    return e;
+  out.resize(raw.size() / (2 * N));
+  for (size_t i = 0; i < out.size(); ++i)
+    for (glm::length_t c = 0; c < N; ++c) {
+      uint16_t h;
+      std::memcpy(&h, &raw[(i * N + size_t(c)) * 2], 2);
+      out[i][c] = halfToFloat(h);
+    }
+  return {};
+}
+
 }  // namespace
 
 Result<ImageRGBA8> Engine::readbackLdr() {
@@ -463,18 +479,9 @@ Result<std::vector<glm::vec4>> Engine::readbackLocalLightIrradiance() {
   if (!impl_->frameRendered || !impl_->localIrradianceRendered)
     return R::failure("readbackLocalLightIrradiance: the last frame did not produce it; set "
                       "FrameParams::outputLocalLightIrradiance");
-  std::vector<uint8_t> raw;
-  if (std::string e = readImage(*impl_, impl_->targets.localIrradiance, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 8,
-                                raw);
-      !e.empty())
+  std::vector<glm::vec4> out;
+  if (std::string e = readHalfImage(*impl_, impl_->targets.localIrradiance, out); !e.empty())
     return R::failure("readbackLocalLightIrradiance: " + e);
-  std::vector<glm::vec4> out(raw.size() / 8);
-  for (size_t i = 0; i < out.size(); ++i)
-    for (int c = 0; c < 4; ++c) {
-      uint16_t h;
-      std::memcpy(&h, &raw[i * 8 + size_t(c) * 2], 2);
-      out[i][c] = halfToFloat(h);
-    }
   return R::success(std::move(out));
 }
 
@@ -484,17 +491,9 @@ Result<std::vector<glm::vec2>> Engine::readbackMotionVectors() {
   if (!impl_->frameRendered || !impl_->prepassRendered)
     return R::failure("readbackMotionVectors: the last frame drew no pre-pass (FrameParams::externalColor); render "
                       "one without it");
-  std::vector<uint8_t> raw;
-  if (std::string e = readImage(*impl_, impl_->targets.motionVectors, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 4, raw);
-      !e.empty())
+  std::vector<glm::vec2> out;
+  if (std::string e = readHalfImage(*impl_, impl_->targets.motionVectors, out); !e.empty())
     return R::failure("readbackMotionVectors: " + e);
-  std::vector<glm::vec2> out(raw.size() / 4);
-  for (size_t i = 0; i < out.size(); ++i)
-    for (int c = 0; c < 2; ++c) {
-      uint16_t h;
-      std::memcpy(&h, &raw[i * 4 + size_t(c) * 2], 2);
-      out[i][c] = halfToFloat(h);
-    }
   return R::success(std::move(out));
 }
 
