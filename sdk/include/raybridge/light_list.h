@@ -1,5 +1,5 @@
 // The engine's light list on the GPU: uploaded once a frame, read by every effect lit by it. The many-light pass
-// (ManyLightPass::record with a LightList), reflection hits (ReflectionSettings::lights) and the pure ray-traced
+// (ManyLightFrame::lightList), reflection hits (ReflectionSettings::lights) and the pure ray-traced
 // mode (PrimaryShadingSettings::lights) read the same upload, so the lights are checked, converted and copied once
 // and the effects stay side by side: none of them reads another's state. HybridEffects owns one for its effects.
 //
