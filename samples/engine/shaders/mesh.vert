@@ -21,8 +21,8 @@ layout(location = 1) out vec3 outNormal;
 layout(location = 2) out vec2 outUv;
 layout(location = 3) out vec4 outTangent;
 // This frame's and last frame's clip positions of the vertex, for the pre-pass's motion vectors (prepass.frag). A
-// vertex whose position, model matrix and camera did not change gets the same value twice, so its motion is exactly 0
-// (two evaluations of one expression may round differently: NVIDIA's compiler fuses them differently).
+// vertex whose position, model matrix and camera did not change gets this frame's twice, so its motion is exactly 0
+// (evaluating last frame's with the same inputs may round differently: NVIDIA's compiler fuses it differently).
 layout(location = 4) out vec4 outCurrentClip;
 layout(location = 5) out vec4 outPreviousClip;
 
@@ -39,7 +39,7 @@ void main() {
   gl_Position = frame.viewProj * position;
   mat4 previousModel = draw.model;
   if (draw.previousModels != uvec2(0)) previousModel = PreviousModels(draw.previousModels).models[draw.instance];
-  outCurrentClip = frame.viewProj * (draw.model * vec4(inPosition, 1.0));
+  outCurrentClip = gl_Position;
   const bool still = inPreviousPosition == inPosition && previousModel == draw.model &&
                      frame.previousViewProj == frame.viewProj;
   outPreviousClip = still ? outCurrentClip : frame.previousViewProj * (previousModel * vec4(inPreviousPosition, 1.0));

@@ -141,7 +141,6 @@ void Deformer::unload() {
   }
   instances_.clear();
   outputs_.clear();
-  previousPositions_.clear();
   hasPreviousFrame_ = false;
   sources_.clear();
   pendingWaits_.clear();
@@ -231,7 +230,6 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
     job.weightOffset = job.targetCount ? pose.weightOffset(i) : 0;
     instances_[k] = {i, inst.mesh, out[0].buffer, out[0].address, out[1].buffer, out[1].address, job.vertexCount};
     scene.instanceVertices[i] = {out[0].buffer, out[1].buffer, out[2].buffer};
-    previousPositions_.push_back(out[2].buffer);
   }
   Buffer staging;
   if (std::string e = gpu_->createBuffer(stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -270,7 +268,7 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
           attributes{0, 0, VkDeviceSize(d.vertexCount) * 36};
       vkCmdCopyBuffer(cmd, b.positions.buffer, d.positionBuffer, 1, &positions);
       vkCmdCopyBuffer(cmd, b.attributes.buffer, d.attributeBuffer, 1, &attributes);
-      vkCmdCopyBuffer(cmd, b.positions.buffer, previousPositions_[k], 1, &positions);
+      vkCmdCopyBuffer(cmd, b.positions.buffer, previousPositions(k), 1, &positions);
     }
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
@@ -313,13 +311,12 @@ std::string Deformer::submit(uint32_t slot, uint64_t value, const ScenePose& pos
                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
                 VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
                     VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
-  // Last frame's positions, kept for the pre-pass's motion vectors before the dispatch overwrites them.
-  for (size_t k = 0; k < instances_.size(); ++k) {
-    const VkBufferCopy region{0, 0, VkDeviceSize(instances_[k].vertexCount) * 12};
-    vkCmdCopyBuffer(cmd, instances_[k].positionBuffer, previousPositions_[k], 1, &region);
+  if (hasPreviousFrame_) {
+    // Last frame's positions, kept for the pre-pass's motion vectors before the dispatch overwrites them.
+    recordKeepPositions(cmd);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   }
-  memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
-                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   DeformConstants c{};
   c.jobs = jobs_.address;
@@ -335,10 +332,7 @@ std::string Deformer::submit(uint32_t slot, uint64_t value, const ScenePose& pos
     // The first frame of the scene has no previous one: last frame's positions are this frame's (no motion).
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-    for (size_t k = 0; k < instances_.size(); ++k) {
-      const VkBufferCopy region{0, 0, VkDeviceSize(instances_[k].vertexCount) * 12};
-      vkCmdCopyBuffer(cmd, instances_[k].positionBuffer, previousPositions_[k], 1, &region);
-    }
+    recordKeepPositions(cmd);
     hasPreviousFrame_ = true;
   }
   if (sl.timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, sl.timestamps, 1);
@@ -373,6 +367,15 @@ double Deformer::collectTimings(uint32_t slot) {
                             VK_QUERY_RESULT_64_BIT) != VK_SUCCESS)
     return 0.0;
   return double(ts[1] - ts[0]) * ctx_->timestampPeriodNs * 1e-6;
+}
+
+VkBuffer Deformer::previousPositions(size_t k) const { return outputs_[kOutputsPerInstance * k + 2].buffer; }
+
+void Deformer::recordKeepPositions(VkCommandBuffer cmd) const {
+  for (size_t k = 0; k < instances_.size(); ++k) {
+    const VkBufferCopy region{0, 0, VkDeviceSize(instances_[k].vertexCount) * 12};
+    vkCmdCopyBuffer(cmd, instances_[k].positionBuffer, previousPositions(k), 1, &region);
+  }
 }
 
 std::string Deformer::readbackPositions(uint32_t index, std::vector<glm::vec3>& out) {

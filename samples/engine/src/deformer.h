@@ -79,6 +79,11 @@ class Deformer {
   std::string readbackPositions(uint32_t index, std::vector<glm::vec3>& out);
 
  private:
+  // instances()[k]'s copy of last frame's positions (outputs_' third buffer of the instance).
+  VkBuffer previousPositions(size_t k) const;
+  // Records the copy of every instance's positions into its last-frame buffer.
+  void recordKeepPositions(VkCommandBuffer cmd) const;
+
   struct Slot {
     VkCommandPool pool = VK_NULL_HANDLE;
     VkCommandBuffer cmd = VK_NULL_HANDLE;
@@ -99,9 +104,8 @@ class Deformer {
   // Per instance: positions, attributes, last frame's positions (copied from the positions before each dispatch
   // overwrites them: the pre-pass's motion vectors).
   std::vector<Buffer> outputs_;
-  std::vector<VkBuffer> previousPositions_;  // outputs_' third buffer of each instance, in instances_ order
-  bool hasPreviousFrame_ = false;            // a submit() since load(): previousPositions_ hold a frame's pose
-  std::vector<Buffer> sources_;              // skin + morph data per mesh (empty Buffer for meshes that do not deform)
+  bool hasPreviousFrame_ = false;  // a submit() since load(): the last-frame positions hold a frame's pose
+  std::vector<Buffer> sources_;    // skin + morph data per mesh (empty Buffer for meshes that do not deform)
   Buffer jobs_, groupJobs_;
   std::vector<VkDeviceMemory> blocks_;
   VkDeviceSize jointBytes_ = 0, weightBytes_ = 0;

@@ -278,9 +278,8 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   {
     DescriptorWrites w;
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
-    const GBufferImage &motion = motionImage(g), &reactive = reactiveImage(g);
-    w.sampledImage(RB_RGB_TEMPORAL_BINDING_MOTION, motion.view, s.sampler, readLayout(motion));
-    w.sampledImage(RB_RGB_TEMPORAL_BINDING_REACTIVE, reactive.view, s.sampler, readLayout(reactive));
+    internal::writeReprojectionInputs(w, g, s.sampler, RB_RGB_TEMPORAL_BINDING_MOTION,
+                                      RB_RGB_TEMPORAL_BINDING_REACTIVE);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_SIGNAL, signal, s.sampler, ro);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_HISTORY_IN, im[prev].view, s.sampler, ro);
     w.sampledImage(RB_RGB_TEMPORAL_BINDING_SURFACE_IN, im[2 + prev].view, s.sampler, ro);
@@ -387,9 +386,7 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
   {
     DescriptorWrites w;
     w.sampledImage(RB_TEMPORAL_BINDING_DEPTH, g.depth.view, s.sampler, readLayout(g.depth));
-    const GBufferImage &motion = motionImage(g), &reactive = reactiveImage(g);
-    w.sampledImage(RB_TEMPORAL_BINDING_MOTION, motion.view, s.sampler, readLayout(motion));
-    w.sampledImage(RB_TEMPORAL_BINDING_REACTIVE, reactive.view, s.sampler, readLayout(reactive));
+    internal::writeReprojectionInputs(w, g, s.sampler, RB_TEMPORAL_BINDING_MOTION, RB_TEMPORAL_BINDING_REACTIVE);
     w.sampledImage(RB_TEMPORAL_BINDING_SIGNAL, signal, s.sampler, ro);
     w.sampledImage(RB_TEMPORAL_BINDING_HISTORY_IN, im[prev].view, s.sampler, ro);
     w.sampledImage(RB_TEMPORAL_BINDING_DISTANCE_IN, im[2 + prev].view, s.sampler, ro);
@@ -437,10 +434,9 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
 }
 
 // The constants every dispatch of a frame shares: the G-buffer's camera and layout (checked as the ray tracing
-// passes check them), and the reprojection from last frame's camera (previousViewProjection, cameraDelta). Also
-// returns this frame's camera position and rotation-only view-projection, which record() keeps for next frame.
-// The temporal pass's constants for `g`, reprojecting from the camera (`previousCamera`, `previousViewProjection`)
-// of the frame the history was written in; `camera` and `viewProjection` receive this frame's, kept for the next.
+// passes check them), and the reprojection from the camera the history was written from (`previousCamera`,
+// `previousViewProjection`). Also returns this frame's camera position and rotation-only view-projection, which
+// record() keeps for the next frame.
 Status prepareConstants(const GBufferDesc& g, uint64_t frame, const double previousCamera[3],
                         const double previousViewProjection[16], const char* who, DenoiseConstants& pc, uint32_t& flags,
                         double camera[3], double viewProjection[16]) {

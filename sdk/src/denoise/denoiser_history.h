@@ -7,6 +7,7 @@
 #include <raybridge/denoiser.h>
 
 #include "pass_constants.h"
+#include "ray_tracing_pipeline.h"
 
 namespace rb::internal {
 
@@ -18,5 +19,16 @@ DenoiseHistory historyFor(const Denoiser& denoiser, const GBufferDesc& g);
 // is the context's frame index; `who` names the caller in G-buffer errors.
 Status historyReprojection(const DenoiseHistory& history, const GBufferDesc& g, uint64_t frame, const char* who,
                            DenoiseConstants& pc);
+
+// Binds the G-buffer's motion vectors and reactive mask as every reader of a history binds them (the temporal passes,
+// adaptive rays, converged tiles): an image the G-buffer does not have is the depth image again, never read (its
+// RB_DN_MOTION / RB_DN_REACTIVE flag is off).
+inline void writeReprojectionInputs(DescriptorWrites& w, const GBufferDesc& g, VkSampler sampler,
+                                    uint32_t motionBinding, uint32_t reactiveBinding) {
+  const GBufferImage& motion = g.motionVectors.view ? g.motionVectors : g.depth;
+  const GBufferImage& reactive = g.reactiveMask.view ? g.reactiveMask : g.depth;
+  w.sampledImage(motionBinding, motion.view, sampler, readLayout(motion));
+  w.sampledImage(reactiveBinding, reactive.view, sampler, readLayout(reactive));
+}
 
 }  // namespace rb::internal

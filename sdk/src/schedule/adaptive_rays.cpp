@@ -168,9 +168,7 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
     DescriptorWrites w;
     const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     w.sampledImage(RB_ADAPTIVE_BINDING_DEPTH, g.depth.view, history.sampler, readLayout(g.depth));
-    const GBufferImage &motion = motionImage(g), &reactive = reactiveImage(g);
-    w.sampledImage(RB_ADAPTIVE_BINDING_MOTION, motion.view, history.sampler, readLayout(motion));
-    w.sampledImage(RB_ADAPTIVE_BINDING_REACTIVE, reactive.view, history.sampler, readLayout(reactive));
+    internal::writeReprojectionInputs(w, g, history.sampler, RB_ADAPTIVE_BINDING_MOTION, RB_ADAPTIVE_BINDING_REACTIVE);
     w.sampledImage(RB_ADAPTIVE_BINDING_HISTORY, history.mean, history.sampler, ro);
     w.sampledImage(RB_ADAPTIVE_BINDING_DISTANCE, history.distance, history.sampler, ro);
     w.storageImage(RB_ADAPTIVE_BINDING_WEIGHTS, images_[0].view);

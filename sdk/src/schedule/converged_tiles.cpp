@@ -115,9 +115,7 @@ Result<bool> ConvergedTiles::record(Context& ctx, VkCommandBuffer cmd, const GBu
 void ConvergedTiles::writeCommon(DescriptorWrites& w, const GBufferDesc& g, const TileClassifier& classifier) const {
   const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   w.sampledImage(RB_CONVERGED_BINDING_DEPTH, g.depth.view, history_.sampler, readLayout(g.depth));
-  const GBufferImage &motion = motionImage(g), &reactive = reactiveImage(g);
-  w.sampledImage(RB_CONVERGED_BINDING_MOTION, motion.view, history_.sampler, readLayout(motion));
-  w.sampledImage(RB_CONVERGED_BINDING_REACTIVE, reactive.view, history_.sampler, readLayout(reactive));
+  internal::writeReprojectionInputs(w, g, history_.sampler, RB_CONVERGED_BINDING_MOTION, RB_CONVERGED_BINDING_REACTIVE);
   w.sampledImage(RB_CONVERGED_BINDING_HISTORY, history_.mean, history_.sampler, ro);
   w.sampledImage(RB_CONVERGED_BINDING_DISTANCE, history_.distance, history_.sampler, ro);
   classifier.writeState(w, RB_CONVERGED_BINDING_STATE);

@@ -287,16 +287,6 @@ void cameraPosition(const GBufferDesc& gbuffer, double out[3]);
 
 VkImageLayout readLayout(const GBufferImage& image);
 
-// The motion vectors and the reactive mask, as every reader of a denoiser's history binds them (the temporal passes,
-// adaptive rays, converged tiles): an image the G-buffer does not have is the depth image again, never read (its
-// RB_DN_MOTION / RB_DN_REACTIVE flag is off).
-inline const GBufferImage& motionImage(const GBufferDesc& g) {
-  return g.motionVectors.view ? g.motionVectors : g.depth;
-}
-inline const GBufferImage& reactiveImage(const GBufferDesc& g) {
-  return g.reactiveMask.view ? g.reactiveMask : g.depth;
-}
-
 // Where the passes read roughness (rbRoughness, shaders/pass_inputs.glsl): the normal's .w when
 // GBufferDesc::roughnessInNormalW, else the roughness image's .x. The denoiser and converged reflection tiles read it
 // the same way, so that they agree with the pass on which pixels have a reflection.
