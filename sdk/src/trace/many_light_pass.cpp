@@ -45,8 +45,8 @@ struct ManyLightPass::Impl {
     if (schedule) schedule->retire(ctx);
   }
   Status ensureTiles(VkDeviceSize tileBytes);
-  // What both record()s share once the settings and the G-buffer are checked: the culling and the rays over
-  // `list` (nullptr = ownLights, staged and not yet uploaded: its upload is recorded inside the pass's time).
+  // What record() does once the frame is checked: the culling and the rays over `list` (nullptr = ownLights, staged
+  // and not yet uploaded: its upload is recorded inside the pass's time).
   Status trace(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const ManyLightSettings& settings,
                ManyLightConstants& pc, const LightListInfo* list);
 };
@@ -137,7 +137,7 @@ Result<std::unique_ptr<ManyLightPass>> ManyLightPass::create(Context& context, c
 
 namespace {
 
-// The settings' checks both record()s share; the message names the field.
+// The settings' checks; the message names the field.
 Status validateSettings(const ManyLightSettings& settings) {
   auto invalid = [](const std::string& m) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: " + m};
@@ -159,27 +159,21 @@ Status validateSettings(const ManyLightSettings& settings) {
   return {};
 }
 
-// The checks record() makes before it reads the lights: the command buffer, the settings, the G-buffer (into `pc`).
-Status checkRecord(VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas, const ManyLightSettings& settings,
-                   uint64_t frameIndex, ManyLightConstants& pc) {
-  if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: cmd is VK_NULL_HANDLE"};
-  if (Status st = validateSettings(settings); !st) return st;
-  return fillGBufferConstants(g, tlas, frameIndex, "ManyLightPass", pc.gbuffer);
-}
-
 }  // namespace
 
 Status ManyLightPass::record(VkCommandBuffer cmd, const ManyLightFrame& frame) {
   Impl& s = *impl_;
   const GBufferDesc& g = frame.gbuffer;
   const TlasInfo& tlas = frame.tlas;
+  if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "ManyLightPass: cmd is VK_NULL_HANDLE"};
   if (frame.lightList && !frame.lights.empty()) {
     return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
                  "ManyLightPass: ManyLightFrame has both lightList and " + std::to_string(frame.lights.size()) +
                      " lights; give one of them (the list when reflections or primary shading read the same lights)"};
   }
+  if (Status st = validateSettings(frame.settings); !st) return st;
   ManyLightConstants pc{};
-  if (Status st = checkRecord(cmd, g, tlas, frame.settings, s.ctx.frameIndex(), pc); !st) return st;
+  if (Status st = fillGBufferConstants(g, tlas, s.ctx.frameIndex(), "ManyLightPass", pc.gbuffer); !st) return st;
   if (!frame.lightList) {
     // The lights as an array (or none): uploaded into the pass's own list, inside its time.
     if (Status st = s.ownLights.stage(s.ctx, frame.lights, tlas, "ManyLightPass: "); !st) return st;
