@@ -47,6 +47,42 @@ float rbDnNoiseVariance(sampler2D signal, ivec2 ip, float mean, float frames) {
   return least;
 }
 
+// Which fraction of the history at `pp` (.x mean, .y frames) to keep for the pixel `ip`
+// whose raw signal is `signal`: 1 = all, 0 = start afresh from this frame. Compares the mean of the 3x3 surface
+// pixels around `ip` this frame with that of the 3x3 history texels around `pp`. The difference's noise: binomial
+// at the two means' average probability (at least 0.05 from 0 and 1, so that a converged 0 or 1 does not read as
+// noise-free) for the rays per pixel, one when unknown; over 9 pixels, and the history's share of it, each texel's by
+// its own frames (a neighbour that just started afresh is as noisy as this frame: counting it as converged would let
+// one reset trigger the next).
+float rbDnHistoryTrust(sampler2D signal, sampler2D depthImage, ivec2 ip, sampler2D historyIn, ivec2 pp) {
+  float c1 = 0.0, cn = 0.0, h1 = 0.0, hn = 0.0, hInverseFrames = 0.0;
+  for (int y = -1; y <= 1; ++y) {
+    for (int x = -1; x <= 1; ++x) {
+      ivec2 q = clamp(ip + ivec2(x, y), ivec2(0), ivec2(pc.size) - 1);
+      if (!rbDnSky(texelFetch(depthImage, q, 0).r)) {
+        float v = rbDnSignalValue(texelFetch(signal, q, 0).r);
+        c1 += v;
+        cn += 1.0;
+      }
+      vec2 h = texelFetch(historyIn, clamp(pp + ivec2(x, y), ivec2(0), ivec2(pc.size) - 1), 0).xy;
+      if (h.y > 0.0) {
+        h1 += h.x;
+        hn += 1.0;
+        hInverseFrames += 1.0 / h.y;
+      }
+    }
+  }
+  if (cn == 0.0 || hn == 0.0) return 1.0;
+  c1 /= cn;
+  h1 /= hn;
+  // Of one pixel's raw value. Rays unknown: as one binary ray, the most a signal in [0, 1] with that mean can vary
+  // (a window's own spread can be 0 by chance: nine equal values of a noisy signal).
+  float p = clamp(0.5 * (c1 + h1), 0.05, 0.95);
+  float variance = p * (1.0 - p) / max(pc.signalRaysPerPixel, 1.0);
+  float differenceVariance = variance / cn + variance * hInverseFrames / (hn * hn);
+  return rbDnLagTrust(abs(c1 - h1) * inversesqrt(differenceVariance), kRbDnLagSigmasLow, kRbDnLagSigmasHigh);
+}
+
 // The largest shift the filter may give a pixel, in standard deviations of its noise: a larger difference
 // between the filtered and the unfiltered value is more than noise explains (an edge, the curve of a penumbra),
 // and the shift then falls off as (limit / difference)^4. One: on the effects bench's demo scene (lavapipe, 160x90)

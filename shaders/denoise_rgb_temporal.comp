@@ -103,7 +103,10 @@ void main() {
       accumulated = h.rgb;
       variance = v;
     } else {
-      frames = min(floor(h.a + 0.5) + 1.0, float(pc.maxHistoryFrames));
+      float kept = floor(h.a + 0.5);
+      if ((pc.flags & RB_DN_ANTI_LAG) != 0u)
+        kept = floor(kept * rbDnRgbHistoryTrust(pixel, rel, gDepth, signalIn, gMotion, historyIn, surfaceIn));
+      frames = min(kept + 1.0, float(pc.maxHistoryFrames));
       float alpha = 1.0 / frames;
       accumulated = mix(h.rgb, value, alpha);
       variance = (1.0 - alpha) * (v + alpha * squared(value - h.rgb));

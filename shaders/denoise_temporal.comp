@@ -1,8 +1,10 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // Temporal accumulation with reprojection: each pixel finds where its surface was last frame (camera motion,
-// or the engine's motion vectors), checks that the same surface is there (view distance within a tolerance),
-// and blends its new noisy value into the history as a running mean over up to `max history` frames.
+// or the engine's motion vectors), reads the history there bilinearly from the texels that hold the same surface
+// (view distance within a tolerance),
+// and blends its new noisy value into the history as a running mean over up to `max history` frames, fewer where
+// the history disagrees with this frame's neighbourhood by more than its noise (anti-lag, rbDnHistoryTrust).
 // It also measures the noise left in that mean (denoise_noise.glsl), which the a-trous steps filter by: .g of
 // the value written is its variance.
 #include "denoise_noise.glsl"
@@ -44,8 +46,11 @@ void main() {
   float accumulated = value;
   float frames = 1.0;
   ivec2 pp;
-  if (rbDnFindHistory(pixel, rel, gMotion, gReactive, distanceIn, pp)) {
-    vec2 h = texelFetch(historyIn, pp, 0).xy;
+  vec2 h;
+  if (rbDnFindHistoryBilinear(pixel, rel, gMotion, gReactive, distanceIn, historyIn, h, pp)) {
+    // Anti-lag: a pixel not traced this frame brings nothing to compare against.
+    if (!kept && (pc.flags & RB_DN_ANTI_LAG) != 0u)
+      h.y = floor(h.y * rbDnHistoryTrust(signalIn, gDepth, ip, historyIn, pp));
     frames = min(kept ? max(h.y, 1.0) : h.y + 1.0, float(pc.maxHistoryFrames));
     accumulated = kept ? h.x : mix(h.x, value, 1.0 / frames);
   }

@@ -158,6 +158,9 @@
 // The G-buffer has a reactive mask (GBufferDesc::reactiveMask): a pixel whose .r exceeds 0.5 finds no history
 // (rbDnFindHistory), in the temporal passes and in every reader that must agree with them.
 #define RB_DN_REACTIVE 0x40u
+// Temporal passes: history whose neighbourhood mean disagrees with this frame's by more than the noise explains is
+// shortened (rbDnHistoryTrust, rbDnRgbHistoryTrust): a moved object, shadow or light is not dragged behind.
+#define RB_DN_ANTI_LAG 0x80u
 
 // Half-resolution tracing (AoConstants/ReflectionConstants::halfResolution): sample (i, j) of frame f traces for
 // G-buffer pixel (2i + x, 2j + y), clamped to the image, with (x, y) = (0,0), (1,1), (1,0), (0,1) for f mod 4 = 0..3:

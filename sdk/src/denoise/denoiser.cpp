@@ -502,6 +502,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const DenoiseFrame& frame) {
     flags |= RB_DN_RGB_REFLECTION | (roughnessInImage(g) ? RB_DN_RGB_ROUGHNESS_IMAGE : 0u);
   }
   if (internal::contextImpl(s.ctx).holdsKeptMarks(signal)) flags |= RB_DN_KEPT_MARKS;
+  if (!settings.disableAntiLag) flags |= RB_DN_ANTI_LAG;
   if (s.signal != DenoiseSignal::Scalar) {
     Status st = recordRgb(s, cmd, g, signal, settings, pc, flags);
     if (st) {
