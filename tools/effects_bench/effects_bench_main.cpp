@@ -9,6 +9,7 @@
 
 #include "effect_sweeps.h"
 #include "effects_bench_options.h"
+#include "motion_sweep.h"
 #include "report.h"
 
 namespace se = sample_engine;
@@ -83,10 +84,8 @@ int main(int argc, char** argv) {
   // and must not lose its measurements because that step failed.
   std::optional<RawRate> raw;
   std::string rawRateError;
-  if (!o.rawRateJson.empty()) {
-    RawRate r;
-    rawRateError = readRawRate(o.rawRateJson, r);
-    if (rawRateError.empty()) raw = r;
+  if (RawRate r; !o.rawRateJson.empty()) {
+    if (rawRateError = readRawRate(o.rawRateJson, r); rawRateError.empty()) raw = r;
     else
       std::fprintf(stderr, "raybridge-effects-bench: warning: %s; rays/s are reported without fractions\n",
                    rawRateError.c_str());
@@ -96,6 +95,12 @@ int main(int argc, char** argv) {
   FrameDriver::Config dc;
   dc.device = o.device;
   dc.validation = o.validation;
+  const bool motion = o.scenario == "motion";
+  MotionScene motionScene;
+  if (motion) {
+    motionScene = makeMotionScene(o.scenes.empty() ? RAYBRIDGE_SOURCE_DIR "/../shared/scenes" : o.scenes, o.characters);
+    dc.scene = motionScene.scene;
+  }
   auto created = FrameDriver::create(dc);
   if (!created) return fail(created.error);
   FrameDriver& driver = *created.value;
@@ -115,8 +120,15 @@ int main(int argc, char** argv) {
   const std::pair<rb::EffectBits, Sweep> sweeps[] = {{rb::kEffectShadows, runShadowSweep},
                                                      {rb::kEffectAo, runAoSweep},
                                                      {rb::kEffectReflections, runReflectionSweep}};
+  nlohmann::json motionResult;
+  if (motion) {
+    auto m = runMotionScenario(driver, motionScene,
+                               makeMotionPlan(o.quick, width, height, o.effects, o.images, o.noAntiLag));
+    if (!m) return fail(m.error);
+    motionResult = std::move(m.value);
+  }
   for (auto [flag, sweep] : sweeps) {
-    if (!(o.effects & flag)) continue;
+    if (motion || !(o.effects & flag)) continue;
     if (o.scenario == "adaptive" && flag == rb::kEffectReflections) continue;  // adaptive rays: shadows and AO
     auto r = o.scenario == "adaptive" ? runAdaptiveSweep(driver, plan, flag) : sweep(driver, plan);
     if (!r) return fail(r.error);
@@ -176,6 +188,12 @@ int main(int argc, char** argv) {
     doc["effects"][r.effect] = toJson(r, raw);
     checksPassed = checksPassed && r.checkFailures.empty();
   }
+  std::vector<std::string> motionFailures;
+  if (motion) {
+    doc["motion"] = motionResult;
+    motionFailures = motionChecks(motionResult, uint64_t(width) * height);
+    checksPassed = checksPassed && motionFailures.empty();
+  }
   doc["checks_passed"] = checksPassed;
   doc["validation"] = {{"enabled", o.validation}, {"errors", driver.engine().validationErrorCount()}};
   doc["seconds"] = seconds;
@@ -188,6 +206,10 @@ int main(int argc, char** argv) {
   std::printf("total %.1f s\n", seconds);
 
   int code = 0;
+  for (const std::string& f : motionFailures) {
+    std::fprintf(stderr, "raybridge-effects-bench: check failed: motion: %s\n", f.c_str());
+    code = 4;
+  }
   for (const EffectResult& r : results)
     for (const std::string& f : r.checkFailures) {
       std::fprintf(stderr, "raybridge-effects-bench: check failed: %s: %s\n", r.effect.c_str(), f.c_str());

@@ -10,8 +10,10 @@ namespace rbEffects {
 
 namespace {
 
-const std::vector<std::string> kEffectNames = {"shadows", "ao", "reflections"};  // bit i = name i
-static_assert(rb::kEffectShadows == 1 && rb::kEffectAo == 2 && rb::kEffectReflections == 4);
+// bit i = name i; local_lights: --scenario motion only (the other scenarios have no sweep for it)
+const std::vector<std::string> kEffectNames = {"shadows", "ao", "reflections", "local_lights"};
+static_assert(rb::kEffectShadows == 1 && rb::kEffectAo == 2 && rb::kEffectReflections == 4 &&
+              rb::kEffectLocalLights == 8);
 constexpr uint64_t kMaxReferenceRays = 1u << 20;
 
 // "N" (every effect) or "shadows=N,ao=N,reflections=N" (any subset); "" or an error without the option name.
@@ -54,21 +56,34 @@ void addOptions(CLI::App& app, Options& o) {
       "its error (RMSE over surface pixels) against a converged reference traced by Raybridge.");
   app.footer("Defaults: 1920x1080 on a GPU, 320x180 on a CPU device; --quick: tiny size, few settings, and checks.");
   app.add_option("--scenario", o.scenario,
-                 "what to measure: speed-vs-error (default), or adaptive (uniform against adaptive rays for shadows "
-                 "and ao, planned per pixel and per warp-sized tile, accumulated over frames)")
+                 "what to measure: speed-vs-error (default); adaptive (uniform against adaptive rays for shadows "
+                 "and ao, planned per pixel and per warp-sized tile, accumulated over frames); or motion (every "
+                 "denoised effect, local_lights too, frame by frame while the camera and the scene move: error, "
+                 "lag, flicker, disocclusion against a converged reference per frame)")
       ->type_name("NAME")
-      ->check(rbCli::oneOf({"speed-vs-error", "adaptive"}));
+      ->check(rbCli::oneOf({"speed-vs-error", "adaptive", "motion"}));
+  app.add_option("--characters", o.characters,
+                 "motion: skinned characters walking in the walkers case (default 3; 0 = no walkers case)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(0, 64));
+  app.add_flag("--no-anti-lag", o.noAntiLag, "motion: denoisers without anti-lag (DenoiseSettings::disableAntiLag)");
+  app.add_option("--scenes", o.scenes,
+                 "motion: folder of the character glTF models (default ../shared/scenes beside the source tree)")
+      ->type_name("DIR");
   app.add_option_function<std::string>(
          "--effects",
-         [&o](const std::string& value) { rbCli::parseNameSet(value, kEffectNames, "an effect", o.effects); },
-         "effects to sweep, comma-separated (default shadows,ao,reflections)")
+         [&o](const std::string& value) {
+           rbCli::parseNameSet(value, kEffectNames, "an effect", o.effects);
+           o.effectsGiven = true;
+         },
+         "effects to sweep, comma-separated (default shadows,ao,reflections; motion: also local_lights)")
       ->type_name("LIST")
       ->check(CLI::Validator(
           [](std::string& value) {
             uint32_t set = 0;
             std::string e = rbCli::parseNameSet(value, kEffectNames, "an effect", set);
             return !e.empty() ? e
-                   : set == 0 ? std::string("no effect given (shadows, ao, reflections)")
+                   : set == 0 ? std::string("no effect given (shadows, ao, reflections, local_lights)")
                               : std::string();
           },
           ""));
@@ -125,6 +140,9 @@ std::string parseOptions(int argc, char** argv, Options& o) {
   addOptions(app, o);
   if (std::string e = rbCli::parse(app, argc, argv, o.help); !e.empty() || o.help) return e;
   if (o.width.has_value() != o.height.has_value()) return "--width and --height go together";
+  if (o.scenario != "motion" && (o.effects & rb::kEffectLocalLights))
+    return "--effects local_lights: only --scenario motion measures local lights; drop it or add --scenario motion";
+  if (o.scenario == "motion" && !o.effectsGiven) o.effects = rb::kAllEffects;
   return {};
 }
 

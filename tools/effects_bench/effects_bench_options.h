@@ -11,7 +11,11 @@ namespace rbEffects {
 
 struct Options {
   std::string scenario = "speed-vs-error";
-  rb::EffectSet effects = rb::kThesisEffects;
+  rb::EffectSet effects = rb::kThesisEffects;  // motion: every effect unless --effects says otherwise
+  bool effectsGiven = false;
+  uint32_t characters = 3;  // motion: walkers
+  bool noAntiLag = false;   // motion: DenoiseSettings::disableAntiLag
+  std::string scenes;       // motion: character models; empty = ../shared/scenes beside the source tree
   // Empty: 1920x1080 on a GPU, 320x180 on a CPU device (lavapipe); --quick: 160x90.
   std::optional<uint32_t> width, height;
   std::string out;     // JSON file; empty = none

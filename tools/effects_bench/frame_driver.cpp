@@ -20,7 +20,8 @@ se::Result<std::unique_ptr<FrameDriver>> FrameDriver::create(const Config& confi
   if (!engine) return R::failure("engine: " + engine.error);
   d->engine_ = std::move(engine.value);
   se::Engine& e = *d->engine_;
-  if (se::Status s = e.loadScene(se::makeDefaultDemoScene()); !s) return R::failure("loadScene: " + s.error);
+  if (se::Status s = e.loadScene(config.scene ? *config.scene : se::makeDefaultDemoScene()); !s)
+    return R::failure("loadScene: " + s.error);
   if (config.width && config.height) {
     if (se::Status s = e.setRenderSize(config.width, config.height); !s) return R::failure(s.error);
   }
@@ -44,11 +45,15 @@ se::Result<std::unique_ptr<FrameDriver>> FrameDriver::create(const Config& confi
     // An effect that is off names a 1x1 neutral image: nothing to capture.
     const rb::EffectSet on = self->adapter_->effects().desc().effects;
     auto of = [&](rb::EffectSet effect, const rb::EffectImage& e) { return (on & effect) ? e.image : VK_NULL_HANDLE; };
-    const std::vector<rbRender::CaptureImage> images = {{"shadow_raw", of(rb::kEffectShadows, fo.shadowRaw), 1},
-                                                        {"shadow", of(rb::kEffectShadows, fo.shadow), 1},
-                                                        {"ao_raw", of(rb::kEffectAo, fo.aoRaw), 1},
-                                                        {"ao", of(rb::kEffectAo, fo.ao), 1},
-                                                        {"reflection", of(rb::kEffectReflections, fo.reflection), 4}};
+    const std::vector<rbRender::CaptureImage> images = {
+        {"shadow_raw", of(rb::kEffectShadows, fo.shadowRaw), 1},
+        {"shadow", of(rb::kEffectShadows, fo.shadow), 1},
+        {"ao_raw", of(rb::kEffectAo, fo.aoRaw), 1},
+        {"ao", of(rb::kEffectAo, fo.ao), 1},
+        {"reflection_raw", of(rb::kEffectReflections, fo.reflectionRaw), 4},
+        {"reflection", of(rb::kEffectReflections, fo.reflection), 4},
+        {"lights_raw", of(rb::kEffectLocalLights, fo.localLightsRaw), 4},
+        {"lights", of(rb::kEffectLocalLights, fo.localLights), 4}};
     if (se::Status s = self->capture_->record(info, info.normalRoughness, images); !s) self->captureError_ = s.error;
   });
   return R::success(std::move(d));

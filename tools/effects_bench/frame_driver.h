@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,8 @@ class FrameDriver {
     uint32_t width = 0, height = 0;  // 0 = decided by the caller after create() (see setRenderSize)
     std::string device;
     bool validation = false;
+    // The scene to load; empty = the default demo scene (makeDefaultDemoScene).
+    std::optional<sample_engine::Scene> scene;
   };
   // Creates the engine on a device with Raybridge's features, loads the default demo scene, creates the adapter
   // (shadows at first) and installs the hook. Never throws.
@@ -50,7 +53,8 @@ class FrameDriver {
       const sample_engine::FrameParams& params, uint32_t warmup, uint32_t timed,
       const std::function<void(uint32_t, sample_engine::FrameParams&)>& vary = {});
   // Renders one frame that also copies the depth and the adapter's effect images (named "shadow_raw",
-  // "shadow", "ao_raw", "ao", "reflection"; absent where the frame had none) to the host. The engine's
+  // "shadow", "ao_raw", "ao", "reflection_raw", "reflection", "lights_raw", "lights"; absent where the frame had
+  // none) to the host. The engine's
   // readbacks (readbackHdr, readbackShadowVisibility, readbackSsao) refer to this frame afterwards.
   // `sample` receives the frame's statistics when given.
   sample_engine::Result<rbRender::CapturedFrame> capture(const sample_engine::FrameParams& params,

@@ -1,0 +1,50 @@
+// --scenario motion: every denoised effect scored while the world and the camera move, frame by frame, against a
+// converged reference of that frame's exact pose and time (the same passes, many rays, no denoiser, accumulated over
+// frames with the scene frozen at that instant). Cases (motion_sweep.cpp): still, pan, turn, walkers, teleport, lamp
+// jump, door. Metrics per case, effect and ray count: RMSE over the surface, over the pixels whose reference changed
+// since the previous frame and over the newly visible ones; lag (frames after an event until the changed pixels'
+// error is within 1.5x of a still sequence's at the same frame); the steady-state ratio of a moving object's changed
+// pixels; flicker (mean absolute frame-to-frame change of the output against the reference's). See docs/effects.md,
+// "Motion".
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "frame_driver.h"
+#include "motion_scene.h"
+
+namespace rbEffects {
+
+struct MotionPlan {
+  uint32_t width = 0, height = 0;
+  uint32_t warmupFrames = 16;    // frames before the measured ones: the histories fill
+  uint32_t measuredFrames = 10;  // captured and scored
+  uint32_t eventFrame = 3;       // measured frame at which the pillar teleports and the lamp jumps
+  uint32_t referenceFrames = 4;  // per measured frame
+  uint32_t referenceRaysPerFrame = 64;
+  std::vector<uint32_t> rays = {1, 4, 16};
+  uint32_t stripRays = 4;  // the ray count whose teleport frames are written as PNGs
+  double fps = 30.0;
+  bool disableAntiLag = false;  // --no-anti-lag: DenoiseSettings::disableAntiLag, to measure what it buys
+  rb::EffectSet effects = 0;
+  std::string imagesDir;  // "" = no PNGs
+};
+
+// The published plan (GPU: 16 warm-up and 10 measured frames, references of 4 x 64 rays, 1, 4 and 16 rays) or, with
+// `quick`, the ctest smoke run's (every case at 4 rays, few frames).
+MotionPlan makeMotionPlan(bool quick, uint32_t width, uint32_t height, rb::EffectSet effects, const std::string& images,
+                          bool disableAntiLag);
+// The smoke run's self-checks on a report: the teleport changed the reference (the animation played) and the still
+// case did not (references frozen per frame, scene at rest: at most 2% of `pixels`, the references' noise). Returns
+// the failures.
+std::vector<std::string> motionChecks(const nlohmann::json& motion, uint64_t pixels);
+
+// Runs every case at every ray count; returns the "motion" part of the JSON report, and prints a summary table.
+sample_engine::Result<nlohmann::json> runMotionScenario(FrameDriver& driver, const MotionScene& scene,
+                                                        const MotionPlan& plan);
+
+}  // namespace rbEffects
