@@ -30,7 +30,13 @@ vec3 rbDnViewPosition(uvec2 pixel, float depth) {
 // the point relative to last frame's camera.
 vec2 rbDnPreviousPixel(uvec2 pixel, vec3 rel, sampler2D motion, out vec3 prevRel) {
   prevRel = rel + pc.cameraDelta;
-  if ((pc.flags & RB_DN_MOTION) != 0u) return vec2(pixel) + 0.5 - texelFetch(motion, ivec2(pixel), 0).xy;
+  if ((pc.flags & RB_DN_MOTION) != 0u) {
+    vec2 m = texelFetch(motion, ivec2(pixel), 0).xy;
+    // A NaN or infinite motion vector (an engine bug, a division by w = 0) has no previous pixel: off screen, so the
+    // pixel starts afresh instead of reading a history texel chosen by undefined float-to-int conversion.
+    if (any(isnan(m)) || any(isinf(m))) return vec2(-1e9);
+    return vec2(pixel) + 0.5 - m;
+  }
   vec4 clip = pc.previousViewProjection * vec4(prevRel, 1.0);
   return (clip.xy / clip.w * 0.5 + 0.5) * vec2(pc.size);
 }
@@ -100,11 +106,12 @@ bool rbDnKeptMark(float v) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && v < -
 // frame's by under kRbDnLagSigmasLow standard deviations of that difference's noise, not at all from
 // kRbDnLagSigmasHigh on, linearly between. Comparing means over the same footprint, not the pixel alone, is what
 // makes one-ray signals usable: a single binary ray says nothing, nine of them against a converged history do. The
-// low end sits above the noise (a still scene keeps its history; a 2.5-sigma excursion of the 3x3 mean is rare and
-// only trims it), the high end is met at once by an occluder that appears or leaves (a full-contrast change of the
-// mean is 6 sigmas at one ray and p = 0.5, 12 at four rays).
-const float kRbDnLagSigmasLow = 2.5;
-const float kRbDnLagSigmasHigh = 5.0;
+// low end sits above the noise (a still scene keeps its history: flicker unchanged on the motion tests), and the
+// ramp is short because a history kept in part keeps its stale value in part (tests/motion_lag_test.cpp, AO at 4
+// rays two frames after a teleport: 2.7x the still error with a 2.5 to 5 ramp, 1.8x with 3 to 3.5). A full-contrast
+// change of the mean is 6 sigmas at one ray and p = 0.5, 12 at four rays.
+const float kRbDnLagSigmasLow = 3.0;
+const float kRbDnLagSigmasHigh = 3.5;
 
 float rbDnLagTrust(float z, float low, float high) { return clamp((high - z) / (high - low), 0.0, 1.0); }
 

@@ -353,10 +353,13 @@ TEST_CASE("a camera move re-traces the tiles it disoccluded (soft shadows and AO
   REQUIRE(disoccluded > 0);
   CHECK(wrong == 0);
   CHECK(marked == s.tilesConverged);
-  // Everything else is traced: the denoised images agree with the reference's as in a static scene.
+  // Everything else is traced: the denoised images agree with the reference's as in a static scene. Not to the
+  // pixel: the traced run's anti-lag trims a few histories at sharp shadow edges the move shifted by a fraction of a
+  // pixel, which a skipped tile, with no new rays to compare, keeps (soft shadows: RMSE 0.024, 0.0046 with anti-lag
+  // off in both runs; AO 0.0071 either way).
   const Difference d = difference(p.denoised(*p.skipping), p.denoised(*p.plain), p.cpu);
   INFO("denoised after the move: RMSE " << d.rmse << ", max " << d.max);
-  CHECK(d.rmse < 0.02);
+  CHECK(d.rmse < (effect == Effect::Shadows ? 0.035 : 0.02));
 }
 
 TEST_CASE("bad converged-tile settings are named", "[shadow][converged][bad_input]") {

@@ -25,6 +25,16 @@ void keepFirst(std::string& error, std::string message) {
   if (error.empty()) error = std::move(message);
 }
 
+// A pre-pass image as Raybridge's hand-over: its view, layout and format stated, at the viewport's size (every
+// pre-pass image has it), so Raybridge checks them before it records anything.
+rb::GBufferImage gbufferImage(const se::PassImage& image, VkExtent2D extent) {
+  return {.view = image.view,
+          .layout = image.layout,
+          .format = image.format,
+          .width = extent.width,
+          .height = extent.height};
+}
+
 // The engine's materials as reflection hits shade them, and the texture table they index: base colour and
 // emissive as the engine's sRGB views, metallic-roughness as its UNORM views (G = roughness, B = metallic).
 void convertMaterials(const se::Scene& scene, std::span<const se::GpuTexture> gpu, std::vector<rb::Material>& out,
@@ -252,16 +262,16 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
   rb::HybridFrame f;
   rb::GBufferDesc& g = f.gbuffer;
   g.width = info.extent.width, g.height = info.extent.height;
-  g.depth = {info.depth.view, info.depth.layout}, g.depthFormat = info.depth.format;  // DEPTH_READ_ONLY_OPTIMAL
+  g.depth = gbufferImage(info.depth, info.extent), g.depthFormat = info.depth.format;  // DEPTH_READ_ONLY_OPTIMAL
   g.depthConvention = info.reversedZ ? rb::DepthConvention::ReversedZ : rb::DepthConvention::Standard;
-  g.geometricNormal = {info.geometricNormal.view, info.geometricNormal.layout};  // w = metallic, unused
+  g.geometricNormal = gbufferImage(info.geometricNormal, info.extent);  // w = metallic, unused
   // Pixels, current - previous: the denoisers follow moving and skinned objects, not only the camera.
-  g.motionVectors = {info.motionVectors.view, info.motionVectors.layout};
+  g.motionVectors = gbufferImage(info.motionVectors, info.extent);
   std::memcpy(g.view, &info.view[0][0], sizeof(g.view));
   std::memcpy(g.projection, &info.proj[0][0], sizeof(g.projection));
   for (int i = 0; i < 3; ++i) g.cameraPosition[i] = info.cameraPositionD[i];  // camera-relative TLAS and rays
   rb::GBufferDesc shading = g;  // roughness lives in normalRoughness.w: reflections read the shading normals
-  shading.normal = {info.normalRoughness.view, info.normalRoughness.layout};
+  shading.normal = gbufferImage(info.normalRoughness, info.extent);
   shading.roughnessInNormalW = true;
   g.normal = a.config.geometricNormals ? g.geometricNormal : shading.normal;
   g.roughnessInNormalW = !a.config.geometricNormals;

@@ -65,6 +65,9 @@ inline constexpr float kDefaultDenoiseConvergedNoise = 0.1f;
 
 // Default of DenoiseSettings::maxHistoryFrames: frames the temporal running mean averages at most.
 inline constexpr uint32_t kDefaultMaxHistoryFrames = 32;
+// The largest DenoiseSettings::maxHistoryFrames: the frame count is kept in a half float, exact to 2048; more is
+// refused by name (a negative int converted to uint32_t lands there too).
+inline constexpr uint32_t kMaxDenoiseHistoryFrames = 1024;
 
 struct DenoiseSettings {
   // false = accumulate over frames. Rgb: true still runs the temporal dispatch (it measures the noise), without
@@ -79,9 +82,10 @@ struct DenoiseSettings {
   // their weights follow the measured noise, so the wide reach only blurs where the signal is still noisy).
   // At most 6.
   uint32_t spatialIterations = 0;
-  uint32_t maxHistoryFrames = 0;  // 0 = kDefaultMaxHistoryFrames: the running mean forgets more slowly than this
-  float depthSigma = 0.0f;        // 0 = 0.005: plane-distance tolerance relative to view distance, per step
-  float normalPower = 0.0f;       // 0 = 32: exponent of the normal similarity weight
+  // 0 = kDefaultMaxHistoryFrames: the running mean forgets more slowly than this; at most kMaxDenoiseHistoryFrames.
+  uint32_t maxHistoryFrames = 0;
+  float depthSigma = 0.0f;   // 0 = 0.005: plane-distance tolerance relative to view distance, per step
+  float normalPower = 0.0f;  // 0 = 32: exponent of the normal similarity weight
   // Scalar signals: rays per pixel behind the signal, when it is a fraction of binary rays (shadow visibility,
   // binary AO): the noise is then binomial, and an edge that all rays agree on is kept.
   // 0 = unknown: the noise is estimated from the 3x3 neighbourhood, which also blurs thin noise-free features.

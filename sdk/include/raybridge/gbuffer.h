@@ -37,9 +37,12 @@
 //
 // Images: every G-buffer image is created with VK_IMAGE_USAGE_SAMPLED_BIT (the passes read it with texelFetch
 // through an unfiltered sampler) and its view has one aspect: COLOR, or DEPTH alone for the depth buffer (a view
-// of a depth-stencil image with both aspects cannot be sampled). Vulkan cannot be asked a view's aspect or an
-// image's usage, so GBufferImage::usage and ::aspectMask state them; where stated they are checked before anything
-// is recorded, with an error naming the field. A combined depth-stencil depthFormat requires depth.aspectMask.
+// of a depth-stencil image with both aspects cannot be sampled). Each is the G-buffer's size (GBufferDesc::width,
+// height), and its format is one a float sampler reads (no UINT/SINT): a depth format for depth, a colour format
+// for the others. Vulkan cannot be asked a view's aspect or format or an image's usage or size, so
+// GBufferImage::usage, ::aspectMask, ::format, ::width and ::height state them; where stated they are checked before
+// anything is recorded, with an error naming the field. A combined depth-stencil depthFormat requires
+// depth.aspectMask.
 //
 // Conventions: none of its own. Raybridge inverts the view and projection it is given, so a left- or right-handed
 // world, Y-up or Y-down, a projection that flips Y and reversed-Z (DepthConvention) all work, as long as the
@@ -80,6 +83,16 @@ struct GBufferImage {
   // The view's subresourceRange.aspectMask. 0 = not stated: COLOR, or DEPTH for GBufferDesc::depth. Stated, it
   // must be COLOR (DEPTH alone for the depth buffer): a depth view with the STENCIL aspect is an error.
   VkImageAspectFlags aspectMask = 0;
+  // The view's format, as the engine created it. UNDEFINED = not stated (not checked); stated, it must suit the
+  // field: for depth a depth format equal to GBufferDesc::depthFormat (UNDEFINED there = D32_SFLOAT); for the
+  // others no depth/stencil and no UINT/SINT format; for motionVectors a signed float of two or more channels
+  // (R16G16_SFLOAT, R32G32_SFLOAT or their 3- and 4-channel SFLOAT forms: motion is in pixels, so UNORM and SNORM
+  // are refused); for reactiveMask one with a red channel, not block-compressed (R8_UNORM, R16_SFLOAT, RGBA8, ...).
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  // The image's extent (VkImageCreateInfo::extent). 0 and 0 = not stated (not checked); stated, both must equal
+  // GBufferDesc::width and height: every G-buffer image is the G-buffer's size.
+  uint32_t width = 0;
+  uint32_t height = 0;  // 0 = not stated; see width
 };
 
 struct GBufferDesc {

@@ -38,27 +38,4 @@ Error vulkanError(VkResult result, const std::string& what) {
                what + " failed: " + toString(result) + " (" + std::to_string(static_cast<int>(result)) + ")"};
 }
 
-const char* formatName(VkFormat format) {
-  switch (format) {
-#define RB_CASE(f) \
-  case f: return #f;
-    RB_CASE(VK_FORMAT_UNDEFINED)
-    RB_CASE(VK_FORMAT_R32G32B32_SFLOAT)
-    RB_CASE(VK_FORMAT_R32G32_SFLOAT)
-    RB_CASE(VK_FORMAT_R32G32B32A32_SFLOAT)
-    RB_CASE(VK_FORMAT_R16G16B16A16_SFLOAT)
-    RB_CASE(VK_FORMAT_R16G16_SFLOAT)
-    RB_CASE(VK_FORMAT_R16G16B16A16_SNORM)
-    RB_CASE(VK_FORMAT_R16G16_SNORM)
-    RB_CASE(VK_FORMAT_R8G8B8A8_UNORM)
-    RB_CASE(VK_FORMAT_R8G8B8A8_SNORM)
-    RB_CASE(VK_FORMAT_R32_SFLOAT)
-    RB_CASE(VK_FORMAT_R32_UINT)
-    RB_CASE(VK_FORMAT_R16_SFLOAT)
-    RB_CASE(VK_FORMAT_D32_SFLOAT)
-#undef RB_CASE
-    default: return "VkFormat(other)";
-  }
-}
-
 }  // namespace rb

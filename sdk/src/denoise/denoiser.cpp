@@ -479,6 +479,12 @@ Status Denoiser::record(VkCommandBuffer cmd, const DenoiseFrame& frame) {
   if (!cmd) return invalid("cmd is VK_NULL_HANDLE");
   if (!signal) return invalid("DenoiseFrame::signal is VK_NULL_HANDLE; pass the noisy image's view");
   if (settings.spatialIterations > 6) return invalid("DenoiseSettings::spatialIterations exceeds 6");
+  if (settings.maxHistoryFrames > kMaxDenoiseHistoryFrames) {
+    return invalid("DenoiseSettings::maxHistoryFrames " + std::to_string(settings.maxHistoryFrames) + " exceeds " +
+                   std::to_string(kMaxDenoiseHistoryFrames) +
+                   " (a negative count converted to unsigned?); 0 = the default of " +
+                   std::to_string(kDefaultMaxHistoryFrames));
+  }
   if (settings.disableTemporal && settings.disableSpatial) {
     return invalid("both temporal and spatial filtering are disabled; use the raw signal instead");
   }

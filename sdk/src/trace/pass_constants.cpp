@@ -1,8 +1,9 @@
 #include "pass_constants.h"
 
+#include "vulkan_formats.h"
+
 #include <cmath>
 #include <string>
-#include <utility>
 
 namespace rb {
 
@@ -76,11 +77,12 @@ bool isCombinedDepthStencil(VkFormat f) {
   return f == VK_FORMAT_D32_SFLOAT_S8_UINT || f == VK_FORMAT_D24_UNORM_S8_UINT || f == VK_FORMAT_D16_UNORM_S8_UINT;
 }
 
+// What a G-buffer field holds, which decides the formats it may have.
+enum class ImageRole : uint8_t { Depth, Color, Motion, Reactive };
+
 // One G-buffer image against the hand-over contract of gbuffer.h ("Images"): a sampled-read layout, and where
 // the engine states them, SAMPLED usage and a single aspect. Returns "" when it holds, else the message.
-std::string checkImage(const GBufferImage& image, const char* field, bool depth) {
-  if (!image.view) return {};
-  const std::string name = std::string("GBufferDesc::") + field;
+std::string checkImage(const GBufferImage& image, const std::string& name, bool depth) {
   switch (image.layout) {
     case VK_IMAGE_LAYOUT_UNDEFINED:
     case VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL:
@@ -113,6 +115,66 @@ std::string checkImage(const GBufferImage& image, const char* field, bool depth)
   return {};
 }
 
+// Why a stated motion-vector format cannot hold motion in pixels, or "" when it can: a signed float of two or
+// more 16- or 32-bit channels.
+std::string motionFormatProblem(const FormatTraits& t) {
+  if (t.read == FormatRead::Float && t.hasSign && !t.bits64 && t.channels >= 2) return {};
+  if (t.read == FormatRead::Compressed) return "is block-compressed";
+  if (t.channels == 1) return "has one channel, and the passes read motion from .xy";
+  if (t.read == FormatRead::Normalized || t.read == FormatRead::Scaled) {
+    return "is normalized: motion is in pixels, so a [0, 1] or [-1, 1] range clamps it";
+  }
+  if (t.read == FormatRead::Float && !t.hasSign) return "has no sign bit, and motion is signed";
+  return "is not a signed float format of two or more 16- or 32-bit channels";
+}
+
+// GBufferImage::format (where stated) against what the passes read from the field. "" when it holds.
+std::string checkFormat(const GBufferImage& image, const std::string& name, ImageRole role) {
+  if (image.format == VK_FORMAT_UNDEFINED) return {};
+  const FormatTraits t = formatTraits(image.format);
+  const std::string stated = name + ".format " + formatName(image.format);
+  if (role == ImageRole::Depth) {
+    if (t.hasDepth) return {};
+    return stated + " is not a depth format: the passes read hardware depth from this field; pass a view of the " +
+           "depth buffer's DEPTH aspect and state the depth image's format";
+  }
+  if (t.read == FormatRead::DepthStencil) {
+    return stated + " is a depth/stencil format, and this field is a colour image: pass the view of the colour " +
+           "image the engine wrote it to (only GBufferDesc::depth is a depth buffer)";
+  }
+  if (t.read == FormatRead::Integer) {
+    return stated + " is an integer format, which the passes' float samplers cannot read: store it in a UNORM " +
+           "or SFLOAT format";
+  }
+  if (role == ImageRole::Motion) {
+    if (std::string problem = motionFormatProblem(t); !problem.empty()) {
+      return stated + " " + problem + ": motion vectors are pixels (current - previous) in .xy; create the image " +
+             "as VK_FORMAT_R16G16_SFLOAT (or R32G32_SFLOAT, or an SFLOAT format with more channels)";
+    }
+  }
+  if (role == ImageRole::Reactive) {
+    if (t.read == FormatRead::Compressed) {
+      return stated + " is block-compressed: the reactive mask is a per-pixel .r the engine writes; use " +
+             "VK_FORMAT_R8_UNORM (or any UNORM or SFLOAT colour format)";
+    }
+    if (t.read != FormatRead::Unknown && !t.hasRed) {
+      return stated + " has no red channel, and the passes read the mask from .r (alpha-only formats read 0 " +
+             "there): use VK_FORMAT_R8_UNORM";
+    }
+  }
+  return {};
+}
+
+// GBufferImage::width/height (where stated) against the G-buffer's size. "" when they match.
+std::string checkExtent(const GBufferImage& image, const std::string& name, const GBufferDesc& g) {
+  if (image.width == 0 && image.height == 0) return {};
+  if (image.width == g.width && image.height == g.height) return {};
+  return name + ".width x .height " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+         " is not the G-buffer's size " + std::to_string(g.width) + "x" + std::to_string(g.height) +
+         " (GBufferDesc::width x height): every G-buffer image must be the G-buffer's size, pixel for pixel; " +
+         "render or copy it at that size (or leave both at 0: not stated)";
+}
+
 }  // namespace
 
 Status validateGBufferImages(const GBufferDesc& g, const char* passName) {
@@ -125,15 +187,34 @@ Status validateGBufferImages(const GBufferDesc& g, const char* passName) {
                    "subresourceRange.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT and set GBufferDesc::depth.aspectMask "
                    "to VK_IMAGE_ASPECT_DEPTH_BIT to say so");
   }
-  const std::pair<const GBufferImage*, const char*> images[] = {{&g.depth, "depth"},
-                                                                {&g.normal, "normal"},
-                                                                {&g.geometricNormal, "geometricNormal"},
-                                                                {&g.roughnessMetalness, "roughnessMetalness"},
-                                                                {&g.albedo, "albedo"},
-                                                                {&g.motionVectors, "motionVectors"},
-                                                                {&g.reactiveMask, "reactiveMask"}};
-  for (const auto& [image, field] : images) {
-    if (std::string m = checkImage(*image, field, image == &g.depth); !m.empty()) return invalid(m);
+  struct Field {
+    const GBufferImage& image;
+    const char* name;
+    ImageRole role;
+  };
+  const Field fields[] = {{g.depth, "depth", ImageRole::Depth},
+                          {g.normal, "normal", ImageRole::Color},
+                          {g.geometricNormal, "geometricNormal", ImageRole::Color},
+                          {g.roughnessMetalness, "roughnessMetalness", ImageRole::Color},
+                          {g.albedo, "albedo", ImageRole::Color},
+                          {g.motionVectors, "motionVectors", ImageRole::Motion},
+                          {g.reactiveMask, "reactiveMask", ImageRole::Reactive}};
+  for (const Field& f : fields) {
+    if (!f.image.view) continue;
+    const std::string name = std::string("GBufferDesc::") + f.name;
+    for (const std::string& m : {checkImage(f.image, name, f.role == ImageRole::Depth),
+                                 checkFormat(f.image, name, f.role), checkExtent(f.image, name, g)}) {
+      if (!m.empty()) return invalid(m);
+    }
+  }
+  // The depth quantum comes from depthFormat: a stated depth.format that differs would offset ray origins wrongly.
+  const VkFormat depthFormat = g.depthFormat == VK_FORMAT_UNDEFINED ? VK_FORMAT_D32_SFLOAT : g.depthFormat;
+  if (g.depth.view && g.depth.format != VK_FORMAT_UNDEFINED && g.depth.format != depthFormat) {
+    return invalid("GBufferDesc::depth.format " + formatName(g.depth.format) +
+                   " differs from GBufferDesc::depthFormat " + formatName(g.depthFormat) +
+                   (g.depthFormat == VK_FORMAT_UNDEFINED ? " (= D32_SFLOAT)" : "") +
+                   ", which sets how far ray origins are offset (one step of the stored depth): set depthFormat to the "
+                   "depth image's format");
   }
   return {};
 }
