@@ -7,8 +7,9 @@
 #                                                          the failure-injection cases, tlas, the TLAS
 #                                                          benchmarks alone (with the tlas-motion runs of
 #                                                          earlier builds carried as bin/raybridge-bench-X),
-#                                                          and trace, the primary-ray rate against the probe,
-#                                                          run only when named)
+#                                                          trace, the primary-ray rate against the probe, and
+#                                                          motion, the motion benchmark at 2560x1440, run only
+#                                                          when named)
 #
 # Results go to $OUT (the device tool brings that folder back, at most 8 files): bench_gpu.json, bench_gpu.log,
 # tests_gpu.log, effects_gpu.json, effects_gpu.log, render_gpu.tar.gz (render logs, stats.json and final.png
@@ -34,7 +35,7 @@ set -u
 
 MODE="${1:-all}"
 for m in ${MODE//,/ }; do
-  case "$m" in all|bench|tests|inject|render|effects|animated|lights|perf|adaptive|soak|tlas|trace) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, inject, render, effects, animated, lights, perf, adaptive, soak, tlas or trace" >&2; exit 2 ;; esac
+  case "$m" in all|bench|tests|inject|render|effects|animated|lights|perf|adaptive|soak|tlas|trace|motion) ;; *) echo "usage: $0 [all|MODE[,MODE...]] with MODE bench, tests, inject, render, effects, animated, lights, perf, adaptive, soak, tlas, trace or motion" >&2; exit 2 ;; esac
 done
 want() { [ "$MODE" = all ] || [[ ",$MODE," == *",$1,"* ]]; }
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -347,6 +348,21 @@ if want perf; then
     --renders "$PDIR" --command "bash scripts/gpu/run_remote.sh perf" --out "$OUT/perf_gpu.json"
   grep -E '^(perf|demo)|trace (primary|stress)|GPU ms|^in place|^device copy|^copy' "$OUT/perf_gpu.log" | head -n 80
   tar -C "$PDIR" -czf "$OUT/perf_render_gpu.tar.gz" --exclude='*.exr' --exclude='*.png' . 2>/dev/null
+fi
+# ---- motion: raybridge-effects-bench --scenario motion (docs/effects.md, "Motion") at RB_MOTION_SIZE (default
+# 2560x1440), every case at 1, 4 and 16 rays, with the walking characters from the carried models; the JSON and the
+# teleport strip's PNGs come back as motion_gpu.json and motion_images_gpu.tar.gz. RB_MOTION_ARGS adds arguments
+# (e.g. --no-anti-lag). Validation off. Run only when named (not part of all).
+if [[ ",$MODE," == *,motion,* ]]; then
+  : >"$OUT/motion_gpu.log"
+  MIMG="$(mktemp -d)"
+  read -r MW MH <<<"${RB_MOTION_SIZE:-2560 1440}"
+  read -r -a MARGS <<<"${RB_MOTION_ARGS:-}"
+  RAYBRIDGE_VALIDATION=0 step "effects motion" "${RB_MOTION_SECONDS:-420}" "$OUT/motion_gpu.log" \
+    "$RT/bin/raybridge-effects-bench" --scenario motion --width "$MW" --height "$MH" --scenes "$SCENES" \
+    --images "$MIMG" --out "$OUT/motion_gpu.json" "${MARGS[@]}"
+  grep -E '^motion:' "$OUT/motion_gpu.log" | grep -v reference | head -n 120
+  tar -C "$MIMG" -czf "$OUT/motion_images_gpu.tar.gz" . 2>/dev/null
 fi
 # ---- adaptive: docs/performance.md's "trace only where needed" and half resolution. The probe, then
 # raybridge-effects-bench --scenario adaptive (uniform against adaptive rays after 8 accumulated frames) and the

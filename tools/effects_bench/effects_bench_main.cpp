@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
   nlohmann::json motionResult;
   if (motion) {
     auto m = runMotionScenario(driver, motionScene,
-                               makeMotionPlan(o.quick, width, height, o.effects, o.images, o.noAntiLag));
+                               makeMotionPlan(o.quick, width, height, o.effects, o.images, o.noAntiLag, o.motionRays));
     if (!m) return fail(m.error);
     motionResult = std::move(m.value);
   }
@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
     if (!r) return fail(r.error);
     results.push_back(std::move(r.value));
   }
-  printTables(results, raw);
+  if (!motion) printTables(results, raw);
 
   const se::FrameParams& base = driver.baseParams();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

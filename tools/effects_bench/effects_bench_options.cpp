@@ -66,6 +66,9 @@ void addOptions(CLI::App& app, Options& o) {
                  "motion: skinned characters walking in the walkers case (default 3; 0 = no walkers case)")
       ->type_name("N")
       ->check(rbCli::wholeNumber(0, 64));
+  app.add_option("--motion-rays", o.motionRays, "motion: rays per pixel of the denoised sequences (default 1 4 16)")
+      ->type_name("N ...")
+      ->check(rbCli::wholeNumber(1, 64));
   app.add_flag("--no-anti-lag", o.noAntiLag, "motion: denoisers without anti-lag (DenoiseSettings::disableAntiLag)");
   app.add_option("--scenes", o.scenes,
                  "motion: folder of the character glTF models (default ../shared/scenes beside the source tree)")

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <raybridge/presets.h>
 
@@ -13,9 +14,10 @@ struct Options {
   std::string scenario = "speed-vs-error";
   rb::EffectSet effects = rb::kThesisEffects;  // motion: every effect unless --effects says otherwise
   bool effectsGiven = false;
-  uint32_t characters = 3;  // motion: walkers
-  bool noAntiLag = false;   // motion: DenoiseSettings::disableAntiLag
-  std::string scenes;       // motion: character models; empty = ../shared/scenes beside the source tree
+  uint32_t characters = 3;           // motion: walkers
+  bool noAntiLag = false;            // motion: DenoiseSettings::disableAntiLag
+  std::vector<uint32_t> motionRays;  // motion: rays per pixel of the denoised sequences; empty = 1, 4, 16
+  std::string scenes;                // motion: character models; empty = ../shared/scenes beside the source tree
   // Empty: 1920x1080 on a GPU, 320x180 on a CPU device (lavapipe); --quick: 160x90.
   std::optional<uint32_t> width, height;
   std::string out;     // JSON file; empty = none

@@ -29,11 +29,16 @@ struct MotionEffect {
   const char* raw = "";  // FrameDriver::capture names
   const char* denoised = "";
   bool rgb = false;
+  rb::PassStats rb::HybridStats::*pass = nullptr;
+  rb::PassStats rb::HybridStats::*denoise = nullptr;
 };
-const MotionEffect kEffects[] = {{"shadows", rb::kEffectShadows, "shadow_raw", "shadow", false},
-                                 {"ao", rb::kEffectAo, "ao_raw", "ao", false},
-                                 {"reflections", rb::kEffectReflections, "reflection_raw", "reflection", true},
-                                 {"local_lights", rb::kEffectLocalLights, "lights_raw", "lights", true}};
+using HS = rb::HybridStats;
+const MotionEffect kEffects[] = {
+    {"shadows", rb::kEffectShadows, "shadow_raw", "shadow", false, &HS::shadow, &HS::shadowDenoise},
+    {"ao", rb::kEffectAo, "ao_raw", "ao", false, &HS::ao, &HS::aoDenoise},
+    {"reflections", rb::kEffectReflections, "reflection_raw", "reflection", true, &HS::reflection,
+     &HS::reflectionDenoise},
+    {"local_lights", rb::kEffectLocalLights, "lights_raw", "lights", true, &HS::localLights, &HS::localLightsDenoise}};
 // A pixel's converged value changed: by 0.2 of visibility / open fraction, or 20% of the frame's mean colour (the
 // references' own noise, 256 rays at p = 0.5: 0.03 a pixel, 0.044 between two frames, stays well under it).
 constexpr float kChangeThreshold = 0.2f;
@@ -56,6 +61,7 @@ struct Frame {
   std::vector<uint8_t> surface;
   std::vector<glm::vec2> motion;
   std::map<std::string, EffectFrame> effects;  // "<effect>" (denoised) and "<effect>_raw"
+  rb::HybridStats stats;                       // the frame's GPU ms and rays per pass
 };
 
 se::Result<EffectFrame> extract(const rbRender::CapturedFrame& f, const char* name, bool rgb) {
@@ -187,9 +193,11 @@ se::Status Runner::setDesc(uint32_t rays, bool reference) {
 
 se::Result<Frame> Runner::capture(const se::FrameParams& params, bool withOutputs) {
   using R = se::Result<Frame>;
-  auto cap = driver_.capture(params);
+  FrameSample sample;
+  auto cap = driver_.capture(params, &sample);
   if (!cap) return R::failure(cap.error);
   Frame f;
+  f.stats = sample.passes;
   f.surface = surfaceMask(cap.value.depth);
   f.viewDepth = viewDepth(cap.value.depth, params.camera.zNear, params.camera.zFar, false);
   auto mv = driver_.engine().readbackMotionVectors();
@@ -261,12 +269,14 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
                              const std::vector<Frame>& frames, const std::vector<Frame>& control) {
   const uint32_t m = plan_.measuredFrames;
   const uint32_t w = plan_.width, h = plan_.height;
-  std::vector<double> all, raw, changed, disoccluded, flickerOut, flickerRef;
+  std::vector<double> all, raw, changed, disoccluded, flickerOut, flickerRef, passMs, denoiseMs;
   std::vector<uint64_t> changedCount, disoccludedCount;
   for (uint32_t j = 0; j < m; ++j) {
     const Frame& f = frames[j];
     const Frame& r = refs[j];
     all.push_back(rmseOver(f.effects.at(e.name), r.effects.at(e.name), f.surface));
+    passMs.push_back((f.stats.*e.pass).gpuMs);
+    denoiseMs.push_back((f.stats.*e.denoise).gpuMs);
     raw.push_back(rmseOver(f.effects.at(e.name + "_raw"), r.effects.at(e.name), f.surface));
     if (j == 0) continue;
     const std::vector<uint8_t> surfaces = both(f.surface, frames[j - 1].surface);
@@ -288,6 +298,8 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
                       {"disoccluded_pixels", disoccludedCount},
                       {"flicker", flickerOut},
                       {"flicker_reference", flickerRef},
+                      {"pass_gpu_ms_median", median(passMs)},
+                      {"denoise_gpu_ms_median", median(denoiseMs)},
                       {"rmse_mean", mean(all)},
                       {"rmse_raw_mean", mean(raw)}};
   const double fo = mean(flickerOut), fr = mean(flickerRef);
@@ -416,7 +428,7 @@ se::Result<nlohmann::json> Runner::run() {
 }  // namespace
 
 MotionPlan makeMotionPlan(bool quick, uint32_t width, uint32_t height, rb::EffectSet effects, const std::string& images,
-                          bool disableAntiLag) {
+                          bool disableAntiLag, const std::vector<uint32_t>& rays) {
   MotionPlan mp;
   mp.width = width;
   mp.height = height;
@@ -431,6 +443,8 @@ MotionPlan makeMotionPlan(bool quick, uint32_t width, uint32_t height, rb::Effec
     mp.referenceRaysPerFrame = 16;
     mp.rays = {4};
   }
+  if (!rays.empty()) mp.rays = rays;
+  mp.stripRays = mp.rays.size() > 1 ? mp.rays[1] : mp.rays[0];
   return mp;
 }
 

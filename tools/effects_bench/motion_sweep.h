@@ -35,9 +35,9 @@ struct MotionPlan {
 };
 
 // The published plan (GPU: 16 warm-up and 10 measured frames, references of 4 x 64 rays, 1, 4 and 16 rays) or, with
-// `quick`, the ctest smoke run's (every case at 4 rays, few frames).
+// `quick`, the ctest smoke run's (every case at 4 rays, few frames); `rays` (when not empty) replaces the ray counts.
 MotionPlan makeMotionPlan(bool quick, uint32_t width, uint32_t height, rb::EffectSet effects, const std::string& images,
-                          bool disableAntiLag);
+                          bool disableAntiLag, const std::vector<uint32_t>& rays);
 // The smoke run's self-checks on a report: the teleport changed the reference (the animation played) and the still
 // case did not (references frozen per frame, scene at rest: at most 2% of `pixels`, the references' noise). Returns
 // the failures.

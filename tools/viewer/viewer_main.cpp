@@ -1,7 +1,9 @@
 // raybridge-viewer: the sample engine in a GLFW window with the Raybridge adapter, toggling at run time between
 // the engine's own terms (shadow map, SSAO, reflection probe) and Raybridge's ray-traced shadows, AO and
 // reflections, and between presets, with a Dear ImGui overlay (viewer_overlay.h, viewer_panel.h) showing the
-// controls and the statistics. Combines exactly one platform side (the engine's GLFW Window) with the adapter.
+// controls and the statistics, and any effect shown raw, denoised or as its history length behind it
+// (viewer_inspect.h, drawn by viewer_backdrop.h). Combines exactly one platform side (the engine's GLFW Window) with
+// the adapter.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,6 +19,8 @@
 #include "sample_engine/gltf_loader.h"
 #include "sample_engine/procedural.h"
 #include "sample_engine/window.h"
+#include "viewer_backdrop.h"
+#include "viewer_inspect.h"
 #include "viewer_overlay.h"
 #include "viewer_panel.h"
 
@@ -33,6 +37,7 @@ struct Options {
   bool validation = false;
   bool overlay = true;            // the ImGui window is shown at start (F1 toggles it)
   bool screenshotOverlay = true;  // the screenshot shows the overlay when it is shown
+  rbViewer::Inspect inspect;      // the view at start (default: the lit frame)
 };
 
 const char* kKeys =
@@ -79,6 +84,20 @@ int parse(int argc, char** argv, Options& o, bool& exitNow) {
           [](std::string& value) {
             return rb::parsePreset(value) ? std::string()
                                           : rbCli::quote(value) + " is not a preset (" + rb::presetNames() + ")";
+          },
+          ""));
+  app.add_option_function<std::string>(
+         "--inspect", [&o](const std::string& value) { o.inspect = *rbViewer::parseInspect(value); },
+         "start showing one effect instead of the lit frame (the overlay's inspect control):\n"
+         "raw (before denoising), denoised, or history (the denoiser's history length, black\n"
+         "0 frames to white the maximum); e.g. ao:history. Default: lit.\n" +
+             rbViewer::inspectNames())
+      ->type_name("EFFECT:VIEW")
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            return rbViewer::parseInspect(value)
+                       ? std::string()
+                       : rbCli::quote(value) + " is not a view (" + rbViewer::inspectNames() + ")";
           },
           ""));
   app.add_flag("--validation", o.validation,
@@ -154,6 +173,8 @@ struct Viewer {
   std::unique_ptr<se::Engine> engine;
   std::unique_ptr<rbAdapter::Adapter> adapter;
   std::unique_ptr<rbViewer::ImGuiOverlay> overlay;
+  std::unique_ptr<rbViewer::Backdrop> backdrop;
+  rbViewer::Inspect inspect;  // what the backdrop shows, read by the overlay hook
   bool overlayAttached = false;
 
   Viewer() = default;
@@ -202,7 +223,15 @@ std::string createViewer(const Options& o, const se::Scene& scene, Viewer& v) {
   auto overlay = rbViewer::ImGuiOverlay::create(static_cast<GLFWwindow*>(window.glfwHandle()));
   if (!overlay) return "overlay: " + overlay.error;
   v.overlay = std::move(overlay.value);
-  engine.setOverlayHook(v.overlay->hook());
+  v.backdrop = std::make_unique<rbViewer::Backdrop>();
+  v.inspect = o.inspect;
+  // The inspected image under the UI. Asked for in the hook, after this frame's effects were recorded: a history
+  // ping-pongs, so only then does the front end name the image this frame wrote.
+  engine.setOverlayHook([&v, ui = v.overlay->hook()](const se::OverlayHookInfo& info) {
+    v.backdrop->record(info,
+                       rbViewer::inspectImage(v.adapter->effects(), v.adapter->settings().enabled, v.inspect).image);
+    ui(info);
+  });
   v.overlayAttached = true;
   return {};
 }
@@ -217,6 +246,8 @@ struct Session {
         rt(*v.adapter),
         fx(rt.effects()),
         overlay(*v.overlay),
+        backdrop(*v.backdrop),
+        inspect(v.inspect),
         keys{static_cast<GLFWwindow*>(window.glfwHandle())},
         preset(o.preset),
         localLights(!engine.scene().lights.empty()),
@@ -235,6 +266,8 @@ struct Session {
   rbAdapter::Adapter& rt;
   rb::HybridEffects& fx;
   rbViewer::ImGuiOverlay& overlay;
+  const rbViewer::Backdrop& backdrop;
+  rbViewer::Inspect& inspect;
   Keys keys;
 
   rb::Preset preset;
@@ -258,6 +291,10 @@ struct Session {
                 rt.settings().enabled ? "hybrid" : "raster", rb::toString(preset), effectsToString(d.effects).c_str(),
                 shadowRays(d) > 1 ? "soft" : "hard", shadowRays(d), aoRays(d), denoiseOn(d) ? "on" : "off",
                 glm::degrees(sunAzimuth), glm::degrees(sunElevation));
+    if (inspect.view == rbViewer::InspectView::LitFrame) return;
+    const bool off = !(d.effects & rbViewer::effectBit(inspect.effect));
+    std::printf("inspect %s:%s%s\n", rbViewer::toString(inspect.effect), rbViewer::toString(inspect.view),
+                off ? " (that effect is off: the lit frame is shown)" : "");
   }
   void setDesc(const rb::HybridEffectsDesc& d) {
     if (rb::Status s = fx.setDesc(d); !s) std::fprintf(stderr, "raybridge-viewer: %s\n", s.error().message.c_str());
@@ -318,6 +355,8 @@ struct Session {
     m.shadowRays = (d.effects & rb::kEffectShadows) ? shadowRays(d) : 0u;
     m.aoRays = (d.effects & rb::kEffectAo) ? aoRays(d) : 0u;
     m.paused = paused;
+    m.inspect = inspect;
+    m.inspectNote = rbViewer::inspectImage(fx, m.hybrid, inspect).note;
     m.sunAzimuthDegrees = glm::degrees(sunAzimuth);
     m.sunElevationDegrees = glm::degrees(sunElevation);
     m.frameMs = frameMs;
@@ -332,6 +371,7 @@ struct Session {
     if (req.toggleEffects) toggleEffects(req.toggleEffects);
     if (req.toggleSoftShadows) toggleSoftShadows();
     if (req.toggleDenoise) toggleDenoise();
+    if (req.inspect) inspect = *req.inspect, printState();
     engineTerms();
   }
 
@@ -340,6 +380,7 @@ struct Session {
     if (withOverlay) drawPanel();
     se::Status s = engine.renderFrame(params);
     if (s && !overlay.lastError().empty()) return se::Status::failure("overlay: " + overlay.lastError());
+    if (s && !backdrop.lastError().empty()) return se::Status::failure("inspect view: " + backdrop.lastError());
     return s;
   }
 
@@ -481,6 +522,7 @@ int main(int argc, char** argv) {
   std::printf("rendered %u frames\n", session.frames);
   engine.setOverlayHook({});
   viewer.overlay.reset();
+  viewer.backdrop.reset();
   engine.setPrepassHook({});
   viewer.adapter.reset();
   if (o.validation) {

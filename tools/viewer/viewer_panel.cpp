@@ -33,6 +33,38 @@ void effectToggle(const char* label, rb::EffectBits bit, const PanelModel& m, Pa
   if (ImGui::Checkbox(label, &on)) r.toggleEffects |= bit;
 }
 
+// Which effect (among those enabled) to show, and how; the lit frame by default.
+void inspectControls(const PanelModel& m, PanelRequests& r) {
+  // Wide enough for the longest name and the arrow.
+  auto comboWidth = [](const char* longest) {
+    return ImGui::CalcTextSize(longest).x + ImGui::GetFrameHeight() + 2 * ImGui::GetStyle().FramePadding.x;
+  };
+  ImGui::TextUnformatted("inspect");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(comboWidth("reflections"));
+  if (ImGui::BeginCombo("##inspect effect", toString(m.inspect.effect))) {
+    for (uint32_t i = 0; i < kInspectEffectCount; ++i) {
+      const InspectEffect e = InspectEffect(i);
+      if (!(m.effects & effectBit(e))) continue;
+      if (ImGui::Selectable(toString(e), e == m.inspect.effect)) r.inspect = Inspect{e, m.inspect.view};
+    }
+    ImGui::EndCombo();
+  }
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(comboWidth("history length"));
+  if (ImGui::BeginCombo("##inspect view", label(m.inspect.view))) {
+    for (uint32_t i = 0; i < kInspectViewCount; ++i) {
+      const InspectView v = InspectView(i);
+      if (ImGui::Selectable(label(v), v == m.inspect.view)) r.inspect = Inspect{m.inspect.effect, v};
+    }
+    ImGui::EndCombo();
+  }
+  if (!m.inspectNote.empty()) {
+    ImGui::SameLine();
+    ImGui::TextDisabled("%s", m.inspectNote.c_str());
+  }
+}
+
 }  // namespace
 
 PanelRequests drawPanel(const PanelModel& m) {
@@ -73,6 +105,7 @@ PanelRequests drawPanel(const PanelModel& m) {
   if (ImGui::Checkbox("denoise (N)", &denoise)) r.toggleDenoise = true;
   ImGui::Text("rays/pixel: shadows %u, AO %u   sun az %.0f el %.0f deg%s", m.shadowRays, m.aoRays, m.sunAzimuthDegrees,
               m.sunElevationDegrees, m.paused ? "   (paused)" : "");
+  inspectControls(m, r);
 
   // --- GPU time ---
   if (ImGui::CollapsingHeader("GPU passes", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -1,6 +1,6 @@
-// The viewer's ImGui window: mode, preset, effect and denoise toggles, per-pass GPU times and rays/s, the
-// acceleration structures' statistics and the SDK's memory by category. It only shows what it is given and
-// returns what the user asked for; the viewer applies those requests exactly as it applies its keys.
+// The viewer's ImGui window: mode, preset, effect and denoise toggles, the inspect view (viewer_inspect.h), per-pass
+// GPU times and rays/s, the acceleration structures' statistics and the SDK's memory by category. It only shows what it
+// is given and returns what the user asked for; the viewer applies those requests exactly as it applies its keys.
 #pragma once
 
 #include <optional>
@@ -9,6 +9,7 @@
 #include <raybridge/raybridge.h>
 
 #include "sample_engine/engine.h"
+#include "viewer_inspect.h"
 
 namespace rbViewer {
 
@@ -21,6 +22,8 @@ struct PanelModel {
   bool denoise = true;
   uint32_t shadowRays = 0, aoRays = 0;  // effective rays per pixel (1 shadow ray = hard shadows)
   bool paused = false;                  // animation clock
+  Inspect inspect;                      // what the window shows behind the panel
+  std::string inspectNote;              // why that is not quite what was asked for ("" = it is)
   float sunAzimuthDegrees = 0.0f, sunElevationDegrees = 0.0f;
   double frameMs = 0.0;               // CPU time between frames, smoothed
   sample_engine::PassTimings engine;  // the engine's passes (hookMs holds everything Raybridge recorded)
@@ -36,6 +39,7 @@ struct PanelRequests {
   rb::EffectSet toggleEffects = 0;  // effects to switch on or off
   bool toggleDenoise = false;
   bool toggleSoftShadows = false;
+  std::optional<Inspect> inspect;
 };
 
 // Draws the window (between ImGuiOverlay::beginFrame and endFrame).
