@@ -64,12 +64,34 @@ bool rbDnFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D reactive
   return prevDist > 0.0 && abs(prevDist - length(prevRel)) <= 0.02 * length(prevRel) + 1e-3;
 }
 
-// The temporal pass's own read of the history (rbDnFindHistory's test, texel by texel): bilinear over the four
-// texels around the reprojected point, each kept only where it holds the same surface. Nearest-texel reprojection
-// drifts: a camera that moves 0.3 px a frame rounds to the same texel every frame, so the history stays behind the
-// image and a moving camera drags shadows several pixels (measured: the motion bench's pan and turn, denoised
-// shadows 3x the raw error). Returns whether any texel holds the surface: then `h` is (mean, frames) and `pp` the
-// nearest texel (rbDnFindHistory's, the anti-lag window's centre).
+// The bilinear footprint of a reprojected point in last frame's history (both temporal passes): the four texels
+// around `prevPixel` (continuous, texel centres at .5) from `base`, texel k at base + (k & 1, k >> 1), weighted
+// bilinearly where the texel holds the same surface (its stored view distance, .x of `distanceIn`, within 2% of
+// `expected`, rbDnFindHistory's test) and 0 elsewhere, outside the image too. Returns the weights' sum: about 0 when no
+// texel holds the surface. Nearest-texel reads drift: a camera that moves 0.3 px a frame rounds to the same texel
+// every frame, so the history stays behind the image (the motion bench's pan and turn: denoised shadows dragged
+// several pixels, 3x the raw error).
+float rbDnBilinearSameSurface(vec2 prevPixel, float expected, sampler2D distanceIn, out ivec2 base, out vec4 w) {
+  vec2 f = prevPixel - 0.5;
+  base = ivec2(floor(f));
+  vec2 t = f - vec2(base);
+  float sum = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    ivec2 o = ivec2(k & 1, k >> 1);
+    ivec2 q = base + o;
+    w[k] = 0.0;
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(pc.size)))) continue;
+    float prevDist = texelFetch(distanceIn, q, 0).x;
+    if (!(prevDist > 0.0 && abs(prevDist - expected) <= 0.02 * expected + 1e-3)) continue;
+    w[k] = (o.x == 1 ? t.x : 1.0 - t.x) * (o.y == 1 ? t.y : 1.0 - t.y);
+    sum += w[k];
+  }
+  return sum;
+}
+
+// The scalar temporal pass's own read of the history: rbDnFindHistory's test texel by texel, over the bilinear
+// footprint (rbDnBilinearSameSurface). Returns whether any texel holds the surface: then `h` is (mean, frames) and
+// `pp` the nearest texel (rbDnFindHistory's, the anti-lag window's centre).
 bool rbDnFindHistoryBilinear(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D reactive, sampler2D distanceIn,
                              sampler2D historyIn, out vec2 h, out ivec2 pp) {
   h = vec2(0.0);
@@ -77,22 +99,12 @@ bool rbDnFindHistoryBilinear(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D 
   vec2 prevPixel = rbDnPreviousPixel(pixel, rel, motion, prevRel);
   pp = ivec2(floor(prevPixel));
   if ((pc.flags & RB_DN_HISTORY) == 0u || rbDnReactive(pixel, reactive)) return false;
-  vec2 f = prevPixel - 0.5;
-  ivec2 base = ivec2(floor(f));
-  vec2 t = f - vec2(base);
-  float expected = length(prevRel);
-  float weights = 0.0;
-  for (int k = 0; k < 4; ++k) {
-    ivec2 o = ivec2(k & 1, k >> 1);
-    ivec2 q = base + o;
-    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(pc.size)))) continue;
-    float prevDist = texelFetch(distanceIn, q, 0).r;
-    if (!(prevDist > 0.0 && abs(prevDist - expected) <= 0.02 * expected + 1e-3)) continue;
-    float w = (o.x == 1 ? t.x : 1.0 - t.x) * (o.y == 1 ? t.y : 1.0 - t.y);
-    h += w * texelFetch(historyIn, q, 0).xy;
-    weights += w;
-  }
+  ivec2 base;
+  vec4 w;
+  float weights = rbDnBilinearSameSurface(prevPixel, length(prevRel), distanceIn, base, w);
   if (weights <= 1e-3) return false;
+  for (int k = 0; k < 4; ++k)
+    if (w[k] > 0.0) h += w[k] * texelFetch(historyIn, base + ivec2(k & 1, k >> 1), 0).xy;
   h /= weights;
   h.y = floor(h.y + 0.5);
   return true;

@@ -26,33 +26,26 @@ bool rbDnRgbKeptMark(float a) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && a 
 // Its history is stale: it starts afresh, as a disoccluded pixel does.
 bool rbDnRgbStaleMark(float a) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && a > 1.5; }
 
-// Where the surface at `pixel` (camera-relative position `rel`) was in the latest history, read bilinearly over the
-// four history texels around the reprojected point, each kept only where it holds the same surface (its distance
-// from last frame's camera matches); nearest-texel reprojection would drift and blur the history by up to half a
-// pixel every frame the camera moves. Returns whether any did: then `h` is the history (rgb mean, a frames) and `v`
-// the variance of one frame's colour there; none where the engine's reactive mask is set (rbDnReactive). The temporal
-// pass's test, shared with the converged reflection tiles, which must find the history it finds.
+// Where the surface at `pixel` (camera-relative position `rel`) was in the latest history, read over the bilinear
+// footprint of the texels that hold the same surface (rbDnBilinearSameSurface). Returns whether any did: then `h` is
+// the history (rgb mean, a frames) and `v` the variance of one frame's colour there; none where the engine's reactive
+// mask is set (rbDnReactive). The temporal pass's test, shared with the converged reflection tiles, which must find
+// the history it finds.
 bool rbDnRgbFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D reactive, sampler2D historyIn,
                         sampler2D surfaceIn, out vec4 h, out float v) {
   h = vec4(0.0);
   v = 0.0;
   if ((pc.flags & RB_DN_HISTORY) == 0u || rbDnReactive(pixel, reactive)) return false;
   vec3 prevRel;
-  vec2 f = rbDnPreviousPixel(pixel, rel, motion, prevRel) - 0.5;
-  ivec2 base = ivec2(floor(f));
-  vec2 t = f - vec2(base);
-  float expected = length(prevRel);
-  float weights = 0.0;
+  vec2 prevPixel = rbDnPreviousPixel(pixel, rel, motion, prevRel);
+  ivec2 base;
+  vec4 w;
+  float weights = rbDnBilinearSameSurface(prevPixel, length(prevRel), surfaceIn, base, w);
   for (int k = 0; k < 4; ++k) {
-    ivec2 o = ivec2(k & 1, k >> 1);
-    ivec2 pp = base + o;
-    if (any(lessThan(pp, ivec2(0))) || any(greaterThanEqual(pp, ivec2(pc.size)))) continue;
-    vec2 prevSurface = texelFetch(surfaceIn, pp, 0).xy;
-    if (!(prevSurface.x > 0.0 && abs(prevSurface.x - expected) <= 0.02 * expected + 1e-3)) continue;
-    float w = (o.x == 1 ? t.x : 1.0 - t.x) * (o.y == 1 ? t.y : 1.0 - t.y);
-    h += w * texelFetch(historyIn, pp, 0);
-    v += w * prevSurface.y;
-    weights += w;
+    if (w[k] <= 0.0) continue;
+    ivec2 q = base + ivec2(k & 1, k >> 1);
+    h += w[k] * texelFetch(historyIn, q, 0);
+    v += w[k] * texelFetch(surfaceIn, q, 0).y;
   }
   if (weights <= 1e-3) return false;
   h /= weights;

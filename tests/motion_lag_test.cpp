@@ -158,6 +158,12 @@ double rmseOver(const std::vector<float>& a, const std::vector<float>& b, const 
 
 const char* name(Effect e) { return e == Effect::Shadow ? "shadow" : "ao"; }
 
+// Pixel `i` sees the same surface point in both worlds (the ground where the box is in neither).
+bool sameSurface(const World& a, const World& b, size_t i) {
+  return a.cpu.hit[i] && b.cpu.hit[i] && a.cpu.instance[i] == b.cpu.instance[i] &&
+         glm::length(a.cpu.position[i] - b.cpu.position[i]) <= 1e-3;
+}
+
 }  // namespace
 
 TEST_CASE("anti-lag drops a teleported occluder's stale shadow and AO history at once", "[denoise][motion]") {
@@ -171,9 +177,7 @@ TEST_CASE("anti-lag drops a teleported occluder's stale shadow and AO history at
       std::vector<uint8_t> changed(size_t(kW) * kH, 0);
       size_t count = 0;
       for (size_t i = 0; i < changed.size(); ++i) {
-        if (!before.cpu.hit[i] || !after.cpu.hit[i] || before.cpu.instance[i] != after.cpu.instance[i] ||
-            glm::length(before.cpu.position[i] - after.cpu.position[i]) > 1e-3)
-          continue;
+        if (!sameSurface(before, after, i)) continue;
         if (std::fabs(refBefore[i] - refAfter[i]) > 0.2f) changed[i] = 1, ++count;
       }
       INFO(count << " changed pixels");
@@ -288,8 +292,7 @@ TEST_CASE("anti-lag resets history where the picture changed and nowhere else", 
       for (uint32_t y = 0; y < kH; ++y)
         for (uint32_t x = 0; x < kW; ++x) {
           const size_t i = size_t(y) * kW + x;
-          const bool other = before.cpu.hit[i] != after.cpu.hit[i] || before.cpu.instance[i] != after.cpu.instance[i] ||
-                             glm::length(before.cpu.position[i] - after.cpu.position[i]) > 1e-3;
+          const bool other = (before.cpu.hit[i] || after.cpu.hit[i]) && !sameSurface(before, after, i);
           if (other || std::fabs(refBefore[i] - refAfter[i]) > 0.15f)
             for (int dy = -2; dy <= 2; ++dy)
               for (int dx = -2; dx <= 2; ++dx) {
@@ -304,9 +307,8 @@ TEST_CASE("anti-lag resets history where the picture changed and nowhere else", 
         if (!changed[i] && reset) ++farReset;
         // A large change (shadows: an umbra that left or arrived; AO: 0.4 of the open fraction, 4.5 sigmas of the 3x3
         // mean's noise at 4 rays): always detected.
-        const bool sameSurface = before.cpu.hit[i] && before.cpu.instance[i] == after.cpu.instance[i] &&
-                                 glm::length(before.cpu.position[i] - after.cpu.position[i]) <= 1e-3;
-        if (sameSurface && std::fabs(refBefore[i] - refAfter[i]) > (effect == Effect::Shadow ? 0.6f : 0.4f)) {
+        if (sameSurface(before, after, i) &&
+            std::fabs(refBefore[i] - refAfter[i]) > (effect == Effect::Shadow ? 0.6f : 0.4f)) {
           ++big;
           bigReset += last[i] < 4.0f ? 1 : 0;  // kept at most a short part of its history
         }

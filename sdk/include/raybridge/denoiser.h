@@ -1,8 +1,12 @@
 // Denoising for ray-traced signals: single-channel ones (shadow visibility, AO), RGB HDR ones (the many-light
 // irradiance of ManyLightPass) and reflections (ReflectionPass), chosen by DenoiserDesc::signal. Temporal
 // accumulation with reprojection (camera motion, or the engine's motion vectors when GBufferDesc::motionVectors is
-// given), followed by an edge-aware a-trous spatial filter guided by depth and normals. Each signal needs its own
-// Denoiser (it keeps that signal's history). The raw input is left untouched, so raw and denoised are both
+// given; the history read bilinearly from the texels that hold the same surface), followed by an edge-aware a-trous
+// spatial filter guided by depth and normals. Under motion the history follows what changed: a pixel whose history
+// is on another surface (disocclusion), whose motion vector is not finite, or whose engine reactive mask is set
+// starts afresh, and anti-lag shortens the history where its 3x3 mean disagrees with this frame's by more than the
+// noise explains (a moved object, shadow, reflection or light; DenoiseSettings::disableAntiLag). Each signal needs its
+// own Denoiser (it keeps that signal's history). The raw input is left untouched, so raw and denoised are both
 // available.
 //
 // Scalar signals: the filtering follows the noise measured in the data. The temporal pass estimates the variance
