@@ -350,8 +350,9 @@ se::Status Runner::writeStrip(const Case& c, const std::vector<Frame>& refs, con
       const std::pair<const char*, const EffectFrame*> images[] = {{"raw", &frames[j].effects.at(e.name + "_raw")},
                                                                    {"denoised", &frames[j].effects.at(e.name)},
                                                                    {"reference", &refs[j].effects.at(e.name)}};
-      for (auto [kind, img] : images) {
+      for (const auto& [kind, image] : images) {
         const std::string id = c.name + "_" + kind + "_f" + std::to_string(int(j) - int(plan_.eventFrame));
+        const EffectFrame* img = image;  // Clang before 16 cannot capture a structured binding
         SweepPlan sp;
         sp.imagesDir = plan_.imagesDir;
         auto written = writeImage(sp, "motion/" + e.name, id, [&](const std::string& path) {
