@@ -30,14 +30,15 @@ bool rbDnRgbStaleMark(float a) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && a
 // footprint of the texels that hold the same surface (rbDnBilinearSameSurface). Returns whether any did: then `h` is
 // the history (rgb mean, a frames) and `v` the variance of one frame's colour there; none where the engine's reactive
 // mask is set (rbDnReactive). The temporal pass's test, shared with the converged reflection tiles, which must find
-// the history it finds.
+// the history it finds. `pp`: the nearest history texel (the anti-lag window's centre).
 bool rbDnRgbFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D reactive, sampler2D historyIn,
-                        sampler2D surfaceIn, out vec4 h, out float v) {
+                        sampler2D surfaceIn, out vec4 h, out float v, out ivec2 pp) {
   h = vec4(0.0);
   v = 0.0;
-  if ((pc.flags & RB_DN_HISTORY) == 0u || rbDnReactive(pixel, reactive)) return false;
   vec3 prevRel;
   vec2 prevPixel = rbDnPreviousPixel(pixel, rel, motion, prevRel);
+  pp = ivec2(floor(prevPixel));
+  if ((pc.flags & RB_DN_HISTORY) == 0u || rbDnReactive(pixel, reactive)) return false;
   ivec2 base;
   vec4 w;
   float weights = rbDnBilinearSameSurface(prevPixel, length(prevRel), surfaceIn, base, w);
@@ -52,29 +53,31 @@ bool rbDnRgbFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D react
   v /= weights;
   return true;
 }
+bool rbDnRgbFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D reactive, sampler2D historyIn,
+                        sampler2D surfaceIn, out vec4 h, out float v) {
+  ivec2 pp;
+  return rbDnRgbFindHistory(pixel, rel, motion, reactive, historyIn, surfaceIn, h, v, pp);
+}
 
 // Anti-lag of the RGB signals (RB_DN_ANTI_LAG; as rbDnHistoryTrust for scalar ones): which fraction of the history
-// (rbDnRgbFindHistory) the pixel keeps. The mean colour of the 3x3
-// pixels around it this frame (surface pixels; reflections: those with coverage) against that of the 3x3 history
-// texels around where it was (those with history); the squared distance of the two in units of its noise (the
-// variance of one frame's colour, at least this frame's 3x3 spread, over 9 pixels, plus the history's share, each
-// texel's by its own frames (a neighbour that just started afresh is as noisy as this frame), plus a 1% floor of the colour so that a
-// noise-free signal tolerates half-float rounding and a sub-pixel shift of its texture). A moved object seen in a
-// reflection, or a light that switched on, differs by many sigmas; noise by about one.
+// (rbDnRgbFindHistory, whose nearest texel is `pp`) the pixel at `ip` keeps. The mean colour of the 3x3 pixels around
+// it this frame (surface pixels; reflections: those with coverage) against that of the 3x3 history texels around
+// `pp` (those with history): the distance of the two in units of its noise. The noise: one frame's variance (below)
+// over the 9 pixels, plus the history's share, each texel's by its own frames (a neighbour that just started afresh
+// is as noisy as this frame), plus a 1% floor of the colour, so that a noise-free signal tolerates half-float
+// rounding and a sub-pixel shift of its texture. A moved object seen in a reflection, or a light that switched on,
+// differs by many sigmas; noise by about one.
 // RGB signals are heavy-tailed (a light sampled with a small probability, a reflected highlight): a rare bright
 // sample moves a 3x3 mean by more sigmas than binary noise does, and trimming the history on it keeps that sample at
-// a large weight (a colour bias). Hence the pooled variance above, and thresholds a little above the scalar ones
-// (red+blue light test, 1 ray, 16 frames: blue 1.036 of exact at 3 / 6, as without anti-lag; 1.086 at 5 / 10 with
-// one pixel's variance; a short ramp, as the scalar one's, for the same reason).
+// a large weight (a colour bias). Hence the pooled variance below, and thresholds a little above the scalar ones
+// (red+blue light test, 1 ray, 16 frames: blue 1.036 of exact, as without anti-lag; 1.086 with one pixel's variance
+// and 5 / 10); the ramp is short, as the scalar one, for the same reason.
 const float kRbDnRgbLagSigmasLow = 3.5;
 const float kRbDnRgbLagSigmasHigh = 4.0;
 
-float rbDnRgbHistoryTrust(uvec2 pixel, vec3 rel, sampler2D depthImage, sampler2D signal, sampler2D motion,
-                          sampler2D historyIn, sampler2D surfaceIn) {
+float rbDnRgbHistoryTrust(ivec2 ip, ivec2 pp, sampler2D depthImage, sampler2D signal, sampler2D historyIn,
+                          sampler2D surfaceIn) {
   const bool reflection = (pc.flags & RB_DN_RGB_REFLECTION) != 0u;
-  vec3 prevRel;
-  ivec2 pp = ivec2(floor(rbDnPreviousPixel(pixel, rel, motion, prevRel)));
-  ivec2 ip = ivec2(pixel);
   vec3 c1 = vec3(0.0), h1 = vec3(0.0), gx = vec3(0.0), gy = vec3(0.0);
   float c2 = 0.0, cn = 0.0, hn = 0.0, hInverseFrames = 0.0, pooled = 0.0;
   for (int y = -1; y <= 1; ++y) {
@@ -102,11 +105,10 @@ float rbDnRgbHistoryTrust(uvec2 pixel, vec3 rel, sampler2D depthImage, sampler2D
   c1 /= cn;
   h1 /= hn;
   // One frame's variance: the history's, pooled over the 3x3 texels (one pixel's recurrence starts at 0 and, on
-  // heavy-tailed samples, reads low until a rare one comes), at least this frame's window spread about its plane
-  // (with the plain spread, a lamp's steep falloff read as noise and its jump went unseen: lamp jump, 4 rays, changed
-  // pixels 0.21 at the event against 0.06 now).
-  // The window's spread less its plane (mean and two slopes, as spatialVariance: a light's smooth falloff is not
-  // noise; 6 degrees of freedom remain), with all 9 pixels on the surface; else none.
+  // heavy-tailed samples, reads low until a rare one comes), at least this frame's window spread about its plane:
+  // less its mean and two slopes, as spatialVariance, 6 degrees of freedom left, with all 9 pixels on the surface
+  // (the plain spread read a lamp's steep falloff as noise and its jump went unseen: lamp jump, 4 rays, changed
+  // pixels 0.21 at the event against 0.10).
   float spread = cn == 9.0 ? max(c2 - 9.0 * dot(c1, c1) - dot(gx, gx) / 6.0 - dot(gy, gy) / 6.0, 0.0) / 6.0 : 0.0;
   float variance = max(pooled / hn, spread);
   vec3 floorNoise = 0.01 * (abs(c1) + abs(h1)) + 1e-4;

@@ -96,17 +96,19 @@ void main() {
   float frames = 1.0;
   vec4 h;
   float v;
-  if (!rbDnRgbStaleMark(texel.a) && rbDnRgbFindHistory(pixel, rel, gMotion, gReactive, historyIn, surfaceIn, h, v)) {
+  ivec2 pp;
+  if (!rbDnRgbStaleMark(texel.a) &&
+      rbDnRgbFindHistory(pixel, rel, gMotion, gReactive, historyIn, surfaceIn, h, v, pp)) {
     if (kept) {
       // Not traced this frame: the history as it was, no frame added (the mark's rgb is this same mean).
       frames = clamp(floor(h.a + 0.5), 1.0, float(pc.maxHistoryFrames));
       accumulated = h.rgb;
       variance = v;
     } else {
-      float kept = floor(h.a + 0.5);
+      float previous = floor(h.a + 0.5);  // frames the history holds
       if ((pc.flags & RB_DN_ANTI_LAG) != 0u)
-        kept = floor(kept * rbDnRgbHistoryTrust(pixel, rel, gDepth, signalIn, gMotion, historyIn, surfaceIn));
-      frames = min(kept + 1.0, float(pc.maxHistoryFrames));
+        previous = floor(previous * rbDnRgbHistoryTrust(ip, pp, gDepth, signalIn, historyIn, surfaceIn));
+      frames = min(previous + 1.0, float(pc.maxHistoryFrames));
       float alpha = 1.0 / frames;
       accumulated = mix(h.rgb, value, alpha);
       variance = (1.0 - alpha) * (v + alpha * squared(value - h.rgb));

@@ -2,9 +2,9 @@
 #extension GL_GOOGLE_include_directive : require
 // Temporal accumulation with reprojection: each pixel finds where its surface was last frame (camera motion,
 // or the engine's motion vectors), reads the history there bilinearly from the texels that hold the same surface
-// (view distance within a tolerance),
-// and blends its new noisy value into the history as a running mean over up to `max history` frames, fewer where
-// the history disagrees with this frame's neighbourhood by more than its noise (anti-lag, rbDnHistoryTrust).
+// (view distance within a tolerance), and blends its new noisy value into the history as a running mean over up to
+// `max history` frames, fewer where the history disagrees with this frame's neighbourhood by more than its noise
+// (anti-lag, rbDnHistoryTrust).
 // It also measures the noise left in that mean (denoise_noise.glsl), which the a-trous steps filter by: .g of
 // the value written is its variance.
 #include "denoise_noise.glsl"

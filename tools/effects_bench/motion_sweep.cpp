@@ -51,8 +51,9 @@ struct Case {
   std::string name;
   Kind kind = Kind::Still;
   std::string what;
-  std::function<se::FrameParams(uint32_t)> at;       // frame k of warmup + measured
-  std::function<se::FrameParams(uint32_t)> control;  // null for the still case
+  std::function<se::FrameParams(uint32_t)> at;  // frame k of warmup + measured
+  // Every case but the still one has a control: its last frame's state held from the first frame on.
+  bool hasControl() const { return kind != Kind::Still; }
 };
 
 // One captured frame, reduced to what the metrics read.
@@ -103,8 +104,7 @@ class Runner {
 
 std::vector<Case> Runner::makeCases() const {
   const se::FrameParams base = driver_.baseParams();
-  const uint32_t n = plan_.warmupFrames + plan_.measuredFrames;
-  const uint32_t last = n - 1;
+  const uint32_t last = plan_.warmupFrames + plan_.measuredFrames - 1;
   const double fps = plan_.fps;
   auto still = [base](uint32_t) {
     se::FrameParams p = base;
@@ -112,7 +112,7 @@ std::vector<Case> Runner::makeCases() const {
     return p;
   };
   std::vector<Case> cases;
-  cases.push_back({"still", Kind::Still, "camera and scene at rest", still, {}});
+  cases.push_back({"still", Kind::Still, "camera and scene at rest", still});
   // Pan: the camera slides sideways 2 cm a frame (0.6 m/s at 30 fps); ends on the scene's camera.
   auto pan = [base, last](uint32_t k) {
     se::FrameParams p = base;
@@ -124,8 +124,7 @@ std::vector<Case> Runner::makeCases() const {
     p.camera.target += offset;
     return p;
   };
-  cases.push_back({"pan", Kind::Camera, "camera slides sideways 0.02 m per frame", pan,
-                   [pan, last](uint32_t) { return pan(last); }});
+  cases.push_back({"pan", Kind::Camera, "camera slides sideways 0.02 m per frame", pan});
   // Turn: the camera yaws 2 degrees a frame (60 degrees/s at 30 fps) about its eye.
   auto turn = [base, last](uint32_t k) {
     se::FrameParams p = base;
@@ -135,8 +134,7 @@ std::vector<Case> Runner::makeCases() const {
     p.camera.target = base.camera.eye + glm::vec3(r * glm::vec4(base.camera.target - base.camera.eye, 0.0f));
     return p;
   };
-  cases.push_back(
-      {"turn", Kind::Camera, "camera turns 2 degrees per frame", turn, [turn, last](uint32_t) { return turn(last); }});
+  cases.push_back({"turn", Kind::Camera, "camera turns 2 degrees per frame", turn});
   if (!scene_.walkers.empty()) {
     auto walk = [base, fps, walkers = scene_.walkers](uint32_t k) {
       se::FrameParams p = base;
@@ -144,8 +142,7 @@ std::vector<Case> Runner::makeCases() const {
       p.time = 1.0 + double(k) / fps;
       return p;
     };
-    cases.push_back({"walkers", Kind::Steady, "skinned characters walk: " + scene_.walkersNote, walk,
-                     [walk, last](uint32_t) { return walk(last); }});
+    cases.push_back({"walkers", Kind::Steady, "skinned characters walk: " + scene_.walkersNote, walk});
   }
   // Events: the animation's STEP key falls on measured frame eventFrame.
   const uint32_t event = plan_.warmupFrames + plan_.eventFrame;
@@ -156,7 +153,7 @@ std::vector<Case> Runner::makeCases() const {
       p.time = std::max(0.0, kMotionEventTime + (double(k) - double(event)) / fps);
       return p;
     };
-    cases.push_back({name, Kind::Event, what, at, [at, last](uint32_t) { return at(last); }});
+    cases.push_back({name, Kind::Event, what, at});
   };
   eventCase("teleport", "a pillar jumps 4 m across the ground in front of the mirror", scene_.teleportAnimation);
   eventCase("lamp_jump", "a point lamp jumps 5 m", scene_.lampAnimation);
@@ -166,8 +163,7 @@ std::vector<Case> Runner::makeCases() const {
     p.time = 0.5 + double(k) / fps;
     return p;
   };
-  cases.push_back({"door", Kind::Steady, "a door swings 30 degrees per second", door,
-                   [door, last](uint32_t) { return door(last); }});
+  cases.push_back({"door", Kind::Steady, "a door swings 30 degrees per second", door});
   return cases;
 }
 
@@ -271,6 +267,9 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
   const uint32_t w = plan_.width, h = plan_.height;
   std::vector<double> all, raw, changed, disoccluded, flickerOut, flickerRef, passMs, denoiseMs;
   std::vector<uint64_t> changedCount, disoccludedCount;
+  // changedMask[j]: frame j's pixels whose reference changed since frame j - 1 (none for frame 0); the event and
+  // steady summaries below read it at their frames.
+  std::vector<std::vector<uint8_t>> changedMask(m);
   for (uint32_t j = 0; j < m; ++j) {
     const Frame& f = frames[j];
     const Frame& r = refs[j];
@@ -280,8 +279,8 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
     raw.push_back(rmseOver(f.effects.at(e.name + "_raw"), r.effects.at(e.name), f.surface));
     if (j == 0) continue;
     const std::vector<uint8_t> surfaces = both(f.surface, frames[j - 1].surface);
-    const std::vector<uint8_t> ch = changedPixels(refs[j - 1].effects.at(e.name), r.effects.at(e.name), surfaces,
-                                                  kChangeThreshold);
+    changedMask[j] = changedPixels(refs[j - 1].effects.at(e.name), r.effects.at(e.name), surfaces, kChangeThreshold);
+    const std::vector<uint8_t>& ch = changedMask[j];
     const std::vector<uint8_t> dis = disoccludedPixels(f.viewDepth, frames[j - 1].viewDepth, f.motion, f.surface, w, h);
     changedCount.push_back(count(ch));
     disoccludedCount.push_back(count(dis));
@@ -310,8 +309,7 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
   if (c.kind == Kind::Event) {
     // The pixels the event changed (reference before vs after it), followed frame by frame against the control.
     const uint32_t ev = plan_.eventFrame;
-    const std::vector<uint8_t> ch = changedPixels(refs[ev - 1].effects.at(e.name), refs[ev].effects.at(e.name),
-                                                  both(frames[ev].surface, frames[ev - 1].surface), kChangeThreshold);
+    const std::vector<uint8_t>& ch = changedMask[ev];
     std::vector<double> moved, still, ratio;
     nlohmann::json lag = nullptr;
     for (uint32_t k = ev; k < m; ++k) {
@@ -329,10 +327,7 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
     // The last frame against the same frame of a sequence that was at rest there all along: the changed pixels
     // (steady motion) or every surface pixel (camera motion).
     const uint32_t last = m - 1;
-    const std::vector<uint8_t> pixels =
-        c.kind == Kind::Steady ? changedPixels(refs[last - 1].effects.at(e.name), refs[last].effects.at(e.name),
-                                               both(frames[last].surface, frames[last - 1].surface), kChangeThreshold)
-                               : frames[last].surface;
+    const std::vector<uint8_t>& pixels = c.kind == Kind::Steady ? changedMask[last] : frames[last].surface;
     const double moving = rmseOver(frames[last].effects.at(e.name), refs[last].effects.at(e.name), pixels);
     const double rest = rmseOver(control[last].effects.at(e.name), refs[last].effects.at(e.name), pixels);
     j["steady"] = {{"pixels", count(pixels)},
@@ -386,11 +381,12 @@ se::Result<nlohmann::json> Runner::run() {
       auto frames = sequence(c.at, [](uint32_t) { return true; });
       if (!frames) return R::failure(c.name + ": " + frames.error);
       std::vector<Frame> control;
-      if (c.control) {
+      if (c.hasControl()) {
         const uint32_t last = plan_.measuredFrames - 1;
         const uint32_t ev = plan_.eventFrame;
         const bool event = c.kind == Kind::Event;
-        auto ctl = sequence(c.control, [&](uint32_t j) { return event ? j >= ev : j == last; });
+        const se::FrameParams atRest = c.at(plan_.warmupFrames + last);
+        auto ctl = sequence([&](uint32_t) { return atRest; }, [&](uint32_t j) { return event ? j >= ev : j == last; });
         if (!ctl) return R::failure(c.name + " control: " + ctl.error);
         control = std::move(ctl.value);
       }

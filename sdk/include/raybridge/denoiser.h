@@ -79,8 +79,8 @@ struct DenoiseSettings {
   bool disableTemporal = false;
   bool disableSpatial = false;  // false = run the a-trous filter
   // false = anti-lag: history whose 3x3 neighbourhood mean differs from this frame's by more than the noise explains
-  // (2.5 to 5 standard deviations: kept in part, then dropped) is shortened, so a moved object, shadow, reflection or
-  // light is followed within a frame or two instead of fading in over maxHistoryFrames. true = pure accumulation.
+  // (scalar signals: 3 to 3.5 standard deviations, RGB: 3.5 to 4; kept in part between, dropped beyond) is shortened,
+  // so a moved object, shadow, reflection or light is not faded in over maxHistoryFrames. true = pure accumulation.
   bool disableAntiLag = false;
   // 0 = 2 for Scalar (steps 1 and 2: a 13x13 footprint), 5 for Rgb and Reflection (3x3 taps at steps 1 to 16:
   // their weights follow the measured noise, so the wide reach only blurs where the signal is still noisy).
