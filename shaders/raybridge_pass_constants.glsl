@@ -153,6 +153,22 @@ struct AdaptivePlanConstants {
   uvec2 tileSize;     // 32: adaptive_allocate_tiles.comp: the tile in pixels (powers of two, at most 16)
 };
 
+// HybridEffects' change masks (change_masks.comp): where the SDK knows the world changed this frame. 224 bytes.
+struct ChangeMaskConstants {
+  GBufferConstants gbuffer;  //   0: the frame's camera and layout (cameraToTlas: the boxes' space)
+  uvec2 boxes;               // 160: device address of ChangeBox[boxCount] (change_masks.comp), TLAS space
+  uint boxCount;             // 168
+  uint masks;                // 172: RB_CHANGE_* bits: the masks written
+  vec3 lightDirection;       // 176: shadows: towards a directional light, unit length
+  uint lightType;            // 188: RB_LIGHT_*
+  vec3 lightPosition;        // 192: shadows: a point or spot light, TLAS space
+  float aoRange;             // 204: AO: how far an occluder counts
+  float lightSpread;         // 208: shadows: tan(angular radius) of a directional light, radius of a point or spot
+  uint reactive;             // 212: 1 = the engine's reactive mask (.r > 0.5) is set in every mask too
+  uint pad0;                 // 216
+  uint pad1;                 // 220
+};
+
 // The refit-quality measure of dynamic BLASes (blas_cluster_bounds.comp). 48 bytes.
 struct ClusterBoundsConstants {
   uvec2 positions;      //  0: device address of vertex 0's position

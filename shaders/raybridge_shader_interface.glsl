@@ -72,6 +72,19 @@
 #define RB_ATROUS_BINDING_SIGNAL_IN 2
 #define RB_ATROUS_BINDING_SIGNAL_OUT 3  // rg: value, variance (denoise_atrous.comp); r: the output (_final.comp)
 #define RB_ATROUS_BINDING_TEMPORAL 4    // denoise_atrous_final.comp: the temporal result the shift starts from
+// HybridEffects' change masks (change_masks.comp): one r8 storage image per mask; a mask not written is bound to one
+// that is (never touched: its RB_CHANGE_* bit is off).
+#define RB_CHANGE_BINDING_DEPTH 0
+#define RB_CHANGE_BINDING_REACTIVE 1  // the engine's reactive mask, or the depth image again without one
+#define RB_CHANGE_BINDING_SHADOWS 2
+#define RB_CHANGE_BINDING_AO 3
+#define RB_CHANGE_BINDING_LOCAL_LIGHTS 4
+#define RB_CHANGE_BINDING_REFLECTIONS 5
+// The masks (ChangeMaskConstants::masks) and the effects a change box concerns (ChangeBox::effects).
+#define RB_CHANGE_SHADOWS 1u
+#define RB_CHANGE_AO 2u
+#define RB_CHANGE_LOCAL_LIGHTS 4u
+#define RB_CHANGE_REFLECTIONS 8u
 // The depth-aware upsample of half-resolution AO and reflections (upsample_depth_aware.glsl).
 #define RB_UPSAMPLE_BINDING_DEPTH 0
 #define RB_UPSAMPLE_BINDING_NORMAL 1

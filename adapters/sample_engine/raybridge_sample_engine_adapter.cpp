@@ -133,9 +133,10 @@ struct Adapter::Impl {
   std::unique_ptr<rb::MaterialTable> materials;
   std::unique_ptr<rb::PrimaryShadingPass> shading;
   std::unique_ptr<rb::LightList> lightList;
-  rb::TlasInfo tlas;                     // ray-traced mode's latest
-  std::vector<rb::MeshHandle> meshes;    // parallel to engine.meshes(); null for empty meshes
-  std::vector<rb::MeshHandle> deformed;  // parallel to engine.deformedInstances(): dynamic BLASes
+  rb::TlasInfo tlas;                           // ray-traced mode's latest
+  std::vector<rb::MeshHandle> meshes;          // parallel to engine.meshes(); null for empty meshes
+  std::vector<rb::MeshHandle> deformed;        // parallel to engine.deformedInstances(): dynamic BLASes
+  std::vector<rb::MeshBounds> deformedBounds;  // their pose boxes this frame: where the denoisers restart
   std::vector<rb::Instance> instances;
   std::vector<uint32_t> instanceSource;  // Scene::instances index of each entry of `instances`
   std::vector<rb::LightSource> lights;   // this frame's punctual lights (local lights effect)
@@ -255,9 +256,18 @@ void Adapter::recordFrame(const se::PrepassHookInfo& info, se::LightingInputs& i
     for (size_t k = 0; k < a.instances.size(); ++k)
       a.instances[k].setTransformColumnMajor(&info.instanceTransforms[a.instanceSource[k]][0][0]);
   const rb::AsyncBuildWait ready{info.deformSemaphore, info.deformValue};  // this frame's deformation
-  if (!a.deformed.empty() && a.settings.updateDeformedMeshes)
-    if (rb::Status s = a.as->updateDynamicMeshes(a.deformed, ready, info.submitWaits, info.deformWaits); !s)
+  if (!a.deformed.empty() && a.settings.updateDeformedMeshes) {
+    a.deformedBounds.resize(a.deformed.size());
+    for (size_t k = 0; k < a.deformed.size(); ++k) {
+      const se::DeformedInstance& di = a.engine.deformedInstances()[k];
+      std::memcpy(a.deformedBounds[k].min, &di.boundsMin[0], sizeof(float) * 3);
+      std::memcpy(a.deformedBounds[k].max, &di.boundsMax[0], sizeof(float) * 3);
+    }
+    if (rb::Status s = a.as->updateDynamicMeshes(a.deformed, ready, info.submitWaits, info.deformWaits,
+                                                 a.deformedBounds);
+        !s)
       return keepFirst(a.error, message("updateDynamicMeshes", s.error()));
+  }
   if (a.shading) return recordRayTraced(info);
   rb::HybridFrame f;
   rb::GBufferDesc& g = f.gbuffer;

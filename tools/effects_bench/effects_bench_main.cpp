@@ -122,8 +122,9 @@ int main(int argc, char** argv) {
                                                      {rb::kEffectReflections, runReflectionSweep}};
   nlohmann::json motionResult;
   if (motion) {
-    auto m = runMotionScenario(driver, motionScene,
-                               makeMotionPlan(o.quick, width, height, o.effects, o.images, o.noAntiLag, o.motionRays));
+    MotionPlan plan = makeMotionPlan(o.quick, width, height, o.effects, o.images, o.noAntiLag, o.motionRays);
+    plan.disableChangeResets = o.noChangeResets;
+    auto m = runMotionScenario(driver, motionScene, plan);
     if (!m) return fail(m.error);
     motionResult = std::move(m.value);
   }

@@ -70,6 +70,9 @@ void addOptions(CLI::App& app, Options& o) {
       ->type_name("N ...")
       ->check(rbCli::wholeNumber(1, 64));
   app.add_flag("--no-anti-lag", o.noAntiLag, "motion: denoisers without anti-lag (DenoiseSettings::disableAntiLag)");
+  app.add_flag("--no-change-resets", o.noChangeResets,
+               "motion: no change resets (HybridEffectsDesc::disableChangeResets): the denoisers follow moved objects "
+               "and lights by anti-lag alone");
   app.add_option("--scenes", o.scenes,
                  "motion: folder of the character glTF models (default ../shared/scenes beside the source tree)")
       ->type_name("DIR");

@@ -181,6 +181,7 @@ se::Status Runner::setDesc(uint32_t rays, bool reference) {
   d.localLights.raysPerPixel = rays;
   d.localLights.disableDenoiser = reference;
   d.denoiser.disableAntiLag = plan_.disableAntiLag;
+  d.disableChangeResets = plan_.disableChangeResets;
   // The local lights' reference is exact (one ray per light and pixel): no noise to accumulate.
   if (reference) d.localLights.mode = rb::ManyLightMode::Exact;
   rb::Status st = driver_.adapter().effects().setDesc(d);
@@ -477,7 +478,9 @@ se::Result<nlohmann::json> runMotionScenario(FrameDriver& driver, const MotionSc
                {"rays", plan.rays},
                {"fps", plan.fps},
                {"change_threshold", kChangeThreshold},
-               {"lag_factor", kLagFactor}};
+               {"lag_factor", kLagFactor},
+               {"anti_lag", !plan.disableAntiLag},
+               {"change_resets", !plan.disableChangeResets}};
   return r;
 }
 

@@ -29,7 +29,8 @@ struct MotionPlan {
   std::vector<uint32_t> rays = {1, 4, 16};
   uint32_t stripRays = 4;  // the ray count whose teleport frames are written as PNGs
   double fps = 30.0;
-  bool disableAntiLag = false;  // --no-anti-lag: DenoiseSettings::disableAntiLag, to measure what it buys
+  bool disableAntiLag = false;       // --no-anti-lag: DenoiseSettings::disableAntiLag, to measure what it buys
+  bool disableChangeResets = false;  // --no-change-resets: HybridEffectsDesc::disableChangeResets, likewise
   rb::EffectSet effects = 0;
   std::string imagesDir;  // "" = no PNGs
 };

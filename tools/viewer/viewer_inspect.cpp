@@ -49,15 +49,17 @@ const char* toString(InspectView view) {
     case InspectView::LitFrame: return "lit";
     case InspectView::Raw: return "raw";
     case InspectView::Denoised: return "denoised";
-    case InspectView::HistoryLength: break;
+    case InspectView::HistoryLength: return "history";
+    case InspectView::ChangeMask: break;
   }
-  return "history";
+  return "changes";
 }
 
 const char* label(InspectView view) {
   switch (view) {
     case InspectView::LitFrame: return "lit frame";
     case InspectView::HistoryLength: return "history length";
+    case InspectView::ChangeMask: return "change mask";
     default: return toString(view);
   }
 }
@@ -122,6 +124,17 @@ InspectImage inspectImage(const rb::HybridEffects& fx, bool hybrid, const Inspec
       r.image.scale = 1.0f / float(maxFrames);
       r.note = h.valid ? "black 0 frames, white " + std::to_string(maxFrames)
                        : "history not valid (reset, or temporal filtering off)";
+      break;
+    }
+    case InspectView::ChangeMask: {
+      if (!images.denoiser) return r.note = "no denoiser runs: no history to restart", r;
+      if (fx.desc().disableChangeResets) return r.note = "change resets are off (HybridEffectsDesc)", r;
+      const rb::EffectImage mask = fx.changeMask(effectBit(inspect.effect));
+      // A frame without a known change writes no mask: nothing restarted but by anti-lag and disocclusion.
+      if (!mask.view) return r.note = "no known change this frame", r;
+      r.image.view = mask.view;
+      r.image.channel = BackdropChannel::Red;
+      r.note = "white: restarted by a known change";
       break;
     }
   }

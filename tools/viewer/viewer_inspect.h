@@ -1,5 +1,6 @@
 // The viewer's inspect views: one effect of rb::HybridEffects shown over the whole window instead of the lit frame,
-// raw (the pass's output), denoised, or as the length of its denoiser's history. Says which image and how to show
+// raw (the pass's output), denoised, as the length of its denoiser's history, or as the mask of the pixels a known
+// change restarted. Says which image and how to show
 // it (a BackdropImage, viewer_backdrop.h); the panel and --inspect choose, the overlay hook draws it.
 #pragma once
 
@@ -25,15 +26,19 @@ enum class InspectView : uint32_t {
   // maxHistoryFrames white in linear light: a pixel whose history was dropped this frame (anti-lag, disocclusion,
   // the reactive mask) holds 1 frame, dark grey (1/32 of white by default).
   HistoryLength,
+  // The front end's change mask for the effect this frame (HybridEffects::changeMask): white where a known change (a
+  // moved, deformed, appeared or vanished instance, a changed light, the engine's reactive mask) restarted the
+  // history, black elsewhere; all black on a frame without a known change.
+  ChangeMask,
 };
-inline constexpr uint32_t kInspectViewCount = 4;
+inline constexpr uint32_t kInspectViewCount = 5;
 
 struct Inspect {
   InspectEffect effect = InspectEffect::Shadows;
   InspectView view = InspectView::LitFrame;
 };
 
-// Names as --inspect spells them: shadows, ao, reflections, lights; lit, raw, denoised, history.
+// Names as --inspect spells them: shadows, ao, reflections, lights; lit, raw, denoised, history, changes.
 const char* toString(InspectEffect effect);
 const char* toString(InspectView view);
 const char* label(InspectView view);  // as the panel shows it ("history length")

@@ -89,8 +89,9 @@ int parse(int argc, char** argv, Options& o, bool& exitNow) {
   app.add_option_function<std::string>(
          "--inspect", [&o](const std::string& value) { o.inspect = *rbViewer::parseInspect(value); },
          "start showing one effect instead of the lit frame (the overlay's inspect control):\n"
-         "raw (before denoising), denoised, or history (the denoiser's history length, black\n"
-         "0 frames to white the maximum); e.g. ao:history. Default: lit.\n" +
+         "raw (before denoising), denoised, history (the denoiser's history length, black\n"
+         "0 frames to white the maximum) or changes (white where a known change restarted the\n"
+         "history this frame); e.g. ao:history. Default: lit.\n" +
              rbViewer::inspectNames())
       ->type_name("EFFECT:VIEW")
       ->check(CLI::Validator(

@@ -140,6 +140,7 @@ void Deformer::unload() {
     slot.timingPending = false;
   }
   instances_.clear();
+  bounds_.clear();
   outputs_.clear();
   hasPreviousFrame_ = false;
   sources_.clear();
@@ -229,8 +230,12 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
     job.jointOffset = job.influences ? pose.jointOffset(i) : 0;
     job.weightOffset = job.targetCount ? pose.weightOffset(i) : 0;
     instances_[k] = {i, inst.mesh, out[0].buffer, out[0].address, out[1].buffer, out[1].address, job.vertexCount};
+    bounds_.push_back(makeDeformBoundsSource(mesh, job.influences != 0));
     scene.instanceVertices[i] = {out[0].buffer, out[1].buffer, out[2].buffer};
   }
+  // The buffers start as copies of the bind pose.
+  for (size_t k = 0; k < instances_.size(); ++k)
+    poseBounds(bounds_[k], {}, {}, instances_[k].boundsMin, instances_[k].boundsMax);
   Buffer staging;
   if (std::string e = gpu_->createBuffer(stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                          VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
@@ -288,7 +293,15 @@ std::string Deformer::load(GpuScene& scene, const ScenePose& pose) {
   return {};
 }
 
+void Deformer::updateBounds(const ScenePose& pose) {
+  for (size_t k = 0; k < instances_.size(); ++k) {
+    DeformedInstance& d = instances_[k];
+    poseBounds(bounds_[k], pose.jointMatrices(d.instance), pose.morphWeights(d.instance), d.boundsMin, d.boundsMax);
+  }
+}
+
 std::string Deformer::submit(uint32_t slot, uint64_t value, const ScenePose& pose) {
+  updateBounds(pose);
   Slot& sl = slots_[slot];
   char* mapped = static_cast<char*>(sl.pose.mapped);
   // host-coherent. A model without skins (or without morph targets) has an empty span, whose data() may be null:

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "deform_bounds.h"
 #include "gpu_memory.h"
 #include "gpu_scene.h"
 #include "sample_engine/animation.h"
@@ -101,6 +102,8 @@ class Deformer {
 
   // Per scene.
   std::vector<DeformedInstance> instances_;
+  std::vector<DeformBoundsSource> bounds_;   // per instance: what its pose boxes are made of
+  void updateBounds(const ScenePose& pose);  // instances_[k].boundsMin/Max for `pose`
   // Per instance: positions, attributes, last frame's positions (copied from the positions before each dispatch
   // overwrites them: the pre-pass's motion vectors).
   std::vector<Buffer> outputs_;

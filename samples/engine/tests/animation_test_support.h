@@ -2,6 +2,7 @@
 // buffers and instance transforms with it.
 #pragma once
 
+#include <cmath>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -105,6 +106,20 @@ inline size_t compareWithReference(Engine& engine, const std::vector<pose_refere
       maxError = std::max(maxError, glm::length(glm::dvec3(positions.value[v]) - p.localPositions[v]));
     INFO("max deformed-position error " << maxError << ", tolerance " << tolerance);
     CHECK(maxError <= tolerance);
+    // The pose box the engine reports holds every deformed vertex, and is not much larger than they are.
+    const DeformedInstance& di = engine.deformedInstances()[deformedOf[i]];
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    size_t outside = 0;
+    for (const glm::vec3& q : positions.value) {
+      lo = glm::min(lo, q), hi = glm::max(hi, q);
+      outside += glm::any(glm::lessThan(q, di.boundsMin)) || glm::any(glm::greaterThan(q, di.boundsMax));
+    }
+    INFO("pose box x " << di.boundsMin.x << " .. " << di.boundsMax.x << ", y " << di.boundsMin.y << " .. "
+                       << di.boundsMax.y << ", z " << di.boundsMin.z << " .. " << di.boundsMax.z << "; vertices x "
+                       << lo.x << " .. " << hi.x << ", y " << lo.y << " .. " << hi.y << ", z " << lo.z << " .. "
+                       << hi.z);
+    CHECK(outside == 0);
+    CHECK(glm::length(di.boundsMax - di.boundsMin) <= 3.0f * glm::length(hi - lo) + 1e-4f);
     ++compared;
   }
   return compared;

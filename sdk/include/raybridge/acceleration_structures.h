@@ -130,6 +130,17 @@ struct RefitPolicy {
   uint64_t rebuildTrianglesPerFrame = 0;
 };
 
+// An axis-aligned box in a mesh's object space. Plain value. All zero = not given.
+struct MeshBounds {
+  float min[3] = {0.0f, 0.0f, 0.0f};
+  float max[3] = {0.0f, 0.0f, 0.0f};
+  bool given() const {
+    for (int i = 0; i < 3; ++i)
+      if (min[i] != 0.0f || max[i] != 0.0f) return true;
+    return false;
+  }
+};
+
 // Describes one mesh from the engine's own buffers.
 struct MeshDesc {
   VkDeviceAddress vertexAddress = 0;   // required: device address of the first vertex position
@@ -151,6 +162,13 @@ struct MeshDesc {
   const void* hostVertices = nullptr;  // optional CPU copy, laid out like the GPU buffer (vertexCount*stride)
   const void* hostIndices = nullptr;   // optional CPU copy of the indices (triangleCount*3 indices, any alignment)
   const char* debugName = nullptr;     // optional; appears in error messages (copied: need not outlive the call)
+  // Optional object-space box of the vertices (min <= max per axis, finite). HybridEffects restarts the denoisers'
+  // history where an instance of the mesh moved, appeared, vanished or deformed: inside its old and new world box,
+  // and for shadows and AO where that box can reach (hybrid_effects.h, "Change resets"). All zero = derived from
+  // hostVertices when given with R32G32B32_SFLOAT or R32G32B32A32_SFLOAT positions, else unknown: the mesh's changes
+  // are then left to the denoisers' anti-lag. A dynamic mesh's box must hold the pose of every update that does not
+  // bring its own (MeshUpdate::bounds); a derived one is the registered pose's.
+  MeshBounds bounds{};
 
   // Optional vertex attributes, read (by device address, in place) where reflection rays hit the mesh. The
   // same vertex indexing as the positions. 0 = absent: hits use the triangle's geometric normal and
@@ -333,6 +351,9 @@ struct MeshUpdate {
   // format, index type, opacity) needs forceRebuild, else updateMesh fails naming the old and new values.
   const MeshDesc* desc = nullptr;
   bool forceRebuild = false;  // rebuild in the next dynamic work, outside the staggering budget
+  // The new pose's object-space box (the one an engine culls a skinned mesh with); all zero = the registered one
+  // (or desc's). See MeshDesc::bounds.
+  MeshBounds bounds{};
 };
 
 // What made this frame's deformed vertex buffers ready: a value of the engine's timeline semaphore, signalled
@@ -438,11 +459,13 @@ class AccelerationStructureService {
   // The wait the engine's next write to the vertex buffers of dynamic meshes needs: the value of the latest
   // submission that read them, stage ALL_COMMANDS. Returns false and leaves `out` alone when none is needed.
   bool fillVertexReuseWait(VkSemaphoreSubmitInfo& out) const;
-  // The four calls above in one, for the usual frame: updateMesh() for each of `meshes`, submitDynamicWork(ready),
-  // then the waits appended to the engine's lists (either may be nullptr when the engine has no such list).
+  // The four calls above in one, for the usual frame: updateMesh() for each of `meshes` (with poseBounds[i] as its
+  // MeshUpdate::bounds when given: one per mesh, or empty), submitDynamicWork(ready), then the waits appended to the
+  // engine's lists (either may be nullptr when the engine has no such list).
   Status updateDynamicMeshes(std::span<const MeshHandle> meshes, const AsyncBuildWait& ready,
                              std::vector<VkSemaphoreSubmitInfo>* tlasWaits,
-                             std::vector<VkSemaphoreSubmitInfo>* vertexReuseWaits);
+                             std::vector<VkSemaphoreSubmitInfo>* vertexReuseWaits,
+                             std::span<const MeshBounds> poseBounds = {});
 
   // Records compaction copies and queued builds into `cmd` within the scratch budget, followed by a barrier that
   // makes them visible to TLAS builds; in DynamicBuildMode::InFrame and the async fallback also the frame's
@@ -483,6 +506,16 @@ class AccelerationStructureService {
   // Live registrations with MeshDesc::nonOpaque (what AsStats::nonOpaqueMeshes reports), without resolving the
   // rest of the statistics: a TLAS needs shading records for alpha testing when it is non-zero.
   uint32_t nonOpaqueMeshCount() const;
+  // What HybridEffects' change resets read per instance (out.size() == instances.size()): the mesh's box and how
+  // many times it was updated. A stale or null handle gives bounds.given() == false. Thread safety: as meshState().
+  struct MeshChange {
+    MeshBounds bounds{};  // object space; not given() = unknown
+    uint64_t poses = 0;   // updateMesh calls so far (dynamic meshes)
+    // bounds is the latest update's own MeshUpdate::bounds: a new pose with an unchanged box is read as the same
+    // pose (an engine that updates a paused character every frame). Else any update is read as a deformation.
+    bool poseBounds = false;
+  };
+  void meshChanges(std::span<const Instance> instances, std::span<MeshChange> out) const;
 
   struct Impl;
 

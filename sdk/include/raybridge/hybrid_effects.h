@@ -32,6 +32,22 @@
 // disabled effect has no pass, no denoiser, no image of its own and traces no ray; hard shadows (one ray) are never
 // denoised. The G-buffer hand-over (stages, accesses, layouts) is in gbuffer.h.
 //
+// Change resets: the denoisers restart where the SDK knows the world changed, not only where their anti-lag sees it
+// (denoiser.h). Each frame that builds the TLAS compares HybridFrame::instances and localLights with the previous
+// frame's, entry by entry (keep their order from frame to frame). An instance whose transform or mesh changed, that
+// appeared or vanished, or whose dynamic mesh was updated (updateMesh) changes its old and new world box (the mesh's
+// MeshDesc::bounds or MeshUpdate::bounds under the transform; a mesh without a known box is left to anti-lag); a local
+// light that changed changes its old and new range. HybridFrame::changedBoxes adds the engine's own. A compute
+// pass turns them into one mask per denoised effect (1 byte a pixel each, allocated at the first change):
+//   - every effect: pixels whose surface lies in a box (the object itself);
+//   - shadows: pixels whose ray to HybridFrame::light crosses a box (the old and new shadow);
+//   - AO: pixels within AoEffectSettings::range of a box (the contact shadow it left and brought);
+//   - local lights: pixels within a changed light's range (a light of unlimited range changes every pixel).
+// The effect's denoiser, converged tiles and adaptive rays read its mask as they read the engine's reactive mask
+// (which the masks include): those pixels start afresh, every other pixel keeps its history. A frame without a known
+// change records nothing for it. The shadow light itself (HybridFrame::light) is not tracked: a sun that turns slowly
+// would reset every pixel each frame; anti-lag follows it. changeMask() shows a mask.
+//
 // Lifetime: setDesc()/applyPreset() and the destructor retire passes to the Context's deferred release (see
 // context.h), so switching effects mid-run needs no wait-idle. Destroy it before its Context and before the
 // AccelerationStructureService it was given.
@@ -145,10 +161,21 @@ struct HybridEffectsDesc {
   // How record() builds the TLAS each frame (TlasBuildOptions::mode). Default Adaptive: refits, and rebuilds
   // when the instances drifted apart or every kDefaultTlasMaxRefits frames. Only used when record() builds the TLAS.
   TlasBuildMode tlasMode = TlasBuildMode::Adaptive;
+  // false = change resets (see "Change resets" above). true = the denoisers follow changes by anti-lag alone.
+  bool disableChangeResets = false;
 };
 
 // `base` with the preset's effect set, ray counts and AO resolution (every other field is kept).
 HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset);
+
+// A world-space box where the engine knows the world changed this frame (HybridFrame::changedBoxes): min <= max
+// per axis, finite. Plain value.
+struct ChangedBox {
+  double min[3] = {0.0, 0.0, 0.0};
+  double max[3] = {0.0, 0.0, 0.0};
+};
+// Largest HybridFrame::changedBoxes. Boxes beyond the GPU's per-frame list (256, with the SDK's own) are merged.
+inline constexpr uint32_t kMaxEngineChangedBoxes = 4096;
 
 // One frame's inputs. gbuffer is required; the scene comes from `tlas` or `instances`.
 struct HybridFrame {
@@ -169,6 +196,9 @@ struct HybridFrame {
   // unless explicitValues. The sun's direction is `light`'s: lighting.sunDirection and lighting.noSun are not read
   // (a point or spot `light` leaves the hits to the sky).
   SceneLighting lighting{};
+  // Where the engine knows the world changed (a teleport, a cut-scene swap, geometry the SDK does not see): reset
+  // like a moved instance's box (see "Change resets"). At most kMaxEngineChangedBoxes. Copied during record().
+  std::span<const ChangedBox> changedBoxes{};
 };
 
 // An image the front end owns: left in `layout` after record(), readable by fragment, compute and ray tracing
@@ -244,6 +274,11 @@ class HybridEffects {
   const TlasInfo& lastTlas() const;  // the TLAS the latest record() traced
   // Forget the denoisers' history (camera cut, scene change): shadows, AO, local lights and reflections.
   void resetHistory();
+  // The change mask of one effect (kEffectShadows, kEffectAo, kEffectLocalLights or kEffectReflections) that the
+  // latest record() wrote: R8_UNORM, 1 = the effect's history restarts there, in SHADER_READ_ONLY_OPTIMAL until the
+  // next record(). image == VK_NULL_HANDLE when that record() had no known change for it (or the effect has no
+  // denoiser). For debug views and tests.
+  EffectImage changeMask(EffectSet effect) const;
 
   HybridStats stats() const;
   // Device memory of the Context's pass categories (ShaderTables, PassImages, PassBuffers; the other

@@ -155,3 +155,23 @@ Result<VkDeviceAddress> AccelerationStructureService::blasAddress(MeshHandle mes
 }
 
 }  // namespace rb
+
+namespace rb {
+
+void AccelerationStructureService::meshChanges(std::span<const Instance> instances, std::span<MeshChange> out) const {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  const size_t n = std::min(instances.size(), out.size());
+  for (size_t i = 0; i < n; ++i) {
+    const MeshHandle h = instances[i].mesh;
+    out[i] = {};
+    if (h.isNull() || h.index >= s.registrations.size()) continue;
+    const Registration& reg = s.registrations[h.index];
+    if (!reg.live || reg.generation != h.generation) continue;
+    out[i].poseBounds = reg.poseBounds.given();
+    out[i].bounds = out[i].poseBounds ? reg.poseBounds : reg.mesh.desc.bounds;
+    out[i].poses = s.entries[reg.blas].dyn.pose;
+  }
+}
+
+}  // namespace rb

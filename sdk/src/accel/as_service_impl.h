@@ -98,6 +98,7 @@ struct Registration {
   bool live = false;
   uint32_t blas = 0;  // BlasEntry index
   ValidatedMesh mesh;
+  MeshBounds poseBounds;  // the latest MeshUpdate::bounds; not given() = mesh.desc.bounds
 };
 
 // One recorded build batch whose queries resolve once its frame is done.

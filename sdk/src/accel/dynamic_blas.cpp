@@ -194,6 +194,11 @@ Status AccelerationStructureService::updateMesh(MeshHandle mesh, const MeshUpdat
                  "updateMesh: " + name +
                      " was registered with MeshRole::Static; register deforming meshes as MeshRole::Dynamic"};
   }
+  if (update.bounds.given()) {
+    if (Status st = checkBounds(update.bounds); !st)
+      return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                   "updateMesh: " + name + ": MeshUpdate::" + st.error().message};
+  }
   if (update.desc) {
     Result<ValidatedMesh> v = validateMesh(*update.desc, s.c.vk, s.c.desc.physicalDevice, s.c.info.maxPrimitiveCount);
     if (!v) return Error{v.error().code, v.error().vkResult, "updateMesh: MeshUpdate::desc: " + v.error().message};
@@ -251,6 +256,7 @@ Status AccelerationStructureService::updateMesh(MeshHandle mesh, const MeshUpdat
     e.mesh = v.value();
     e.sourceRegistration = mesh.index;
   }
+  reg.poseBounds = update.bounds;
   ++e.dyn.pose;
   if (e.state == BlasState::Built) {
     e.dyn.updatePending = true;

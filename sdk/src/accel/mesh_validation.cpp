@@ -1,5 +1,7 @@
 #include "mesh_validation.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <string>
 
@@ -21,6 +23,58 @@ uint32_t vertexFormatSize(VkFormat format) {
     default: return 0;
   }
 }
+
+Status checkBounds(const MeshBounds& b) {
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(b.min[i]) || !std::isfinite(b.max[i]) || b.min[i] > b.max[i]) {
+      return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                   "bounds: axis " + std::to_string(i) + " has min " + std::to_string(b.min[i]) + " and max " +
+                       std::to_string(b.max[i]) +
+                       "; give finite values with min <= max (the object-space box of the vertices), or all zero "
+                       "when the box is unknown"};
+    }
+  }
+  return {};
+}
+
+namespace {
+
+// The box of MeshDesc::bounds, else the one of hostVertices when its positions are 32-bit floats, else none
+// (all zero). Host pointers are only read here and by the content hash, during registerMesh.
+Status resolveBounds(const MeshDesc& in, MeshBounds& out, uint64_t vertexBytes) {
+  out = {};
+  if (in.bounds.given()) {
+    if (Status st = checkBounds(in.bounds); !st) return st;
+    out = in.bounds;
+    return {};
+  }
+  const VkFormat format = in.vertexFormat == VK_FORMAT_UNDEFINED ? VK_FORMAT_R32G32B32_SFLOAT : in.vertexFormat;
+  if (!in.hostVertices || in.vertexCount == 0 ||
+      (format != VK_FORMAT_R32G32B32_SFLOAT && format != VK_FORMAT_R32G32B32A32_SFLOAT)) {
+    return {};
+  }
+  const uint32_t stride = in.vertexStride ? in.vertexStride : vertexFormatSize(format);
+  if (uint64_t(in.vertexCount - 1) * stride + 12 > vertexBytes) return {};
+  MeshBounds b;
+  for (int i = 0; i < 3; ++i) b.min[i] = INFINITY, b.max[i] = -INFINITY;
+  const auto* bytes = static_cast<const uint8_t*>(in.hostVertices);
+  for (uint32_t v = 0; v < in.vertexCount; ++v) {
+    float p[3];
+    std::memcpy(p, bytes + uint64_t(v) * stride, sizeof p);
+    for (int i = 0; i < 3; ++i) {
+      // A non-finite position makes the box unknown rather than infinite (the BLAS build treats it as inactive).
+      if (!std::isfinite(p[i])) return {};
+      b.min[i] = std::min(b.min[i], p[i]);
+      b.max[i] = std::max(b.max[i], p[i]);
+    }
+  }
+  // A box at exactly zero would read as "not given": widen it by one float step.
+  if (!b.given()) b.max[0] = std::nextafter(0.0f, 1.0f);
+  out = b;
+  return {};
+}
+
+}  // namespace
 
 Result<ValidatedMesh> validateMesh(const MeshDesc& in, const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
                                    uint64_t maxPrimitiveCount) {
@@ -121,6 +175,7 @@ Result<ValidatedMesh> validateMesh(const MeshDesc& in, const DeviceFunctions& vk
   uint64_t layout = hashCombine(hashCombine(d.vertexFormat, d.vertexStride),
                                 hashCombine(uint64_t(d.indexType) << 32 | d.triangleCount,
                                             uint64_t(d.vertexCount) << 1 | (d.nonOpaque ? 1 : 0)));
+  if (Status st = resolveBounds(in, d.bounds, vertexBytes); !st) return invalid(st.error().message);
   if (d.contentKey != 0) {
     out.key = hashCombine(0x6b6579ull, d.contentKey);
   } else if (in.hostVertices && (in.hostIndices || !out.indexSize)) {

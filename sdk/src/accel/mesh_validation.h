@@ -19,6 +19,8 @@ struct ValidatedMesh {
 };
 
 uint32_t vertexFormatSize(VkFormat format);  // 0 for formats Raybridge does not know
+// A given MeshBounds (MeshDesc::bounds, MeshUpdate::bounds): finite, min <= max. The message starts "bounds: ".
+Status checkBounds(const MeshBounds& b);
 
 Result<ValidatedMesh> validateMesh(const MeshDesc& desc, const DeviceFunctions& vk, VkPhysicalDevice physicalDevice,
                                    uint64_t maxPrimitiveCount);

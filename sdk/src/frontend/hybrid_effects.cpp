@@ -1,10 +1,13 @@
 // The effects front end (hybrid_effects.h): passes and denoisers of the enabled effects, recorded in order.
 #include <raybridge/hybrid_effects.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "change_masks.h"
+#include "change_tracker.h"
 #include "light_validation.h"
 #include "neutral_images.h"
 #include "pass_constants.h"
@@ -234,9 +237,25 @@ struct HybridEffects::Impl {
   HybridOutputs outputs;
   TlasInfo tlas;
   NeutralImages neutral;  // what outputs() names for an effect that is off (or not sized yet)
+  // Change resets (hybrid_effects.h): this frame's known changes and the masks made of them.
+  ChangeTracker changes;
+  ChangeMasks changeMasks;
+  std::vector<AccelerationStructureService::MeshChange> meshChanges;
+  std::vector<GpuChangeBox> gpuChangeBoxes;
 
   Impl(Context& c, AccelerationStructureService* s) : ctx(c), service(s) {}
-  ~Impl() { neutral.retire(ctx); }
+  ~Impl() {
+    neutral.retire(ctx);
+    changeMasks.retire(ctx);
+  }
+
+  // The masks to write: one per effect whose denoiser exists (the readers of a history).
+  uint32_t changeMaskEffects() const {
+    if (desc.disableChangeResets) return 0u;
+    return (shadowDenoiser ? RB_CHANGE_SHADOWS : 0u) | (aoDenoiser ? RB_CHANGE_AO : 0u) |
+           (localLightDenoiser ? RB_CHANGE_LOCAL_LIGHTS : 0u) | (reflectionDenoiser ? RB_CHANGE_REFLECTIONS : 0u);
+  }
+  Status recordChanges(VkCommandBuffer cmd, const HybridFrame& f, bool trackInstances);
 
   // The denoiser of one signal: created when wanted (with the outputs, so its output is named from create() on,
   // or by record()), retired when not.
@@ -392,6 +411,31 @@ struct HybridEffects::Impl {
   Status recordLocalLights(VkCommandBuffer cmd, const HybridFrame& f);
 };
 
+Status HybridEffects::Impl::recordChanges(VkCommandBuffer cmd, const HybridFrame& f, bool trackInstances) {
+  const uint32_t effects = changeMaskEffects();
+  if (effects == 0u) {
+    changeMasks.clear();
+    changes.forget();  // resumed later, it compares against that frame, not a stale one
+    return {};
+  }
+  const std::span<const Instance> instances = trackInstances ? f.instances : std::span<const Instance>{};
+  meshChanges.assign(instances.size(), {});
+  if (service && !instances.empty()) service->meshChanges(instances, meshChanges);
+  const std::span<const LightSource> lights = localLights ? f.localLights : std::span<const LightSource>{};
+  changes.update(instances, meshChanges, lights, f.changedBoxes);
+  changes.toGpu(tlas.originOffset, gpuChangeBoxes);
+  ChangeMaskInputs in;
+  in.masks = effects;
+  // The widest disk a soft shadow samples (planShadows may widen the frame's), so no changed ray is missed.
+  in.shadowLight = f.light;
+  in.shadowLight.angularRadiusDegrees = std::max(
+      {f.light.angularRadiusDegrees, desc.shadows.softAngularRadiusDegrees, kDefaultSoftLightAngularRadiusDegrees});
+  in.aoRange = desc.ao.range > 0.0f ? desc.ao.range : kDefaultAoRange;
+  Result<bool> recorded = changeMasks.record(ctx, cmd, f.gbuffer, tlas, gpuChangeBoxes, in);
+  if (!recorded) return wrap("change masks", recorded.error());
+  return {};
+}
+
 Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridFrame& f) {
   ManyLightSettings s;
   s.mode = desc.localLights.mode;
@@ -400,13 +444,13 @@ Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridF
   s.materials = materials.get();
   s.schedule = effectSchedule(desc.localLights.schedule, localLightDenoiser.get());
   if (Status st = lightList->record(cmd, tlas, f.localLights); !st) return wrap("HybridFrame::localLights", st.error());
-  if (Status st =
-          localLights->record(cmd, {.gbuffer = f.gbuffer, .tlas = tlas, .lightList = lightList.get(), .settings = s});
+  const GBufferDesc g = changeMasks.gbufferFor(f.gbuffer, RB_CHANGE_LOCAL_LIGHTS);
+  if (Status st = localLights->record(cmd, {.gbuffer = g, .tlas = tlas, .lightList = lightList.get(), .settings = s});
       !st)
     return wrap("ManyLightPass::record", st.error());
   const ManyLightOutputs& o = localLights->outputs();
-  return denoise(localLightDenoiser, localLightsDenoised(), "Denoiser (local lights)", cmd, f.gbuffer, o.irradianceView,
-                 0, DenoiseSignal::Rgb);
+  return denoise(localLightDenoiser, localLightsDenoised(), "Denoiser (local lights)", cmd, g, o.irradianceView, 0,
+                 DenoiseSignal::Rgb);
 }
 
 Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -416,12 +460,13 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   s.materials = materials.get();  // alpha tests non-opaque geometry
   // Adaptive rays and converged tiles: only for soft shadows, whose denoiser runs after the pass this frame.
   s.schedule = effectSchedule(desc.shadows.schedule, shadowDenoiser.get(), plan.soft);
-  if (Status st = shadow->record(cmd, {.gbuffer = f.gbuffer, .tlas = tlas, .light = plan.light, .settings = s}); !st)
+  const GBufferDesc g = changeMasks.gbufferFor(f.gbuffer, RB_CHANGE_SHADOWS);
+  if (Status st = shadow->record(cmd, {.gbuffer = g, .tlas = tlas, .light = plan.light, .settings = s}); !st)
     return wrap("ShadowPass::record", st.error());
   const ShadowOutputs& o = shadow->outputs();
   // The visibility is a fraction of plan.rays binary rays; with adaptive rays the count varies per pixel, so the
   // denoiser measures the noise instead.
-  return denoise(shadowDenoiser, plan.soft && !desc.shadows.disableDenoiser, "Denoiser (shadows)", cmd, f.gbuffer,
+  return denoise(shadowDenoiser, plan.soft && !desc.shadows.disableDenoiser, "Denoiser (shadows)", cmd, g,
                  o.visibilityView, desc.shadows.schedule.adaptive.enabled ? 0u : plan.rays);
 }
 
@@ -432,7 +477,8 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   s.range = desc.ao.range;
   s.estimator = desc.ao.estimator;
   s.schedule = effectSchedule(desc.ao.schedule, aoDenoiser.get());
-  if (Status st = ao->record(cmd, {.gbuffer = f.gbuffer, .tlas = tlas, .settings = s}); !st)
+  const GBufferDesc g = changeMasks.gbufferFor(f.gbuffer, RB_CHANGE_AO);
+  if (Status st = ao->record(cmd, {.gbuffer = g, .tlas = tlas, .settings = s}); !st)
     return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
   // Binary AO is a fraction of binary rays; distance-weighted AO is not, nor is adaptive AO (the count varies per
@@ -440,7 +486,7 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   const uint32_t rays = s.estimator == AoEstimator::Binary && !desc.ao.schedule.adaptive.enabled
                             ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays)
                             : 0u;
-  return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, f.gbuffer, o.aoView, rays);
+  return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, g, o.aoView, rays);
 }
 
 Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -452,7 +498,8 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.schedule = effectSchedule(desc.reflections.schedule, reflectionDenoiser.get());
   s.lighting = reflectionLighting(f);
   if (lightList && !f.localLights.empty()) s.lights = lightList.get();  // recorded earlier this frame
-  const GBufferDesc& g = f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer;
+  const GBufferDesc g = changeMasks.gbufferFor(f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer,
+                                               RB_CHANGE_REFLECTIONS);
   if (Status st = reflection->record(cmd, {.gbuffer = g, .tlas = tlas, .settings = s}); !st)
     return wrap("ReflectionPass::record", st.error());
   const ReflectionOutputs& o = reflection->outputs();
@@ -535,6 +582,21 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
                                                         "HybridEffects: record: HybridFrame::lighting");
     if (!lit) return lit.error();
   }
+  if (frame.changedBoxes.size() > kMaxEngineChangedBoxes) {
+    return invalid("record: HybridFrame::changedBoxes holds " + std::to_string(frame.changedBoxes.size()) +
+                   " boxes, more than kMaxEngineChangedBoxes (" + std::to_string(kMaxEngineChangedBoxes) +
+                   "); merge nearby ones, or reset the history (resetHistory) for a change that large");
+  }
+  for (size_t i = 0; i < frame.changedBoxes.size(); ++i) {
+    const ChangedBox& b = frame.changedBoxes[i];
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(b.min[k]) || !std::isfinite(b.max[k]) || b.min[k] > b.max[k]) {
+        return invalid("record: HybridFrame::changedBoxes[" + std::to_string(i) + "] has min " +
+                       std::to_string(b.min[k]) + " and max " + std::to_string(b.max[k]) + " on axis " +
+                       std::to_string(k) + "; give finite world-space corners with min <= max");
+      }
+    }
+  }
   a.neutral.recordInit(a.ctx, cmd);
   if (frame.tlas && frame.tlas->tlas) {
     a.tlas = *frame.tlas;
@@ -558,8 +620,8 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
     if (!tlas) return wrap("recordTlasBuild", tlas.error());
     a.tlas = tlas.value();
   }
-  Status st;
-  if (a.shadow) st = a.recordShadows(cmd, frame);
+  Status st = a.recordChanges(cmd, frame, !(frame.tlas && frame.tlas->tlas));
+  if (st && a.shadow) st = a.recordShadows(cmd, frame);
   if (st && a.ao) st = a.recordAo(cmd, frame);
   if (st && a.localLights) st = a.recordLocalLights(cmd, frame);
   if (st && a.reflection) st = a.recordReflections(cmd, frame);
@@ -574,7 +636,21 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
 const HybridOutputs& HybridEffects::outputs() const { return impl_->outputs; }
 const TlasInfo& HybridEffects::lastTlas() const { return impl_->tlas; }
 
+EffectImage HybridEffects::changeMask(EffectSet effect) const {
+  uint32_t bit = 0;
+  if (effect == kEffectShadows) bit = RB_CHANGE_SHADOWS;
+  if (effect == kEffectAo) bit = RB_CHANGE_AO;
+  if (effect == kEffectLocalLights) bit = RB_CHANGE_LOCAL_LIGHTS;
+  if (effect == kEffectReflections) bit = RB_CHANGE_REFLECTIONS;
+  const GpuImage* image = impl_->changeMasks.mask(bit);
+  if (!image) return {};
+  return {image->image, image->view,  image->format, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+          image->width, image->height};
+}
+
 void HybridEffects::resetHistory() {
+  impl_->changes.forget();
+  impl_->changeMasks.clear();
   if (impl_->shadowDenoiser) impl_->shadowDenoiser->resetHistory();
   if (impl_->aoDenoiser) impl_->aoDenoiser->resetHistory();
   if (impl_->localLightDenoiser) impl_->localLightDenoiser->resetHistory();

@@ -264,6 +264,30 @@ RB_ASSERT_OFFSET(ClusterBoundsConstants, indexType, 32);
 RB_ASSERT_OFFSET(ClusterBoundsConstants, triangleCount, 36);
 RB_ASSERT_OFFSET(ClusterBoundsConstants, firstCluster, 40);
 
+struct ChangeMaskConstants {
+  GBufferConstants gbuffer;  // the frame's camera and layout (cameraToTlas: the boxes' space)
+  uint32_t boxes[2];         // device address of the ChangeBox array, TLAS space
+  uint32_t boxCount;
+  uint32_t masks;           // RB_CHANGE_* bits: the masks written
+  float lightDirection[3];  // shadows: towards a directional light
+  uint32_t lightType;       // RB_LIGHT_*
+  float lightPosition[3];   // shadows: a point or spot light, TLAS space
+  float aoRange;            // AO: how far an occluder counts
+  float lightSpread;        // tan(angular radius) of a directional light, radius of a point or spot
+  uint32_t reactive;        // 1 = the engine's reactive mask is set in every mask too
+  uint32_t pad[2];
+};
+static_assert(sizeof(ChangeMaskConstants) == 224);
+RB_ASSERT_OFFSET(ChangeMaskConstants, boxes, 160);
+RB_ASSERT_OFFSET(ChangeMaskConstants, boxCount, 168);
+RB_ASSERT_OFFSET(ChangeMaskConstants, masks, 172);
+RB_ASSERT_OFFSET(ChangeMaskConstants, lightDirection, 176);
+RB_ASSERT_OFFSET(ChangeMaskConstants, lightType, 188);
+RB_ASSERT_OFFSET(ChangeMaskConstants, lightPosition, 192);
+RB_ASSERT_OFFSET(ChangeMaskConstants, aoRange, 204);
+RB_ASSERT_OFFSET(ChangeMaskConstants, lightSpread, 208);
+RB_ASSERT_OFFSET(ChangeMaskConstants, reactive, 212);
+
 #undef RB_ASSERT_OFFSET
 
 // The enumerations the shaders test, by their public names.

@@ -326,6 +326,11 @@ struct DeformedInstance {
   VkBuffer attributeBuffer = VK_NULL_HANDLE;
   VkDeviceAddress attributeAddress = 0;
   uint32_t vertexCount = 0;
+  // The box of the pose the latest deformation wrote, in the positions' (instance-local) space: each joint's
+  // bind-pose box of the vertices it moves under its joint matrix, widened by the morph targets' reach at the frame's
+  // weights (conservative: every deformed vertex lies inside). What a culling pass tests; renderFrame() updates it
+  // before the pre-pass hook runs.
+  glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};
 };
 
 // One image of the pre-pass, as the hook receives it.

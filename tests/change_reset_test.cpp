@@ -1,0 +1,298 @@
+// Change resets (hybrid_effects.h, "Change resets"; issue 29): when HybridEffects sees an instance move, it restarts
+// the denoisers' history where the move can have changed the effect, and nowhere else. A box of the conformance
+// scene jumps; the shadow and AO masks the front end writes are compared with the same footprints computed here on
+// the CPU from the Embree G-buffer (every pixel inside a narrower footprint is set, none outside a wider one), and
+// the denoisers' history lengths show that exactly the masked (and disoccluded) pixels started afresh.
+#include <catch2/catch_test_macros.hpp>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/packing.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "synthetic_gbuffer.h"
+
+using namespace rbtest;
+
+namespace {
+
+constexpr uint32_t kW = 96, kH = 72;
+constexpr uint32_t kStillFrames = 4;  // frames with the box at its first place
+constexpr float kAoRange = 1.0f;
+constexpr float kSunDegrees = 2.0f;
+const glm::dvec3 kSun = glm::normalize(glm::dvec3(0.5, 0.8, -0.4));  // towards the light
+
+SyntheticView view() {
+  SyntheticView v;
+  v.eye = {-6.0, 5.0, 8.0};
+  v.target = {0.0, 0.5, 1.0};
+  v.fovYDegrees = 45.0;
+  v.width = kW;
+  v.height = kH;
+  return v;
+}
+
+struct World {
+  TestScene scene;
+  EmbreeScene embree;
+  CpuGBuffer cpu;
+  explicit World(float x, float z) : scene(makeConformanceScene()) {
+    scene.instances[3].transform = translation(x, 1.2f, z);  // instance 3: a box
+    addToEmbree(embree, scene);
+    cpu = traceGBuffer(embree, view());
+  }
+};
+
+// The world box of instance `i` (its mesh's vertices under its transform).
+struct Box {
+  glm::dvec3 lo{1e300}, hi{-1e300};
+};
+Box worldBox(const TestScene& s, uint32_t i) {
+  const rbsamples::CpuMesh& m = s.meshes[s.instances[i].mesh];
+  const auto& t = s.instances[i].transform;
+  Box b;
+  for (size_t v = 0; v < m.positions.size(); v += 3) {
+    glm::dvec3 p;
+    for (int r = 0; r < 3; ++r)
+      p[r] = t[r * 4 + 0] * m.positions[v] + t[r * 4 + 1] * m.positions[v + 1] + t[r * 4 + 2] * m.positions[v + 2] +
+             t[r * 4 + 3];
+    b.lo = glm::min(b.lo, p);
+    b.hi = glm::max(b.hi, p);
+  }
+  return b;
+}
+
+double distanceTo(const Box& b, const glm::dvec3& p) {
+  return glm::length(glm::max(glm::max(b.lo - p, p - b.hi), glm::dvec3(0.0)));
+}
+
+// Whether the ray p + t * d (t >= 0) meets the box grown by `grow`.
+bool rayHits(const Box& b, double grow, const glm::dvec3& p, const glm::dvec3& d) {
+  double enter = 0.0, leave = 1e300;
+  for (int k = 0; k < 3; ++k) {
+    const double lo = b.lo[k] - grow, hi = b.hi[k] + grow;
+    if (std::abs(d[k]) < 1e-12) {
+      if (p[k] < lo || p[k] > hi) return false;
+      continue;
+    }
+    double t0 = (lo - p[k]) / d[k], t1 = (hi - p[k]) / d[k];
+    if (t0 > t1) std::swap(t0, t1);
+    enter = std::max(enter, t0);
+    leave = std::min(leave, t1);
+  }
+  return enter <= leave;
+}
+
+// The shadow footprint of the boxes at pixel position p: in a box, or its ray to the sun crosses one widened by the
+// soft light's spread (tan(angle) * the distance to the box's far side, as change_masks.comp) scaled by `spread`,
+// plus `pad`.
+bool inShadowFootprint(const std::vector<Box>& boxes, const glm::dvec3& p, double spread, double pad) {
+  for (const Box& b : boxes) {
+    const glm::dvec3 centre = 0.5 * (b.lo + b.hi);
+    const double reach = glm::length(centre - p) + glm::length(b.hi - centre);
+    const double widen = spread * std::tan(kSunDegrees * M_PI / 180.0) * reach + pad;
+    if (distanceTo(b, p) <= pad || rayHits(b, widen, p, kSun)) return true;
+  }
+  return false;
+}
+
+bool inAoFootprint(const std::vector<Box>& boxes, const glm::dvec3& p, double range) {
+  for (const Box& b : boxes)
+    if (distanceTo(b, p) <= range) return true;
+  return false;
+}
+
+std::vector<float> readR8(GpuFixture& fx, const rb::EffectImage& image) {
+  std::vector<uint8_t> raw = readPassImage(fx, image.image, image.width, image.height, 1);
+  std::vector<float> out(raw.size());
+  for (size_t i = 0; i < raw.size(); ++i) out[i] = raw[i] / 255.0f;
+  return out;
+}
+
+// Frames accumulated per pixel in a scalar denoiser's history (RG16F: mean, frames).
+std::vector<float> historyFrames(GpuFixture& fx, const rb::Denoiser& denoiser) {
+  const rb::DenoiseHistory h = denoiser.history();
+  REQUIRE(h.meanImage != VK_NULL_HANDLE);
+  std::vector<uint8_t> raw = readPassImage(fx, h.meanImage, h.width, h.height, 4);
+  std::vector<float> frames(size_t(h.width) * h.height);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    uint16_t half;
+    std::memcpy(&half, raw.data() + 4 * i + 2, 2);
+    frames[i] = glm::unpackHalf1x16(half);
+  }
+  return frames;
+}
+
+struct Run {
+  std::vector<float> shadowMask, aoMask, shadowFrames, aoFrames;
+  bool stillFrameHadMask = true;
+};
+
+// kStillFrames frames of `before`, then one of `after`, through HybridEffects (soft shadows and AO at 4 rays,
+// denoised, anti-lag off so that only disocclusion and change resets restart a pixel).
+Run run(GpuFixture& fx, const World& before, const World& after, bool changeResets) {
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  BuiltScene built = buildScene(fx, *service.value(), before.scene);
+  rb::HybridEffectsDesc desc;
+  desc.effects = rb::kEffectShadows | rb::kEffectAo;
+  desc.shadows.raysPerPixel = 4;
+  desc.ao.raysPerPixel = 4;
+  desc.ao.range = kAoRange;
+  desc.ao.schedule.halfResolution = false;
+  desc.denoiser.disableAntiLag = true;
+  desc.disableChangeResets = !changeResets;
+  auto fxs = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
+  RB_REQUIRE_OK(fxs);
+  rb::HybridEffects& effects = *fxs.value();
+  Run out;
+  for (uint32_t f = 0; f <= kStillFrames; ++f) {
+    const World& w = f < kStillFrames ? before : after;
+    std::vector<rb::Instance> instances = built.instances;
+    for (size_t i = 0; i < instances.size(); ++i)
+      std::copy(w.scene.instances[i].transform.begin(), w.scene.instances[i].transform.end(), instances[i].transform);
+    GpuGBuffer gbuffer(fx, w.cpu);
+    rb::HybridFrame frame;
+    frame.gbuffer = gbuffer.desc();
+    frame.instances = instances;
+    frame.light.direction[0] = float(kSun.x);
+    frame.light.direction[1] = float(kSun.y);
+    frame.light.direction[2] = float(kSun.z);
+    frame.light.angularRadiusDegrees = kSunDegrees;
+    fx.runFrame([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });
+    if (f == kStillFrames - 1) {
+      out.stillFrameHadMask = effects.changeMask(rb::kEffectShadows).image != VK_NULL_HANDLE ||
+                              effects.changeMask(rb::kEffectAo).image != VK_NULL_HANDLE;
+    }
+    if (f == kStillFrames) {
+      if (changeResets) {
+        REQUIRE(effects.changeMask(rb::kEffectShadows).image != VK_NULL_HANDLE);
+        REQUIRE(effects.changeMask(rb::kEffectAo).image != VK_NULL_HANDLE);
+        out.shadowMask = readR8(fx, effects.changeMask(rb::kEffectShadows));
+        out.aoMask = readR8(fx, effects.changeMask(rb::kEffectAo));
+      } else {
+        CHECK(effects.changeMask(rb::kEffectShadows).image == VK_NULL_HANDLE);
+      }
+      out.shadowFrames = historyFrames(fx, *effects.shadowDenoiser());
+      out.aoFrames = historyFrames(fx, *effects.aoDenoiser());
+    }
+  }
+  (void)fx.device().waitIdle();
+  fxs.value().reset();
+  destroyScene(fx, built);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("a moved instance resets history only inside its old and new footprint", "[denoise][motion][changes]") {
+  GpuFixture fx;
+  const World before(-1.0f, 1.0f), after(1.5f, 2.0f);
+  const std::vector<Box> boxes = {worldBox(before.scene, 3), worldBox(after.scene, 3)};
+  const Run on = run(fx, before, after, true);
+  CHECK_FALSE(on.stillFrameHadMask);  // frames without a change write no mask
+
+  // The masks against the footprints computed here: all of a narrower one set, nothing outside a wider one.
+  uint32_t shadowSet = 0, aoSet = 0, shadowMissed = 0, aoMissed = 0, shadowStray = 0, aoStray = 0, surface = 0;
+  for (size_t i = 0; i < size_t(kW) * kH; ++i) {
+    if (!after.cpu.hit[i]) {
+      CHECK(on.shadowMask[i] == 0.0f);  // the sky has no history to reset
+      continue;
+    }
+    ++surface;
+    const glm::dvec3 p = after.cpu.position[i];
+    const double pad = 1e-3 * glm::length(p - view().eye);
+    const bool shadow = on.shadowMask[i] > 0.5f, ao = on.aoMask[i] > 0.5f;
+    shadowSet += shadow;
+    aoSet += ao;
+    shadowMissed += !shadow && inShadowFootprint(boxes, p, 0.9, 0.0);
+    shadowStray += shadow && !inShadowFootprint(boxes, p, 1.1, 3.0 * pad + 0.01);
+    aoMissed += !ao && inAoFootprint(boxes, p, kAoRange * 0.99);
+    aoStray += ao && !inAoFootprint(boxes, p, kAoRange * 1.01 + 3.0 * pad + 0.01);
+  }
+  std::printf("change masks: shadows %u, AO %u of %u surface pixels; missed %u / %u, stray %u / %u\n", shadowSet, aoSet,
+              surface, shadowMissed, aoMissed, shadowStray, aoStray);
+  CHECK(shadowSet > 50);  // the box and both of its shadows are in view
+  CHECK(aoSet > 50);
+  CHECK(shadowSet < surface / 2);  // and most of the image is not
+  CHECK(aoSet < surface / 2);
+  CHECK(shadowMissed == 0);
+  CHECK(aoMissed == 0);
+  CHECK(shadowStray == 0);
+  CHECK(aoStray == 0);
+
+  // The history: a masked pixel starts afresh (1 frame); an unmasked one keeps its history unless disoccluded (the
+  // surface there is another one than last frame's: the box's old place, its new place).
+  auto check = [&](const std::vector<float>& mask, const std::vector<float>& frames, const char* what) {
+    uint32_t reset = 0, kept = 0, strayResets = 0, maskedKept = 0;
+    for (size_t i = 0; i < size_t(kW) * kH; ++i) {
+      if (!after.cpu.hit[i]) continue;
+      const bool disoccluded = !before.cpu.hit[i] || before.cpu.instance[i] != after.cpu.instance[i] ||
+                               glm::length(before.cpu.position[i] - after.cpu.position[i]) > 1e-3;
+      if (mask[i] > 0.5f) {
+        maskedKept += frames[i] != 1.0f;
+        ++reset;
+      } else if (!disoccluded) {
+        strayResets += frames[i] != float(kStillFrames + 1);
+        ++kept;
+      }
+    }
+    std::printf("%s history: %u masked pixels restarted (%u did not), %u kept (%u did not)\n", what, reset, maskedKept,
+                kept, strayResets);
+    CHECK(maskedKept == 0);
+    CHECK(strayResets == 0);
+    CHECK(kept > reset);
+  };
+  check(on.shadowMask, on.shadowFrames, "shadow");
+  check(on.aoMask, on.aoFrames, "AO");
+
+  // Without change resets (and anti-lag off) the same pixels keep their history: the restarts above are the masks'.
+  const Run off = run(fx, before, after, false);
+  uint32_t restartedOff = 0, restartedOn = 0;
+  for (size_t i = 0; i < size_t(kW) * kH; ++i) {
+    restartedOff += after.cpu.hit[i] && off.aoFrames[i] == 1.0f;
+    restartedOn += after.cpu.hit[i] && on.aoFrames[i] == 1.0f;
+  }
+  CHECK(restartedOn > restartedOff + 50);
+}
+
+TEST_CASE("engine change boxes that are not finite or inverted are refused by name, nothing recorded",
+          "[hybrid_effects][changes][errors]") {
+  GpuFixture fx;
+  const World w(-1.0f, 1.0f);
+  auto service = rb::AccelerationStructureService::create(fx.ctx());
+  RB_REQUIRE_OK(service);
+  BuiltScene built = buildScene(fx, *service.value(), w.scene);
+  rb::HybridEffectsDesc desc;
+  desc.effects = rb::kEffectAo;
+  auto effects = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
+  RB_REQUIRE_OK(effects);
+  GpuGBuffer gbuffer(fx, w.cpu);
+  rb::ChangedBox bad[2];
+  bad[1].min[1] = 2.0;  // min above max on y
+  bad[1].max[1] = 1.0;
+  rb::ChangedBox nan;
+  nan.max[2] = std::nan("");
+  for (std::span<const rb::ChangedBox> boxes :
+       {std::span<const rb::ChangedBox>(bad, 2), std::span<const rb::ChangedBox>(&nan, 1)}) {
+    rb::HybridFrame frame;
+    frame.gbuffer = gbuffer.desc();
+    frame.instances = built.instances;
+    frame.changedBoxes = boxes;
+    auto cmd = fx.device().beginCommands();
+    RB_REQUIRE_OK(cmd);
+    fx.ctx().beginFrame();
+    rb::Status st = effects.value()->record(cmd.value(), frame);
+    REQUIRE_FALSE(st);
+    const std::string m = st.error().message;
+    INFO(m);
+    CHECK(m.find("changedBoxes[") != std::string::npos);
+    CHECK(m.find("min <= max") != std::string::npos);
+    RB_REQUIRE_OK(fx.device().submitAndWait(cmd.value()));
+  }
+  effects.value().reset();
+  destroyScene(fx, built);
+}
