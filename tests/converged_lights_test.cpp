@@ -32,7 +32,9 @@ struct LightsPair {
   std::unique_ptr<GpuGBuffer> gbuffer;
   std::unique_ptr<rb::HybridEffects> skipping, plain;
   std::vector<rb::LightSource> lights = roomLights();
-  explicit LightsPair(GpuFixture& f) : fx(f) {
+  // changeResets = false: a moved light is not a change HybridEffects knows of (hybrid_effects.h, "Change resets"),
+  // so only the converged tiles' own refresh and stale marks catch it: what the refresh test checks.
+  explicit LightsPair(GpuFixture& f, bool changeResets = true) : fx(f) {
     addToEmbree(embree, scene);
     cpu = traceGBuffer(embree, roomView(kWidth, kHeight));
     gbuffer = std::make_unique<GpuGBuffer>(fx, cpu);
@@ -43,6 +45,7 @@ struct LightsPair {
     rb::HybridEffectsDesc desc;
     desc.effects = rb::kEffectLocalLights;
     desc.localLights.raysPerPixel = 2;
+    desc.disableChangeResets = !changeResets;
     auto p = rb::HybridEffects::create(fx.ctx(), service.get(), desc);
     RB_REQUIRE_OK(p);
     plain = std::move(p.value());
@@ -115,7 +118,7 @@ TEST_CASE("local lights: a still scene converges, then its converged tiles are s
 TEST_CASE("local lights: a light moved over converged tiles is traced again within the refresh period",
           "[many_lights][classifier][converged]") {
   GpuFixture fx;
-  LightsPair p(fx);
+  LightsPair p(fx, /*changeResets=*/false);
   for (int i = 0; i < 10; ++i) p.frame();
   REQUIRE(p.stats(*p.skipping).tilesConverged > 0);
   std::vector<float> before, since;  // the reference's raw irradiance over 6 frames before the move, and after it
@@ -140,6 +143,29 @@ TEST_CASE("local lights: a light moved over converged tiles is traced again with
   REQUIRE(r.changed > 20);
   CHECK(r.caught * 20 >= r.changed * 19);
   CHECK(stale > 0);
+}
+
+TEST_CASE("local lights: with change resets, a moved light's converged tiles are traced on the move's own frame",
+          "[many_lights][classifier][converged][changes]") {
+  GpuFixture fx;
+  LightsPair p(fx);
+  for (int i = 0; i < 10; ++i) p.frame();
+  REQUIRE(p.stats(*p.skipping).tilesConverged > 0);
+  std::vector<float> before, after;
+  for (int i = 0; i < 6; ++i) {
+    p.frame();
+    addToMean(before, p.raw(*p.plain), 6);
+  }
+  REQUIRE(p.stats(*p.skipping).tilesConverged > 0);  // tiles are being skipped when the light moves
+  p.lights[0].light.position[0] = -p.lights[0].light.position[0];
+  p.lights[0].light.position[2] += 2.0;
+  p.frame();
+  addToMean(after, p.raw(*p.plain), 1);
+  const Retraced r = retracedPixels(before, after, p.raw(*p.plain), p.raw(*p.skipping));
+  INFO(r.changed << " pixels whose irradiance changed, " << r.caught << " traced on the move's frame");
+  REQUIRE(r.changed > 20);
+  CHECK(r.caught * 20 >= r.changed * 19);
+  CHECK(p.skipping->changeMask(rb::kEffectLocalLights).image != VK_NULL_HANDLE);
 }
 
 TEST_CASE("bad local-light converged-tile settings are named", "[many_lights][converged][bad_input]") {

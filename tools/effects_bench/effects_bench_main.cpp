@@ -122,9 +122,9 @@ int main(int argc, char** argv) {
                                                      {rb::kEffectReflections, runReflectionSweep}};
   nlohmann::json motionResult;
   if (motion) {
-    MotionPlan plan = makeMotionPlan(o.quick, width, height, o.effects, o.images, o.noAntiLag, o.motionRays);
-    plan.disableChangeResets = o.noChangeResets;
-    auto m = runMotionScenario(driver, motionScene, plan);
+    const MotionSwitches switches{o.noAntiLag, o.noChangeResets, o.convergedTiles};
+    auto m = runMotionScenario(driver, motionScene,
+                               makeMotionPlan(o.quick, width, height, o.effects, o.images, switches, o.motionRays));
     if (!m) return fail(m.error);
     motionResult = std::move(m.value);
   }

@@ -17,6 +17,7 @@ struct Options {
   uint32_t characters = 3;           // motion: walkers
   bool noAntiLag = false;            // motion: DenoiseSettings::disableAntiLag
   bool noChangeResets = false;       // motion: HybridEffectsDesc::disableChangeResets
+  bool convergedTiles = false;       // motion: RaySchedule::convergedTiles on for every effect
   std::vector<uint32_t> motionRays;  // motion: rays per pixel of the denoised sequences; empty = 1, 4, 16
   std::string scenes;                // motion: character models; empty = ../shared/scenes beside the source tree
   // Empty: 1920x1080 on a GPU, 320x180 on a CPU device (lavapipe); --quick: 160x90.

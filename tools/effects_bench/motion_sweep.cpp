@@ -7,6 +7,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -180,8 +181,14 @@ se::Status Runner::setDesc(uint32_t rays, bool reference) {
   d.reflections.disableDenoiser = reference;
   d.localLights.raysPerPixel = rays;
   d.localLights.disableDenoiser = reference;
-  d.denoiser.disableAntiLag = plan_.disableAntiLag;
-  d.disableChangeResets = plan_.disableChangeResets;
+  d.denoiser.disableAntiLag = plan_.switches.disableAntiLag;
+  d.disableChangeResets = plan_.switches.disableChangeResets;
+  if (plan_.switches.convergedTiles && !reference) {
+    d.shadows.schedule.convergedTiles.enabled = true;
+    d.ao.schedule.convergedTiles.enabled = true;
+    d.reflections.schedule.convergedTiles.enabled = true;
+    d.localLights.schedule.convergedTiles.enabled = true;
+  }
   // The local lights' reference is exact (one ray per light and pixel): no noise to accumulate.
   if (reference) d.localLights.mode = rb::ManyLightMode::Exact;
   rb::Status st = driver_.adapter().effects().setDesc(d);
@@ -413,6 +420,16 @@ se::Result<nlohmann::json> Runner::run() {
                  s["flicker_mean"].get<double>(), s["flicker_reference_mean"].get<double>(), summary.c_str());
       }
       jc["rays"][std::to_string(n)] = je;
+      // The change masks' GPU time, on the measured frames that recorded them (frames with a known change).
+      std::vector<double> maskMs;
+      for (const Frame& f : frames.value) {
+        const rb::HybridStats& st = f.stats;
+        const uint64_t frame = std::max({st.shadow.frame, st.ao.frame, st.reflection.frame, st.localLights.frame});
+        if (st.changeMasks.frame != 0 && st.changeMasks.frame == frame) maskMs.push_back(st.changeMasks.gpuMs);
+      }
+      jc["change_masks_gpu_ms_median"][std::to_string(n)] = maskMs.empty() ? nlohmann::json(nullptr)
+                                                                           : nlohmann::json(median(maskMs));
+      jc["change_masks_frames"][std::to_string(n)] = maskMs.size();
       if (n == plan_.stripRays && c.name == "teleport" && !plan_.imagesDir.empty()) {
         if (se::Status st = writeStrip(c, refs.value, frames.value); !st) return R::failure(st.error);
       }
@@ -426,13 +443,13 @@ se::Result<nlohmann::json> Runner::run() {
 }  // namespace
 
 MotionPlan makeMotionPlan(bool quick, uint32_t width, uint32_t height, rb::EffectSet effects, const std::string& images,
-                          bool disableAntiLag, const std::vector<uint32_t>& rays) {
+                          const MotionSwitches& switches, const std::vector<uint32_t>& rays) {
   MotionPlan mp;
   mp.width = width;
   mp.height = height;
   mp.effects = effects;
   mp.imagesDir = images;
-  mp.disableAntiLag = disableAntiLag;
+  mp.switches = switches;
   if (quick) {
     mp.warmupFrames = 3;
     mp.measuredFrames = 4;
@@ -479,8 +496,9 @@ se::Result<nlohmann::json> runMotionScenario(FrameDriver& driver, const MotionSc
                {"fps", plan.fps},
                {"change_threshold", kChangeThreshold},
                {"lag_factor", kLagFactor},
-               {"anti_lag", !plan.disableAntiLag},
-               {"change_resets", !plan.disableChangeResets}};
+               {"anti_lag", !plan.switches.disableAntiLag},
+               {"change_resets", !plan.switches.disableChangeResets},
+               {"converged_tiles", plan.switches.convergedTiles}};
   return r;
 }
 

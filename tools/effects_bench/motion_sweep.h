@@ -19,6 +19,13 @@
 
 namespace rbEffects {
 
+// The mechanisms a run turns off or on, to measure what each buys or costs.
+struct MotionSwitches {
+  bool disableAntiLag = false;       // --no-anti-lag: DenoiseSettings::disableAntiLag
+  bool disableChangeResets = false;  // --no-change-resets: HybridEffectsDesc::disableChangeResets
+  bool convergedTiles = false;       // --converged-tiles: every effect skips its converged tiles (not the reference)
+};
+
 struct MotionPlan {
   uint32_t width = 0, height = 0;
   uint32_t warmupFrames = 16;    // frames before the measured ones: the histories fill
@@ -29,8 +36,7 @@ struct MotionPlan {
   std::vector<uint32_t> rays = {1, 4, 16};
   uint32_t stripRays = 4;  // the ray count whose teleport frames are written as PNGs
   double fps = 30.0;
-  bool disableAntiLag = false;       // --no-anti-lag: DenoiseSettings::disableAntiLag, to measure what it buys
-  bool disableChangeResets = false;  // --no-change-resets: HybridEffectsDesc::disableChangeResets, likewise
+  MotionSwitches switches;
   rb::EffectSet effects = 0;
   std::string imagesDir;  // "" = no PNGs
 };
@@ -38,7 +44,7 @@ struct MotionPlan {
 // The published plan (GPU: 16 warm-up and 10 measured frames, references of 4 x 64 rays, 1, 4 and 16 rays) or, with
 // `quick`, the ctest smoke run's (every case at 4 rays, few frames); `rays` (when not empty) replaces the ray counts.
 MotionPlan makeMotionPlan(bool quick, uint32_t width, uint32_t height, rb::EffectSet effects, const std::string& images,
-                          bool disableAntiLag, const std::vector<uint32_t>& rays);
+                          const MotionSwitches& switches, const std::vector<uint32_t>& rays);
 // The smoke run's self-checks on a report: the teleport changed the reference (the animation played) and the still
 // case did not (references frozen per frame, scene at rest: at most 2% of `pixels`, the references' noise). Returns
 // the failures.

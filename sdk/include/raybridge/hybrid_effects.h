@@ -27,10 +27,11 @@
 // shadow effect's switches between denoised and raw when the frame's light switches between soft and hard
 // (ShadowEffectSettings), and generation says so.
 //
-// Order inside record(): pending BLAS work and the TLAS (when it builds one) -> shadows [-> denoiser] -> AO
-// [-> denoiser] -> local lights [-> denoiser] -> reflections [-> denoiser]. Only what the description enables exists: a
-// disabled effect has no pass, no denoiser, no image of its own and traces no ray; hard shadows (one ray) are never
-// denoised. The G-buffer hand-over (stages, accesses, layouts) is in gbuffer.h.
+// Order inside record(): pending BLAS work and the TLAS (when it builds one) -> change masks (on a frame with a known
+// change, see below) -> shadows [-> denoiser] -> AO [-> denoiser] -> local lights [-> denoiser] -> reflections
+// [-> denoiser]. Only what the description enables exists: a disabled effect has no pass, no denoiser, no image of its
+// own and traces no ray; hard shadows (one ray) are never denoised. The G-buffer hand-over (stages, accesses, layouts)
+// is in gbuffer.h.
 //
 // Change resets: the denoisers restart where the SDK knows the world changed, not only where their anti-lag sees it
 // (denoiser.h). Each frame that builds the TLAS compares HybridFrame::instances and localLights with the previous
@@ -232,6 +233,9 @@ struct HybridOutputs {
 // Per-pass measurements of the latest recordings whose frames have finished (zero for what does not exist).
 struct HybridStats {
   PassStats shadow, shadowDenoise, ao, aoDenoise, reflection, localLights, localLightsDenoise, reflectionDenoise;
+  // The change masks ("Change resets"): recorded only on frames with a known change, so this is the latest such
+  // frame's (PassStats::frame says which); not in totalGpuMs(), which is this frame's.
+  PassStats changeMasks;
   double totalGpuMs() const {
     return shadow.gpuMs + shadowDenoise.gpuMs + ao.gpuMs + aoDenoise.gpuMs + reflection.gpuMs + localLights.gpuMs +
            localLightsDenoise.gpuMs + reflectionDenoise.gpuMs;

@@ -21,13 +21,7 @@ int ChangeMasks::slotOf(uint32_t effect) {
   }
 }
 
-Result<bool> ChangeMasks::record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,
-                                 std::span<const GpuChangeBox> boxes, const ChangeMaskInputs& in) {
-  written_ = 0;
-  if (boxes.empty() || in.masks == 0) return false;
-  ChangeMaskConstants pc{};
-  if (Status st = fillGBufferConstants(g, tlas, ctx.frameIndex(), "HybridEffects: change masks", pc.gbuffer); !st)
-    return st.error();
+Status ChangeMasks::prepare(Context& ctx, uint32_t masks, uint32_t width, uint32_t height) {
   if (!pipeline_.pipeline) {
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     auto binding = [&](uint32_t b, VkDescriptorType t) { return VkDescriptorSetLayoutBinding{b, t, 1, cs, nullptr}; };
@@ -42,14 +36,17 @@ Result<bool> ChangeMasks::record(Context& ctx, VkCommandBuffer cmd, const GBuffe
     if (!p) return p.error();
     pipeline_ = p.value();
   }
+  if (!metricsReady_) {
+    if (Status st = metrics_.init(ctx, "change masks", /*countsRays=*/false); !st) return st;
+    metricsReady_ = true;
+  }
   if (!sampler_) {
     Result<VkSampler> sampler = createNearestSampler(ctx);
     if (!sampler) return sampler.error();
     sampler_ = sampler.value();
   }
-  const uint32_t slots = ctx.framesInFlight();
   if (!ring_.valid()) {
-    Result<GpuBuffer> r = createBuffer(ctx, VkDeviceSize(kMaxChangeBoxes) * sizeof(GpuChangeBox) * slots,
+    Result<GpuBuffer> r = createBuffer(ctx, VkDeviceSize(kMaxChangeBoxes) * sizeof(GpuChangeBox) * ctx.framesInFlight(),
                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
                                        MemoryLocation::HostVisible, MemoryCategory::PassBuffers,
                                        "HybridEffects: change boxes");
@@ -59,16 +56,29 @@ Result<bool> ChangeMasks::record(Context& ctx, VkCommandBuffer cmd, const GBuffe
   // One image per mask asked for, at the G-buffer's size (a new size: new images; the old ones are retired).
   for (uint32_t effect : {RB_CHANGE_SHADOWS, RB_CHANGE_AO, RB_CHANGE_LOCAL_LIGHTS, RB_CHANGE_REFLECTIONS}) {
     GpuImage& image = images_[slotOf(effect)];
-    const bool wanted = (in.masks & effect) != 0u;
-    if (image.valid() && (!wanted || image.width != g.width || image.height != g.height)) retireImage(ctx, image);
+    const bool wanted = (masks & effect) != 0u;
+    if (image.valid() && (!wanted || image.width != width || image.height != height)) retireImage(ctx, image);
     if (!wanted || image.valid()) continue;
-    Result<GpuImage> created = createStorageImage(ctx, g.width, g.height, VK_FORMAT_R8_UNORM,
+    Result<GpuImage> created = createStorageImage(ctx, width, height, VK_FORMAT_R8_UNORM,
                                                   VK_IMAGE_USAGE_TRANSFER_SRC_BIT, MemoryCategory::PassImages,
                                                   "HybridEffects: change mask");
     if (!created) return created.error();
     image = created.value();
   }
+  return {};
+}
 
+Result<bool> ChangeMasks::record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,
+                                 std::span<const GpuChangeBox> boxes, const ChangeMaskInputs& in) {
+  written_ = 0;
+  if (in.masks == 0) return false;
+  // Everything exists from the first frame that could need it, so that a later change allocates nothing.
+  if (Status st = prepare(ctx, in.masks, g.width, g.height); !st) return st.error();
+  if (boxes.empty()) return false;
+  ChangeMaskConstants pc{};
+  if (Status st = fillGBufferConstants(g, tlas, ctx.frameIndex(), "HybridEffects: change masks", pc.gbuffer); !st)
+    return st.error();
+  const uint32_t slots = ctx.framesInFlight();
   const uint32_t count = uint32_t(std::min<size_t>(boxes.size(), kMaxChangeBoxes));
   const VkDeviceSize slotBytes = VkDeviceSize(kMaxChangeBoxes) * sizeof(GpuChangeBox);
   const VkDeviceSize offset = (ctx.frameIndex() % slots) * slotBytes;
@@ -93,6 +103,8 @@ Result<bool> ChangeMasks::record(Context& ctx, VkCommandBuffer cmd, const GBuffe
   pc.aoRange = in.aoRange;
   pc.reactive = g.reactiveMask.view ? 1u : 0u;
 
+  if (Status st = metrics_.beginRecording(ctx, cmd); !st) return st.error();
+  metrics_.writeStart(ctx, cmd);
   const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   const VkPipelineStageFlags readers = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
                                        VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
@@ -126,6 +138,7 @@ Result<bool> ChangeMasks::record(Context& ctx, VkCommandBuffer cmd, const GBuffe
       toRead[n++] = colorImageBarrier(image.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                                       VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
   vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, readers, 0, 0, nullptr, 0, nullptr, n, toRead);
+  metrics_.writeEnd(ctx, cmd);
   written_ = in.masks;
   return true;
 }
@@ -153,7 +166,9 @@ void ChangeMasks::retire(Context& ctx) {
   for (GpuImage& image : images_)
     if (image.valid()) retireImage(ctx, image);
   if (ring_.valid()) retireBuffer(ctx, ring_);
-  pipeline_.retire(ctx);
+  if (pipeline_.pipeline) pipeline_.retire(ctx);
+  if (metricsReady_) metrics_.retire(ctx);
+  metricsReady_ = false;
   if (sampler_) {
     Context* context = &ctx;
     VkSampler sampler = sampler_;

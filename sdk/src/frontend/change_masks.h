@@ -3,7 +3,8 @@
 // pass and denoiser take the G-buffer with its reactive mask replaced by the effect's mask, so the denoiser, its
 // converged tiles and adaptive rays all restart exactly those pixels (denoiser.h, ray_schedule.h). Frames without a
 // known change record nothing and leave the G-buffer as the engine gave it. The images exist from the first frame
-// with a change, at the G-buffer's size, for the effects that have a denoiser (1 byte a pixel each).
+// that could need them (change resets on, the effect denoised), at the G-buffer's size: 1 byte a pixel each; a change
+// then allocates nothing, so memory stays flat however rarely changes come.
 //
 // Thread safety: none; owned by one HybridEffects, used by its record().
 #pragma once
@@ -16,6 +17,7 @@
 #include "change_tracker.h"
 #include "compute_pipeline.h"
 #include "gpu_memory.h"
+#include "pass_metrics.h"
 
 namespace rb {
 
@@ -29,9 +31,13 @@ struct ChangeMaskInputs {
 class ChangeMasks {
  public:
   // Records this frame's masks, or nothing (returns false) when `boxes` is empty: then gbufferFor() gives the
-  // engine's G-buffer unchanged. Errors (an image or buffer that could not be created) record nothing.
+  // engine's G-buffer unchanged. Creates what the masks of in.masks need first, changes or not. Errors (an image or
+  // buffer that could not be created) record nothing.
   Result<bool> record(Context& ctx, VkCommandBuffer cmd, const GBufferDesc& g, const TlasInfo& tlas,
                       std::span<const GpuChangeBox> boxes, const ChangeMaskInputs& in);
+  // Creates the pipeline, box ring, sampler, timer and the images of `masks` (RB_CHANGE_* bits) at width x height,
+  // and retires the images of other masks or another size. record() calls it too.
+  Status prepare(Context& ctx, uint32_t masks, uint32_t width, uint32_t height);
   // `g` with its reactive mask replaced by the mask of `effect` (one RB_CHANGE_* bit) when the latest record()
   // wrote one, else `g`.
   GBufferDesc gbufferFor(const GBufferDesc& g, uint32_t effect) const;
@@ -40,6 +46,8 @@ class ChangeMasks {
   // Forget the latest record(): gbufferFor() gives the engine's G-buffer until the next record() with changes.
   void clear() { written_ = 0; }
   void retire(Context& ctx);  // to the deferred release
+  // GPU time of the latest frame that recorded masks (0 before the first).
+  PassStats stats(Context& ctx) { return metricsReady_ ? metrics_.latest(ctx) : PassStats{}; }
 
  private:
   static int slotOf(uint32_t effect);
@@ -47,7 +55,9 @@ class ChangeMasks {
   GpuBuffer ring_;      // host-visible: kMaxChangeBoxes boxes per frame in flight
   ComputePipeline pipeline_;
   VkSampler sampler_ = VK_NULL_HANDLE;  // nearest: the depth and reactive mask are read with texelFetch
-  uint32_t written_ = 0;                // RB_CHANGE_* bits of the masks the latest record() wrote
+  PassMetrics metrics_;
+  bool metricsReady_ = false;
+  uint32_t written_ = 0;  // RB_CHANGE_* bits of the masks the latest record() wrote
 };
 
 }  // namespace rb

@@ -284,6 +284,9 @@ struct HybridEffects::Impl {
           !st)
         return st;
     }
+    if (const uint32_t masks = changeMaskEffects(); masks != 0u) {
+      if (Status st = changeMasks.prepare(ctx, masks, w, h); !st) return wrap("change masks", st.error());
+    }
     auto prepare = [&](auto* object, const char* what) -> Status {
       if (!object) return {};
       if (Status st = object->prepare(w, h); !st) return wrap(what, st.error());
@@ -381,6 +384,10 @@ struct HybridEffects::Impl {
     if (!ao || desc.ao.disableDenoiser) aoDenoiser.reset();
     if (!localLightsDenoised()) localLightDenoiser.reset();
     if (!reflection || desc.reflections.disableDenoiser) reflectionDenoiser.reset();
+    if (changeMaskEffects() == 0u) {  // the change masks follow the denoisers (prepareOutputs sizes new ones)
+      changeMasks.retire(ctx);
+      changes.forget();
+    }
     if (Status st = syncMaterialTable(); !st) return st;
     if (Status st = prepareOutputs(); !st) return st;
     return refreshOutputs();
@@ -414,8 +421,8 @@ struct HybridEffects::Impl {
 Status HybridEffects::Impl::recordChanges(VkCommandBuffer cmd, const HybridFrame& f, bool trackInstances) {
   const uint32_t effects = changeMaskEffects();
   if (effects == 0u) {
-    changeMasks.clear();
-    changes.forget();  // resumed later, it compares against that frame, not a stale one
+    changeMasks.retire(ctx);  // nothing reads a mask: no byte of it is kept
+    changes.forget();         // resumed later, it compares against that frame, not a stale one
     return {};
   }
   const std::span<const Instance> instances = trackInstances ? f.instances : std::span<const Instance>{};
@@ -658,7 +665,7 @@ void HybridEffects::resetHistory() {
 }
 
 HybridStats HybridEffects::stats() const {
-  const Impl& a = *impl_;
+  Impl& a = *impl_;
   return {statsOf(a.shadow),
           statsOf(a.shadowDenoiser),
           statsOf(a.ao),
@@ -666,7 +673,8 @@ HybridStats HybridEffects::stats() const {
           statsOf(a.reflection),
           statsOf(a.localLights),
           statsOf(a.localLightDenoiser),
-          statsOf(a.reflectionDenoiser)};
+          statsOf(a.reflectionDenoiser),
+          a.changeMasks.stats(a.ctx)};
 }
 
 MemoryStats HybridEffects::memoryStats() const {
