@@ -112,20 +112,6 @@ std::vector<float> readR8(GpuFixture& fx, const rb::EffectImage& image) {
   return out;
 }
 
-// Frames accumulated per pixel in a scalar denoiser's history (RG16F: mean, frames).
-std::vector<float> historyFrames(GpuFixture& fx, const rb::Denoiser& denoiser) {
-  const rb::DenoiseHistory h = denoiser.history();
-  REQUIRE(h.meanImage != VK_NULL_HANDLE);
-  std::vector<uint8_t> raw = readPassImage(fx, h.meanImage, h.width, h.height, 4);
-  std::vector<float> frames(size_t(h.width) * h.height);
-  for (size_t i = 0; i < frames.size(); ++i) {
-    uint16_t half;
-    std::memcpy(&half, raw.data() + 4 * i + 2, 2);
-    frames[i] = glm::unpackHalf1x16(half);
-  }
-  return frames;
-}
-
 struct Run {
   std::vector<float> shadowMask, aoMask, shadowFrames, aoFrames;
   bool stillFrameHadMask = true;

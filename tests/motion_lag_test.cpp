@@ -67,20 +67,6 @@ rb::Light sunLight() {
 // Runs one frame per entry of `worlds` (the scene as it is that frame) through the effect's pass, and the denoiser
 // when `denoise`; returns every frame's output. Frame k uses the context's frame k noise in every sequence, so a
 // still and a teleport sequence differ only by what they show.
-// Frames accumulated per pixel in the scalar history a denoiser's latest record() left (RG16F: mean, frames).
-std::vector<float> historyFrames(GpuFixture& fx, const rb::Denoiser& denoiser) {
-  const rb::DenoiseHistory h = denoiser.history();
-  REQUIRE(h.meanImage != VK_NULL_HANDLE);
-  std::vector<uint8_t> raw = readPassImage(fx, h.meanImage, h.width, h.height, 4);
-  std::vector<float> frames(size_t(h.width) * h.height);
-  for (size_t i = 0; i < frames.size(); ++i) {
-    uint16_t half;
-    std::memcpy(&half, raw.data() + 4 * i + 2, 2);
-    frames[i] = glm::unpackHalf1x16(half);
-  }
-  return frames;
-}
-
 // `frames` (when given) receives each frame's history length per pixel (denoised runs only).
 std::vector<std::vector<float>> runSequence(GpuFixture& fx, Effect effect, const std::vector<const World*>& worlds,
                                             uint32_t rays, bool denoise, const rb::DenoiseSettings& dn = {},

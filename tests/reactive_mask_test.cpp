@@ -16,20 +16,6 @@ constexpr uint32_t kW = 40, kH = 30;
 
 bool masked(uint32_t x, uint32_t y) { return x >= 10 && x < 22 && y >= 8 && y < 17; }
 
-// Frames accumulated per pixel: the .y of the scalar history (RG16F: mean, frames).
-std::vector<float> historyFrames(GpuFixture& fx, const rb::Denoiser& denoiser) {
-  const rb::DenoiseHistory h = denoiser.history();
-  REQUIRE(h.meanImage != VK_NULL_HANDLE);
-  std::vector<uint8_t> raw = readPassImage(fx, h.meanImage, kW, kH, 4);
-  std::vector<float> frames(size_t(kW) * kH);
-  for (size_t i = 0; i < frames.size(); ++i) {
-    uint16_t half;
-    std::memcpy(&half, raw.data() + 4 * i + 2, 2);
-    frames[i] = glm::unpackHalf1x16(half);
-  }
-  return frames;
-}
-
 }  // namespace
 
 TEST_CASE("a reactive mask drops the history of exactly the masked pixels", "[denoise][reactive]") {

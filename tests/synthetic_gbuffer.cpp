@@ -1,6 +1,7 @@
 #include "synthetic_gbuffer.h"
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/packing.hpp>
 
 #include <cmath>
 #include <cstring>
@@ -249,6 +250,19 @@ std::vector<float> readR32f(GpuFixture& fx, VkImage image, uint32_t width, uint3
   std::vector<float> out(size_t(width) * height);
   std::memcpy(out.data(), raw.data(), raw.size());
   return out;
+}
+
+std::vector<float> historyFrames(GpuFixture& fx, const rb::Denoiser& denoiser) {
+  const rb::DenoiseHistory h = denoiser.history();
+  REQUIRE(h.meanImage != VK_NULL_HANDLE);
+  const std::vector<uint8_t> raw = readPassImage(fx, h.meanImage, h.width, h.height, 4);
+  std::vector<float> frames(size_t(h.width) * h.height);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    uint16_t half;
+    std::memcpy(&half, raw.data() + 4 * i + 2, 2);
+    frames[i] = glm::unpackHalf1x16(half);
+  }
+  return frames;
 }
 
 }  // namespace rbtest
