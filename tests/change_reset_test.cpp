@@ -25,15 +25,7 @@ constexpr float kAoRange = 1.0f;
 constexpr float kSunDegrees = 2.0f;
 const glm::dvec3 kSun = glm::normalize(glm::dvec3(0.5, 0.8, -0.4));  // towards the light
 
-SyntheticView view() {
-  SyntheticView v;
-  v.eye = {-6.0, 5.0, 8.0};
-  v.target = {0.0, 0.5, 1.0};
-  v.fovYDegrees = 45.0;
-  v.width = kW;
-  v.height = kH;
-  return v;
-}
+SyntheticView view() { return motionTestView(kW, kH); }
 
 struct World {
   TestScene scene;

@@ -24,15 +24,7 @@ constexpr uint32_t kW = 96, kH = 72;
 constexpr uint32_t kRays = 4;
 constexpr uint32_t kStillFrames = 12;  // frames with the box at its first place before it teleports
 
-SyntheticView motionView() {
-  SyntheticView v;
-  v.eye = {-6.0, 5.0, 8.0};
-  v.target = {0.0, 0.5, 1.0};
-  v.fovYDegrees = 45.0;
-  v.width = kW;
-  v.height = kH;
-  return v;
-}
+SyntheticView motionView() { return motionTestView(kW, kH); }
 
 // The conformance scene with its box (instance 3) at `x`, `z`.
 TestScene sceneWithBoxAt(float x, float z) {

@@ -19,6 +19,16 @@ SyntheticView conformanceView(uint32_t width, uint32_t height, double fovYDegree
   return v;
 }
 
+SyntheticView motionTestView(uint32_t width, uint32_t height) {
+  SyntheticView v;
+  v.eye = {-6.0, 5.0, 8.0};
+  v.target = {0.0, 0.5, 1.0};
+  v.fovYDegrees = 45.0;
+  v.width = width;
+  v.height = height;
+  return v;
+}
+
 CpuGBuffer traceGBuffer(const EmbreeScene& embree, const SyntheticView& v, const std::vector<float>& roughness) {
   CpuGBuffer g;
   g.view = v;

@@ -28,6 +28,9 @@ struct SyntheticView {
 
 // The conformance scene's camera (conformanceCamera()) as a synthetic view of the given size.
 SyntheticView conformanceView(uint32_t width, uint32_t height, double fovYDegrees = 60.0);
+// The motion tests' view of the conformance scene: from above and behind its boxes, so that a box's shadow from a
+// light behind it (as seen) falls on visible ground.
+SyntheticView motionTestView(uint32_t width, uint32_t height);
 
 // CPU-side G-buffer: per pixel the exact hit (world position in double, geometric normal facing the eye).
 struct CpuGBuffer {
