@@ -40,10 +40,11 @@ float distance2(vec3 p, vec3 lo, vec3 hi) {
   return dot(d, d);
 }
 
-// Whether the segment p + t d, t in [0, tMax], meets the box (slab test; a zero component of d is an infinite
-// inverse, which the comparisons handle).
+// Whether the segment p + t d, t in [0, tMax], meets the box (slab test). A zero component of d (the default sun,
+// straight up) becomes a tiny one: an infinite inverse times a zero distance would be NaN, and min/max of NaN is not
+// defined.
 bool segmentHits(vec3 p, vec3 d, float tMax, vec3 lo, vec3 hi) {
-  vec3 inv = 1.0 / d;
+  vec3 inv = 1.0 / mix(d, vec3(1e-20), lessThan(abs(d), vec3(1e-20)));
   vec3 t0 = (lo - p) * inv, t1 = (hi - p) * inv;
   vec3 tn = min(t0, t1), tf = max(t0, t1);
   float enter = max(max(tn.x, tn.y), max(tn.z, 0.0));

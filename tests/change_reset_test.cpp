@@ -24,6 +24,7 @@ constexpr uint32_t kStillFrames = 4;  // frames with the box at its first place
 constexpr float kAoRange = 1.0f;
 constexpr float kSunDegrees = 2.0f;
 const glm::dvec3 kSun = glm::normalize(glm::dvec3(0.5, 0.8, -0.4));  // towards the light
+const glm::dvec3 kSunUp(0.0, 1.0, 0.0);  // rb::Light's default: axis-aligned, the slab test's zero components
 
 SyntheticView view() { return motionTestView(kW, kH); }
 
@@ -81,12 +82,13 @@ bool rayHits(const Box& b, double grow, const glm::dvec3& p, const glm::dvec3& d
 // The shadow footprint of the boxes at pixel position p: in a box, or its ray to the sun crosses one widened by the
 // soft light's spread (tan(angle) * the distance to the box's far side, as change_masks.comp) scaled by `spread`,
 // plus `pad`.
-bool inShadowFootprint(const std::vector<Box>& boxes, const glm::dvec3& p, double spread, double pad) {
+bool inShadowFootprint(const std::vector<Box>& boxes, const glm::dvec3& p, const glm::dvec3& sun, double spread,
+                       double pad) {
   for (const Box& b : boxes) {
     const glm::dvec3 centre = 0.5 * (b.lo + b.hi);
     const double reach = glm::length(centre - p) + glm::length(b.hi - centre);
     const double widen = spread * std::tan(kSunDegrees * M_PI / 180.0) * reach + pad;
-    if (distanceTo(b, p) <= pad || rayHits(b, widen, p, kSun)) return true;
+    if (distanceTo(b, p) <= pad || rayHits(b, widen, p, sun)) return true;
   }
   return false;
 }
@@ -111,7 +113,7 @@ struct Run {
 
 // kStillFrames frames of `before`, then one of `after`, through HybridEffects (soft shadows and AO at 4 rays,
 // denoised, anti-lag off so that only disocclusion and change resets restart a pixel).
-Run run(GpuFixture& fx, const World& before, const World& after, bool changeResets) {
+Run run(GpuFixture& fx, const World& before, const World& after, bool changeResets, const glm::dvec3& sun = kSun) {
   auto service = rb::AccelerationStructureService::create(fx.ctx());
   RB_REQUIRE_OK(service);
   BuiltScene built = buildScene(fx, *service.value(), before.scene);
@@ -136,9 +138,9 @@ Run run(GpuFixture& fx, const World& before, const World& after, bool changeRese
     rb::HybridFrame frame;
     frame.gbuffer = gbuffer.desc();
     frame.instances = instances;
-    frame.light.direction[0] = float(kSun.x);
-    frame.light.direction[1] = float(kSun.y);
-    frame.light.direction[2] = float(kSun.z);
+    frame.light.direction[0] = float(sun.x);
+    frame.light.direction[1] = float(sun.y);
+    frame.light.direction[2] = float(sun.z);
     frame.light.angularRadiusDegrees = kSunDegrees;
     fx.runFrame([&](VkCommandBuffer cmd) { RB_REQUIRE_OK(effects.record(cmd, frame)); });
     if (f == kStillFrames - 1) {
@@ -186,8 +188,8 @@ TEST_CASE("a moved instance resets history only inside its old and new footprint
     const bool shadow = on.shadowMask[i] > 0.5f, ao = on.aoMask[i] > 0.5f;
     shadowSet += shadow;
     aoSet += ao;
-    shadowMissed += !shadow && inShadowFootprint(boxes, p, 0.9, 0.0);
-    shadowStray += shadow && !inShadowFootprint(boxes, p, 1.1, 3.0 * pad + 0.01);
+    shadowMissed += !shadow && inShadowFootprint(boxes, p, kSun, 0.9, 0.0);
+    shadowStray += shadow && !inShadowFootprint(boxes, p, kSun, 1.1, 3.0 * pad + 0.01);
     aoMissed += !ao && inAoFootprint(boxes, p, kAoRange * 0.99);
     aoStray += ao && !inAoFootprint(boxes, p, kAoRange * 1.01 + 3.0 * pad + 0.01);
   }
@@ -235,6 +237,31 @@ TEST_CASE("a moved instance resets history only inside its old and new footprint
     restartedOn += after.cpu.hit[i] && on.aoFrames[i] == 1.0f;
   }
   CHECK(restartedOn > restartedOff + 50);
+}
+
+TEST_CASE("a sun straight overhead casts the moved box's shadow footprint too", "[denoise][motion][changes]") {
+  GpuFixture fx;
+  const World before(-1.0f, 1.0f), after(1.5f, 2.0f);
+  const std::vector<Box> boxes = {worldBox(before.scene, 3), worldBox(after.scene, 3)};
+  const Run on = run(fx, before, after, true, kSunUp);
+  uint32_t set = 0, missed = 0, stray = 0, under = 0;
+  for (size_t i = 0; i < size_t(kW) * kH; ++i) {
+    if (!after.cpu.hit[i]) continue;
+    const glm::dvec3 p = after.cpu.position[i];
+    const double pad = 1e-3 * glm::length(p - view().eye);
+    const bool shadow = on.shadowMask[i] > 0.5f;
+    set += shadow;
+    missed += !shadow && inShadowFootprint(boxes, p, kSunUp, 0.9, 0.0);
+    stray += shadow && !inShadowFootprint(boxes, p, kSunUp, 1.1, 3.0 * pad + 0.01);
+    // The ground straight under either box: in its shadow, outside the box itself.
+    for (const Box& b : boxes)
+      under += shadow && p.y < b.lo.y && p.x > b.lo.x && p.x < b.hi.x && p.z > b.lo.z && p.z < b.hi.z;
+  }
+  std::printf("change mask, sun overhead: shadows %u set, %u under the boxes; missed %u, stray %u\n", set, under,
+              missed, stray);
+  CHECK(under > 10);
+  CHECK(missed == 0);
+  CHECK(stray == 0);
 }
 
 TEST_CASE("engine change boxes that are not finite or inverted are refused by name, nothing recorded",
