@@ -52,27 +52,82 @@ bool segmentHits(vec3 p, vec3 d, float tMax, vec3 lo, vec3 hi) {
   return enter <= leave;
 }
 
+// Per 8x8 workgroup, the boxes that can change any of its pixels: each box is tested once against the tile's surface
+// points (their bounding box, by the Minkowski sum with it), so a pixel loops over the few boxes near it instead of
+// every box of the frame. Every per-pixel test below is implied by the tile's (a superset), so the masks are the same.
+shared vec3 tileLo[64];
+shared vec3 tileHi[64];
+shared uint candidateCount;
+shared uint candidates[RB_CHANGE_MAX_BOXES];
+
+// Whether box b can change a pixel whose surface point lies within `extent` of `c` (margin: the largest pixel margin).
+bool mayChangeTile(ChangeBox b, vec3 c, vec3 extent, float margin, float spread) {
+  const uint effects = b.effects & pc.masks;
+  vec3 lo = b.lo - extent, hi = b.hi + extent;  // the box grown by the tile: tests from c stand for every point
+  float d2 = distance2(c, lo, hi);
+  if (d2 <= margin * margin) return true;
+  if ((effects & RB_CHANGE_AO) != 0u && d2 <= (pc.aoRange + margin) * (pc.aoRange + margin)) return true;
+  if ((effects & RB_CHANGE_SHADOWS) != 0u) {
+    vec3 centre = 0.5 * (b.lo + b.hi);
+    float reach = length(centre - c) + length(extent) + length(b.hi - centre);
+    float widen = margin + (pc.lightType == RB_LIGHT_DIRECTIONAL ? spread * reach : spread);
+    vec3 toLight = pc.lightType == RB_LIGHT_DIRECTIONAL ? pc.lightDirection : pc.lightPosition - c;
+    float lightDistance = pc.lightType == RB_LIGHT_DIRECTIONAL ? 1e30 : length(toLight);
+    // A point light's segments from the tile's points lie within `extent` of the one from c (their hull); a directional
+    // light's rays are parallel.
+    if (segmentHits(c, normalize(toLight), lightDistance, lo - widen, hi + widen)) return true;
+  }
+  return false;
+}
+
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (any(greaterThanEqual(pixel, pc.gbuffer.size))) return;
-  ivec2 ip = ivec2(pixel);
+  const uint local = gl_LocalInvocationIndex;
+  // Threads outside the image take part in the workgroup's steps (barriers) but write nothing.
+  const bool inImage = all(lessThan(pixel, pc.gbuffer.size));
+  ivec2 ip = ivec2(min(pixel, pc.gbuffer.size - 1u));
   uint changed = 0u;
   if (pc.reactive != 0u && texelFetch(gReactive, ip, 0).r > 0.5) changed = pc.masks;
   float depth = texelFetch(gDepth, ip, 0).r;
   const bool reversedZ = (pc.gbuffer.flags & RB_GB_REVERSED_Z) != 0u;
   const bool sky = reversedZ ? depth <= 0.0 : depth >= 1.0;
-  if (!sky && changed != pc.masks) {
-    vec3 rel = rbReconstructCameraRelative(pixel, vec2(pc.gbuffer.size), depth, pc.gbuffer.inverseProjection,
-                                           pc.gbuffer.viewToWorld, pc.gbuffer.wAtDepthOne, reversedZ);
-    vec3 p = rel + pc.gbuffer.cameraToTlas;
+  const bool test = inImage && !sky && changed != pc.masks;
+  vec3 rel = vec3(0.0), p = vec3(0.0);
+  if (test) {
+    rel = rbReconstructCameraRelative(pixel, vec2(pc.gbuffer.size), depth, pc.gbuffer.inverseProjection,
+                                      pc.gbuffer.viewToWorld, pc.gbuffer.wAtDepthOne, reversedZ);
+    p = rel + pc.gbuffer.cameraToTlas;
+  }
+  tileLo[local] = test ? p : vec3(1e30);
+  tileHi[local] = test ? p : vec3(-1e30);
+  if (local == 0u) candidateCount = 0u;
+  barrier();
+  for (uint stride = 32u; stride > 0u; stride >>= 1) {
+    if (local < stride) {
+      tileLo[local] = min(tileLo[local], tileLo[local + stride]);
+      tileHi[local] = max(tileHi[local], tileHi[local + stride]);
+    }
+    barrier();
+  }
+  const vec3 tLo = tileLo[0], tHi = tileHi[0];
+  if (tLo.x <= tHi.x) {
+    const vec3 c = 0.5 * (tLo + tHi), extent = 0.5 * (tHi - tLo);
+    const float tileMargin = 1e-3 * (length(c - pc.gbuffer.cameraToTlas) + length(extent)) + 1e-4;
+    ChangeBoxes boxes = ChangeBoxes(pc.boxes);
+    for (uint i = local; i < pc.boxCount; i += 64u)
+      if (mayChangeTile(boxes.b[i], c, extent, tileMargin, pc.lightSpread)) candidates[atomicAdd(candidateCount, 1u)] = i;
+  }
+  barrier();
+
+  if (test) {
     // The reconstructed point's error: a surface of the box's own object reads as inside.
     float margin = 1e-3 * length(rel) + 1e-4;
     vec3 toLight = pc.lightType == RB_LIGHT_DIRECTIONAL ? pc.lightDirection : pc.lightPosition - p;
     float lightDistance = pc.lightType == RB_LIGHT_DIRECTIONAL ? 1e30 : length(toLight);
     toLight = normalize(toLight);
     ChangeBoxes boxes = ChangeBoxes(pc.boxes);
-    for (uint i = 0u; i < pc.boxCount && changed != pc.masks; ++i) {
-      ChangeBox b = boxes.b[i];
+    for (uint k = 0u; k < candidateCount && changed != pc.masks; ++k) {
+      ChangeBox b = boxes.b[candidates[k]];
       uint effects = b.effects & pc.masks & ~changed;
       if (effects == 0u) continue;
       float d2 = distance2(p, b.lo, b.hi);
@@ -92,6 +147,7 @@ void main() {
       }
     }
   }
+  if (!inImage) return;
   if ((pc.masks & RB_CHANGE_SHADOWS) != 0u)
     imageStore(shadowMask, ip, vec4((changed & RB_CHANGE_SHADOWS) != 0u ? 1.0 : 0.0));
   if ((pc.masks & RB_CHANGE_AO) != 0u) imageStore(aoMask, ip, vec4((changed & RB_CHANGE_AO) != 0u ? 1.0 : 0.0));

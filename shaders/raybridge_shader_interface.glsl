@@ -85,6 +85,8 @@
 #define RB_CHANGE_AO 2u
 #define RB_CHANGE_LOCAL_LIGHTS 4u
 #define RB_CHANGE_REFLECTIONS 8u
+// Boxes a frame's list holds at most (rb::kMaxChangeBoxes, change_tracker.h).
+#define RB_CHANGE_MAX_BOXES 256
 // The depth-aware upsample of half-resolution AO and reflections (upsample_depth_aware.glsl).
 #define RB_UPSAMPLE_BINDING_DEPTH 0
 #define RB_UPSAMPLE_BINDING_NORMAL 1

@@ -29,7 +29,7 @@ inline constexpr uint32_t kChangeAllEffects = RB_CHANGE_SHADOWS | RB_CHANGE_AO |
                                               RB_CHANGE_REFLECTIONS;
 // Boxes a frame sends to the GPU at most; the rest are merged into the last one (a larger box: more resets, none
 // missed). Each costs every pixel a box test.
-inline constexpr uint32_t kMaxChangeBoxes = 256;
+inline constexpr uint32_t kMaxChangeBoxes = RB_CHANGE_MAX_BOXES;
 // The half-extent given to a change without a bound (a local light of unlimited range, or a directional one).
 inline constexpr double kUnboundedChange = 1e30;
 
