@@ -34,12 +34,13 @@
 // is in gbuffer.h.
 //
 // Change resets: the denoisers restart where the SDK knows the world changed, not only where their anti-lag sees it
-// (denoiser.h). Each frame that builds the TLAS compares HybridFrame::instances and localLights with the previous
-// frame's, entry by entry (keep their order from frame to frame). An instance whose transform or mesh changed, that
-// appeared or vanished, or whose dynamic mesh was updated (updateMesh) changes its old and new world box (the mesh's
-// MeshDesc::bounds or MeshUpdate::bounds under the transform; a mesh without a known box is left to anti-lag); a local
-// light that changed changes its old and new range. HybridFrame::changedBoxes adds the engine's own. A compute
-// pass turns them into one mask per denoised effect (1 byte a pixel each, allocated at the first change):
+// (denoiser.h). Each frame compares HybridFrame::instances (when record() builds the TLAS) and localLights with the
+// previous frame's, entry by entry (keep their order from frame to frame). An instance whose transform or mesh
+// changed, that appeared or vanished, or whose dynamic mesh brought a new pose box (MeshUpdate::bounds; an update
+// without one counts as a change) changes its old and new world box: the mesh's box (MeshDesc::bounds, or the pose
+// box) under the transform; a mesh without a known box is left to anti-lag. A local light that changed changes its
+// old and new range. HybridFrame::changedBoxes adds the engine's own. A compute pass turns them into one mask per
+// denoised effect (1 byte a pixel each, allocated with the denoisers):
 //   - every effect: pixels whose surface lies in a box (the object itself);
 //   - shadows: pixels whose ray to HybridFrame::light crosses a box (the old and new shadow);
 //   - AO: pixels within AoEffectSettings::range of a box (the contact shadow it left and brought);
