@@ -60,24 +60,28 @@ shared vec3 tileHi[64];
 shared uint candidateCount;
 shared uint candidates[RB_CHANGE_MAX_BOXES];
 
-// Whether box b can change a pixel whose surface point lies within `extent` of `c` (margin: the largest pixel margin).
-bool mayChangeTile(ChangeBox b, vec3 c, vec3 extent, float margin, float spread) {
-  const uint effects = b.effects & pc.masks;
-  vec3 lo = b.lo - extent, hi = b.hi + extent;  // the box grown by the tile: tests from c stand for every point
+// Which of `effects` box b changes at the surface points within `extent` of `c` (per axis), `margin` being the
+// largest of their reconstruction margins: a pixel's own test is extent 0, a tile's is its points' bounding box (the
+// box grown by it: a test from c then stands for every point, so the tile's result holds every pixel's).
+uint changedEffects(ChangeBox b, uint effects, vec3 c, vec3 extent, float margin) {
+  vec3 lo = b.lo - extent, hi = b.hi + extent;
   float d2 = distance2(c, lo, hi);
-  if (d2 <= margin * margin) return true;
-  if ((effects & RB_CHANGE_AO) != 0u && d2 <= (pc.aoRange + margin) * (pc.aoRange + margin)) return true;
+  if (d2 <= margin * margin) return effects;  // on the object itself
+  uint changed = 0u;
+  if ((effects & RB_CHANGE_AO) != 0u && d2 <= (pc.aoRange + margin) * (pc.aoRange + margin)) changed |= RB_CHANGE_AO;
   if ((effects & RB_CHANGE_SHADOWS) != 0u) {
+    // Soft shadow rays spread: a directional light's by tan(angle) per unit of distance (taken at the box's far
+    // side), a sphere light's by up to its radius.
     vec3 centre = 0.5 * (b.lo + b.hi);
     float reach = length(centre - c) + length(extent) + length(b.hi - centre);
-    float widen = margin + (pc.lightType == RB_LIGHT_DIRECTIONAL ? spread * reach : spread);
+    float widen = margin + (pc.lightType == RB_LIGHT_DIRECTIONAL ? pc.lightSpread * reach : pc.lightSpread);
     vec3 toLight = pc.lightType == RB_LIGHT_DIRECTIONAL ? pc.lightDirection : pc.lightPosition - c;
     float lightDistance = pc.lightType == RB_LIGHT_DIRECTIONAL ? 1e30 : length(toLight);
-    // A point light's segments from the tile's points lie within `extent` of the one from c (their hull); a directional
-    // light's rays are parallel.
-    if (segmentHits(c, normalize(toLight), lightDistance, lo - widen, hi + widen)) return true;
+    // A point light's segments from the tile's points lie within `extent` of the one from c (their hull); a
+    // directional light's rays are parallel.
+    if (segmentHits(c, normalize(toLight), lightDistance, lo - widen, hi + widen)) changed |= RB_CHANGE_SHADOWS;
   }
-  return false;
+  return changed;
 }
 
 void main() {
@@ -115,36 +119,19 @@ void main() {
     const float tileMargin = 1e-3 * (length(c - pc.gbuffer.cameraToTlas) + length(extent)) + 1e-4;
     ChangeBoxes boxes = ChangeBoxes(pc.boxes);
     for (uint i = local; i < pc.boxCount; i += 64u)
-      if (mayChangeTile(boxes.b[i], c, extent, tileMargin, pc.lightSpread)) candidates[atomicAdd(candidateCount, 1u)] = i;
+      if (changedEffects(boxes.b[i], boxes.b[i].effects & pc.masks, c, extent, tileMargin) != 0u)
+        candidates[atomicAdd(candidateCount, 1u)] = i;
   }
   barrier();
 
   if (test) {
     // The reconstructed point's error: a surface of the box's own object reads as inside.
     float margin = 1e-3 * length(rel) + 1e-4;
-    vec3 toLight = pc.lightType == RB_LIGHT_DIRECTIONAL ? pc.lightDirection : pc.lightPosition - p;
-    float lightDistance = pc.lightType == RB_LIGHT_DIRECTIONAL ? 1e30 : length(toLight);
-    toLight = normalize(toLight);
     ChangeBoxes boxes = ChangeBoxes(pc.boxes);
     for (uint k = 0u; k < candidateCount && changed != pc.masks; ++k) {
       ChangeBox b = boxes.b[candidates[k]];
       uint effects = b.effects & pc.masks & ~changed;
-      if (effects == 0u) continue;
-      float d2 = distance2(p, b.lo, b.hi);
-      if (d2 <= margin * margin) {
-        changed |= effects;
-        continue;
-      }
-      if ((effects & RB_CHANGE_AO) != 0u && d2 <= (pc.aoRange + margin) * (pc.aoRange + margin))
-        changed |= RB_CHANGE_AO;
-      if ((effects & RB_CHANGE_SHADOWS) != 0u) {
-        // Soft shadow rays spread: a directional light's by tan(angle) per unit of distance (taken at the box's
-        // far side), a sphere light's by up to its radius.
-        vec3 centre = 0.5 * (b.lo + b.hi);
-        float reach = length(centre - p) + length(b.hi - centre);
-        float widen = margin + (pc.lightType == RB_LIGHT_DIRECTIONAL ? pc.lightSpread * reach : pc.lightSpread);
-        if (segmentHits(p, toLight, lightDistance, b.lo - widen, b.hi + widen)) changed |= RB_CHANGE_SHADOWS;
-      }
+      if (effects != 0u) changed |= changedEffects(b, effects, p, vec3(0.0), margin);
     }
   }
   if (!inImage) return;
