@@ -309,7 +309,8 @@ struct Loader {
     }
     out.name = mesh.name.empty() ? "mesh" : mesh.name;
     out.positions.resize(f.size() / 3);
-    std::memcpy(out.positions.data(), f.data(), f.size() * sizeof(float));
+    // An empty accessor leaves both pointers null: memcpy from null is undefined even for 0 bytes (the fuzzer's UBSan).
+    if (!f.empty()) std::memcpy(out.positions.data(), f.data(), f.size() * sizeof(float));
     auto optional = [&](const char* name, int comps, auto& dst) {
       auto it = prim.attributes.find(name);
       if (it == prim.attributes.end()) return;
