@@ -24,6 +24,8 @@ TEST_CASE("preset names round-trip and the table matches the thesis", "[presets]
     CHECK(bool(d.effects & rb::kEffectAo) == (d.aoRaysPerPixel > 0));
     CHECK(d.aoHalfResolution == bool(d.effects & rb::kEffectAo));         // every preset with AO traces it at half res
     CHECK((d.raster.mapSize == 0) == !(d.effects & rb::kEffectShadows));  // a raster shadow map iff shadows
+    // Every soft-shadow preset skips converged shadow tiles (presets.h says why); a hard shadow has none to skip.
+    CHECK(d.shadowConvergedTiles == (d.shadowRaysPerPixel > 1));
   }
   CHECK(rb::parsePreset("shadows") == rb::Preset::SoftShadows);  // the old single-effect name
   CHECK_FALSE(rb::parsePreset("High").has_value());
@@ -43,6 +45,8 @@ TEST_CASE("preset names round-trip and the table matches the thesis", "[presets]
   base.ao.range = 3.0f;
   base.reflections.roughnessThreshold = 0.7f;
   const rb::HybridEffectsDesc low = rb::withPreset(base, rb::Preset::Low);
+  CHECK_FALSE(low.shadows.schedule.convergedTiles.enabled);
+  CHECK(rb::withPreset(base, rb::Preset::High).shadows.schedule.convergedTiles.enabled);
   CHECK(low.effects == (rb::kEffectShadows | rb::kEffectAo));
   CHECK(low.ao.schedule.halfResolution);
   CHECK(low.ao.range == 3.0f);

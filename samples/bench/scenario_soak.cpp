@@ -417,7 +417,11 @@ void SoakRun::changeSetting() {
   switch (pick(13)) {
     case 0: d.shadows.raysPerPixel = kRays[pick(4)]; break;
     case 1: d.shadows.softAngularRadiusDegrees = std::array<float, 3>{0.0f, 0.5f, 2.0f}[pick(3)]; break;
-    case 2: d.shadows.disableDenoiser = !d.shadows.disableDenoiser; break;
+    case 2:
+      d.shadows.disableDenoiser = !d.shadows.disableDenoiser;
+      // Converged tiles (the soft-shadow presets') read the denoiser's history: off with it, as an engine must.
+      if (d.shadows.disableDenoiser) d.shadows.schedule.convergedTiles.enabled = false;
+      break;
     case 3: d.shadows.schedule.tileClassifier = !d.shadows.schedule.tileClassifier; break;
     case 4: d.ao.raysPerPixel = kRays[pick(4)]; break;
     case 5:

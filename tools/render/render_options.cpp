@@ -30,7 +30,8 @@ std::string presetTable() {
     line.resize(18, ' ');
     std::vector<std::string> parts;
     if (d.effects & rb::kEffectShadows)
-      parts.push_back(d.shadowRaysPerPixel > 1 ? "soft shadows " + std::to_string(d.shadowRaysPerPixel) + " rays"
+      parts.push_back(d.shadowRaysPerPixel > 1 ? "soft shadows " + std::to_string(d.shadowRaysPerPixel) + " rays" +
+                                                     (d.shadowConvergedTiles ? ", converged tiles skipped" : "")
                                                : std::string("hard shadows"));
     if (d.effects & rb::kEffectAo)
       parts.push_back("AO " + std::to_string(d.aoRaysPerPixel) + " rays" + (d.aoHalfResolution ? " at half res" : ""));
@@ -380,9 +381,13 @@ void addScheduleOptions(CLI::App& app, RenderOptions& o) {
   app.add_option_function<uint32_t>(
          "--converged-tiles", [&o](const uint32_t& v) { o.convergedTiles = v; },
          "soft shadows: skip the 8x8 tiles whose denoised history has converged, each\n"
-         "still traced once in K frames (turns the tile classifier on; e.g. 8, the default)")
+         "still traced once in K frames (turns the tile classifier on; e.g. 8, the default;\n"
+         "the soft-shadow presets skip them at the default K without this option)")
       ->type_name("K")
       ->check(rbCli::wholeNumber(1, 65535));
+  app.add_flag("--no-converged-tiles", o.noConvergedTiles,
+               "soft shadows: trace every tile every frame (the soft-shadow presets skip converged\n"
+               "tiles by default)");
   app.add_option_function<uint32_t>(
          "--converged-ao", [&o](const uint32_t& v) { o.convergedAo = v; },
          "AO: skip the 8x8 tiles whose denoised history has converged, each still traced\n"
@@ -542,7 +547,9 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.shadows.raysPerPixel = shadowRays;
   h.shadows.disableDenoiser = !o.denoise;
   h.shadows.schedule.tileClassifier = o.tileClassifier;
-  h.shadows.schedule.convergedTiles.enabled = o.convergedTiles.has_value();
+  // The preset's converged tiles need the shadow denoiser's history: --no-denoise leaves them off.
+  h.shadows.schedule.convergedTiles.enabled = o.convergedTiles.has_value() ||
+                                              (p.shadowConvergedTiles && o.denoise && !o.noConvergedTiles);
   h.shadows.schedule.convergedTiles.refreshPeriod = o.convergedTiles.value_or(0);
   h.shadows.schedule.adaptive.enabled = o.adaptiveShadowsMs.has_value();
   h.shadows.schedule.adaptive.timeBudgetMs = o.adaptiveShadowsMs.value_or(0.0f);
@@ -608,6 +615,7 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
            "punctual lights; AO and reflections need the G-buffer it does not draw, so it takes no effect list";
   if (o.mode == Mode::RayTraced && o.geometricNormals)
     return "--gbuffer-normals: --mode raytraced draws no G-buffer; its hits shade with the mesh normals";
+  if (o.convergedTiles && o.noConvergedTiles) return "--converged-tiles and --no-converged-tiles: give one of them";
   if (o.convergedTiles && !o.denoise)
     return "--converged-tiles: converged tiles are read from the shadow denoiser's history; drop --no-denoise";
   if (o.convergedTiles && o.mode != Mode::Hybrid)

@@ -60,6 +60,8 @@ struct RenderOptions {
   // --converged-tiles K: HybridEffectsDesc::shadows.schedule.convergedTiles, each converged tile traced once in K
   // frames.
   std::optional<uint32_t> convergedTiles;
+  // --no-converged-tiles: the soft-shadow presets' converged tiles off (every tile traced every frame).
+  bool noConvergedTiles = false;
   // --converged-ao K: HybridEffectsDesc::ao.schedule.convergedTiles, likewise (AO at full resolution: --half-res
   // without ao).
   std::optional<uint32_t> convergedAo;

@@ -105,6 +105,7 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--adaptive pixel", "--adaptive: 'pixel' names no effect with adaptive rays (shadows, ao)"},
       {"--converged-tiles 0", "--converged-tiles: 0 is outside 1..65535"},
       {"--converged-tiles 8 --no-denoise", "--converged-tiles: converged tiles are read from the shadow denoiser's"},
+      {"--converged-tiles 8 --no-converged-tiles", "--converged-tiles and --no-converged-tiles: give one of them"},
       {"--converged-reflections 0", "--converged-reflections: 0 is outside 1..65535"},
       {"--converged-lights 8 --light-rays 0", "--converged-lights: --light-rays 0 traces every light exactly"},
       {"--converged-reflections 8 --no-denoise",
@@ -169,6 +170,29 @@ TEST_CASE("raybridge-render --half-res traces AO and reflections at half resolut
     INFO(pass << ": half / full rays " << ratio);
     CHECK((ratio > 0.2 && ratio < 0.3));
   }
+}
+
+TEST_CASE("raybridge-render: the soft-shadow presets skip converged shadow tiles; --no-converged-tiles traces them",
+          "[render][presets][converged]") {
+  // A still camera for 24 frames: the shadow history converges and the preset's converged tiles skip some tiles.
+  // --no-converged-tiles and --no-denoise (no history to read) trace every tile, as hard-shadows (no soft light).
+  auto converged = [](const std::string& name, const std::string& extra) {
+    const fs::path dir = tempDir(name);
+    const RunResult r = runRender("--width 96 --height 64 --frames 24 --dump " + extra + " --out " + dir.string());
+    INFO(extra << "\n" << r.output);
+    REQUIRE(r.exitCode == 0);
+    const nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir / "stats.json"));
+    CHECK(stats["validation"]["errors"] == 0);
+    const nlohmann::json& shadow = stats["raybridge"]["passes"]["shadow"];
+    return shadow.contains("tiles") ? shadow["tiles"]["converged"].get<uint64_t>() : uint64_t(0);
+  };
+  for (const char* preset : {"soft-shadows", "high"}) {
+    INFO(preset);
+    CHECK(converged(std::string("converged_") + preset, std::string("--preset ") + preset) > 0);
+  }
+  CHECK(converged("converged_off", "--preset high --no-converged-tiles") == 0);
+  CHECK(converged("converged_no_denoise", "--preset high --no-denoise") == 0);
+  CHECK(converged("converged_hard", "--preset hard-shadows") == 0);
 }
 
 TEST_CASE("raybridge-render --reorder: stats.json says whether reflections reordered", "[render][reorder]") {

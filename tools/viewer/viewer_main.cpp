@@ -322,6 +322,9 @@ struct Session {
   void toggleDenoise() {
     rb::HybridEffectsDesc d = fx.desc();
     d.shadows.disableDenoiser = d.ao.disableDenoiser = denoiseOn(d);
+    // Converged tiles read the shadow denoiser's history: off with it, the preset's choice back with it.
+    d.shadows.schedule.convergedTiles.enabled = !d.shadows.disableDenoiser &&
+                                                rb::presetDesc(preset).shadowConvergedTiles;
     setDesc(d);
   }
   void setHybrid(bool hybrid) {

@@ -167,7 +167,8 @@ struct HybridEffectsDesc {
   bool disableChangeResets = false;
 };
 
-// `base` with the preset's effect set, ray counts and AO resolution (every other field is kept).
+// `base` with the preset's effect set, ray counts, AO resolution and whether soft shadows skip converged tiles
+// (every other field is kept).
 HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset);
 
 // A world-space box where the engine knows the world changed this frame (HybridFrame::changedBoxes): min <= max

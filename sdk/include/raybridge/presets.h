@@ -2,18 +2,18 @@
 // draws when it renders without Raybridge (its shadow-map size and PCF kernel), so both modes of one preset
 // can be compared.
 //
-//   preset          shadow rays  AO rays      reflections  raster shadow map, PCF
-//   none                 0          0             no        none
-//   hard-shadows         1          0             no        2048
-//   ao                   0          4, half res   no        none
-//   ao16                 0         16, half res   no        none
-//   reflections          0          0             yes       none
-//   soft-shadows         4          0             no        4096, PCF 4
-//   soft-shadows8        8          0             no        8192, PCF 8
-//   low                  1          4, half res   no        2048
-//   medium               4          4, half res   no        4096, PCF 4
-//   high                 4          4, half res   yes       4096, PCF 4
-//   ultra                8         16, half res   yes       8192, PCF 8
+//   preset          shadow rays       AO rays      reflections  raster shadow map, PCF
+//   none                 0               0             no        none
+//   hard-shadows         1               0             no        2048
+//   ao                   0               4, half res   no        none
+//   ao16                 0              16, half res   no        none
+//   reflections          0               0             yes       none
+//   soft-shadows         4, converged    0             no        4096, PCF 4
+//   soft-shadows8        8, converged    0             no        8192, PCF 8
+//   low                  1               4, half res   no        2048
+//   medium               4, converged    4, half res   no        4096, PCF 4
+//   high                 4, converged    4, half res   yes       4096, PCF 4
+//   ultra                8, converged   16, half res   yes       8192, PCF 8
 //
 // One shadow ray means hard shadows (towards the light's centre); more rays sample the light's disk.
 // Every preset with AO traces it at half resolution (AoSettings::schedule.halfResolution: a quarter of the pixels, a
@@ -21,6 +21,13 @@
 // "Half resolution"). Reflections stay at full resolution: at half resolution they are several times faster but
 // their denoised error is several times worse (same section). Set the flag back to false for the
 // thesis's full-resolution AO.
+// Every soft-shadow preset skips the shadow tiles whose denoised history has converged
+// (ShadowSettings::schedule.convergedTiles, "converged" above): under motion it costs no lag, because the change masks
+// of HybridEffects (hybrid_effects.h) make the tiles a known change touches trace on that change's own frame, and the
+// still error stays within 2% (docs/effects.md, "Motion": converged tiles under motion). The other effects keep every
+// tile: AO is at half resolution, which converged tiles exclude; a local light's shadow falls outside the boxes that
+// moved, so a converged tile there would show it late; reflections gain nothing measurable. Set the flag back to false
+// for every tile traced every frame.
 //
 // Thread safety: plain data and pure functions.
 #pragma once
@@ -72,6 +79,9 @@ struct PresetDesc {
   uint32_t shadowRaysPerPixel = 0;  // 0 when the preset has no shadows; 1 = hard shadows
   uint32_t aoRaysPerPixel = 0;      // 0 when the preset has no AO
   bool aoHalfResolution = false;    // AoSettings::schedule.halfResolution (true for every preset with AO, above)
+  // ShadowSettings::schedule.convergedTiles.enabled, at the default refresh period (true for every soft-shadow
+  // preset, above).
+  bool shadowConvergedTiles = false;
   RasterShadowDesc raster{};
 };
 

@@ -13,19 +13,20 @@ struct PresetRow {
   PresetDesc desc;
 };
 
-// The thesis's table, AO at half resolution (presets.h says why), in the order of the enum (checked by presetDesc).
+// The thesis's table, AO at half resolution and soft shadows skipping converged tiles (presets.h says why), in the
+// order of the enum (checked by presetDesc).
 constexpr std::array<PresetRow, kPresetCount> kPresetTable = {{
-    {Preset::None, "none", {0, 0, 0, false, {0, 0}}},
-    {Preset::HardShadows, "hard-shadows", {kEffectShadows, 1, 0, false, {2048, 0}}},
-    {Preset::Ao, "ao", {kEffectAo, 0, 4, true, {0, 0}}},
-    {Preset::Ao16, "ao16", {kEffectAo, 0, 16, true, {0, 0}}},
-    {Preset::Reflections, "reflections", {kEffectReflections, 0, 0, false, {0, 0}}},
-    {Preset::SoftShadows, "soft-shadows", {kEffectShadows, 4, 0, false, {4096, 4}}},
-    {Preset::SoftShadows8, "soft-shadows8", {kEffectShadows, 8, 0, false, {8192, 8}}},
-    {Preset::Low, "low", {kEffectShadows | kEffectAo, 1, 4, true, {2048, 0}}},
-    {Preset::Medium, "medium", {kEffectShadows | kEffectAo, 4, 4, true, {4096, 4}}},
-    {Preset::High, "high", {kThesisEffects, 4, 4, true, {4096, 4}}},
-    {Preset::Ultra, "ultra", {kThesisEffects, 8, 16, true, {8192, 8}}},
+    {Preset::None, "none", {0, 0, 0, false, false, {0, 0}}},
+    {Preset::HardShadows, "hard-shadows", {kEffectShadows, 1, 0, false, false, {2048, 0}}},
+    {Preset::Ao, "ao", {kEffectAo, 0, 4, true, false, {0, 0}}},
+    {Preset::Ao16, "ao16", {kEffectAo, 0, 16, true, false, {0, 0}}},
+    {Preset::Reflections, "reflections", {kEffectReflections, 0, 0, false, false, {0, 0}}},
+    {Preset::SoftShadows, "soft-shadows", {kEffectShadows, 4, 0, false, true, {4096, 4}}},
+    {Preset::SoftShadows8, "soft-shadows8", {kEffectShadows, 8, 0, false, true, {8192, 8}}},
+    {Preset::Low, "low", {kEffectShadows | kEffectAo, 1, 4, true, false, {2048, 0}}},
+    {Preset::Medium, "medium", {kEffectShadows | kEffectAo, 4, 4, true, true, {4096, 4}}},
+    {Preset::High, "high", {kThesisEffects, 4, 4, true, true, {4096, 4}}},
+    {Preset::Ultra, "ultra", {kThesisEffects, 8, 16, true, true, {8192, 8}}},
 }};
 
 constexpr bool tableInEnumOrder() {
