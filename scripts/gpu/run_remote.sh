@@ -28,6 +28,8 @@
 #   size, frames per row and along the path, presets (of the current build and of the earlier ones) and benchmark
 #   arguments (smaller ones for a rehearsal on lavapipe); RB_PERF_EXTRAS=0 leaves out the raster, ray-traced,
 #   classifier and fly-through rows (the presets and their earlier builds only)
+#   RB_PERF_PATH_VARIANTS=1: the earlier builds' hybrid rows along the fly-through too; RB_PERF_BENCHES=0 leaves
+#   out the perf mode's TLAS and trace benchmarks
 #   RB_RUNTIME_DIR=DIR  where .devcarry is unpacked (default /tmp/raybridge-devcarry)
 #   RB_TESTS="NAME ..." the tests mode runs only these executables (tests.txt names); RB_TEST_ARGS="[tag]" gives
 #                       them these arguments instead of their own
@@ -319,6 +321,15 @@ if want perf; then
       perf_render "perf__${mode}__${preset}__path" "$RT/bin/raybridge-render" --perf-scene --models-from "$SCENES" \
         --mode "$mode" --preset "$preset" --camera-path "$ROOT/scripts/gpu/perf_flythrough.json" \
         --frames "${RB_PERF_PATH_FRAMES:-240}"
+      # RB_PERF_PATH_VARIANTS=1: the earlier builds along the path too (hybrid only), right after the current one.
+      [ "${RB_PERF_PATH_VARIANTS:-0}" = 1 ] && [ "$mode" = hybrid ] || continue
+      for vbin in "$RT"/bin/raybridge-render-*; do
+        [ -x "$vbin" ] || continue
+        variant="${vbin##*/raybridge-render-}"
+        perf_render "perf-${variant}__${mode}__${preset}__path" "$vbin" --perf-scene --models-from "$SCENES" \
+          --mode "$mode" --preset "$preset" --camera-path "$ROOT/scripts/gpu/perf_flythrough.json" \
+          --frames "${RB_PERF_PATH_FRAMES:-240}"
+      done
     done
   done
   # Cost curves (ultra, 20 frames each): resolution, triangles (the ground alone, 10k to 10M) and instances (more
@@ -340,10 +351,12 @@ if want perf; then
     done
   fi
   read -r -a PBENCH <<<"${RB_PERF_BENCH_ARGS:---full}"
-  RAYBRIDGE_VALIDATION=0 step "perf tlas bench" 150 "$OUT/perf_gpu.log" "$RT/bin/raybridge-bench" --scenario tlas \
-    "${PBENCH[@]}" --out "$OUT/perf_tlas_gpu.json"
-  RAYBRIDGE_VALIDATION=0 step "perf trace bench" 90 "$OUT/perf_gpu.log" "$RT/bin/raybridge-bench" --scenario trace \
-    "${PBENCH[@]}" --out "$OUT/perf_trace_gpu.json"
+  if [ "${RB_PERF_BENCHES:-1}" = 1 ]; then
+    RAYBRIDGE_VALIDATION=0 step "perf tlas bench" 150 "$OUT/perf_gpu.log" "$RT/bin/raybridge-bench" --scenario tlas \
+      "${PBENCH[@]}" --out "$OUT/perf_tlas_gpu.json"
+    RAYBRIDGE_VALIDATION=0 step "perf trace bench" 90 "$OUT/perf_gpu.log" "$RT/bin/raybridge-bench" --scenario trace \
+      "${PBENCH[@]}" --out "$OUT/perf_trace_gpu.json"
+  fi
   step "perf report" 30 "$OUT/perf_gpu.log" python3 "$ROOT/scripts/perf_report.py" --probe-log "$OUT/probe_gpu.log" \
     --renders "$PDIR" --command "bash scripts/gpu/run_remote.sh perf" --out "$OUT/perf_gpu.json"
   grep -E '^(perf|demo)|trace (primary|stress)|GPU ms|^in place|^device copy|^copy' "$OUT/perf_gpu.log" | head -n 80
