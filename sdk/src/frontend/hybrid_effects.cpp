@@ -186,20 +186,6 @@ Status ensure(std::unique_ptr<T>& slot, bool wanted, const char* what, Create cr
 
 }  // namespace
 
-HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset) {
-  const PresetDesc p = presetDesc(preset);
-  base.effects = p.effects;
-  if (p.effects & kEffectShadows) {
-    base.shadows.raysPerPixel = p.shadowRaysPerPixel;
-    base.shadows.schedule.convergedTiles.enabled = p.shadowConvergedTiles;
-  }
-  if (p.effects & kEffectAo) {
-    base.ao.raysPerPixel = p.aoRaysPerPixel;
-    base.ao.schedule.halfResolution = p.aoHalfResolution;
-  }
-  return base;
-}
-
 struct HybridEffects::Impl {
   Context& ctx;
   AccelerationStructureService* service = nullptr;

@@ -1,4 +1,5 @@
-// The preset table (presets.h) and its names.
+// The preset table (presets.h), its names, and withPreset (hybrid_effects.h), which applies a row.
+#include <raybridge/hybrid_effects.h>
 #include <raybridge/presets.h>
 
 #include <array>
@@ -52,6 +53,20 @@ std::optional<Preset> parsePreset(std::string_view name) {
     if (name == r.name) return r.preset;
   if (name == "shadows") return Preset::SoftShadows;  // the single-effect preset of earlier releases
   return std::nullopt;
+}
+
+HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset) {
+  const PresetDesc p = presetDesc(preset);
+  base.effects = p.effects;
+  if (p.effects & kEffectShadows) {
+    base.shadows.raysPerPixel = p.shadowRaysPerPixel;
+    base.shadows.schedule.convergedTiles.enabled = p.shadowConvergedTiles;
+  }
+  if (p.effects & kEffectAo) {
+    base.ao.raysPerPixel = p.aoRaysPerPixel;
+    base.ao.schedule.halfResolution = p.aoHalfResolution;
+  }
+  return base;
 }
 
 const char* presetNames() {
