@@ -186,6 +186,11 @@ TEST_CASE("pass memory follows the enabled effects at run time", "[adapter][memo
 
   rb::HybridEffectsDesc raw = fx.desc();  // the denoisers go, the passes stay
   raw.shadows.disableDenoiser = raw.ao.disableDenoiser = true;
+  // Ultra's converged shadow tiles read the shadow denoiser's history: refused by name while they are on.
+  const rb::Status refused = fx.setDesc(raw);
+  REQUIRE_FALSE(refused.ok());
+  CHECK(refused.error().message.find("shadows.schedule.convergedTiles.enabled") != std::string::npos);
+  raw.shadows.schedule.convergedTiles.enabled = false;
   REQUIRE(fx.setDesc(raw).ok());
   const rb::MemoryStats rawMemory = settle();
   CHECK(fx.shadowDenoiser() == nullptr);
