@@ -186,7 +186,8 @@ fi
 # ---- render command: frame times raster vs hybrid at 1920x1080 (validation off) -------------------------------
 if want render; then
   : >"$OUT/render_gpu.log"
-  RENDER="$RT/bin/raybridge-render"
+  # RB_RENDER_BIN=NAME: another render command of bin/ (an earlier build, or a wrapper such as raybridge-render-noconv).
+  RENDER="$RT/bin/${RB_RENDER_BIN:-raybridge-render}"
   RDIR="$(mktemp -d)"
   for variant in "raster|--mode raster" "hybrid|--mode hybrid" "raster_ultra|--mode raster --preset ultra" \
                  "hybrid_ultra|--mode hybrid --preset ultra" "hybrid_low|--mode hybrid --preset low"; do
