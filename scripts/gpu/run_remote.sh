@@ -287,19 +287,24 @@ if want perf; then
     RAYBRIDGE_VALIDATION=0 step "perf $name" 90 "$OUT/perf_gpu.log" "$bin" --width "$PW" --height "$PH" --dump "$@" \
       --out "$PDIR/$name"
   }
+  # The same row with each earlier build carried as bin/raybridge-render-VARIANT, right after the current one: the
+  # before/after rows, named SCENE-VARIANT__SUFFIX.
+  perf_render_variants() {  # SCENE SUFFIX ARGS...
+    local scene="$1" suffix="$2" vbin
+    shift 2
+    for vbin in "$RT"/bin/raybridge-render-*; do
+      [ -x "$vbin" ] || continue
+      perf_render "${scene}-${vbin##*/raybridge-render-}__${suffix}" "$vbin" "$@"
+    done
+  }
   for scene in perf demo; do
     sargs=()
     [ "$scene" = perf ] && sargs=(--perf-scene --models-from "$SCENES")
     for preset in ${RB_PERF_PRESETS:-hard-shadows low medium high ultra}; do
       perf_render "${scene}__hybrid__$preset" "$RT/bin/raybridge-render" "${sargs[@]}" --preset "$preset" \
         --frames "$PFRAMES"
-      # Earlier builds (bin/raybridge-render-VARIANT), each right after the current one: the before/after rows.
       case " ${RB_PERF_VARIANT_PRESETS:-hard-shadows low ultra} " in *" $preset "*) ;; *) continue ;; esac
-      for vbin in "$RT"/bin/raybridge-render-*; do
-        [ -x "$vbin" ] || continue
-        variant="${vbin##*/raybridge-render-}"
-        perf_render "${scene}-${variant}__hybrid__$preset" "$vbin" "${sargs[@]}" --preset "$preset" --frames "$PFRAMES"
-      done
+      perf_render_variants "$scene" "hybrid__$preset" "${sargs[@]}" --preset "$preset" --frames "$PFRAMES"
     done
     [ "${RB_PERF_EXTRAS:-1}" = 1 ] || continue
     for preset in low ultra; do
@@ -322,15 +327,10 @@ if want perf; then
       perf_render "perf__${mode}__${preset}__path" "$RT/bin/raybridge-render" --perf-scene --models-from "$SCENES" \
         --mode "$mode" --preset "$preset" --camera-path "$ROOT/scripts/gpu/perf_flythrough.json" \
         --frames "${RB_PERF_PATH_FRAMES:-240}"
-      # RB_PERF_PATH_VARIANTS=1: the earlier builds along the path too (hybrid only), right after the current one.
+      # RB_PERF_PATH_VARIANTS=1: the earlier builds along the path too (hybrid only).
       [ "${RB_PERF_PATH_VARIANTS:-0}" = 1 ] && [ "$mode" = hybrid ] || continue
-      for vbin in "$RT"/bin/raybridge-render-*; do
-        [ -x "$vbin" ] || continue
-        variant="${vbin##*/raybridge-render-}"
-        perf_render "perf-${variant}__${mode}__${preset}__path" "$vbin" --perf-scene --models-from "$SCENES" \
-          --mode "$mode" --preset "$preset" --camera-path "$ROOT/scripts/gpu/perf_flythrough.json" \
-          --frames "${RB_PERF_PATH_FRAMES:-240}"
-      done
+      perf_render_variants perf "${mode}__${preset}__path" --perf-scene --models-from "$SCENES" --mode "$mode" \
+        --preset "$preset" --camera-path "$ROOT/scripts/gpu/perf_flythrough.json" --frames "${RB_PERF_PATH_FRAMES:-240}"
     done
   done
   # Cost curves (ultra, 20 frames each): resolution, triangles (the ground alone, 10k to 10M) and instances (more
