@@ -6,4 +6,4 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 bash scripts/build.sh
 export RAYBRIDGE_VALIDATION=1
-ctest --test-dir build --output-on-failure --timeout 1800 -j 1
+ctest --test-dir build --output-on-failure --timeout 1800 -j 2

@@ -18,6 +18,7 @@ layout(set = 0, binding = RB_ATROUS_BINDING_SIGNAL_IN) uniform sampler2D signalI
 #ifdef RB_DN_ATROUS_FINAL
 layout(set = 0, binding = RB_ATROUS_BINDING_TEMPORAL) uniform sampler2D temporalIn;  // r: value, g: variance
 layout(set = 0, binding = RB_ATROUS_BINDING_SIGNAL_OUT, r16f) uniform writeonly image2D signalOut;
+layout(set = 0, binding = RB_ATROUS_BINDING_HISTORY) uniform sampler2D historyIn;  // y: the pixel's frames
 #else
 layout(set = 0, binding = RB_ATROUS_BINDING_SIGNAL_OUT, rg16f) uniform writeonly image2D signalOut;
 #endif
@@ -51,10 +52,11 @@ float biasSquared(ivec2 ip, bool same[9]) {
 #endif
 }
 
-// `temporal`: the pixel's temporal value and variance (the final step's anchor; unused before it).
-void store(ivec2 ip, vec2 temporal, float value, float variance, float bias2) {
+// `temporal`: the pixel's temporal value and variance (the final step's anchor; unused before it). `youth`:
+// rbDnYouth of the pixel's history.
+void store(ivec2 ip, vec2 temporal, float value, float variance, float bias2, float youth) {
 #ifdef RB_DN_ATROUS_FINAL
-  imageStore(signalOut, ip, vec4(rbDnLimitedShift(temporal.r, temporal.g, value, bias2)));
+  imageStore(signalOut, ip, vec4(rbDnLimitedShift(temporal.r, temporal.g, value, bias2, youth)));
 #else
   imageStore(signalOut, ip, vec4(value, variance, 0.0, 0.0));
 #endif
@@ -69,17 +71,19 @@ void main() {
   // expression): skip the filter. Bit-identical to filtering and discarding; it is most of the pixels of a
   // converged signal (lit ground, open sky light, many rays or a full history).
   vec2 temporal = texelFetch(temporalIn, ip, 0).rg;
-  if (sqrt(max(temporal.g, 0.0)) / pc.convergedNoise - 1.0 <= 0.0) {
+  const float youth = rbDnYouth(texelFetch(historyIn, ip, 0).y);
+  if (sqrt(max(temporal.g, 0.0)) / rbDnGateNoise(youth) - 1.0 <= 0.0) {
     imageStore(signalOut, ip, vec4(temporal.r));
     return;
   }
 #else
   vec2 temporal = vec2(0.0);
+  const float youth = 0.0;
 #endif
   vec2 centre = texelFetch(signalIn, ip, 0).rg;
   float depth = texelFetch(gDepth, ip, 0).r;
   if (rbDnSky(depth)) {
-    store(ip, temporal, centre.r, centre.g, 0.0);
+    store(ip, temporal, centre.r, centre.g, 0.0, youth);
     return;
   }
   // Positions in view space, the centre's normal turned into it (viewToWorld is a rotation: its transpose is its
@@ -128,5 +132,5 @@ void main() {
     }
   }
 #endif
-  store(ip, temporal, centre.r + sum / weights, variances / (weights * weights), biasSquared(ip, same));
+  store(ip, temporal, centre.r + sum / weights, variances / (weights * weights), biasSquared(ip, same), youth);
 }

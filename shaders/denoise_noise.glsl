@@ -95,12 +95,33 @@ const float kRbDnShiftSigmas = 1.0;
 // `bias2`: the filter's squared bias around the pixel, estimated by the caller; the shift is scaled by the Wiener
 // gain variance / (variance + bias2), so where filtering changes the signal itself (a shadow pattern finer than
 // the filter) more than the noise it removes, the pixel stays near its own value.
-float rbDnLimitedShift(float anchor, float variance, float filtered, float bias2) {
+// Short-history filtering (RB_DN_SHORT_HISTORY, DenoiseSettings::shortHistoryFilter): a pixel whose history holds
+// fewer than kRbDnShortHistoryRays rays (frames x pc.signalRaysPerPixel; after a reset, a teleport, a
+// disocclusion) is filtered towards a quarter of pc.convergedNoise, not the whole, with a shift limit of up to two
+// standard deviations, not one: its spatial neighbours then stand in for the frames it lacks, as in ReBLUR's
+// history fix. Both scale with rbDnYouth: 1 for no ray at all, 0 from kRbDnShortHistoryRays on, so one frame of
+// 32 rays is filtered as before. On tests/motion_lag_test.cpp's teleport (4 rays, 96x72, lavapipe) AO's changed
+// pixels come within 1.5x of a long history's error on the third frame (1.8x without); on the effects bench's
+// single-frame rows AO's error falls at 1 to 16 rays. Shadows lose by it (their narrow penumbrae take the
+// filter's bias: +10% to +100% on those rows), so it is a setting per signal.
+const float kRbDnShortHistoryRays = 24.0;
+const float kRbDnShortHistoryNoise = 0.25;
+const float kRbDnShortHistoryShiftSigmas = 2.0;
+
+float rbDnYouth(float frames) {
+  if ((pc.flags & RB_DN_SHORT_HISTORY) == 0u || pc.signalRaysPerPixel <= 0.0) return 0.0;
+  return clamp(1.0 - frames * pc.signalRaysPerPixel / kRbDnShortHistoryRays, 0.0, 1.0);
+}
+
+// The noise under which a pixel of youth `youth` passes unfiltered.
+float rbDnGateNoise(float youth) { return pc.convergedNoise * mix(1.0, kRbDnShortHistoryNoise, youth); }
+
+float rbDnLimitedShift(float anchor, float variance, float filtered, float bias2, float youth) {
   float sigma = sqrt(max(variance, 0.0));
-  float gain = clamp(sigma / pc.convergedNoise - 1.0, 0.0, 1.0);
+  float gain = clamp(sigma / rbDnGateNoise(youth) - 1.0, 0.0, 1.0);
   if (gain <= 0.0) return anchor;
   float d = filtered - anchor;
-  float limit = kRbDnShiftSigmas * sigma;
+  float limit = mix(kRbDnShiftSigmas, kRbDnShortHistoryShiftSigmas, youth) * sigma;
   float r = abs(d) <= limit ? 1.0 : limit / abs(d);
   float wiener = variance / (variance + max(bias2, 0.0));
   return anchor + gain * wiener * d * (r * r) * (r * r);

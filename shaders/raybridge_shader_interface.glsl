@@ -72,6 +72,7 @@
 #define RB_ATROUS_BINDING_SIGNAL_IN 2
 #define RB_ATROUS_BINDING_SIGNAL_OUT 3  // rg: value, variance (denoise_atrous.comp); r: the output (_final.comp)
 #define RB_ATROUS_BINDING_TEMPORAL 4    // denoise_atrous_final.comp: the temporal result the shift starts from
+#define RB_ATROUS_BINDING_HISTORY 5     // denoise_atrous_final.comp: this frame's history (.y: its frames)
 // HybridEffects' change masks (change_masks.comp): one r8 storage image per mask; a mask not written is bound to one
 // that is (never touched: its RB_CHANGE_* bit is off).
 #define RB_CHANGE_BINDING_DEPTH 0
@@ -176,6 +177,9 @@
 // Temporal passes: history whose neighbourhood mean disagrees with this frame's by more than the noise explains is
 // shortened (rbDnHistoryTrust, rbDnRgbHistoryTrust): a moved object, shadow or light is not dragged behind.
 #define RB_DN_ANTI_LAG 0x80u
+// Scalar a-trous final step: a pixel whose history holds few rays (DenoiseSettings::shortHistoryFilter) is
+// filtered harder (rbDnYouth, denoise_noise.glsl).
+#define RB_DN_SHORT_HISTORY 0x800u
 
 // Half-resolution tracing (AoConstants/ReflectionConstants::halfResolution): sample (i, j) of frame f traces for
 // G-buffer pixel (2i + x, 2j + y), clamped to the image, with (x, y) = (0,0), (1,1), (1,0), (0,1) for f mod 4 = 0..3:

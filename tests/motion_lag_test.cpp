@@ -1,6 +1,7 @@
 // Denoisers while things move (issue 29): a box teleports over the conformance scene's ground; in the ground pixels
 // whose converged value changed, anti-lag (DenoiseSettings::disableAntiLag) must cut the error of the lagging
-// history from the first frame on (shadows by 10x, AO by 2x), printed against a still sequence's error. Also: a still
+// history from the first frame on (shadows by 10x, AO by 2x), and AO must come within 1.5x of a still sequence's
+// error two frames after the teleport's (DenoiseSettings::shortHistoryFilter). Also: a still
 // scene's denoised output does not flicker, and the converged reference the motion benchmark builds (a mean of
 // frames) converges as 1/sqrt(frames).
 #include <catch2/catch_test_macros.hpp>
@@ -163,27 +164,43 @@ TEST_CASE("anti-lag drops a teleported occluder's stale shadow and AO history at
       constexpr uint32_t kAfter = 4;
       std::vector<const World*> still(kStillFrames + kAfter, &after), teleport(kStillFrames, &before);
       for (uint32_t k = 0; k < kAfter; ++k) teleport.push_back(&after);
-      const auto stillRun = runSequence(fx, effect, still, kRays, true);
-      const auto moved = runSequence(fx, effect, teleport, kRays, true);
-      rb::DenoiseSettings off;
+      // AO as HybridEffects denoises it (AoEffectSettings::disableShortHistoryFilter = false): pixels with a short
+      // history filtered harder. Shadows have no such filter (it blurs their penumbrae).
+      rb::DenoiseSettings shipped;
+      shipped.shortHistoryFilter = effect == Effect::Ao;
+      const auto stillRun = runSequence(fx, effect, still, kRays, true, shipped);
+      const auto moved = runSequence(fx, effect, teleport, kRays, true, shipped);
+      rb::DenoiseSettings off = shipped;
       off.disableAntiLag = true;
       const auto lagging = runSequence(fx, effect, teleport, kRays, true, off);
+      std::vector<std::vector<float>> plain;  // AO without the short-history filter
+      if (effect == Effect::Ao) plain = runSequence(fx, effect, teleport, kRays, true);
       for (uint32_t k = 0; k < kAfter; ++k) {
         const size_t f = kStillFrames + k;
         const double eStill = rmseOver(stillRun[f], refAfter, changed), eMoved = rmseOver(moved[f], refAfter, changed),
                      eLag = rmseOver(lagging[f], refAfter, changed);
         std::printf("[denoise][motion] %s, %u rays, frame %u after the teleport: changed-pixel RMSE %.4f, still %.4f "
-                    "(%.2fx); without anti-lag %.4f (%.2fx)\n",
-                    name(effect), kRays, k + 1, eMoved, eStill, eMoved / eStill, eLag, eLag / eStill);
+                    "(%.2fx); without anti-lag %.4f (%.2fx)",
+                    name(effect), kRays, k, eMoved, eStill, eMoved / eStill, eLag, eLag / eStill);
+        if (!plain.empty()) {
+          const double ePlain = rmseOver(plain[f], refAfter, changed);
+          std::printf("; without the short-history filter %.4f (%.2fx)", ePlain, ePlain / eStill);
+          // The filter is what brings AO within the bound: without it the changed pixels stay above it.
+          if (k == 2) CHECK(ePlain > 1.5 * eStill);
+        }
+        std::printf("\n");
 
-        INFO("frame " << k + 1 << " after: " << eMoved << " against still " << eStill << ", no anti-lag " << eLag);
-        // Anti-lag resets the changed pixels' history: their error drops from the lagging one at once. What it does
-        // not reach yet is the issue's 1.5x of a still sequence within 2 frames: a reset pixel's one or two frames,
-        // spatially filtered, stay 2.5-3.5x the error of 12+ accumulated frames (measured here: shadows 3.1x, AO 2.7x
-        // at frame 2); see docs/effects.md, "Motion".
+        INFO("frame " << k << " after (0 = the teleport's): " << eMoved << " against still " << eStill
+                      << ", no anti-lag " << eLag);
+        // Anti-lag resets the changed pixels' history: their error drops from the lagging one at once.
         CHECK(eMoved <= (effect == Effect::Shadow ? 0.1 : 0.5) * eLag);
         // Without anti-lag the history drags the old picture along.
         if (k == 1) CHECK(eLag > 1.5 * eStill);
+        // The issue's bound, lag <= 2 frames: AO's changed pixels within 1.5x of the still sequence's error by the
+        // second frame after the teleport's. Shadows do not reach it (3.0x here): every changed pixel is reset, and
+        // what is left is the narrow penumbra's noise after 12 rays, which no spatial filter removes without
+        // blurring the penumbra (docs/effects.md, "Motion").
+        if (effect == Effect::Ao && k >= 2) CHECK(eMoved <= 1.5 * eStill);
       }
     }
   }

@@ -105,6 +105,9 @@ struct AoEffectSettings {
   float range = 0.0f;         // 0 = kDefaultAoRange
   AoEstimator estimator = AoEstimator::Binary;
   bool disableDenoiser = false;  // false = denoised
+  // false = the AO denoiser filters pixels with a short history harder (DenoiseSettings::shortHistoryFilter; binary
+  // AO without adaptive rays, whose rays per pixel are known). true = as every other pixel.
+  bool disableShortHistoryFilter = false;
   // Where and how many rays (ray_schedule.h; AoSettings::schedule): adaptive rays, half resolution (a quarter of
   // the rays, depth-aware upsample; every preset with AO sets it) and converged tiles (full resolution; the raw AO
   // output then holds kept-history marks there, the denoised one is complete). Adaptive rays and converged tiles

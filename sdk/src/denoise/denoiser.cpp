@@ -192,11 +192,12 @@ Result<std::unique_ptr<Denoiser>> Denoiser::create(Context& context, const Denoi
                                 sizeof(DenoiseConstants), "denoiser a-trous");
     if (!a) return a.error();
     impl->atrous = a.value();
-    Result<ComputePipeline> f = ComputePipeline::create(
-        context, SpirvModule::of(spirv::denoise_atrous_final_comp),
-        {sampled(RB_ATROUS_BINDING_DEPTH), sampled(RB_ATROUS_BINDING_NORMAL), sampled(RB_ATROUS_BINDING_SIGNAL_IN),
-         storage(RB_ATROUS_BINDING_SIGNAL_OUT), sampled(RB_ATROUS_BINDING_TEMPORAL)},
-        sizeof(DenoiseConstants), "denoiser a-trous (final)");
+    Result<ComputePipeline> f =
+        ComputePipeline::create(context, SpirvModule::of(spirv::denoise_atrous_final_comp),
+                                {sampled(RB_ATROUS_BINDING_DEPTH), sampled(RB_ATROUS_BINDING_NORMAL),
+                                 sampled(RB_ATROUS_BINDING_SIGNAL_IN), storage(RB_ATROUS_BINDING_SIGNAL_OUT),
+                                 sampled(RB_ATROUS_BINDING_TEMPORAL), sampled(RB_ATROUS_BINDING_HISTORY)},
+                                sizeof(DenoiseConstants), "denoiser a-trous (final)");
     if (!f) return f.error();
     impl->atrousFinal = f.value();
   }
@@ -419,7 +420,10 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
     w.sampledImage(RB_ATROUS_BINDING_NORMAL, g.normal.view, s.sampler, readLayout(g.normal));
     w.sampledImage(RB_ATROUS_BINDING_SIGNAL_IN, im[input].view, s.sampler, ro);
     w.storageImage(RB_ATROUS_BINDING_SIGNAL_OUT, im[out].view);
-    if (final) w.sampledImage(RB_ATROUS_BINDING_TEMPORAL, im[4].view, s.sampler, ro);
+    if (final) {
+      w.sampledImage(RB_ATROUS_BINDING_TEMPORAL, im[4].view, s.sampler, ro);
+      w.sampledImage(RB_ATROUS_BINDING_HISTORY, im[cur].view, s.sampler, ro);  // this frame's: .y the frames
+    }
     (final ? s.atrousFinal : s.atrous).dispatch(ctx, cmd, w.writes, &pc, sizeof pc, g.width, g.height);
     batch.add(im[out], gen, ro, write, read);
     writable[out] = false;
@@ -509,6 +513,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const DenoiseFrame& frame) {
   }
   if (internal::contextImpl(s.ctx).holdsKeptMarks(signal)) flags |= RB_DN_KEPT_MARKS;
   if (!settings.disableAntiLag) flags |= RB_DN_ANTI_LAG;
+  if (settings.shortHistoryFilter) flags |= RB_DN_SHORT_HISTORY;
   if (s.signal != DenoiseSignal::Scalar) {
     Status st = recordRgb(s, cmd, g, signal, settings, pc, flags);
     if (st) {

@@ -391,11 +391,12 @@ struct HybridEffects::Impl {
   // `rays`: binary rays behind a scalar signal (DenoiseSettings::raysPerPixel; 0 = estimate the noise).
   Status denoise(std::unique_ptr<Denoiser>& slot, bool wanted, const char* what, VkCommandBuffer cmd,
                  const GBufferDesc& gbuffer, VkImageView signal, uint32_t rays,
-                 DenoiseSignal kind = DenoiseSignal::Scalar) {
+                 DenoiseSignal kind = DenoiseSignal::Scalar, bool shortHistoryFilter = false) {
     if (Status st = ensureDenoiser(slot, wanted, kind, what); !st) return st;
     if (!slot) return {};
     DenoiseSettings d = desc.denoiser;
     d.raysPerPixel = kind == DenoiseSignal::Scalar ? rays : 0u;
+    d.shortHistoryFilter = d.shortHistoryFilter || shortHistoryFilter;
     if (Status st = slot->record(cmd, {.gbuffer = gbuffer, .signal = signal, .settings = d}); !st)
       return wrap(what, st.error());
     return {};
@@ -482,7 +483,8 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   const uint32_t rays = s.estimator == AoEstimator::Binary && !desc.ao.schedule.adaptive.enabled
                             ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays)
                             : 0u;
-  return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, g, o.aoView, rays);
+  return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, g, o.aoView, rays, DenoiseSignal::Scalar,
+                 !desc.ao.disableShortHistoryFilter);
 }
 
 Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
