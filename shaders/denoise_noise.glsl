@@ -95,22 +95,26 @@ const float kRbDnShiftSigmas = 1.0;
 // `bias2`: the filter's squared bias around the pixel, estimated by the caller; the shift is scaled by the Wiener
 // gain variance / (variance + bias2), so where filtering changes the signal itself (a shadow pattern finer than
 // the filter) more than the noise it removes, the pixel stays near its own value.
-// Short-history filtering (RB_DN_SHORT_HISTORY, DenoiseSettings::shortHistoryFilter): a pixel whose history holds
-// fewer than kRbDnShortHistoryRays rays (frames x pc.signalRaysPerPixel; after a reset, a teleport, a
-// disocclusion) is filtered towards a quarter of pc.convergedNoise, not the whole, with a shift limit of up to two
-// standard deviations, not one: its spatial neighbours then stand in for the frames it lacks, as in ReBLUR's
-// history fix. Both scale with rbDnYouth: 1 for no ray at all, 0 from kRbDnShortHistoryRays on, so one frame of
-// 32 rays is filtered as before. On tests/motion_lag_test.cpp's teleport (4 rays, 96x72, lavapipe) AO's changed
-// pixels come within 1.5x of a long history's error on the third frame (1.8x without); on the effects bench's
-// single-frame rows AO's error falls at 1 to 16 rays. Shadows lose by it (their narrow penumbrae take the
-// filter's bias: +10% to +100% on those rows), so it is a setting per signal.
-const float kRbDnShortHistoryRays = 24.0;
+// Short-history filtering (RB_DN_SHORT_HISTORY, DenoiseSettings::shortHistoryFilter): a pixel whose history is
+// short (after a reset, a teleport, a disocclusion) is filtered towards a quarter of pc.convergedNoise, not the
+// whole, with a shift limit of up to two standard deviations, not one: its spatial neighbours stand in for the
+// frames it lacks, as in ReBLUR's history fix. Both scale with rbDnYouth, which falls linearly over the first
+// kRbDnShortHistoryFrames frames, from (1 - rays / kRbDnShortHistoryRays) at the first: a signal of 32 rays and more
+// per frame is filtered as before, and so is every pixel from 16 frames on (a still camera's). Tuned on
+// tests/motion_lag_test.cpp's teleport (4 rays, 96x72, lavapipe): AO's changed pixels at 1.15-1.3x a long
+// history's error on frames 1 to 5 after the teleport's, 1.8x without; the effects bench's single-frame AO rows
+// lose 4-46% of their error at 1 to 16 rays (half resolution at 16 rays +1.6%). Shadows lose by it (their narrow
+// penumbrae take the filter's bias: +10% to +100% on those rows), so it is a setting per signal.
+const float kRbDnShortHistoryFrames = 16.0;
+const float kRbDnShortHistoryRays = 32.0;
 const float kRbDnShortHistoryNoise = 0.25;
 const float kRbDnShortHistoryShiftSigmas = 2.0;
 
+// 0 = filter as any pixel, 1 = the short-history filter in full (the first frame of a one-ray signal).
 float rbDnYouth(float frames) {
   if ((pc.flags & RB_DN_SHORT_HISTORY) == 0u || pc.signalRaysPerPixel <= 0.0) return 0.0;
-  return clamp(1.0 - frames * pc.signalRaysPerPixel / kRbDnShortHistoryRays, 0.0, 1.0);
+  return clamp(1.0 - pc.signalRaysPerPixel / kRbDnShortHistoryRays, 0.0, 1.0) *
+         clamp(1.0 - frames / kRbDnShortHistoryFrames, 0.0, 1.0);
 }
 
 // The noise under which a pixel of youth `youth` passes unfiltered.

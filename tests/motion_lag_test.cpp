@@ -161,7 +161,7 @@ TEST_CASE("anti-lag drops a teleported occluder's stale shadow and AO history at
       }
       INFO(count << " changed pixels");
       REQUIRE(count >= 60);
-      constexpr uint32_t kAfter = 4;
+      constexpr uint32_t kAfter = 6;
       std::vector<const World*> still(kStillFrames + kAfter, &after), teleport(kStillFrames, &before);
       for (uint32_t k = 0; k < kAfter; ++k) teleport.push_back(&after);
       // AO as HybridEffects denoises it (AoEffectSettings::disableShortHistoryFilter = false): pixels with a short
@@ -197,9 +197,9 @@ TEST_CASE("anti-lag drops a teleported occluder's stale shadow and AO history at
         // Without anti-lag the history drags the old picture along.
         if (k == 1) CHECK(eLag > 1.5 * eStill);
         // The issue's bound, lag <= 2 frames: AO's changed pixels within 1.5x of the still sequence's error by the
-        // second frame after the teleport's. Shadows do not reach it (3.0x here): every changed pixel is reset, and
-        // what is left is the narrow penumbra's noise after 12 rays, which no spatial filter removes without
-        // blurring the penumbra (docs/effects.md, "Motion").
+        // second frame after the teleport's, and staying there (1.15-1.3x here). Shadows do not reach it (2.7-3.1x
+        // here): every changed pixel is reset, and what is left is the narrow penumbra's noise after a few frames
+        // of 4 rays, which no spatial filter removes without blurring the penumbra (docs/effects.md, "Motion").
         if (effect == Effect::Ao && k >= 2) CHECK(eMoved <= 1.5 * eStill);
       }
     }

@@ -98,12 +98,13 @@ struct DenoiseSettings {
   // Scalar signals: standard deviation of the noise under which a pixel passes unfiltered (its temporal mean, or
   // the raw value without history). 0 = kDefaultDenoiseConvergedNoise.
   float convergedNoise = 0.0f;
-  // Scalar signals with raysPerPixel known: a pixel whose history holds fewer than 32 rays (after a reset, a
-  // teleported occluder, a disocclusion) is filtered harder, towards a quarter of convergedNoise, so that its
-  // neighbours stand in for the frames it lacks (denoise_noise.glsl, rbDnYouth). For smooth signals: AO's changed
-  // pixels after a teleport come within 1.5x of a long history's error on the third frame, not 1.8x, and AO of a
-  // single frame at 1 to 16 rays loses 6-46% of its error. Not for shadows: their narrow penumbrae take the filter's
-  // bias (single frames +10% to +100%). false = every pixel by convergedNoise alone. HybridEffects sets it for AO
+  // Scalar signals with raysPerPixel known, under 32: a pixel in the first 16 frames of its history (after a
+  // reset, a teleported occluder, a disocclusion) is filtered harder, down to a quarter of convergedNoise, so that
+  // its neighbours stand in for the frames it lacks; less so the more rays and frames it has
+  // (shaders/denoise_noise.glsl, rbDnYouth). For smooth signals: AO's changed pixels after a teleport come within
+  // 1.5x of a long history's error from the first frame after the teleport's (1.8x without), and AO of a single
+  // frame at 1 to 16 rays loses 4-46% of its error. Not for shadows: their narrow penumbrae take the filter's bias
+  // (single frames +10% to +100%). false = every pixel by convergedNoise alone. HybridEffects sets it for AO
   // (AoEffectSettings::disableShortHistoryFilter).
   bool shortHistoryFilter = false;
 };
