@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
                                                      {rb::kEffectReflections, runReflectionSweep}};
   nlohmann::json motionResult;
   if (motion) {
-    const MotionSwitches switches{o.noAntiLag, o.noChangeResets, o.convergedTiles};
+    const MotionSwitches switches{o.noAntiLag, o.noChangeResets, o.convergedTiles, o.noShortHistoryFilter};
     auto m = runMotionScenario(driver, motionScene,
                                makeMotionPlan(o.quick, width, height, o.effects, o.images, switches, o.motionRays));
     if (!m) return fail(m.error);

@@ -70,6 +70,9 @@ void addOptions(CLI::App& app, Options& o) {
       ->type_name("N ...")
       ->check(rbCli::wholeNumber(1, 64));
   app.add_flag("--no-anti-lag", o.noAntiLag, "motion: denoisers without anti-lag (DenoiseSettings::disableAntiLag)");
+  app.add_flag("--no-short-history-filter", o.noShortHistoryFilter,
+               "motion: AO's denoiser without the short-history filter\n"
+               "(AoEffectSettings::disableShortHistoryFilter)");
   app.add_flag(
       "--converged-tiles", o.convergedTiles,
       "motion: every effect skips its converged tiles (RaySchedule::convergedTiles), to measure their lag cost");

@@ -14,12 +14,13 @@ struct Options {
   std::string scenario = "speed-vs-error";
   rb::EffectSet effects = rb::kThesisEffects;  // motion: every effect unless --effects says otherwise
   bool effectsGiven = false;
-  uint32_t characters = 3;           // motion: walkers
-  bool noAntiLag = false;            // motion: DenoiseSettings::disableAntiLag
-  bool noChangeResets = false;       // motion: HybridEffectsDesc::disableChangeResets
-  bool convergedTiles = false;       // motion: RaySchedule::convergedTiles on for every effect
-  std::vector<uint32_t> motionRays;  // motion: rays per pixel of the denoised sequences; empty = 1, 4, 16
-  std::string scenes;                // motion: character models; empty = ../shared/scenes beside the source tree
+  uint32_t characters = 3;            // motion: walkers
+  bool noAntiLag = false;             // motion: DenoiseSettings::disableAntiLag
+  bool noShortHistoryFilter = false;  // motion: AoEffectSettings::disableShortHistoryFilter
+  bool noChangeResets = false;        // motion: HybridEffectsDesc::disableChangeResets
+  bool convergedTiles = false;        // motion: RaySchedule::convergedTiles on for every effect
+  std::vector<uint32_t> motionRays;   // motion: rays per pixel of the denoised sequences; empty = 1, 4, 16
+  std::string scenes;                 // motion: character models; empty = ../shared/scenes beside the source tree
   // Empty: 1920x1080 on a GPU, 320x180 on a CPU device (lavapipe); --quick: 160x90.
   std::optional<uint32_t> width, height;
   std::string out;     // JSON file; empty = none

@@ -182,6 +182,7 @@ se::Status Runner::setDesc(uint32_t rays, bool reference) {
   d.localLights.raysPerPixel = rays;
   d.localLights.disableDenoiser = reference;
   d.denoiser.disableAntiLag = plan_.switches.disableAntiLag;
+  d.ao.disableShortHistoryFilter = plan_.switches.disableShortHistoryFilter;
   d.disableChangeResets = plan_.switches.disableChangeResets;
   if (plan_.switches.convergedTiles && !reference) {
     d.shadows.schedule.convergedTiles.enabled = true;
@@ -498,7 +499,8 @@ se::Result<nlohmann::json> runMotionScenario(FrameDriver& driver, const MotionSc
                {"lag_factor", kLagFactor},
                {"anti_lag", !plan.switches.disableAntiLag},
                {"change_resets", !plan.switches.disableChangeResets},
-               {"converged_tiles", plan.switches.convergedTiles}};
+               {"converged_tiles", plan.switches.convergedTiles},
+               {"short_history_filter", !plan.switches.disableShortHistoryFilter}};
   return r;
 }
 

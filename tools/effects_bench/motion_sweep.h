@@ -24,6 +24,8 @@ struct MotionSwitches {
   bool disableAntiLag = false;       // --no-anti-lag: DenoiseSettings::disableAntiLag
   bool disableChangeResets = false;  // --no-change-resets: HybridEffectsDesc::disableChangeResets
   bool convergedTiles = false;       // --converged-tiles: every effect skips its converged tiles (not the reference)
+  // --no-short-history-filter: AoEffectSettings::disableShortHistoryFilter
+  bool disableShortHistoryFilter = false;
 };
 
 struct MotionPlan {

@@ -388,6 +388,9 @@ void addScheduleOptions(CLI::App& app, RenderOptions& o) {
   app.add_flag("--no-converged-tiles", o.noConvergedTiles,
                "soft shadows: trace every tile every frame (the soft-shadow presets skip converged\n"
                "tiles by default)");
+  app.add_flag("--no-short-history-filter", o.noShortHistoryFilter,
+               "AO: its denoiser filters pixels with a short history as any other\n"
+               "(AoEffectSettings::disableShortHistoryFilter; to measure what the filter costs)");
   app.add_option_function<uint32_t>(
          "--converged-ao", [&o](const uint32_t& v) { o.convergedAo = v; },
          "AO: skip the 8x8 tiles whose denoised history has converged, each still traced\n"
@@ -564,6 +567,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.range = o.aoRange ? *o.aoRange : rb::kDefaultAoRange;
   h.ao.estimator = o.aoEstimator;
   h.ao.disableDenoiser = !o.denoise;
+  h.ao.disableShortHistoryFilter = o.noShortHistoryFilter;
   h.ao.schedule.adaptive.enabled = o.adaptiveAoMs.has_value();
   h.ao.schedule.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
   h.ao.schedule.adaptive.granularity = o.adaptiveGranularity;
@@ -616,6 +620,11 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
   if (o.mode == Mode::RayTraced && o.geometricNormals)
     return "--gbuffer-normals: --mode raytraced draws no G-buffer; its hits shade with the mesh normals";
   if (o.convergedTiles && o.noConvergedTiles) return "--converged-tiles and --no-converged-tiles: give one of them";
+  if (o.noShortHistoryFilter && !o.denoise)
+    return "--no-short-history-filter: the filter is part of the AO denoiser, which --no-denoise turns off; give one "
+           "of them";
+  if (o.noShortHistoryFilter && o.mode != Mode::Hybrid)
+    return "--no-short-history-filter: only --mode hybrid denoises the SDK's AO";
   if (o.convergedTiles && !o.denoise)
     return "--converged-tiles: converged tiles are read from the shadow denoiser's history; drop --no-denoise";
   if (o.convergedTiles && o.mode != Mode::Hybrid)

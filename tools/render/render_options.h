@@ -62,6 +62,8 @@ struct RenderOptions {
   std::optional<uint32_t> convergedTiles;
   // --no-converged-tiles: the soft-shadow presets' converged tiles off (every tile traced every frame).
   bool noConvergedTiles = false;
+  // --no-short-history-filter: HybridEffectsDesc::ao.disableShortHistoryFilter (to measure what the filter costs).
+  bool noShortHistoryFilter = false;
   // --converged-ao K: HybridEffectsDesc::ao.schedule.convergedTiles, likewise (AO at full resolution: --half-res
   // without ao).
   std::optional<uint32_t> convergedAo;

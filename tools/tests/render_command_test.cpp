@@ -106,6 +106,9 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--converged-tiles 0", "--converged-tiles: 0 is outside 1..65535"},
       {"--converged-tiles 8 --no-denoise", "--converged-tiles: converged tiles are read from the shadow denoiser's"},
       {"--converged-tiles 8 --no-converged-tiles", "--converged-tiles and --no-converged-tiles: give one of them"},
+      {"--no-short-history-filter --no-denoise", "--no-short-history-filter: the filter is part of the AO denoiser"},
+      {"--no-short-history-filter --mode raster",
+       "--no-short-history-filter: only --mode hybrid denoises the SDK's AO"},
       {"--converged-reflections 0", "--converged-reflections: 0 is outside 1..65535"},
       {"--converged-lights 8 --light-rays 0", "--converged-lights: --light-rays 0 traces every light exactly"},
       {"--converged-reflections 8 --no-denoise",
@@ -193,6 +196,33 @@ TEST_CASE("raybridge-render: the soft-shadow presets skip converged shadow tiles
   CHECK(converged("converged_off", "--preset high --no-converged-tiles") == 0);
   CHECK(converged("converged_no_denoise", "--preset high --no-denoise") == 0);
   CHECK(converged("converged_hard", "--preset hard-shadows") == 0);
+}
+
+TEST_CASE("raybridge-render --no-short-history-filter changes the denoised AO of a short history and nothing else",
+          "[render][denoise]") {
+  // Two frames: every pixel's history is short, so the AO denoiser's short-history filter is at work; without it the
+  // denoised AO differs and the raw AO (the same rays) does not.
+  auto render = [](const std::string& name, const std::string& extra) {
+    const fs::path dir = tempDir(name);
+    const RunResult r = runRender("--width 96 --height 64 --frames 2 --preset ao --dump " + extra + " --out " +
+                                  dir.string());
+    INFO(extra << "\n" << r.output);
+    REQUIRE(r.exitCode == 0);
+    return dir;
+  };
+  auto red = [](const fs::path& file) {
+    int w = 0, h = 0;
+    return readExrRed(file, w, h);
+  };
+  const fs::path withFilter = render("shf_on", ""), without = render("shf_off", "--no-short-history-filter");
+  CHECK(red(withFilter / "ao_raw.exr") == red(without / "ao_raw.exr"));
+  const std::vector<float> on = red(withFilter / "ao.exr"), off = red(without / "ao.exr");
+  REQUIRE(on.size() == 96u * 64u);
+  REQUIRE(off.size() == on.size());
+  size_t differ = 0;
+  for (size_t i = 0; i < on.size(); ++i) differ += on[i] != off[i];
+  INFO(differ << " of " << on.size() << " denoised AO pixels differ");
+  CHECK(differ > on.size() / 20);
 }
 
 TEST_CASE("raybridge-render --reorder: stats.json says whether reflections reordered", "[render][reorder]") {
