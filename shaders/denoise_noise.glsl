@@ -90,19 +90,14 @@ float rbDnHistoryTrust(sampler2D signal, sampler2D depthImage, ivec2 ip, sampler
 // against 0.0066 raw); one halves that, and kDefaultDenoiseConvergedNoise leaves many-ray pixels alone.
 const float kRbDnShiftSigmas = 1.0;
 
-// `anchor` (unfiltered, noise variance `variance`) moved towards `filtered` as far as its noise explains; left
-// exactly as it is where the noise's standard deviation is under pc.convergedNoise, with a ramp up to twice that.
-// `bias2`: the filter's squared bias around the pixel, estimated by the caller; the shift is scaled by the Wiener
-// gain variance / (variance + bias2), so where filtering changes the signal itself (a shadow pattern finer than
-// the filter) more than the noise it removes, the pixel stays near its own value.
 // Short-history filtering (RB_DN_SHORT_HISTORY, DenoiseSettings::shortHistoryFilter): a pixel whose history is
 // short (after a reset, a teleport, a disocclusion) is filtered towards a quarter of pc.convergedNoise, not the
 // whole, with a shift limit of up to two standard deviations, not one: its spatial neighbours stand in for the
 // frames it lacks, as in ReBLUR's history fix. Both scale with rbDnYouth, which falls linearly over the first
 // kRbDnShortHistoryFrames frames, from (1 - rays / kRbDnShortHistoryRays) at the first: a signal of 32 rays and more
 // per frame is filtered as before, and so is every pixel from 16 frames on (a still camera's). Tuned on
-// tests/motion_lag_test.cpp's teleport (4 rays, 96x72, lavapipe): AO's changed pixels at 1.15-1.3x a long
-// history's error on frames 1 to 5 after the teleport's, 1.8x without; the effects bench's single-frame AO rows
+// tests/motion_lag_test.cpp's teleport (4 rays, 96x72, lavapipe): AO's changed pixels at 1.04-1.43x a long
+// history's error on frames 1 to 5 after the teleport's, 1.8-1.9x without; the effects bench's single-frame AO rows
 // lose 4-46% of their error at 1 to 16 rays (half resolution at 16 rays +1.6%). Shadows lose by it (their narrow
 // penumbrae take the filter's bias: +10% to +100% on those rows), so it is a setting per signal.
 const float kRbDnShortHistoryFrames = 16.0;
@@ -120,6 +115,12 @@ float rbDnYouth(float frames) {
 // The noise under which a pixel of youth `youth` passes unfiltered.
 float rbDnGateNoise(float youth) { return pc.convergedNoise * mix(1.0, kRbDnShortHistoryNoise, youth); }
 
+// `anchor` (unfiltered, noise variance `variance`) moved towards `filtered` as far as its noise explains; left
+// exactly as it is where the noise's standard deviation is under pc.convergedNoise, with a ramp up to twice that.
+// `bias2`: the filter's squared bias around the pixel, estimated by the caller; the shift is scaled by the Wiener
+// gain variance / (variance + bias2), so where filtering changes the signal itself (a shadow pattern finer than
+// the filter) more than the noise it removes, the pixel stays near its own value. `youth`: rbDnYouth of the
+// pixel's history, which lowers that threshold and widens the limit.
 float rbDnLimitedShift(float anchor, float variance, float filtered, float bias2, float youth) {
   float sigma = sqrt(max(variance, 0.0));
   float gain = clamp(sigma / rbDnGateNoise(youth) - 1.0, 0.0, 1.0);

@@ -177,7 +177,7 @@
 // Temporal passes: history whose neighbourhood mean disagrees with this frame's by more than the noise explains is
 // shortened (rbDnHistoryTrust, rbDnRgbHistoryTrust): a moved object, shadow or light is not dragged behind.
 #define RB_DN_ANTI_LAG 0x80u
-// Scalar a-trous final step: a pixel whose history holds few rays (DenoiseSettings::shortHistoryFilter) is
+// Scalar a-trous final step: a pixel in the first frames of its history (DenoiseSettings::shortHistoryFilter) is
 // filtered harder (rbDnYouth, denoise_noise.glsl).
 #define RB_DN_SHORT_HISTORY 0x800u
 

@@ -106,7 +106,8 @@ struct AoEffectSettings {
   AoEstimator estimator = AoEstimator::Binary;
   bool disableDenoiser = false;  // false = denoised
   // false = the AO denoiser filters pixels with a short history harder (DenoiseSettings::shortHistoryFilter; binary
-  // AO without adaptive rays, whose rays per pixel are known). true = as every other pixel.
+  // AO without adaptive rays, whose rays per pixel are known). true = as every other pixel, unless
+  // HybridEffectsDesc::denoiser.shortHistoryFilter asks for it on every scalar signal.
   bool disableShortHistoryFilter = false;
   // Where and how many rays (ray_schedule.h; AoSettings::schedule): adaptive rays, half resolution (a quarter of
   // the rays, depth-aware upsample; every preset with AO sets it) and converged tiles (full resolution; the raw AO
