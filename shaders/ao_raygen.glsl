@@ -19,6 +19,7 @@ layout(push_constant) uniform AoPushConstants { AoConstants pc; };
 #include "pass_inputs.glsl"
 #include "adaptive_rays.glsl"
 #include "ray_counters.glsl"
+#include "reset_rays.glsl"
 #ifdef RB_AO_TILE_LIST
 #include "shadow_tiles.glsl"
 #endif
@@ -63,7 +64,7 @@ void main() {
     return;
   }
 #else
-  const uint count = max(pc.raysPerPixel, 1u);
+  const uint count = rbResetRayCount(ip, max(pc.raysPerPixel, 1u));
 #endif
   bool weighted = pc.estimator == RB_AO_DISTANCE_WEIGHTED;
   float range = pc.range;

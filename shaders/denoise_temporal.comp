@@ -44,7 +44,9 @@ void main() {
   float dist = length(rel);
   imageStore(distanceOut, ip, vec4(dist));
   float accumulated = value;
-  float frames = 1.0;
+  // A pixel whose history the reactive mask restarts traced RaySchedule::resetRays rays (reset_rays.glsl): its value
+  // counts as that many frames of the usual rays, so the frames after it weigh in by their rays.
+  float frames = rbDnReactive(pixel, gReactive) ? min(pc.resetFrames, float(pc.maxHistoryFrames)) : 1.0;
   ivec2 pp;
   vec2 h;
   if (rbDnFindHistoryBilinear(pixel, rel, gMotion, gReactive, distanceIn, historyIn, h, pp)) {

@@ -18,7 +18,7 @@ struct GBufferConstants {
   uint flags;              // 136: RB_GB_*
   uint frameIndex;         // 140: the noise seed
   float wAtDepthOne;       // 144: w of inverse(projection) * (x, y, 1, 1), formed in double on the host
-  uint pad0;               // 148
+  uint resetRays;          // 148: RaySchedule::resetRays where the reactive mask is set (RB_GB_REACTIVE); 0 = none
   uint pad1;               // 152
   uint pad2;               // 156
 };
@@ -48,7 +48,7 @@ struct AoConstants {
   uint halfResolution;       // 172: 1 = one sample per 2x2 block into the half-resolution image (half_resolution.glsl)
 };
 
-// ReflectionPass. 224 bytes.
+// ReflectionPass. 240 bytes.
 struct ReflectionConstants {
   GBufferConstants gbuffer;  //   0
   vec3 sunDirection;         // 160: towards the sun, unit length
@@ -60,7 +60,9 @@ struct ReflectionConstants {
   uint lightCount;           // 208: local lights lighting hits (RB_REFLECTION_BINDING_LIGHTS); 0 = none
   uint lightCandidates;      // 212: lights weighed per hit to pick the one it traces a shadow ray to
   uint halfResolution;       // 216: 1 = one sample per 2x2 block into the half-resolution image (half_resolution.glsl)
-  uint pad0;                 // 220
+  uint changedBoxCount;      // 220: boxes at changedBoxes (ReflectionSettings::changedBoxes + relitBoxes); 0 = none
+  uvec2 changedBoxes;        // 224: their device address (RbReflectionChangedBox[], reflection_changes.glsl)
+  uvec2 pad1;                // 232
 };
 
 // The depth-aware upsample of half-resolution AO and reflections (upsample_depth_aware.glsl). 176 bytes.
@@ -128,6 +130,7 @@ struct DenoiseConstants {
   float signalRaysPerPixel;     // 220: rays per pixel of the noisy signal; 0 = unknown
   float convergedNoise;         // 224: scalar: noise standard deviation under which the value passes unfiltered
   float roughnessThreshold;     // 228: converged reflection tiles: the reflection pass's (rougher = no reflection)
+  float resetFrames;            // 232: scalar temporal: the frames a reactive pixel's new value counts as (>= 1)
 };
 
 // The converged-tile dispatches (shadow_converged.glsl, rgb_converged.glsl): the denoiser's reprojection, then

@@ -10,6 +10,9 @@
 #define RB_BINDING_NORMAL 2
 #define RB_BINDING_GEOMETRIC_NORMAL 3  // the normal image again when the G-buffer has no geometric normal
 #define RB_BINDING_RAY_COUNTERS 4
+// The reactive mask (HybridEffects: the effect's change mask), or the depth image again without one: where it is set
+// (.r > 0.5, RB_GB_REACTIVE) the pixel's history restarts, and it traces GBufferConstants::resetRays rays.
+#define RB_BINDING_REACTIVE 13
 // Pass-specific bindings of set 0.
 #define RB_SHADOW_BINDING_VISIBILITY 5
 #define RB_SHADOW_BINDING_HIT_DISTANCE 6  // only in the module that writes it (shadow_distance.rgen)
@@ -113,6 +116,7 @@
 #define RB_GB_ROUGHNESS_IMAGE 16u
 #define RB_GB_ALBEDO_IMAGE 32u
 #define RB_GB_ALPHA_TEST 64u  // the TLAS holds non-opaque geometry and a material table is bound: rays run any-hits
+#define RB_GB_REACTIVE 128u   // the G-buffer has a reactive mask (RB_BINDING_REACTIVE)
 
 // GpuMaterial::alphaMode: the values of rb::AlphaMode.
 #define RB_ALPHA_OPAQUE 0u

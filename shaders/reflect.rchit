@@ -29,4 +29,5 @@ void main() {
   l.frameIndex = pc.gbuffer.frameIndex;
   // The pass's rays too: the ray generation shader counts them with its own.
   payload.radiance = rbShadeHit(l, barycentrics, payload.shadowRays);
+  payload.hitT = gl_HitTEXT;
 }

@@ -7,6 +7,9 @@ struct ReflectionPayload {
   // Shadow rays the closest-hit shader traced from the hit (sun, local light): the ray generation shader counts
   // them with its own rays in one atomic, instead of one atomic per shadow ray.
   uint shadowRays;
+  // Distance to the hit, written by the closest-hit shader; the ray generation shader sets it below 0 before
+  // tracing, so a ray that escaped keeps that (ReflectionSettings::changedBoxes tests the ray's path).
+  float hitT;
 };
 
 #endif

@@ -23,6 +23,7 @@ layout(push_constant) uniform ReflectionPushConstants { ReflectionConstants pc; 
 #include "half_resolution.glsl"
 #include "pass_inputs.glsl"
 #include "ray_counters.glsl"
+#include "reflection_changes.glsl"
 #include "reflection_common.glsl"
 #ifdef RB_REFLECTION_CONVERGED_TILES
 layout(set = 0, binding = RB_REFLECTION_BINDING_TILE_STATE, std430) readonly buffer TileState { uint tileState[]; };
@@ -100,6 +101,8 @@ void main() {
   rbBasis(n, t, b);
   vec3 sum = vec3(0.0);
   uint traced = 0u;  // reflection rays, plus the shadow rays their hits traced
+  bool stale = false;  // a ray met a change (ReflectionSettings::changedBoxes): the history is stale
+  const vec3 toSun = dot(pc.sunDirection, pc.sunDirection) > 0.0 ? normalize(pc.sunDirection) : vec3(0.0);
   for (uint i = 0u; i < count; ++i) {
     vec3 dir;
     float weight = 1.0;
@@ -118,6 +121,7 @@ void main() {
     if (dot(dir, facing) <= 0.0) dir = normalize(dir - 2.0 * dot(dir, facing) * facing);
     payload.radiance = vec3(0.0);
     payload.shadowRays = 0u;
+    payload.hitT = -1.0;
     uint flags = (pc.gbuffer.flags & RB_GB_ALPHA_TEST) != 0u ? gl_RayFlagsNoneEXT : gl_RayFlagsOpaqueEXT;
 #ifdef RB_REFLECTION_REORDER
     // The same ray, traced into a hit object (any-hit shaders run here); the threads are then regrouped so
@@ -133,8 +137,9 @@ void main() {
 #endif
     sum += weight * payload.radiance;
     traced += 1u + payload.shadowRays;
+    if (pc.changedBoxCount != 0u && !stale) stale = rbReflectionChanged(origin, dir, payload.hitT, toSun);
   }
   // Samples below the surface contribute zero radiance but count: the estimator's denominator is `count`.
-  imageStore(outRadiance, target, vec4(sum / float(count), 1.0));
+  imageStore(outRadiance, target, vec4(sum / float(count), stale ? 2.0 : 1.0));
   if (traced != 0u) rbCountRays(pixel, traced);
 }

@@ -12,6 +12,7 @@
 layout(push_constant) uniform ShadowPushConstants { ShadowConstants pc; };
 #include "adaptive_rays.glsl"
 #include "ray_counters.glsl"
+#include "reset_rays.glsl"
 #include "shadow_pixel.glsl"
 #include "shadow_tiles.glsl"
 
@@ -51,7 +52,7 @@ void main() {
     const uint count = uint(plan.x);
     const float historyMean = plan.y;
 #else
-    const uint count = max(pc.raysPerPixel, 1u);
+    const uint count = rbResetRayCount(ip, max(pc.raysPerPixel, 1u));
     const float historyMean = 0.0;  // never read: every traced pixel gets a ray
 #endif
     uint seed = rbPcg(pixel.x + pc.gbuffer.size.x * pixel.y + rbPcg(pc.gbuffer.frameIndex));

@@ -204,8 +204,10 @@ TEST_CASE("a moved instance resets history only inside its old and new footprint
   CHECK(shadowStray == 0);
   CHECK(aoStray == 0);
 
-  // The history: a masked pixel starts afresh (1 frame); an unmasked one keeps its history unless disoccluded (the
-  // surface there is another one than last frame's: the box's old place, its new place).
+  // The history: a masked pixel starts afresh, at kDefaultResetRaysFactor frames (HybridEffects traced that many
+  // times the rays there: RaySchedule::resetRays); an unmasked one keeps its history unless disoccluded (the surface
+  // there is another one than last frame's: the box's old place, its new place).
+  const float restartFrames = float(rb::kDefaultResetRaysFactor);
   auto check = [&](const std::vector<float>& mask, const std::vector<float>& frames, const char* what) {
     uint32_t reset = 0, kept = 0, strayResets = 0, maskedKept = 0;
     for (size_t i = 0; i < size_t(kW) * kH; ++i) {
@@ -213,7 +215,7 @@ TEST_CASE("a moved instance resets history only inside its old and new footprint
       const bool disoccluded = !before.cpu.hit[i] || before.cpu.instance[i] != after.cpu.instance[i] ||
                                glm::length(before.cpu.position[i] - after.cpu.position[i]) > 1e-3;
       if (mask[i] > 0.5f) {
-        maskedKept += frames[i] != 1.0f;
+        maskedKept += frames[i] != restartFrames;
         ++reset;
       } else if (!disoccluded) {
         strayResets += frames[i] != float(kStillFrames + 1);
@@ -233,8 +235,8 @@ TEST_CASE("a moved instance resets history only inside its old and new footprint
   const Run off = run(fx, before, after, false);
   uint32_t restartedOff = 0, restartedOn = 0;
   for (size_t i = 0; i < size_t(kW) * kH; ++i) {
-    restartedOff += after.cpu.hit[i] && off.aoFrames[i] == 1.0f;
-    restartedOn += after.cpu.hit[i] && on.aoFrames[i] == 1.0f;
+    restartedOff += after.cpu.hit[i] && off.aoFrames[i] < float(kStillFrames + 1);
+    restartedOn += after.cpu.hit[i] && on.aoFrames[i] < float(kStillFrames + 1);
   }
   CHECK(restartedOn > restartedOff + 50);
 }

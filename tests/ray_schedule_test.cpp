@@ -39,6 +39,24 @@ std::vector<Damage> damagesFor(uint32_t allowed) {
   if (!(allowed & rb::kScheduleTileClassifier))
     d.push_back(
         {"tileClassifier: this effect has no tile classifier", [](rb::RaySchedule& s) { s.tileClassifier = true; }});
+  if (!(allowed & rb::kScheduleResetRays))
+    d.push_back({"resetRays: this effect has no reset rays (ray_schedule.h lists each effect's stages); set it to 0",
+                 [](rb::RaySchedule& s) { s.resetRays = 8; }});
+  if (allowed & rb::kScheduleResetRays)
+    d.push_back({"resetRays 5000 exceeds kMaxRaysPerPixel (4096)", [](rb::RaySchedule& s) { s.resetRays = 5000; }});
+  if (allowed & rb::kScheduleResetRays && allowed & rb::kScheduleAdaptiveRays)
+    d.push_back(
+        {"resetRays: adaptive rays already plan the most rays where a history restarts", [](rb::RaySchedule& s) {
+           s.resetRays = 8;
+           s.adaptive.enabled = true;
+         }});
+  if (allowed & rb::kScheduleResetRays && allowed & rb::kScheduleHalfResolution)
+    d.push_back({"resetRays traces more rays in the changed full-resolution pixels: set it to 0 or disable "
+                 "halfResolution",
+                 [](rb::RaySchedule& s) {
+                   s.resetRays = 8;
+                   s.halfResolution = true;
+                 }});
   if (allowed & rb::kScheduleAdaptiveRays)
     d.push_back({"adaptive.tileWidth 3 must be 0", [](rb::RaySchedule& s) {
                    s.adaptive.enabled = true;

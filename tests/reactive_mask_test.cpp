@@ -74,6 +74,81 @@ TEST_CASE("a reactive mask drops the history of exactly the masked pixels", "[de
   destroySampledImage(fx, mask);
 }
 
+TEST_CASE("reset rays trace RaySchedule::resetRays in exactly the masked pixels, counted as that many frames",
+          "[denoise][reactive][schedule]") {
+  GpuFixture fx;
+  TestScene scene = makeConformanceScene();
+  EmbreeScene embree;
+  addToEmbree(embree, scene);
+  CpuGBuffer cpu = traceGBuffer(embree, conformanceView(kW, kH));
+  std::vector<uint8_t> maskBytes(size_t(kW) * kH, 0);
+  for (uint32_t y = 0; y < kH; ++y)
+    for (uint32_t x = 0; x < kW; ++x) maskBytes[size_t(y) * kW + x] = masked(x, y) ? 255 : 0;
+  SampledImage mask = uploadSampledImage(fx, VK_FORMAT_R8_UNORM, VK_IMAGE_ASPECT_COLOR_BIT, kW, kH, maskBytes.data(),
+                                         maskBytes.size());
+  auto ao = rb::AoPass::create(fx.ctx());
+  RB_REQUIRE_OK(ao);
+  auto denoiser = rb::Denoiser::create(fx.ctx());
+  RB_REQUIRE_OK(denoiser);
+  constexpr uint32_t kRays = 2, kResetRays = 8, kResetFrames = kResetRays / kRays;
+  rb::PassStats stats;
+  auto frame = [&](bool withMask) {
+    runPassFrame(
+        fx, scene, cpu, false,
+        [&](VkCommandBuffer cmd, const rb::GBufferDesc& g, const rb::TlasInfo& tlas) {
+          rb::GBufferDesc gbuffer = g;
+          if (withMask) gbuffer.reactiveMask = {mask.view};
+          rb::AoSettings a;
+          a.raysPerPixel = kRays;
+          a.schedule.resetRays = kResetRays;
+          RB_REQUIRE_OK(ao.value()->record(cmd, {.gbuffer = gbuffer, .tlas = tlas, .settings = a}));
+          rb::DenoiseSettings d;
+          d.raysPerPixel = kRays;
+          d.resetFrames = kResetFrames;
+          RB_REQUIRE_OK(denoiser.value()->record(
+              cmd, {.gbuffer = gbuffer, .signal = ao.value()->outputs().aoView, .settings = d}));
+        },
+        [](const rb::GBufferDesc&) {});
+    stats = ao.value()->stats();
+  };
+  for (int i = 0; i < 3; ++i) frame(false);
+  const std::vector<float> before = historyFrames(fx, *denoiser.value());
+  size_t maskedSurface = 0, otherSurface = 0;
+  for (uint32_t y = 0; y < kH; ++y)
+    for (uint32_t x = 0; x < kW; ++x)
+      if (cpu.hit[size_t(y) * kW + x]) (masked(x, y) ? maskedSurface : otherSurface)++;
+  REQUIRE(maskedSurface > 20);
+  REQUIRE(otherSurface > 100);
+  // Without a mask nothing restarts: every surface pixel traces its own rays.
+  CHECK(stats.rays == uint64_t(maskedSurface + otherSurface) * kRays);
+  frame(true);
+  // With it, exactly the masked surface pixels trace the reset rays (sky traces nothing either way).
+  CHECK(stats.rays == uint64_t(otherSurface) * kRays + uint64_t(maskedSurface) * kResetRays);
+  const std::vector<float> after = historyFrames(fx, *denoiser.value());
+  size_t wrong = 0;
+  for (uint32_t y = 0; y < kH; ++y)
+    for (uint32_t x = 0; x < kW; ++x) {
+      const size_t i = size_t(y) * kW + x;
+      if (!cpu.hit[i]) continue;
+      // A masked pixel restarts at resetRays / raysPerPixel frames; every other one adds this frame to its history.
+      const float expected = masked(x, y) ? float(kResetFrames) : before[i] + 1.0f;
+      if (after[i] != expected && wrong++ < 5)
+        UNSCOPED_INFO("pixel " << x << "," << y << ": " << after[i] << " frames, expected " << expected);
+    }
+  CHECK(wrong == 0);
+  // The next frame without a mask adds one frame to the restarted pixels' kResetFrames.
+  frame(false);
+  const std::vector<float> next = historyFrames(fx, *denoiser.value());
+  for (uint32_t y = 0; y < kH; ++y)
+    for (uint32_t x = 0; x < kW; ++x) {
+      const size_t i = size_t(y) * kW + x;
+      if (cpu.hit[i] && masked(x, y) && next[i] != float(kResetFrames + 1) && wrong++ < 5)
+        UNSCOPED_INFO("pixel " << x << "," << y << ": " << next[i] << " frames the frame after");
+    }
+  CHECK(wrong == 0);
+  destroySampledImage(fx, mask);
+}
+
 TEST_CASE("a reactive mask in a layout that cannot be sampled is refused by name", "[denoise][reactive][errors]") {
   GpuFixture fx;
   TestScene scene = makeConformanceScene();

@@ -189,12 +189,18 @@ if want render; then
   # RB_RENDER_BIN=NAME: another render command of bin/ (an earlier build, or a wrapper such as raybridge-render-noconv).
   RENDER="$RT/bin/${RB_RENDER_BIN:-raybridge-render}"
   RDIR="$(mktemp -d)"
-  for variant in "raster|--mode raster" "hybrid|--mode hybrid" "raster_ultra|--mode raster --preset ultra" \
-                 "hybrid_ultra|--mode hybrid --preset ultra" "hybrid_low|--mode hybrid --preset low"; do
+  # RB_RENDER_VARIANTS="name|args;name|args" replaces the variants below (e.g. an A/B of one switch, alternated);
+  # RB_RENDER_SIZE="W H" the size (default 1920 1080); RB_RENDER_FRAMES the frames of each (default 12).
+  VARIANTS=("raster|--mode raster" "hybrid|--mode hybrid" "raster_ultra|--mode raster --preset ultra"
+            "hybrid_ultra|--mode hybrid --preset ultra" "hybrid_low|--mode hybrid --preset low")
+  [ -n "${RB_RENDER_VARIANTS:-}" ] && IFS=';' read -r -a VARIANTS <<<"$RB_RENDER_VARIANTS"
+  read -r RW RH <<<"${RB_RENDER_SIZE:-1920 1080}"
+  for variant in "${VARIANTS[@]}"; do
     name="${variant%%|*}"
     read -r -a vargs <<<"${variant#*|}"
     RAYBRIDGE_VALIDATION=0 step "render $name" 60 "$OUT/render_gpu.log" \
-      "$RENDER" --width 1920 --height 1080 --frames 12 --dump "${vargs[@]}" --out "$RDIR/$name"
+      "$RENDER" --width "$RW" --height "$RH" --frames "${RB_RENDER_FRAMES:-12}" --dump "${vargs[@]}" \
+      --out "$RDIR/$name"
   done
   grep -E 'engine GPU ms|Raybridge:' "$OUT/render_gpu.log"
   # One archive with the render outputs, its log and the environment: the tool brings back at most 8 files.

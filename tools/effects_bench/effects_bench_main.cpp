@@ -33,6 +33,12 @@ nlohmann::json vec(const glm::vec3& v) { return {v.x, v.y, v.z}; }
 
 // The settings each sweep visits. Full: the lists. Quick (the ctest smoke run): two of each, so that the
 // self-checks still have a "fewest" and a "most" row, in well under a minute with validation on lavapipe.
+// The mechanisms the motion scenario's command line turns off or on.
+MotionSwitches switchesOf(const Options& o) {
+  return {o.noAntiLag,   o.noChangeResets,  o.convergedTiles,   o.noShortHistoryFilter,
+          o.noResetRays, o.resetRaysFactor, o.reflectionChanges};
+}
+
 SweepPlan makePlan(const Options& o, bool cpu, uint32_t width, uint32_t height) {
   SweepPlan p;
   p.width = width;
@@ -122,9 +128,8 @@ int main(int argc, char** argv) {
                                                      {rb::kEffectReflections, runReflectionSweep}};
   nlohmann::json motionResult;
   if (motion) {
-    const MotionSwitches switches{o.noAntiLag, o.noChangeResets, o.convergedTiles, o.noShortHistoryFilter};
-    auto m = runMotionScenario(driver, motionScene,
-                               makeMotionPlan(o.quick, width, height, o.effects, o.images, switches, o.motionRays));
+    auto m = runMotionScenario(
+        driver, motionScene, makeMotionPlan(o.quick, width, height, o.effects, o.images, switchesOf(o), o.motionRays));
     if (!m) return fail(m.error);
     motionResult = std::move(m.value);
   }

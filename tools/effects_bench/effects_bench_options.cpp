@@ -73,6 +73,17 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_flag("--no-short-history-filter", o.noShortHistoryFilter,
                "motion: AO's denoiser without the short-history filter\n"
                "(AoEffectSettings::disableShortHistoryFilter)");
+  app.add_flag("--no-reset-rays", o.noResetRays,
+               "motion: soft shadows and AO trace their own rays where a change restarts the history\n"
+               "(Shadow/AoEffectSettings::disableResetRays)");
+  app.add_flag("--reflection-changes", o.reflectionChanges,
+               "motion: reflections restart where a ray hits a changed light's reach\n"
+               "(ReflectionEffectSettings::relitResets)");
+  app.add_option("--reset-rays-factor", o.resetRaysFactor,
+                 "motion: soft shadows and AO trace F x their rays where a change restarts the history\n"
+                 "(RaySchedule::resetRays; default: rb::kDefaultResetRaysFactor)")
+      ->type_name("F")
+      ->check(rbCli::wholeNumber(2, 64));
   app.add_flag(
       "--converged-tiles", o.convergedTiles,
       "motion: every effect skips its converged tiles (RaySchedule::convergedTiles), to measure their lag cost");
@@ -155,6 +166,7 @@ std::string parseOptions(int argc, char** argv, Options& o) {
   if (o.scenario != "motion" && (o.effects & rb::kEffectLocalLights))
     return "--effects local_lights: only --scenario motion measures local lights; drop it or add --scenario motion";
   if (o.scenario == "motion" && !o.effectsGiven) o.effects = rb::kAllEffects;
+  if (o.resetRaysFactor && o.noResetRays) return "--reset-rays-factor and --no-reset-rays: give one of them";
   return {};
 }
 

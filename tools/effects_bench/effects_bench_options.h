@@ -17,6 +17,9 @@ struct Options {
   uint32_t characters = 3;            // motion: walkers
   bool noAntiLag = false;             // motion: DenoiseSettings::disableAntiLag
   bool noShortHistoryFilter = false;  // motion: AoEffectSettings::disableShortHistoryFilter
+  bool noResetRays = false;           // motion: Shadow/AoEffectSettings::disableResetRays
+  bool reflectionChanges = false;     // motion: ReflectionEffectSettings::relitResets
+  uint32_t resetRaysFactor = 0;       // motion: RaySchedule::resetRays = this x the rays; 0 = the SDK's default
   bool noChangeResets = false;        // motion: HybridEffectsDesc::disableChangeResets
   bool convergedTiles = false;        // motion: RaySchedule::convergedTiles on for every effect
   std::vector<uint32_t> motionRays;   // motion: rays per pixel of the denoised sequences; empty = 1, 4, 16

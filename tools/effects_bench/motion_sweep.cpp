@@ -183,6 +183,13 @@ se::Status Runner::setDesc(uint32_t rays, bool reference) {
   d.localLights.disableDenoiser = reference;
   d.denoiser.disableAntiLag = plan_.switches.disableAntiLag;
   d.ao.disableShortHistoryFilter = plan_.switches.disableShortHistoryFilter;
+  d.ao.disableResetRays = plan_.switches.disableResetRays;
+  d.shadows.disableResetRays = plan_.switches.disableResetRays;
+  d.reflections.relitResets = plan_.switches.reflectionChanges;
+  if (plan_.switches.resetRaysFactor && !reference) {
+    d.shadows.schedule.resetRays = plan_.switches.resetRaysFactor * rays;
+    d.ao.schedule.resetRays = plan_.switches.resetRaysFactor * rays;
+  }
   d.disableChangeResets = plan_.switches.disableChangeResets;
   if (plan_.switches.convergedTiles && !reference) {
     d.shadows.schedule.convergedTiles.enabled = true;
@@ -274,7 +281,7 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
                              const std::vector<Frame>& frames, const std::vector<Frame>& control) {
   const uint32_t m = plan_.measuredFrames;
   const uint32_t w = plan_.width, h = plan_.height;
-  std::vector<double> all, raw, changed, disoccluded, flickerOut, flickerRef, passMs, denoiseMs;
+  std::vector<double> all, raw, changed, disoccluded, flickerOut, flickerRef, passMs, denoiseMs, passRays;
   std::vector<uint64_t> changedCount, disoccludedCount;
   // changedMask[j]: frame j's pixels whose reference changed since frame j - 1 (none for frame 0); the event and
   // steady summaries below read it at their frames.
@@ -285,6 +292,7 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
     all.push_back(rmseOver(f.effects.at(e.name), r.effects.at(e.name), f.surface));
     passMs.push_back((f.stats.*e.pass).gpuMs);
     denoiseMs.push_back((f.stats.*e.denoise).gpuMs);
+    passRays.push_back(double((f.stats.*e.pass).rays));  // reset rays add to it in the frames with a change
     raw.push_back(rmseOver(f.effects.at(e.name + "_raw"), r.effects.at(e.name), f.surface));
     if (j == 0) continue;
     const std::vector<uint8_t> surfaces = both(f.surface, frames[j - 1].surface);
@@ -308,6 +316,8 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
                       {"flicker_reference", flickerRef},
                       {"pass_gpu_ms_median", median(passMs)},
                       {"denoise_gpu_ms_median", median(denoiseMs)},
+                      {"pass_rays", passRays},
+                      {"pass_rays_mean", mean(passRays)},
                       {"rmse_mean", mean(all)},
                       {"rmse_raw_mean", mean(raw)}};
   const double fo = mean(flickerOut), fr = mean(flickerRef);
@@ -500,7 +510,12 @@ se::Result<nlohmann::json> runMotionScenario(FrameDriver& driver, const MotionSc
                {"anti_lag", !plan.switches.disableAntiLag},
                {"change_resets", !plan.switches.disableChangeResets},
                {"converged_tiles", plan.switches.convergedTiles},
-               {"short_history_filter", !plan.switches.disableShortHistoryFilter}};
+               {"short_history_filter", !plan.switches.disableShortHistoryFilter},
+               {"reset_rays", !plan.switches.disableResetRays},
+               {"reflection_relit_resets", plan.switches.reflectionChanges},
+               {"reset_rays_factor", plan.switches.disableResetRays  ? 0u
+                                     : plan.switches.resetRaysFactor ? plan.switches.resetRaysFactor
+                                                                     : rb::kDefaultResetRaysFactor}};
   return r;
 }
 

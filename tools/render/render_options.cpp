@@ -391,6 +391,17 @@ void addScheduleOptions(CLI::App& app, RenderOptions& o) {
   app.add_flag("--no-short-history-filter", o.noShortHistoryFilter,
                "AO: its denoiser filters pixels with a short history as any other\n"
                "(AoEffectSettings::disableShortHistoryFilter; to measure what the filter costs)");
+  app.add_flag("--no-reset-rays", o.noResetRays,
+               "soft shadows and AO: trace their own rays per pixel where a change restarts the\n"
+               "history too (Shadow/AoEffectSettings::disableResetRays; to measure what reset rays buy)");
+  app.add_flag("--reflection-changes", o.reflectionChanges,
+               "reflections: restart the history where a reflection ray hits the reach of a local\n"
+               "light that changed (ReflectionEffectSettings::relitResets)");
+  app.add_option("--reset-rays", o.resetRays,
+                 "soft shadows and AO: rays per pixel where a change restarts the history\n"
+                 "(RaySchedule::resetRays; default: rb::kDefaultResetRaysFactor x their rays)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(1, rb::kMaxRaysPerPixel));
   app.add_option_function<uint32_t>(
          "--converged-ao", [&o](const uint32_t& v) { o.convergedAo = v; },
          "AO: skip the 8x8 tiles whose denoised history has converged, each still traced\n"
@@ -568,6 +579,9 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.estimator = o.aoEstimator;
   h.ao.disableDenoiser = !o.denoise;
   h.ao.disableShortHistoryFilter = o.noShortHistoryFilter;
+  h.ao.disableResetRays = o.noResetRays;
+  h.shadows.disableResetRays = o.noResetRays;
+  h.reflections.relitResets = o.reflectionChanges;
   h.ao.schedule.adaptive.enabled = o.adaptiveAoMs.has_value();
   h.ao.schedule.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
   h.ao.schedule.adaptive.granularity = o.adaptiveGranularity;
@@ -587,6 +601,9 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.reflections.roughnessThreshold = o.reflectionRoughness ? *o.reflectionRoughness : kDefaultReflectionRoughness;
   h.reflections.raysPerPixel = o.reflectionRays ? *o.reflectionRays : kDefaultReflectionRays;
   h.reflections.schedule.halfResolution = o.halfResReflections;
+  // --reset-rays where the schedule traces every pixel its own count (not adaptive, not at half resolution).
+  h.shadows.schedule.resetRays = h.shadows.schedule.adaptive.enabled ? 0u : o.resetRays;
+  h.ao.schedule.resetRays = h.ao.schedule.adaptive.enabled || h.ao.schedule.halfResolution ? 0u : o.resetRays;
   h.reflections.schedule.convergedTiles.enabled = o.convergedReflections.has_value();
   h.reflections.schedule.convergedTiles.refreshPeriod = o.convergedReflections.value_or(0);
   h.reflections.invocationReorder = o.invocationReorder;
@@ -625,6 +642,13 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
            "of them";
   if (o.noShortHistoryFilter && o.mode != Mode::Hybrid)
     return "--no-short-history-filter: only --mode hybrid denoises the SDK's AO";
+  if (o.resetRays && o.noResetRays) return "--reset-rays and --no-reset-rays: give one of them";
+  if (o.reflectionChanges && (!o.denoise || o.mode != Mode::Hybrid))
+    return "--reflection-changes: only --mode hybrid's denoised reflections have a history to restart";
+  if (o.noResetRays && !o.denoise)
+    return "--no-reset-rays: reset rays restart a denoiser's history, which --no-denoise turns off; give one of them";
+  if (o.noResetRays && o.mode != Mode::Hybrid)
+    return "--no-reset-rays: only --mode hybrid traces the SDK's soft shadows and AO";
   if (o.convergedTiles && !o.denoise)
     return "--converged-tiles: converged tiles are read from the shadow denoiser's history; drop --no-denoise";
   if (o.convergedTiles && o.mode != Mode::Hybrid)

@@ -64,6 +64,12 @@ struct RenderOptions {
   bool noConvergedTiles = false;
   // --no-short-history-filter: HybridEffectsDesc::ao.disableShortHistoryFilter (to measure what the filter costs).
   bool noShortHistoryFilter = false;
+  // --no-reset-rays: HybridEffectsDesc::shadows and ao.disableResetRays (to measure what reset rays buy).
+  bool noResetRays = false;
+  // --reflection-changes: HybridEffectsDesc::reflections.relitResets.
+  bool reflectionChanges = false;
+  // --reset-rays N: HybridEffectsDesc::shadows and ao.schedule.resetRays (0 = the SDK's default).
+  uint32_t resetRays = 0;
   // --converged-ao K: HybridEffectsDesc::ao.schedule.convergedTiles, likewise (AO at full resolution: --half-res
   // without ao).
   std::optional<uint32_t> convergedAo;

@@ -107,6 +107,14 @@ struct DenoiseSettings {
   // (single frames +10% to +100%). false = every pixel by convergedNoise alone. HybridEffects sets it for AO
   // (AoEffectSettings::disableShortHistoryFilter).
   bool shortHistoryFilter = false;
+  // Scalar signals: how many frames a pixel's new value counts as where its history restarts because the G-buffer's
+  // reactive mask is set there: the pass traced RaySchedule::resetRays rays in those pixels, so set resetRays /
+  // raysPerPixel. The running mean then weighs each frame by its rays (a pixel restarted with 16 rays, then given 4
+  // a frame, averages 16 + 4 + 4 rays, not three equal frames), and the noise the filter assumes is that of the
+  // rays traced. Whole frames (the history counts whole frames): resetRays / raysPerPixel rounded down. 0 = 1 (the
+  // pass traced its usual rays); at most the history's frames (maxHistoryFrames resolved). HybridEffects sets it
+  // with the reset rays it asks for.
+  uint32_t resetFrames = 0;
 };
 
 // What one record() filters. The G-buffer and signal have no defaults: a zero-initialised frame is refused by name.

@@ -35,6 +35,13 @@ struct Light {
   float spotOuterAngleDegrees = 0.0f;  // spot: half-angle of the cone; 0 = kDefaultSpotOuterAngleDegrees
 };
 
+// A world-space box where the world changed this frame (HybridFrame::changedBoxes, ReflectionSettings::changedBoxes):
+// min <= max per axis, finite. Plain value.
+struct ChangedBox {
+  double min[3] = {0.0, 0.0, 0.0};
+  double max[3] = {0.0, 0.0, 0.0};
+};
+
 // What one recorded pass did, resolved once its frame has finished on the GPU.
 struct PassStats {
   uint64_t frame = 0;  // Context::frameIndex() when recorded; 0 = nothing resolved yet

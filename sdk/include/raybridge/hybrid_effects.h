@@ -83,6 +83,13 @@ inline constexpr float kDefaultSoftLightAngularRadiusDegrees = 0.5f;
 // device seen allows 16384 or more).
 inline constexpr uint32_t kMaxHybridOutputSize = 16384;
 
+// RaySchedule::resetRays that HybridEffects asks for when the effect's schedule leaves it 0: this many times the
+// effect's rays per pixel in the pixels whose history a change restarts (the effect's change mask, the engine's
+// reactive mask), for denoised soft shadows and AO without adaptive rays or half resolution. Four: measured on
+// tests/motion_lag_test.cpp's teleport (docs/effects.md, "Reset rays"). ShadowEffectSettings::disableResetRays and
+// AoEffectSettings::disableResetRays turn it off.
+inline constexpr uint32_t kDefaultResetRaysFactor = 4;
+
 struct ShadowEffectSettings {
   // 0 = the light decides: kDefaultSoftShadowRays for a light with a size, one ray (hard) for one without.
   // 1 = hard shadows whatever the light's size (the presets' "1 ray"), unless softAngularRadiusDegrees is set:
@@ -97,7 +104,11 @@ struct ShadowEffectSettings {
   // adaptive rays (raysPerPixel is then the average the budget is made of) and converged tiles (the raw shadow
   // output then holds kept-history marks there, the denoised one is complete). Adaptive rays and converged tiles
   // need the effect's denoiser (disableDenoiser = false); schedule.history is set to it (a value given is ignored).
+  // schedule.resetRays 0 = kDefaultResetRaysFactor x raysPerPixel for denoised soft shadows without adaptive rays.
   RaySchedule schedule{};
+  // false = more rays where a change restarts a soft shadow's history (schedule.resetRays, or the default above).
+  // true = every pixel traces raysPerPixel.
+  bool disableResetRays = false;
 };
 
 struct AoEffectSettings {
@@ -112,8 +123,12 @@ struct AoEffectSettings {
   // Where and how many rays (ray_schedule.h; AoSettings::schedule): adaptive rays, half resolution (a quarter of
   // the rays, depth-aware upsample; every preset with AO sets it) and converged tiles (full resolution; the raw AO
   // output then holds kept-history marks there, the denoised one is complete). Adaptive rays and converged tiles
-  // need the effect's denoiser; schedule.history is set to it (a value given is ignored).
+  // need the effect's denoiser; schedule.history is set to it (a value given is ignored). schedule.resetRays 0 =
+  // kDefaultResetRaysFactor x raysPerPixel for denoised AO without adaptive rays or half resolution.
   RaySchedule schedule{};
+  // false = more rays where a change restarts the AO's history (schedule.resetRays, or the default above). true =
+  // every pixel traces raysPerPixel.
+  bool disableResetRays = false;
 };
 
 struct ReflectionEffectSettings {
@@ -131,6 +146,15 @@ struct ReflectionEffectSettings {
   // output then holds kept-history marks there, a = -1, the denoised one is complete; needs the effect's
   // denoiser). schedule.history is set to the effect's denoiser (a value given is ignored).
   RaySchedule schedule{};
+  // true = the reflection rays test the reach of every local light that changed this frame
+  // (ReflectionSettings::relitBoxes) and the denoiser restarts the pixels whose reflection hit lies in one: a lamp that
+  // moved or switched, seen in a mirror, which anti-lag can miss. With change resets on and the denoiser, at full
+  // resolution; moved objects are left to anti-lag (src/frontend/effect_schedule.h says why). false (default) =
+  // reflections follow every change by anti-lag alone. Off by default because it is not yet a clear gain: on the
+  // motion bench's lamp jump (lavapipe, 160x90, docs/effects.md "Motion") it lowered the mean reflection error at 4
+  // and 16 rays (0.0215 -> 0.0164, 0.0214 -> 0.0181) but lengthened the lag at 1 ray (2 -> 6 frames) and tripled the
+  // flicker; it has not been measured on a GPU.
+  bool relitResets = false;
 };
 
 struct LocalLightEffectSettings {
@@ -175,12 +199,6 @@ struct HybridEffectsDesc {
 // (every other field is kept).
 HybridEffectsDesc withPreset(HybridEffectsDesc base, Preset preset);
 
-// A world-space box where the engine knows the world changed this frame (HybridFrame::changedBoxes): min <= max
-// per axis, finite. Plain value.
-struct ChangedBox {
-  double min[3] = {0.0, 0.0, 0.0};
-  double max[3] = {0.0, 0.0, 0.0};
-};
 // Largest HybridFrame::changedBoxes. Boxes beyond the GPU's per-frame list (256, with the SDK's own) are merged.
 inline constexpr uint32_t kMaxEngineChangedBoxes = 4096;
 

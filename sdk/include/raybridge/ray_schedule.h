@@ -6,7 +6,7 @@
 //   2. mark converged tiles (their pixels hold kept-history marks and trace nothing),
 //   3. classify tiles (list the 8x8 tiles that still need rays),
 //   4. trace: over the tile list (indirect), over every pixel skipping converged tiles, at half resolution, or over
-//      every pixel,
+//      every pixel; resetRays rays where the reactive mask restarts a pixel's history,
 //   5. upsample (half resolution) and check the refreshed converged tiles.
 // A stage an effect does not allow is an error that names the field (kScheduleCapabilities below lists them).
 //
@@ -146,8 +146,8 @@ struct ConvergedTileSettings {
 };
 
 // The stages of a RaySchedule (RayScheduleCapability bits). Which effect allows which:
-//   shadows (ShadowPass, soft lights):     adaptive rays, converged tiles, the tile classifier
-//   ambient occlusion (AoPass):            adaptive rays, converged tiles, half resolution
+//   shadows (ShadowPass, soft lights):     adaptive rays, converged tiles, the tile classifier, reset rays
+//   ambient occlusion (AoPass):            adaptive rays, converged tiles, half resolution, reset rays
 //   reflections (ReflectionPass):          converged tiles, half resolution
 //   local lights (ManyLightPass, Stochastic): converged tiles
 // Converged tiles and half resolution exclude each other (tiles are of full-resolution pixels).
@@ -156,11 +156,12 @@ enum RayScheduleCapability : uint32_t {
   kScheduleConvergedTiles = 1u << 1,
   kScheduleHalfResolution = 1u << 2,
   kScheduleTileClassifier = 1u << 3,
+  kScheduleResetRays = 1u << 4,
 };
 inline constexpr uint32_t kShadowScheduleCapabilities = kScheduleAdaptiveRays | kScheduleConvergedTiles |
-                                                        kScheduleTileClassifier;
+                                                        kScheduleTileClassifier | kScheduleResetRays;
 inline constexpr uint32_t kAoScheduleCapabilities = kScheduleAdaptiveRays | kScheduleConvergedTiles |
-                                                    kScheduleHalfResolution;
+                                                    kScheduleHalfResolution | kScheduleResetRays;
 inline constexpr uint32_t kReflectionScheduleCapabilities = kScheduleConvergedTiles | kScheduleHalfResolution;
 inline constexpr uint32_t kLocalLightScheduleCapabilities = kScheduleConvergedTiles;
 
@@ -186,6 +187,15 @@ struct RaySchedule {
   // the launch covers the others alone (vkCmdTraceRaysIndirectKHR). Converged tiles turn it on. false = off (see
   // shadow_pass.h for when it pays).
   bool tileClassifier = false;
+  // Rays per pixel where the pixel's history restarts this frame: where the G-buffer's reactive mask is set (.r >
+  // 0.5; HybridEffects replaces it with the effect's change mask: the pixels a moved object, light or the engine's own
+  // mask changed). A restarted pixel otherwise holds one frame of raysPerPixel rays beside neighbours that hold
+  // maxHistoryFrames of them, and stays several times their error for as many frames as it takes to catch up
+  // (docs/effects.md, "Reset rays"). Tell the Denoiser: DenoiseSettings::resetFrames = resetRays / raysPerPixel, so
+  // that its running mean weighs this frame's value by its rays. Costs resetRays - raysPerPixel extra rays in each
+  // changed pixel, nothing elsewhere. 0 (or at most raysPerPixel) = off. At most kMaxRaysPerPixel. Not with adaptive
+  // rays (they already plan the most rays where a history restarts) nor halfResolution; soft shadows only.
+  uint32_t resetRays = 0;
 };
 
 }  // namespace rb

@@ -92,7 +92,21 @@ struct ReflectionSettings {
   // tiles above: their pixels hold kept-history marks, a = -1, which the Reflection Denoiser schedule.history
   // reads; full resolution only). Zero = every pixel traces its rays.
   RaySchedule schedule{};
+  // Where the world changed since the last frame, in world space (HybridEffects hands over the reach of every local
+  // light that changed as relitBoxes with ReflectionEffectSettings::relitResets). A reflection shows a change the
+  // pixel's own surface does not: the lamp that moved, seen in a mirror. So the rays test them: a pixel whose
+  // reflection ray crosses a box of changedBoxes (an object moved into or out of its path), or whose hit's sun ray
+  // does (a moved object's shadow seen in the mirror), or whose hit lies in a box of relitBoxes (the reach of a light
+  // that moved, switched or changed), writes a = 2: its history is stale, and the Denoiser filtering the output
+  // starts it afresh. At most kMaxReflectionChangedBoxes in the two together; each min <= max and finite. Ignored at
+  // half resolution (the upsample writes coverage, a = 1). Empty (default) = no test.
+  std::span<const ChangedBox> changedBoxes{};
+  std::span<const ChangedBox> relitBoxes{};
 };
+
+// Largest ReflectionSettings::changedBoxes plus relitBoxes: the GPU tests every box for every ray (HybridEffects merges
+// its boxes to fit).
+inline constexpr uint32_t kMaxReflectionChangedBoxes = 256;
 
 // Fixed for the pass's life. Zero-initialised = images created at the first record().
 struct ReflectionPassDesc {

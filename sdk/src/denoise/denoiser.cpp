@@ -489,6 +489,11 @@ Status Denoiser::record(VkCommandBuffer cmd, const DenoiseFrame& frame) {
                    " (a negative count converted to unsigned?); 0 = the default of " +
                    std::to_string(kDefaultMaxHistoryFrames));
   }
+  if (settings.resetFrames > historyFrames(settings)) {
+    return invalid("DenoiseSettings::resetFrames " + std::to_string(settings.resetFrames) + " exceeds the history's " +
+                   std::to_string(historyFrames(settings)) +
+                   " frames (a negative count converted to unsigned?); set RaySchedule::resetRays / raysPerPixel");
+  }
   if (settings.disableTemporal && settings.disableSpatial) {
     return invalid("both temporal and spatial filtering are disabled; use the raw signal instead");
   }
@@ -503,6 +508,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const DenoiseFrame& frame) {
   pc.depthSigma = settings.depthSigma > 0.0f ? settings.depthSigma : 0.005f;
   pc.normalPower = settings.normalPower > 0.0f ? settings.normalPower : 32.0f;
   pc.signalRaysPerPixel = float(settings.raysPerPixel);
+  pc.resetFrames = float(std::max(settings.resetFrames, 1u));
   pc.convergedNoise = settings.convergedNoise > 0.0f ? settings.convergedNoise : kDefaultDenoiseConvergedNoise;
   if (s.signal == DenoiseSignal::Reflection) {
     if (!g.roughnessInNormalW && !g.roughnessMetalness.view) {

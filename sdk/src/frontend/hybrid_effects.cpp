@@ -8,6 +8,7 @@
 
 #include "change_masks.h"
 #include "change_tracker.h"
+#include "effect_schedule.h"
 #include "light_validation.h"
 #include "neutral_images.h"
 #include "pass_constants.h"
@@ -97,17 +98,6 @@ Status validate(const HybridEffectsDesc& d) {
     }
   }
   return {};
-}
-
-// An effect's schedule as its pass runs it: its history is the effect's denoiser, and the stages that read it wait
-// for the denoiser's first frame (none before it: uniform rays, nothing skipped). `allowed` false (a hard shadow)
-// turns them off.
-RaySchedule effectSchedule(const RaySchedule& wanted, const Denoiser* history, bool allowed = true) {
-  RaySchedule s = wanted;
-  s.history = history;
-  s.adaptive.enabled = s.adaptive.enabled && history && allowed;
-  s.convergedTiles.enabled = s.convergedTiles.enabled && history && allowed;
-  return s;
 }
 
 // The frame's lighting as reflection hits see it: the pass lights hits by one directional light, the frame's; a
@@ -229,6 +219,8 @@ struct HybridEffects::Impl {
   // Change resets (hybrid_effects.h): this frame's known changes and the masks made of them.
   ChangeTracker changes;
   ChangeMasks changeMasks;
+  // This frame's changed local lights as the reflection rays test them (ReflectionSettings::relitBoxes).
+  std::vector<ChangedBox> reflectionRelit;
   std::vector<AccelerationStructureService::MeshChange> meshChanges;
   std::vector<GpuChangeBox> gpuChangeBoxes;
 
@@ -389,14 +381,17 @@ struct HybridEffects::Impl {
 
   // Records the denoiser of one signal when wanted (ensureDenoiser; refreshOutputs names its output).
   // `rays`: binary rays behind a scalar signal (DenoiseSettings::raysPerPixel; 0 = estimate the noise).
+  // `resetFrames`: DenoiseSettings::resetFrames (the pass's reset rays over its rays; 0 = none).
   Status denoise(std::unique_ptr<Denoiser>& slot, bool wanted, const char* what, VkCommandBuffer cmd,
                  const GBufferDesc& gbuffer, VkImageView signal, uint32_t rays,
-                 DenoiseSignal kind = DenoiseSignal::Scalar, bool shortHistoryFilter = false) {
+                 DenoiseSignal kind = DenoiseSignal::Scalar, bool shortHistoryFilter = false,
+                 uint32_t resetFrames = 0) {
     if (Status st = ensureDenoiser(slot, wanted, kind, what); !st) return st;
     if (!slot) return {};
     DenoiseSettings d = desc.denoiser;
     d.raysPerPixel = kind == DenoiseSignal::Scalar ? rays : 0u;
     d.shortHistoryFilter = d.shortHistoryFilter || shortHistoryFilter;
+    d.resetFrames = std::min(resetFrames, d.maxHistoryFrames ? d.maxHistoryFrames : kDefaultMaxHistoryFrames);
     if (Status st = slot->record(cmd, {.gbuffer = gbuffer, .signal = signal, .settings = d}); !st)
       return wrap(what, st.error());
     return {};
@@ -457,6 +452,7 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   s.materials = materials.get();  // alpha tests non-opaque geometry
   // Adaptive rays and converged tiles: only for soft shadows, whose denoiser runs after the pass this frame.
   s.schedule = effectSchedule(desc.shadows.schedule, shadowDenoiser.get(), plan.soft);
+  s.schedule.resetRays = plan.soft ? effectResetRays(s.schedule, desc.shadows.disableResetRays, plan.rays) : 0u;
   const GBufferDesc g = changeMasks.gbufferFor(f.gbuffer, RB_CHANGE_SHADOWS);
   if (Status st = shadow->record(cmd, {.gbuffer = g, .tlas = tlas, .light = plan.light, .settings = s}); !st)
     return wrap("ShadowPass::record", st.error());
@@ -464,7 +460,8 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   // The visibility is a fraction of plan.rays binary rays; with adaptive rays the count varies per pixel, so the
   // denoiser measures the noise instead.
   return denoise(shadowDenoiser, plan.soft && !desc.shadows.disableDenoiser, "Denoiser (shadows)", cmd, g,
-                 o.visibilityView, desc.shadows.schedule.adaptive.enabled ? 0u : plan.rays);
+                 o.visibilityView, desc.shadows.schedule.adaptive.enabled ? 0u : plan.rays, DenoiseSignal::Scalar,
+                 false, denoiserResetFrames(s.schedule.resetRays, plan.rays));
 }
 
 Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -474,6 +471,8 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   s.range = desc.ao.range;
   s.estimator = desc.ao.estimator;
   s.schedule = effectSchedule(desc.ao.schedule, aoDenoiser.get());
+  const uint32_t aoRays = s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays;
+  s.schedule.resetRays = effectResetRays(s.schedule, desc.ao.disableResetRays, aoRays);
   const GBufferDesc g = changeMasks.gbufferFor(f.gbuffer, RB_CHANGE_AO);
   if (Status st = ao->record(cmd, {.gbuffer = g, .tlas = tlas, .settings = s}); !st)
     return wrap("AoPass::record", st.error());
@@ -484,7 +483,7 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
                             ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays)
                             : 0u;
   return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, g, o.aoView, rays, DenoiseSignal::Scalar,
-                 !desc.ao.disableShortHistoryFilter);
+                 !desc.ao.disableShortHistoryFilter, denoiserResetFrames(s.schedule.resetRays, aoRays));
 }
 
 Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -495,6 +494,12 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.invocationReorder = desc.reflections.invocationReorder;
   s.schedule = effectSchedule(desc.reflections.schedule, reflectionDenoiser.get());
   s.lighting = reflectionLighting(f);
+  // The light changes a reflection shows, where the change resets run (the denoiser then drops those pixels'
+  // history; effect_schedule.h says why lights only).
+  if (reflectionDenoiser && desc.reflections.relitResets && (changeMaskEffects() & RB_CHANGE_REFLECTIONS) != 0u) {
+    reflectionRelitBoxes(changes.boxes(), reflectionRelit);
+    s.relitBoxes = reflectionRelit;
+  }
   if (lightList && !f.localLights.empty()) s.lights = lightList.get();  // recorded earlier this frame
   const GBufferDesc g = changeMasks.gbufferFor(f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer,
                                                RB_CHANGE_REFLECTIONS);

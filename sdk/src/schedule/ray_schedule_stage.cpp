@@ -76,11 +76,13 @@ Status validateRaySchedule(const RaySchedule& s, uint32_t capabilities, DenoiseS
       {s.convergedTiles.enabled, kScheduleConvergedTiles, "convergedTiles.enabled", "converged tiles"},
       {s.halfResolution, kScheduleHalfResolution, "halfResolution", "half resolution"},
       {s.tileClassifier, kScheduleTileClassifier, "tileClassifier", "tile classifier"},
+      {s.resetRays != 0u, kScheduleResetRays, "resetRays", "reset rays"},
   };
   for (const Stage& stage : stages) {
     if (stage.on && !(capabilities & stage.capability)) {
       return invalid(std::string(stage.member) + ": this effect has no " + stage.what +
-                     " (ray_schedule.h lists each effect's stages); set it to false");
+                     " (ray_schedule.h lists each effect's stages); set it to " +
+                     (stage.capability == kScheduleResetRays ? "0" : "false"));
     }
   }
   if (s.adaptive.enabled) {
@@ -88,6 +90,18 @@ Status validateRaySchedule(const RaySchedule& s, uint32_t capabilities, DenoiseS
   }
   if (s.convergedTiles.enabled) {
     if (Status st = validateConverged(s.convergedTiles, field); !st) return st;
+  }
+  if (s.resetRays > kMaxRaysPerPixel) {
+    return invalid("resetRays " + std::to_string(s.resetRays) + " exceeds kMaxRaysPerPixel (" +
+                   std::to_string(kMaxRaysPerPixel) + ")");
+  }
+  if (s.resetRays != 0u && s.adaptive.enabled) {
+    return invalid("resetRays: adaptive rays already plan the most rays where a history restarts; set resetRays to 0 "
+                   "or disable adaptive rays");
+  }
+  if (s.resetRays != 0u && s.halfResolution) {
+    return invalid("resetRays traces more rays in the changed full-resolution pixels: set it to 0 or disable "
+                   "halfResolution");
   }
   if (s.convergedTiles.enabled && s.halfResolution) {
     return invalid("convergedTiles skips tiles of full-resolution pixels: disable halfResolution or convergedTiles");

@@ -129,6 +129,7 @@ Status AoPass::record(VkCommandBuffer cmd, const AoFrame& input) {
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultAoRays;
   pc.estimator = static_cast<uint32_t>(settings.estimator);  // RB_AO_*
   pc.halfResolution = settings.schedule.halfResolution ? 1u : 0u;
+  pc.gbuffer.resetRays = settings.schedule.resetRays > pc.raysPerPixel ? settings.schedule.resetRays : 0u;
 
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "AoPass", pc.gbuffer.flags); !st) return st;

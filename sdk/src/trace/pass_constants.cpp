@@ -278,6 +278,7 @@ Status fillGBufferConstants(const GBufferDesc& g, const TlasInfo& tlas, uint64_t
   if (g.roughnessInNormalW) flags |= RB_GB_ROUGHNESS_IN_NORMAL_W;
   if (g.roughnessMetalness.view) flags |= RB_GB_ROUGHNESS_IMAGE;
   if (g.albedo.view) flags |= RB_GB_ALBEDO_IMAGE;
+  if (g.reactiveMask.view) flags |= RB_GB_REACTIVE;
   out.flags = flags;
   out.frameIndex = static_cast<uint32_t>(frame);
   return {};

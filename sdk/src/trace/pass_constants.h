@@ -30,8 +30,9 @@ struct GBufferConstants {
   uint32_t size[2];
   uint32_t flags;  // RB_GB_*
   uint32_t frameIndex;
-  float wAtDepthOne;  // w of inverse(projection) * (x, y, 1, 1)
-  uint32_t pad[3];
+  float wAtDepthOne;   // w of inverse(projection) * (x, y, 1, 1)
+  uint32_t resetRays;  // RaySchedule::resetRays, traced where the reactive mask is set (RB_GB_REACTIVE); 0 = none
+  uint32_t pad[2];
 };
 static_assert(sizeof(GBufferConstants) == 160);
 RB_ASSERT_OFFSET(GBufferConstants, inverseProjection, 0);
@@ -42,6 +43,7 @@ RB_ASSERT_OFFSET(GBufferConstants, size, 128);
 RB_ASSERT_OFFSET(GBufferConstants, flags, 136);
 RB_ASSERT_OFFSET(GBufferConstants, frameIndex, 140);
 RB_ASSERT_OFFSET(GBufferConstants, wAtDepthOne, 144);
+RB_ASSERT_OFFSET(GBufferConstants, resetRays, 148);
 
 struct ShadowConstants {
   GBufferConstants gbuffer;
@@ -95,10 +97,12 @@ struct ReflectionConstants {
   uint32_t raysPerPixel;
   uint32_t lightCount;
   uint32_t lightCandidates;
-  uint32_t halfResolution;  // 1 = one sample per 2x2 block into the half-resolution image
-  uint32_t pad0;
+  uint32_t halfResolution;       // 1 = one sample per 2x2 block into the half-resolution image
+  uint32_t changedBoxCount;      // ReflectionSettings::changedBoxes + relitBoxes at changedBoxes; 0 = none
+  VkDeviceAddress changedBoxes;  // ReflectionChangedBox[] in a host-visible ring (reflection_pass.cpp)
+  uint32_t pad1[2];
 };
-static_assert(sizeof(ReflectionConstants) == 224);
+static_assert(sizeof(ReflectionConstants) == 240);
 RB_ASSERT_OFFSET(ReflectionConstants, gbuffer, 0);
 RB_ASSERT_OFFSET(ReflectionConstants, sunDirection, 160);
 RB_ASSERT_OFFSET(ReflectionConstants, roughnessThreshold, 172);
@@ -109,6 +113,8 @@ RB_ASSERT_OFFSET(ReflectionConstants, raysPerPixel, 204);
 RB_ASSERT_OFFSET(ReflectionConstants, lightCount, 208);
 RB_ASSERT_OFFSET(ReflectionConstants, lightCandidates, 212);
 RB_ASSERT_OFFSET(ReflectionConstants, halfResolution, 216);
+RB_ASSERT_OFFSET(ReflectionConstants, changedBoxCount, 220);
+RB_ASSERT_OFFSET(ReflectionConstants, changedBoxes, 224);
 
 struct UpsampleConstants {
   GBufferConstants gbuffer;  // the traced pass's: full-resolution size, the frame that chose the samples
@@ -211,8 +217,9 @@ struct DenoiseConstants {
   float signalRaysPerPixel;  // 0 = unknown
   float convergedNoise;      // scalar: DenoiseSettings::convergedNoise
   float roughnessThreshold;  // converged reflection tiles: ReflectionSettings::roughnessThreshold
+  float resetFrames;         // scalar temporal pass: DenoiseSettings::resetFrames resolved (at least 1)
 };
-static_assert(sizeof(DenoiseConstants) == 232);
+static_assert(sizeof(DenoiseConstants) == 236);
 RB_ASSERT_OFFSET(DenoiseConstants, inverseProjection, 0);
 RB_ASSERT_OFFSET(DenoiseConstants, viewToWorld, 64);
 RB_ASSERT_OFFSET(DenoiseConstants, previousViewProjection, 112);
@@ -227,10 +234,11 @@ RB_ASSERT_OFFSET(DenoiseConstants, normalPower, 216);
 RB_ASSERT_OFFSET(DenoiseConstants, signalRaysPerPixel, 220);
 RB_ASSERT_OFFSET(DenoiseConstants, convergedNoise, 224);
 RB_ASSERT_OFFSET(DenoiseConstants, roughnessThreshold, 228);
+RB_ASSERT_OFFSET(DenoiseConstants, resetFrames, 232);
 
 struct ConvergedTileConstants {
   DenoiseConstants denoise;
-  uint32_t pad[2];  // std430 rounds the nested struct up to its 16-byte alignment
+  uint32_t pad;  // std430 rounds the nested struct up to its 16-byte alignment (240)
   uint32_t minFrames;
   float maxNoise;
   uint32_t refreshPeriod;

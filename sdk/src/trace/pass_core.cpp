@@ -65,6 +65,7 @@ std::vector<VkDescriptorSetLayoutBinding> PassCore::commonBindings() {
       {RB_BINDING_NORMAL, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
       {RB_BINDING_GEOMETRIC_NORMAL, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
       {RB_BINDING_RAY_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, rg, nullptr},
+      {RB_BINDING_REACTIVE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, rg, nullptr},
   };
 }
 
@@ -78,6 +79,9 @@ void PassCore::writeGBuffer(Context& ctx, DescriptorWrites& w, const GBufferDesc
   w.sampledImage(RB_BINDING_NORMAL, g.normal.view, sampler, readLayout(g.normal));
   const GBufferImage& geo = g.geometricNormal.view ? g.geometricNormal : g.normal;
   w.sampledImage(RB_BINDING_GEOMETRIC_NORMAL, geo.view, sampler, readLayout(geo));
+  // Read only with RB_GB_REACTIVE (fillGBufferConstants); the depth image keeps the binding valid without a mask.
+  const GBufferImage& reactive = g.reactiveMask.view ? g.reactiveMask : g.depth;
+  w.sampledImage(RB_BINDING_REACTIVE, reactive.view, sampler, readLayout(reactive));
   w.storageBuffer(RB_BINDING_RAY_COUNTERS, metrics.counterBuffer(), metrics.counterOffset(ctx), metrics.counterBytes());
 }
 

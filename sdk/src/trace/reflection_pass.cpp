@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include "context_impl.h"
 #include "initial_extent.h"
@@ -75,16 +77,80 @@ struct ReflectionPass::Impl {
   ScheduleStage schedule{reflectionSchedule()};  // half resolution, converged tiles, the reordered variants
   ReflectionOutputs outputs;
   bool reordered = false;  // the latest record() traced with a reordered variant
+  // ReflectionSettings::changedBoxes and relitBoxes: kMaxReflectionChangedBoxes a frame in flight, host-visible,
+  // created with the first frame that gives any.
+  GpuBuffer changedRing;
   explicit Impl(Context& c) : ctx(c) {}
   ~Impl() {  // frames in flight may still trace with it
     core.retire(ctx);
     schedule.retire(ctx);
+    if (changedRing.valid()) retireBuffer(ctx, changedRing);
   }
 };
 
 namespace {
 
 const std::vector<PassImages::Spec> kReflectionOutputs = {{VK_FORMAT_R16G16B16A16_SFLOAT, "reflection radiance"}};
+
+// Mirrors RbReflectionChangedBox (shaders/reflection_changes.glsl): a box in the TLAS's space.
+struct ReflectionChangedBox {
+  float lo[3];
+  uint32_t relit;  // 0: geometry (path and sun ray tested), 1: lighting (the hit point tested)
+  float hi[3];
+  float pad;
+};
+static_assert(sizeof(ReflectionChangedBox) == 32);
+
+// ReflectionSettings::changedBoxes and relitBoxes checked, into this frame's slot of the ring, moved into the TLAS's
+// space; sets pc's count and address (nothing when both are empty, or at half resolution: the upsample writes
+// coverage, not the stale mark).
+Status writeChangedBoxes(ReflectionPass::Impl& s, const ReflectionSettings& settings, const TlasInfo& tlas,
+                         ReflectionConstants& pc) {
+  const size_t count = settings.changedBoxes.size() + settings.relitBoxes.size();
+  if (count > kMaxReflectionChangedBoxes) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "ReflectionPass: ReflectionSettings::changedBoxes and relitBoxes hold " + std::to_string(count) +
+                     " boxes, more than kMaxReflectionChangedBoxes (" + std::to_string(kMaxReflectionChangedBoxes) +
+                     "); merge neighbouring boxes"};
+  }
+  std::vector<ReflectionChangedBox> boxes;
+  boxes.reserve(count);
+  for (const auto& [list, relit, field] :
+       {std::tuple{settings.changedBoxes, 0u, "changedBoxes"}, std::tuple{settings.relitBoxes, 1u, "relitBoxes"}}) {
+    for (size_t i = 0; i < list.size(); ++i) {
+      const ChangedBox& b = list[i];
+      ReflectionChangedBox g{};
+      g.relit = relit;
+      for (int a = 0; a < 3; ++a) {
+        if (!std::isfinite(b.min[a]) || !std::isfinite(b.max[a]) || b.min[a] > b.max[a]) {
+          return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                       std::string("ReflectionPass: ReflectionSettings::") + field + "[" + std::to_string(i) +
+                           "] is not a box (min <= max, finite, on every axis); fix or drop it"};
+        }
+        // Rounded outwards: a float box never leaves out what the double one holds.
+        g.lo[a] = std::nextafter(float(b.min[a] - tlas.originOffset[a]), -INFINITY);
+        g.hi[a] = std::nextafter(float(b.max[a] - tlas.originOffset[a]), INFINITY);
+      }
+      boxes.push_back(g);
+    }
+  }
+  if (boxes.empty() || settings.schedule.halfResolution) return {};
+  const VkDeviceSize slotBytes = VkDeviceSize(kMaxReflectionChangedBoxes) * sizeof(ReflectionChangedBox);
+  if (!s.changedRing.valid()) {
+    Result<GpuBuffer> r = createBuffer(s.ctx, slotBytes * s.ctx.framesInFlight(),
+                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                                       MemoryLocation::HostVisible, MemoryCategory::PassBuffers,
+                                       "ReflectionPass: changed boxes");
+    if (!r) return r.error();
+    s.changedRing = r.value();
+  }
+  const VkDeviceSize offset = (s.ctx.frameIndex() % s.ctx.framesInFlight()) * slotBytes;
+  std::memcpy(static_cast<uint8_t*>(s.changedRing.mapped) + offset, boxes.data(),
+              boxes.size() * sizeof(ReflectionChangedBox));
+  pc.changedBoxes = s.changedRing.address + offset;
+  pc.changedBoxCount = uint32_t(boxes.size());
+  return {};
+}
 
 void nameOutputs(ReflectionPass::Impl& s) {
   s.outputs.radiance = s.core.images[0].image;
@@ -184,6 +250,7 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const ReflectionFrame& input)
     pc.lightCount = lights.count;
     pc.lightCandidates = settings.lightCandidates ? settings.lightCandidates : kDefaultReflectionLightCandidates;
   }
+  if (Status st = writeChangedBoxes(s, settings, tlas, pc); !st) return st;
   DescriptorWrites w;
   const MaterialTable* table = settings.materials ? settings.materials : s.ownMaterials.get();
   if (Status st = s.core.writeMaterials(w, tlas, table, "ReflectionPass", pc.gbuffer.flags); !st) return st;
@@ -198,6 +265,8 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const ReflectionFrame& input)
   w.storageBuffer(RB_REFLECTION_BINDING_LIGHTS, pc.lightCount ? lights.buffer : table->info().materials);
   ScheduleFrame frame{g, settings.schedule, w, &pc, &pc.gbuffer, pc.raysPerPixel, {}, threshold, variant};
   if (Result<bool> traced = s.schedule.trace(s.ctx, s.core, cmd, frame); !traced) return traced.error();
+  // Stale marks (a = 2) where a ray met a change: the Denoiser filtering this view reads them (RB_DN_KEPT_MARKS).
+  if (pc.changedBoxCount != 0u) internal::contextImpl(s.ctx).markKeptHistory(s.core.images[0].view);
   nameOutputs(s);
   return {};
 }

@@ -153,6 +153,7 @@ Status ShadowPass::record(VkCommandBuffer cmd, const ShadowFrame& input) {
   // A hard light's one ray per pixel is exact: nothing to adapt.
   RaySchedule schedule = settings.schedule;
   schedule.adaptive.enabled = schedule.adaptive.enabled && soft;
+  pc.gbuffer.resetRays = soft && schedule.resetRays > pc.raysPerPixel ? schedule.resetRays : 0u;
   const std::vector<PassImages::Spec> specs = outputSpecs(s.desc);
   DescriptorWrites w;
   if (Status st = s.core.writeMaterials(w, tlas, settings.materials, "ShadowPass", pc.gbuffer.flags); !st) return st;
