@@ -93,20 +93,6 @@ std::vector<float> passAlpha(GpuFixture& fx, const MirrorScene& m, rb::Reflectio
   return alpha;
 }
 
-// The Reflection denoiser's history length per pixel (RGBA16F: .a = frames).
-std::vector<float> rgbHistoryFrames(GpuFixture& fx, const rb::Denoiser& denoiser) {
-  const rb::DenoiseHistory h = denoiser.history();
-  REQUIRE(h.meanImage != VK_NULL_HANDLE);
-  const std::vector<uint8_t> raw = readPassImage(fx, h.meanImage, h.width, h.height, 8);
-  std::vector<float> frames(size_t(h.width) * h.height);
-  for (size_t i = 0; i < frames.size(); ++i) {
-    uint16_t half;
-    std::memcpy(&half, raw.data() + 8 * i + 6, 2);
-    frames[i] = glm::unpackHalf1x16(half);
-  }
-  return frames;
-}
-
 }  // namespace
 
 TEST_CASE("reflection rays that meet a changed box mark their pixel stale, exactly where Embree says",
@@ -172,11 +158,11 @@ TEST_CASE("the Reflection denoiser restarts the history of exactly the pixels ma
   RB_REQUIRE_OK(denoiser);
   const rb::ReflectionSettings still = mirrorSettings();
   for (int f = 0; f < 3; ++f) passAlpha(fx, m, *pass.value(), still, denoiser.value().get());
-  const std::vector<float> before = rgbHistoryFrames(fx, *denoiser.value());
+  const std::vector<float> before = historyFrames(fx, *denoiser.value());
   rb::ReflectionSettings changed = still;
   changed.changedBoxes = std::span(&m.box, 1);
   const std::vector<float> alpha = passAlpha(fx, m, *pass.value(), changed, denoiser.value().get());
-  const std::vector<float> after = rgbHistoryFrames(fx, *denoiser.value());
+  const std::vector<float> after = historyFrames(fx, *denoiser.value());
   uint32_t stale = 0, kept = 0, wrong = 0;
   for (size_t i = 0; i < alpha.size(); ++i) {
     if (!m.cpu.hit[i] || m.cpu.instance[i] != 0 || alpha[i] < 0.5f) continue;  // mirror pixels that traced

@@ -265,11 +265,13 @@ std::vector<float> readR32f(GpuFixture& fx, VkImage image, uint32_t width, uint3
 std::vector<float> historyFrames(GpuFixture& fx, const rb::Denoiser& denoiser) {
   const rb::DenoiseHistory h = denoiser.history();
   REQUIRE(h.meanImage != VK_NULL_HANDLE);
-  const std::vector<uint8_t> raw = readPassImage(fx, h.meanImage, h.width, h.height, 4);
+  // Scalar: RG16F (mean, frames); Rgb and Reflection: RGBA16F (mean colour, frames).
+  const size_t texel = denoiser.signal() == rb::DenoiseSignal::Scalar ? 4 : 8;
+  const std::vector<uint8_t> raw = readPassImage(fx, h.meanImage, h.width, h.height, uint32_t(texel));
   std::vector<float> frames(size_t(h.width) * h.height);
   for (size_t i = 0; i < frames.size(); ++i) {
     uint16_t half;
-    std::memcpy(&half, raw.data() + 4 * i + 2, 2);
+    std::memcpy(&half, raw.data() + texel * i + texel - 2, 2);
     frames[i] = glm::unpackHalf1x16(half);
   }
   return frames;

@@ -94,7 +94,8 @@ std::vector<float> readR16f(GpuFixture& fx, VkImage image, uint32_t width, uint3
 // RGBA16F: 4 floats per pixel.
 std::vector<float> readRgba16f(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height);
 std::vector<float> readR32f(GpuFixture& fx, VkImage image, uint32_t width, uint32_t height);
-// Frames accumulated per pixel in the scalar history a denoiser's latest record() left (its RG16F mean image's .g).
+// Frames accumulated per pixel in the history a denoiser's latest record() left (its mean image's last channel:
+// RG16F .g for Scalar, RGBA16F .a for Rgb and Reflection).
 std::vector<float> historyFrames(GpuFixture& fx, const rb::Denoiser& denoiser);
 
 }  // namespace rbtest
