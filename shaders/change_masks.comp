@@ -15,6 +15,7 @@
 // The engine's reactive mask is set in every mask. Each mask is 1 (changed) or 0.
 #include "raybridge_gbuffer.glsl"
 #include "raybridge_pass_constants.glsl"
+#include "segment_box.glsl"
 
 layout(push_constant) uniform ChangeMaskPushConstants { ChangeMaskConstants pc; };
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -40,17 +41,6 @@ float distance2(vec3 p, vec3 lo, vec3 hi) {
   return dot(d, d);
 }
 
-// Whether the segment p + t d, t in [0, tMax], meets the box (slab test). A zero component of d (the default sun,
-// straight up) becomes a tiny one: an infinite inverse times a zero distance would be NaN, and min/max of NaN is not
-// defined.
-bool segmentHits(vec3 p, vec3 d, float tMax, vec3 lo, vec3 hi) {
-  vec3 inv = 1.0 / mix(d, vec3(1e-20), lessThan(abs(d), vec3(1e-20)));
-  vec3 t0 = (lo - p) * inv, t1 = (hi - p) * inv;
-  vec3 tn = min(t0, t1), tf = max(t0, t1);
-  float enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
-  float leave = min(min(tf.x, tf.y), min(tf.z, tMax));
-  return enter <= leave;
-}
 
 // Per 8x8 workgroup, the boxes that can change any of its pixels: each box is tested once against the tile's surface
 // points (their bounding box, by the Minkowski sum with it), so a pixel loops over the few boxes near it instead of
@@ -79,7 +69,7 @@ uint changedEffects(ChangeBox b, uint effects, vec3 c, vec3 extent, float margin
     float lightDistance = pc.lightType == RB_LIGHT_DIRECTIONAL ? 1e30 : length(toLight);
     // A point light's segments from the tile's points lie within `extent` of the one from c (their hull); a
     // directional light's rays are parallel.
-    if (segmentHits(c, normalize(toLight), lightDistance, lo - widen, hi + widen)) changed |= RB_CHANGE_SHADOWS;
+    if (rbSegmentHitsBox(c, normalize(toLight), lightDistance, lo - widen, hi + widen)) changed |= RB_CHANGE_SHADOWS;
   }
   return changed;
 }

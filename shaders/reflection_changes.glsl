@@ -7,6 +7,8 @@
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_buffer_reference_uvec2 : require
 
+#include "segment_box.glsl"
+
 // Mirrors rb::ReflectionChangedBox (reflection_pass.cpp): 32 bytes, in the TLAS's space.
 struct RbReflectionChangedBox {
   vec3 lo;
@@ -17,17 +19,6 @@ struct RbReflectionChangedBox {
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer RbReflectionChangedBoxes {
   RbReflectionChangedBox b[];
 };
-
-// Whether the segment p + t d, t in [0, tMax], meets the box (slab test; a zero component of d becomes a tiny one, as
-// in change_masks.comp, so that no NaN enters the min and max).
-bool rbReflectionSegmentHits(vec3 p, vec3 d, float tMax, vec3 lo, vec3 hi) {
-  vec3 inv = 1.0 / mix(d, vec3(1e-20), lessThan(abs(d), vec3(1e-20)));
-  vec3 t0 = (lo - p) * inv, t1 = (hi - p) * inv;
-  vec3 tn = min(t0, t1), tf = max(t0, t1);
-  float enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
-  float leave = min(min(tf.x, tf.y), min(tf.z, tMax));
-  return enter <= leave;
-}
 
 // A reflection ray from `origin` along unit `dir` that hit at distance hitT (< 0: it escaped to the sky): does what
 // it shows lie in a change? Its path crossing a geometry box (something moved into or out of it), the hit's ray to
@@ -43,8 +34,8 @@ bool rbReflectionChanged(vec3 origin, vec3 dir, float hitT, vec3 toSun) {
       if (hit && all(greaterThanEqual(p, b.lo)) && all(lessThanEqual(p, b.hi))) return true;
       continue;
     }
-    if (rbReflectionSegmentHits(origin, dir, hit ? hitT : 1e30, b.lo, b.hi)) return true;
-    if (sun && rbReflectionSegmentHits(p, toSun, 1e30, b.lo, b.hi)) return true;
+    if (rbSegmentHitsBox(origin, dir, hit ? hitT : 1e30, b.lo, b.hi)) return true;
+    if (sun && rbSegmentHitsBox(p, toSun, 1e30, b.lo, b.hi)) return true;
   }
   return false;
 }

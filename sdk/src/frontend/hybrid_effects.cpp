@@ -8,6 +8,7 @@
 
 #include "change_masks.h"
 #include "change_tracker.h"
+#include "changed_box.h"
 #include "effect_schedule.h"
 #include "light_validation.h"
 #include "neutral_images.h"
@@ -592,12 +593,10 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
   }
   for (size_t i = 0; i < frame.changedBoxes.size(); ++i) {
     const ChangedBox& b = frame.changedBoxes[i];
-    for (int k = 0; k < 3; ++k) {
-      if (!std::isfinite(b.min[k]) || !std::isfinite(b.max[k]) || b.min[k] > b.max[k]) {
-        return invalid("record: HybridFrame::changedBoxes[" + std::to_string(i) + "] has min " +
-                       std::to_string(b.min[k]) + " and max " + std::to_string(b.max[k]) + " on axis " +
-                       std::to_string(k) + "; give finite world-space corners with min <= max");
-      }
+    if (const int k = invalidChangedBoxAxis(b); k >= 0) {
+      return invalid("record: HybridFrame::changedBoxes[" + std::to_string(i) + "] has min " +
+                     std::to_string(b.min[k]) + " and max " + std::to_string(b.max[k]) + " on axis " +
+                     std::to_string(k) + "; give finite world-space corners with min <= max");
     }
   }
   a.neutral.recordInit(a.ctx, cmd);

@@ -6,6 +6,7 @@
 #include <tuple>
 #include <vector>
 
+#include "changed_box.h"
 #include "context_impl.h"
 #include "initial_extent.h"
 #include "light_list_buffer.h"
@@ -119,14 +120,14 @@ Status writeChangedBoxes(ReflectionPass::Impl& s, const ReflectionSettings& sett
        {std::tuple{settings.changedBoxes, 0u, "changedBoxes"}, std::tuple{settings.relitBoxes, 1u, "relitBoxes"}}) {
     for (size_t i = 0; i < list.size(); ++i) {
       const ChangedBox& b = list[i];
+      if (invalidChangedBoxAxis(b) >= 0) {
+        return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                     std::string("ReflectionPass: ReflectionSettings::") + field + "[" + std::to_string(i) +
+                         "] is not a box (min <= max, finite, on every axis); fix or drop it"};
+      }
       ReflectionChangedBox g{};
       g.relit = relit;
       for (int a = 0; a < 3; ++a) {
-        if (!std::isfinite(b.min[a]) || !std::isfinite(b.max[a]) || b.min[a] > b.max[a]) {
-          return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
-                       std::string("ReflectionPass: ReflectionSettings::") + field + "[" + std::to_string(i) +
-                           "] is not a box (min <= max, finite, on every axis); fix or drop it"};
-        }
         // Rounded outwards: a float box never leaves out what the double one holds.
         g.lo[a] = std::nextafter(float(b.min[a] - tlas.originOffset[a]), -INFINITY);
         g.hi[a] = std::nextafter(float(b.max[a] - tlas.originOffset[a]), INFINITY);
