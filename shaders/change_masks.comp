@@ -12,7 +12,9 @@
 //     widened by the light's spread (soft shadows' rays leave P in a cone);
 //   - AO: where P lies within the AO range of a box (the contact shadow the object leaves and brings).
 // Local-light boxes (RB_CHANGE_LOCAL_LIGHTS only) are a light's range: where it can light, it lit differently.
-// The engine's reactive mask is set in every mask. Each mask is 1 (changed) or 0.
+// The engine's reactive mask is set in every mask. Each mask is 1 (changed) or 0, or RB_REACTIVE_FOLLOW_UP_VALUE
+// where only a follow-up box (RB_CHANGE_FOLLOW_UP: a change of one of the last frames) changes the pixel: there the
+// effect's pass traces its reset rays again and its denoiser keeps the history they restarted.
 #include "raybridge_gbuffer.glsl"
 #include "raybridge_pass_constants.glsl"
 #include "segment_box.glsl"
@@ -114,22 +116,27 @@ void main() {
   }
   barrier();
 
+  uint followUp = 0u;  // effects only a follow-up box changes here
   if (test) {
     // The reconstructed point's error: a surface of the box's own object reads as inside.
     float margin = 1e-3 * length(rel) + 1e-4;
     ChangeBoxes boxes = ChangeBoxes(pc.boxes);
     for (uint k = 0u; k < candidateCount && changed != pc.masks; ++k) {
       ChangeBox b = boxes.b[candidates[k]];
-      uint effects = b.effects & pc.masks & ~changed;
-      if (effects != 0u) changed |= changedEffects(b, effects, p, vec3(0.0), margin);
+      const bool isFollowUp = (b.effects & RB_CHANGE_FOLLOW_UP) != 0u;
+      uint effects = b.effects & pc.masks & ~changed & (isFollowUp ? ~followUp : ~0u);
+      if (effects == 0u) continue;
+      const uint hit = changedEffects(b, effects, p, vec3(0.0), margin);
+      if (isFollowUp) followUp |= hit;
+      else changed |= hit;
     }
   }
   if (!inImage) return;
-  if ((pc.masks & RB_CHANGE_SHADOWS) != 0u)
-    imageStore(shadowMask, ip, vec4((changed & RB_CHANGE_SHADOWS) != 0u ? 1.0 : 0.0));
-  if ((pc.masks & RB_CHANGE_AO) != 0u) imageStore(aoMask, ip, vec4((changed & RB_CHANGE_AO) != 0u ? 1.0 : 0.0));
-  if ((pc.masks & RB_CHANGE_LOCAL_LIGHTS) != 0u)
-    imageStore(localLightMask, ip, vec4((changed & RB_CHANGE_LOCAL_LIGHTS) != 0u ? 1.0 : 0.0));
-  if ((pc.masks & RB_CHANGE_REFLECTIONS) != 0u)
-    imageStore(reflectionMask, ip, vec4((changed & RB_CHANGE_REFLECTIONS) != 0u ? 1.0 : 0.0));
+  // The stronger mark wins: a pixel this frame's change restarts is not a follow-up.
+  const vec4 value[3] = vec4[3](vec4(0.0), vec4(RB_REACTIVE_FOLLOW_UP_VALUE), vec4(1.0));
+  #define RB_MARK(effect) value[(changed & effect) != 0u ? 2 : (followUp & effect) != 0u ? 1 : 0]
+  if ((pc.masks & RB_CHANGE_SHADOWS) != 0u) imageStore(shadowMask, ip, RB_MARK(RB_CHANGE_SHADOWS));
+  if ((pc.masks & RB_CHANGE_AO) != 0u) imageStore(aoMask, ip, RB_MARK(RB_CHANGE_AO));
+  if ((pc.masks & RB_CHANGE_LOCAL_LIGHTS) != 0u) imageStore(localLightMask, ip, RB_MARK(RB_CHANGE_LOCAL_LIGHTS));
+  if ((pc.masks & RB_CHANGE_REFLECTIONS) != 0u) imageStore(reflectionMask, ip, RB_MARK(RB_CHANGE_REFLECTIONS));
 }

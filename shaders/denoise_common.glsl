@@ -44,7 +44,15 @@ vec2 rbDnPreviousPixel(uvec2 pixel, vec3 rel, sampler2D motion, out vec3 prevRel
 // The engine's reactive mask drops this pixel's history (RB_DN_REACTIVE: .r > 0.5; particles, UI, anything the
 // SDK does not see change).
 bool rbDnReactive(uvec2 pixel, sampler2D reactive) {
-  return (pc.flags & RB_DN_REACTIVE) != 0u && texelFetch(reactive, ivec2(pixel), 0).r > 0.5;
+  return (pc.flags & RB_DN_REACTIVE) != 0u && texelFetch(reactive, ivec2(pixel), 0).r > RB_REACTIVE_RESTART;
+}
+
+// A follow-up pixel: its history restarted in one of the last frames, and it traced the reset rays again this frame
+// (RB_REACTIVE_FOLLOW_UP < .r <= RB_REACTIVE_RESTART; reset_rays.glsl). It keeps its history.
+bool rbDnFollowUp(uvec2 pixel, sampler2D reactive) {
+  if ((pc.flags & RB_DN_REACTIVE) == 0u) return false;
+  const float r = texelFetch(reactive, ivec2(pixel), 0).r;
+  return r > RB_REACTIVE_FOLLOW_UP && r <= RB_REACTIVE_RESTART;
 }
 
 // Where the surface at `pixel` (camera-relative position `rel`) was in the latest history: `pp`, that history's

@@ -53,8 +53,10 @@ void main() {
     // Anti-lag: a pixel not traced this frame brings nothing to compare against.
     if (!kept && (pc.flags & RB_DN_ANTI_LAG) != 0u)
       h.y = floor(h.y * rbDnHistoryTrust(signalIn, gDepth, ip, historyIn, pp));
-    frames = min(kept ? max(h.y, 1.0) : h.y + 1.0, float(pc.maxHistoryFrames));
-    accumulated = kept ? h.x : mix(h.x, value, 1.0 / frames);
+    // A follow-up pixel traced the reset rays again: its value adds that many frames (the same weighing by rays).
+    const float added = kept ? 0.0 : rbDnFollowUp(pixel, gReactive) ? max(pc.resetFrames, 1.0) : 1.0;
+    frames = min(kept ? max(h.y, 1.0) : h.y + added, float(pc.maxHistoryFrames));
+    accumulated = kept ? h.x : mix(h.x, value, min(added / frames, 1.0));
   }
   imageStore(historyOut, ip, vec4(accumulated, frames, 0.0, 0.0));
   imageStore(valueOut, ip, vec4(accumulated, rbDnNoiseVariance(signalIn, ip, accumulated, frames), 0.0, 0.0));

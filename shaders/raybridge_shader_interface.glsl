@@ -11,8 +11,16 @@
 #define RB_BINDING_GEOMETRIC_NORMAL 3  // the normal image again when the G-buffer has no geometric normal
 #define RB_BINDING_RAY_COUNTERS 4
 // The reactive mask (HybridEffects: the effect's change mask), or the depth image again without one: where it is set
-// (.r > 0.5, RB_GB_REACTIVE) the pixel's history restarts, and it traces GBufferConstants::resetRays rays.
+// (.r > 0.5, RB_GB_REACTIVE) the pixel's history restarts, and it traces GBufferConstants::resetRays rays; where .r
+// is above RB_REACTIVE_FOLLOW_UP alone (a change's follow-up, below) it traces them and keeps its history.
 #define RB_BINDING_REACTIVE 13
+// Reactive mask levels. Above RB_REACTIVE_RESTART: the history restarts. Above RB_REACTIVE_FOLLOW_UP and at most
+// RB_REACTIVE_RESTART: a follow-up pixel (a history restarted in one of the last frames): it traces the reset rays, and
+// the scalar temporal pass adds them to its history as DenoiseSettings::resetFrames frames. The change masks write
+// RB_REACTIVE_FOLLOW_UP_VALUE there (R8: 102 / 255).
+#define RB_REACTIVE_RESTART 0.5
+#define RB_REACTIVE_FOLLOW_UP 0.25
+#define RB_REACTIVE_FOLLOW_UP_VALUE 0.4
 // Pass-specific bindings of set 0.
 #define RB_SHADOW_BINDING_VISIBILITY 5
 #define RB_SHADOW_BINDING_HIT_DISTANCE 6  // only in the module that writes it (shadow_distance.rgen)
@@ -89,6 +97,9 @@
 #define RB_CHANGE_AO 2u
 #define RB_CHANGE_LOCAL_LIGHTS 4u
 #define RB_CHANGE_REFLECTIONS 8u
+// ChangeBox::effects flag: a box of one of the last frames' changes (HybridEffectsDesc::resetFollowUpFrames). Its
+// pixels get RB_REACTIVE_FOLLOW_UP_VALUE, not 1, unless a box of this frame changes them.
+#define RB_CHANGE_FOLLOW_UP 16u
 // Boxes a frame's list holds at most (rb::kMaxChangeBoxes, change_tracker.h).
 #define RB_CHANGE_MAX_BOXES 256
 // The depth-aware upsample of half-resolution AO and reflections (upsample_depth_aware.glsl).

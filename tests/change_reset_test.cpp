@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "raybridge_shader_interface.glsl"
 #include "synthetic_gbuffer.h"
 
 using namespace rbtest;
@@ -108,6 +109,8 @@ std::vector<float> readR8(GpuFixture& fx, const rb::EffectImage& image) {
 
 struct Run {
   std::vector<float> shadowMask, aoMask, shadowFrames, aoFrames;
+  // The frame after the change (nothing moves): its follow-up masks and histories.
+  std::vector<float> shadowFollowMask, aoFollowMask, shadowFollowFrames, aoFollowFrames;
   bool stillFrameHadMask = true;
 };
 
@@ -129,7 +132,7 @@ Run run(GpuFixture& fx, const World& before, const World& after, bool changeRese
   RB_REQUIRE_OK(fxs);
   rb::HybridEffects& effects = *fxs.value();
   Run out;
-  for (uint32_t f = 0; f <= kStillFrames; ++f) {
+  for (uint32_t f = 0; f <= kStillFrames + 1; ++f) {
     const World& w = f < kStillFrames ? before : after;
     std::vector<rb::Instance> instances = built.instances;
     for (size_t i = 0; i < instances.size(); ++i)
@@ -158,6 +161,13 @@ Run run(GpuFixture& fx, const World& before, const World& after, bool changeRese
       }
       out.shadowFrames = historyFrames(fx, *effects.shadowDenoiser());
       out.aoFrames = historyFrames(fx, *effects.aoDenoiser());
+    }
+    if (f == kStillFrames + 1 && changeResets) {
+      REQUIRE(effects.changeMask(rb::kEffectShadows).image != VK_NULL_HANDLE);
+      out.shadowFollowMask = readR8(fx, effects.changeMask(rb::kEffectShadows));
+      out.aoFollowMask = readR8(fx, effects.changeMask(rb::kEffectAo));
+      out.shadowFollowFrames = historyFrames(fx, *effects.shadowDenoiser());
+      out.aoFollowFrames = historyFrames(fx, *effects.aoDenoiser());
     }
   }
   (void)fx.device().waitIdle();
@@ -230,6 +240,29 @@ TEST_CASE("a moved instance resets history only inside its old and new footprint
   };
   check(on.shadowMask, on.shadowFrames, "shadow");
   check(on.aoMask, on.aoFrames, "AO");
+
+  // The frame after (kDefaultResetFollowUpFrames > 0, nothing moves): the same pixels are marked at the follow-up
+  // level and nothing else; they traced the reset rays again and add that many frames to the history they kept.
+  static_assert(rb::kDefaultResetFollowUpFrames > 0);
+  const float followUp = std::round(RB_REACTIVE_FOLLOW_UP_VALUE * 255.0) / 255.0f;
+  auto checkFollowUp = [&](const std::vector<float>& mask, const std::vector<float>& frames,
+                           const std::vector<float>& followMask, const std::vector<float>& followFrames,
+                           const char* what) {
+    uint32_t marked = 0, wrongMark = 0, wrongFrames = 0;
+    for (size_t i = 0; i < size_t(kW) * kH; ++i) {
+      const bool changed = mask[i] > 0.5f;
+      marked += changed;
+      wrongMark += followMask[i] != (changed ? followUp : 0.0f);
+      if (after.cpu.hit[i]) wrongFrames += followFrames[i] != frames[i] + (changed ? restartFrames : 1.0f);
+    }
+    std::printf("%s follow-up: %u pixels, %u marked otherwise, %u histories otherwise\n", what, marked, wrongMark,
+                wrongFrames);
+    CHECK(marked > 50);
+    CHECK(wrongMark == 0);
+    CHECK(wrongFrames == 0);
+  };
+  checkFollowUp(on.shadowMask, on.shadowFrames, on.shadowFollowMask, on.shadowFollowFrames, "shadow");
+  checkFollowUp(on.aoMask, on.aoFrames, on.aoFollowMask, on.aoFollowFrames, "AO");
 
   // Without change resets (and anti-lag off) the same pixels keep their history: the restarts above are the masks'.
   const Run off = run(fx, before, after, false);

@@ -138,8 +138,81 @@ TEST_CASE("the change tracker reports changed local lights by their range, for l
   t.update({}, {}, lights, many);
   std::vector<rb::GpuChangeBox> gpu;
   const double origin[3] = {100.0, 0.0, 0.0};
-  t.toGpu(origin, gpu);
+  t.toGpu(origin, {}, gpu);
   REQUIRE(gpu.size() == rb::kMaxChangeBoxes);
   CHECK(gpu.back().lo[0] <= float(rb::kMaxChangeBoxes - 1) - 100.0f);
   CHECK(gpu.back().hi[0] >= float(many.size() - 1) - 100.0f);  // in the TLAS's space
+}
+
+TEST_CASE("the change tracker sends the last frames' boxes again as follow-ups, after this frame's", "[changes]") {
+  rb::ChangeTracker t;
+  const double origin[3] = {0.0, 0.0, 0.0};
+  const rb::ChangeFollowUp followUp{2, RB_CHANGE_SHADOWS | RB_CHANGE_AO};
+  std::vector<rb::GpuChangeBox> gpu;
+  const MeshChange box = unitBox();
+  std::vector<rb::Instance> instances{at(0.0f)};
+  t.update(instances, std::span<const MeshChange>(&box, 1), {}, {});  // primes: no change
+  instances[0] = at(5.0f);                                            // moves: old and new box
+  t.update(instances, std::span<const MeshChange>(&box, 1), {}, {});
+  t.toGpu(origin, followUp, gpu);
+  REQUIRE(gpu.size() == 2);  // nothing before it to follow up
+  for (const rb::GpuChangeBox& g : gpu) CHECK(g.effects == rb::kChangeAllEffects);
+
+  // The two frames after it: no change of their own, the move's boxes again, for the effects with reset rays only.
+  for (int frame = 1; frame <= 2; ++frame) {
+    t.update(instances, std::span<const MeshChange>(&box, 1), {}, {});
+    t.toGpu(origin, followUp, gpu);
+    INFO("frame " << frame << " after the move");
+    REQUIRE(gpu.size() == 2);
+    CHECK(gpu[0].effects == (RB_CHANGE_SHADOWS | RB_CHANGE_AO | RB_CHANGE_FOLLOW_UP));
+    CHECK(gpu[0].lo[0] == std::nextafter(-1.0f, -INFINITY));  // the old box
+    CHECK(gpu[1].lo[0] == std::nextafter(4.0f, -INFINITY));   // the new box
+  }
+  t.update(instances, std::span<const MeshChange>(&box, 1), {}, {});
+  t.toGpu(origin, followUp, gpu);
+  CHECK(gpu.empty());  // the third frame after it: followUp.frames is 2
+
+  // A change with a follow-up: this frame's boxes come first, unflagged.
+  instances[0] = at(9.0f);
+  t.update(instances, std::span<const MeshChange>(&box, 1), {}, {});
+  instances[0] = at(12.0f);
+  t.update(instances, std::span<const MeshChange>(&box, 1), {}, {});
+  t.toGpu(origin, followUp, gpu);
+  REQUIRE(gpu.size() == 4);
+  CHECK(gpu[0].effects == rb::kChangeAllEffects);
+  CHECK(gpu[1].effects == rb::kChangeAllEffects);
+  CHECK(gpu[2].effects == (RB_CHANGE_SHADOWS | RB_CHANGE_AO | RB_CHANGE_FOLLOW_UP));
+  t.toGpu(origin, {}, gpu);  // no follow-up asked for
+  CHECK(gpu.size() == 2);
+
+  // A local light's box concerns local lights alone, which have no reset rays: no follow-up.
+  std::vector<rb::LightSource> lights{pointLight(0.0, 2.0f)};
+  t.update(instances, std::span<const MeshChange>(&box, 1), lights, {});
+  lights[0].light.position[0] = 3.0;
+  t.update(instances, std::span<const MeshChange>(&box, 1), lights, {});
+  t.update(instances, std::span<const MeshChange>(&box, 1), lights, {});
+  t.toGpu(origin, followUp, gpu);
+  CHECK(gpu.empty());
+
+  // Follow-ups take only the room this frame's boxes leave, and never merge into one of them.
+  std::vector<rb::ChangedBox> many(rb::kMaxChangeBoxes - 1);
+  for (size_t i = 0; i < many.size(); ++i) many[i].min[0] = many[i].max[0] = double(i);
+  t.update(instances, std::span<const MeshChange>(&box, 1), lights, many);
+  t.update(instances, std::span<const MeshChange>(&box, 1), lights, many);
+  t.toGpu(origin, followUp, gpu);
+  REQUIRE(gpu.size() == rb::kMaxChangeBoxes);
+  CHECK(gpu[rb::kMaxChangeBoxes - 2].effects == rb::kChangeAllEffects);
+  CHECK(gpu.back().effects == ((rb::kChangeAllEffects & followUp.effects) | RB_CHANGE_FOLLOW_UP));
+  CHECK(gpu.back().hi[0] >= float(many.size() - 1));  // the rest of the last frame's merged into that follow-up
+  many.push_back(many.back());
+  t.update(instances, std::span<const MeshChange>(&box, 1), lights, many);
+  t.toGpu(origin, followUp, gpu);
+  REQUIRE(gpu.size() == rb::kMaxChangeBoxes);
+  for (const rb::GpuChangeBox& g : gpu) CHECK((g.effects & RB_CHANGE_FOLLOW_UP) == 0u);  // no room: dropped
+
+  // forget() (a history reset) leaves nothing to follow up.
+  t.forget();
+  t.update(instances, std::span<const MeshChange>(&box, 1), lights, {});
+  t.toGpu(origin, followUp, gpu);
+  CHECK(gpu.empty());
 }

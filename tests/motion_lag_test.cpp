@@ -16,6 +16,7 @@
 #include <functional>
 #include <limits>
 
+#include "raybridge_shader_interface.glsl"
 #include "synthetic_gbuffer.h"
 
 using namespace rbtest;
@@ -207,12 +208,20 @@ TEST_CASE("anti-lag drops a teleported occluder's stale shadow and AO history at
               const size_t j = size_t(sy) * kW + size_t(sx);
               if (std::fabs(refBefore[j] - refAfter[j]) > 0.01f) changeMask[size_t(y) * kW + size_t(x)] = 255;
             }
+      // The kDefaultResetFollowUpFrames frames after it come with the same pixels at the follow-up level: they trace
+      // the reset rays again and keep their history (HybridEffectsDesc::resetFollowUpFrames).
+      std::vector<uint8_t> followUpMask(changeMask.size(), 0);
+      for (size_t i = 0; i < changeMask.size(); ++i)
+        if (changeMask[i]) followUpMask[i] = uint8_t(std::lround(RB_REACTIVE_FOLLOW_UP_VALUE * 255.0));
       Resets masked;
       masked.masks.assign(teleport.size(), nullptr);
       masked.masks[kStillFrames] = &changeMask;
+      for (uint32_t k = 1; k <= rb::kDefaultResetFollowUpFrames && kStillFrames + k < teleport.size(); ++k)
+        masked.masks[kStillFrames + k] = &followUpMask;
       masked.resetRays = rb::kDefaultResetRaysFactor * kRays;
-      Resets maskOnly = masked;
-      maskOnly.resetRays = 0;
+      Resets maskOnly;  // the teleport's change mask alone, no reset rays
+      maskOnly.masks.assign(teleport.size(), nullptr);
+      maskOnly.masks[kStillFrames] = &changeMask;
       const auto stillRun = runSequence(fx, effect, still, kRays, true, shipped);
       const auto moved = runSequence(fx, effect, teleport, kRays, true, shipped, nullptr, masked);
       const auto noReset = runSequence(fx, effect, teleport, kRays, true, shipped, nullptr, maskOnly);

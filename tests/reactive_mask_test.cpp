@@ -8,6 +8,7 @@
 #include <memory>
 #include <utility>
 
+#include "raybridge_shader_interface.glsl"
 #include "synthetic_gbuffer.h"
 
 using namespace rbtest;
@@ -24,6 +25,7 @@ struct MaskedScene {
   EmbreeScene embree;
   CpuGBuffer cpu;
   SampledImage mask{};
+  SampledImage followUpMask{};  // the follow-up level (RB_REACTIVE_FOLLOW_UP_VALUE) over the same pixels
   std::unique_ptr<rb::AoPass> ao;
   std::unique_ptr<rb::Denoiser> denoiser;
   GpuFixture& fx;
@@ -35,6 +37,9 @@ struct MaskedScene {
       for (uint32_t x = 0; x < kW; ++x) maskBytes[size_t(y) * kW + x] = masked(x, y) ? 255 : 0;
     mask = uploadSampledImage(fx, VK_FORMAT_R8_UNORM, VK_IMAGE_ASPECT_COLOR_BIT, kW, kH, maskBytes.data(),
                               maskBytes.size());
+    for (uint8_t& b : maskBytes) b = b ? uint8_t(RB_REACTIVE_FOLLOW_UP_VALUE * 255.0 + 0.5) : 0;
+    followUpMask = uploadSampledImage(fx, VK_FORMAT_R8_UNORM, VK_IMAGE_ASPECT_COLOR_BIT, kW, kH, maskBytes.data(),
+                                      maskBytes.size());
     auto a = rb::AoPass::create(fx.ctx());
     RB_REQUIRE_OK(a);
     ao = std::move(a.value());
@@ -42,7 +47,10 @@ struct MaskedScene {
     RB_REQUIRE_OK(d);
     denoiser = std::move(d.value());
   }
-  ~MaskedScene() { destroySampledImage(fx, mask); }
+  ~MaskedScene() {
+    destroySampledImage(fx, mask);
+    destroySampledImage(fx, followUpMask);
+  }
   // The masked and other surface pixels.
   std::pair<size_t, size_t> surfaceCounts() const {
     size_t m = 0, o = 0;
@@ -106,12 +114,13 @@ TEST_CASE("reset rays trace RaySchedule::resetRays in exactly the masked pixels,
   const CpuGBuffer& cpu = m.cpu;
   constexpr uint32_t kRays = 2, kResetRays = 8, kResetFrames = kResetRays / kRays;
   rb::PassStats stats;
-  auto frame = [&](bool withMask) {
+  auto frame = [&](bool withMask, bool followUp = false) {
     runPassFrame(
         fx, m.scene, cpu, false,
         [&](VkCommandBuffer cmd, const rb::GBufferDesc& g, const rb::TlasInfo& tlas) {
           rb::GBufferDesc gbuffer = g;
           if (withMask) gbuffer.reactiveMask = {m.mask.view};
+          if (followUp) gbuffer.reactiveMask = {m.followUpMask.view};
           rb::AoSettings a;
           a.raysPerPixel = kRays;
           a.schedule.resetRays = kResetRays;
@@ -154,6 +163,21 @@ TEST_CASE("reset rays trace RaySchedule::resetRays in exactly the masked pixels,
       const size_t i = size_t(y) * kW + x;
       if (cpu.hit[i] && masked(x, y) && next[i] != float(kResetFrames + 1) && wrong++ < 5)
         UNSCOPED_INFO("pixel " << x << "," << y << ": " << next[i] << " frames the frame after");
+    }
+  CHECK(wrong == 0);
+  // A follow-up (the mask at RB_REACTIVE_FOLLOW_UP_VALUE): the masked pixels trace the reset rays again and keep
+  // their history, which grows by kResetFrames; the others add one frame.
+  frame(false, true);
+  CHECK(stats.rays == uint64_t(otherSurface) * kRays + uint64_t(maskedSurface) * kResetRays);
+  const std::vector<float> followed = historyFrames(fx, *m.denoiser);
+  for (uint32_t y = 0; y < kH; ++y)
+    for (uint32_t x = 0; x < kW; ++x) {
+      const size_t i = size_t(y) * kW + x;
+      if (!cpu.hit[i]) continue;
+      const float expected = next[i] + (masked(x, y) ? float(kResetFrames) : 1.0f);
+      if (followed[i] != expected && wrong++ < 5)
+        UNSCOPED_INFO("pixel " << x << "," << y << ": " << followed[i] << " frames after a follow-up, expected "
+                               << expected);
     }
   CHECK(wrong == 0);
 }

@@ -2,6 +2,8 @@
 // samples/common/cli_support.h).
 #include "effects_bench_options.h"
 
+#include <raybridge/hybrid_effects.h>
+
 #include <vector>
 
 #include "cli_support.h"
@@ -84,6 +86,11 @@ void addOptions(CLI::App& app, Options& o) {
                  "(RaySchedule::resetRays; default: rb::kDefaultResetRaysFactor)")
       ->type_name("F")
       ->check(rbCli::wholeNumber(2, 64));
+  app.add_option("--reset-follow-up", o.resetFollowUp,
+                 "motion: frames after a change that its pixels still trace the reset rays (0 = none;\n"
+                 "HybridEffectsDesc::resetFollowUpFrames, default rb::kDefaultResetFollowUpFrames)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(0, rb::kMaxResetFollowUpFrames));
   app.add_flag(
       "--converged-tiles", o.convergedTiles,
       "motion: every effect skips its converged tiles (RaySchedule::convergedTiles), to measure their lag cost");
@@ -167,6 +174,8 @@ std::string parseOptions(int argc, char** argv, Options& o) {
     return "--effects local_lights: only --scenario motion measures local lights; drop it or add --scenario motion";
   if (o.scenario == "motion" && !o.effectsGiven) o.effects = rb::kAllEffects;
   if (o.resetRaysFactor && o.noResetRays) return "--reset-rays-factor and --no-reset-rays: give one of them";
+  if (o.resetFollowUp && o.noResetRays)
+    return "--reset-follow-up: follow-ups trace the reset rays, which --no-reset-rays turns off; give one of them";
   return {};
 }
 

@@ -20,10 +20,12 @@ struct Options {
   bool noResetRays = false;           // motion: Shadow/AoEffectSettings::disableResetRays
   bool reflectionChanges = false;     // motion: ReflectionEffectSettings::relitResets
   uint32_t resetRaysFactor = 0;       // motion: RaySchedule::resetRays = this x the rays; 0 = the SDK's default
-  bool noChangeResets = false;        // motion: HybridEffectsDesc::disableChangeResets
-  bool convergedTiles = false;        // motion: RaySchedule::convergedTiles on for every effect
-  std::vector<uint32_t> motionRays;   // motion: rays per pixel of the denoised sequences; empty = 1, 4, 16
-  std::string scenes;                 // motion: character models; empty = ../shared/scenes beside the source tree
+  // motion: HybridEffectsDesc::resetFollowUpFrames (0 = disableResetFollowUp); not given = the SDK's default
+  std::optional<uint32_t> resetFollowUp;
+  bool noChangeResets = false;       // motion: HybridEffectsDesc::disableChangeResets
+  bool convergedTiles = false;       // motion: RaySchedule::convergedTiles on for every effect
+  std::vector<uint32_t> motionRays;  // motion: rays per pixel of the denoised sequences; empty = 1, 4, 16
+  std::string scenes;                // motion: character models; empty = ../shared/scenes beside the source tree
   // Empty: 1920x1080 on a GPU, 320x180 on a CPU device (lavapipe); --quick: 160x90.
   std::optional<uint32_t> width, height;
   std::string out;     // JSON file; empty = none

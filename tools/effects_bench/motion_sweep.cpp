@@ -191,6 +191,10 @@ se::Status Runner::setDesc(uint32_t rays, bool reference) {
     d.ao.schedule.resetRays = plan_.switches.resetRaysFactor * rays;
   }
   d.disableChangeResets = plan_.switches.disableChangeResets;
+  if (plan_.switches.resetFollowUp) {
+    d.resetFollowUpFrames = *plan_.switches.resetFollowUp;
+    d.disableResetFollowUp = *plan_.switches.resetFollowUp == 0u;
+  }
   if (plan_.switches.convergedTiles && !reference) {
     d.shadows.schedule.convergedTiles.enabled = true;
     d.ao.schedule.convergedTiles.enabled = true;
@@ -515,7 +519,10 @@ se::Result<nlohmann::json> runMotionScenario(FrameDriver& driver, const MotionSc
                {"reflection_relit_resets", plan.switches.reflectionChanges},
                {"reset_rays_factor", plan.switches.disableResetRays  ? 0u
                                      : plan.switches.resetRaysFactor ? plan.switches.resetRaysFactor
-                                                                     : rb::kDefaultResetRaysFactor}};
+                                                                     : rb::kDefaultResetRaysFactor},
+               {"reset_follow_up_frames", plan.switches.disableResetRays ? 0u
+                                          : plan.switches.resetFollowUp  ? *plan.switches.resetFollowUp
+                                                                         : rb::kDefaultResetFollowUpFrames}};
   return r;
 }
 

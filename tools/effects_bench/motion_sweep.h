@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,8 @@ struct MotionSwitches {
   bool disableResetRays = false;   // --no-reset-rays: Shadow/AoEffectSettings::disableResetRays
   uint32_t resetRaysFactor = 0;    // --reset-rays-factor F: RaySchedule::resetRays = F x the rays; 0 = the default
   bool reflectionChanges = false;  // --reflection-changes: ReflectionEffectSettings::relitResets
+  // --reset-follow-up N: HybridEffectsDesc::resetFollowUpFrames (0 = disableResetFollowUp); not given = the default
+  std::optional<uint32_t> resetFollowUp;
 };
 
 struct MotionPlan {

@@ -402,6 +402,11 @@ void addScheduleOptions(CLI::App& app, RenderOptions& o) {
                  "(RaySchedule::resetRays; default: rb::kDefaultResetRaysFactor x their rays)")
       ->type_name("N")
       ->check(rbCli::wholeNumber(1, rb::kMaxRaysPerPixel));
+  app.add_option("--reset-follow-up", o.resetFollowUp,
+                 "soft shadows and AO: frames after a change that its pixels still trace the reset rays\n"
+                 "(0 = none; HybridEffectsDesc::resetFollowUpFrames, default rb::kDefaultResetFollowUpFrames)")
+      ->type_name("N")
+      ->check(rbCli::wholeNumber(0, rb::kMaxResetFollowUpFrames));
   app.add_option_function<uint32_t>(
          "--converged-ao", [&o](const uint32_t& v) { o.convergedAo = v; },
          "AO: skip the 8x8 tiles whose denoised history has converged, each still traced\n"
@@ -581,6 +586,10 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.disableShortHistoryFilter = o.noShortHistoryFilter;
   h.ao.disableResetRays = o.noResetRays;
   h.shadows.disableResetRays = o.noResetRays;
+  if (o.resetFollowUp) {
+    h.resetFollowUpFrames = *o.resetFollowUp;
+    h.disableResetFollowUp = *o.resetFollowUp == 0u;
+  }
   h.reflections.relitResets = o.reflectionChanges;
   h.ao.schedule.adaptive.enabled = o.adaptiveAoMs.has_value();
   h.ao.schedule.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
@@ -643,6 +652,8 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
   if (o.noShortHistoryFilter && o.mode != Mode::Hybrid)
     return "--no-short-history-filter: only --mode hybrid denoises the SDK's AO";
   if (o.resetRays && o.noResetRays) return "--reset-rays and --no-reset-rays: give one of them";
+  if (o.resetFollowUp && o.noResetRays)
+    return "--reset-follow-up: follow-ups trace the reset rays, which --no-reset-rays turns off; give one of them";
   if (o.reflectionChanges && (!o.denoise || o.mode != Mode::Hybrid))
     return "--reflection-changes: only --mode hybrid's denoised reflections have a history to restart";
   if (o.noResetRays && !o.denoise)

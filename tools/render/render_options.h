@@ -70,6 +70,8 @@ struct RenderOptions {
   bool reflectionChanges = false;
   // --reset-rays N: HybridEffectsDesc::shadows and ao.schedule.resetRays (0 = the SDK's default).
   uint32_t resetRays = 0;
+  // --reset-follow-up N: HybridEffectsDesc::resetFollowUpFrames (0 = disableResetFollowUp); not given = the default.
+  std::optional<uint32_t> resetFollowUp;
   // --converged-ao K: HybridEffectsDesc::ao.schedule.convergedTiles, likewise (AO at full resolution: --half-res
   // without ao).
   std::optional<uint32_t> convergedAo;

@@ -112,6 +112,8 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--no-reset-rays --no-denoise", "--no-reset-rays: reset rays restart a denoiser's history"},
       {"--no-reset-rays --mode raster", "--no-reset-rays: only --mode hybrid traces the SDK's soft shadows and AO"},
       {"--reset-rays 8 --no-reset-rays", "--reset-rays and --no-reset-rays: give one of them"},
+      {"--reset-follow-up 2 --no-reset-rays", "--reset-follow-up: follow-ups trace the reset rays"},
+      {"--reset-follow-up 9", "--reset-follow-up: 9 is outside 0..8"},
       {"--reset-rays 0", "--reset-rays: 0 is outside 1..4096"},
       {"--reflection-changes --no-denoise",
        "--reflection-changes: only --mode hybrid's denoised reflections have a history to restart"},

@@ -111,9 +111,10 @@ struct DenoiseSettings {
   // reactive mask is set there: the pass traced RaySchedule::resetRays rays in those pixels, so set resetRays /
   // raysPerPixel. The running mean then weighs each frame by its rays (a pixel restarted with 16 rays, then given 4
   // a frame, averages 16 + 4 + 4 rays, not three equal frames), and the noise the filter assumes is that of the
-  // rays traced. Whole frames (the history counts whole frames): resetRays / raysPerPixel rounded down. 0 = 1 (the
-  // pass traced its usual rays); at most the history's frames (maxHistoryFrames resolved). HybridEffects sets it
-  // with the reset rays it asks for.
+  // rays traced. A follow-up pixel (the mask above 0.25 and at most 0.5: GBufferDesc::reactiveMask) keeps its history
+  // and adds this many frames to it. Whole frames (the history counts whole frames): resetRays / raysPerPixel rounded
+  // down. 0 = 1 (the pass traced its usual rays); at most the history's frames (maxHistoryFrames resolved).
+  // HybridEffects sets it with the reset rays it asks for.
   uint32_t resetFrames = 0;
 };
 

@@ -128,6 +128,9 @@ struct GBufferDesc {
   // denoisers drop the pixel's history and start afresh, and the ray schedule treats the pixel as new (adaptive rays
   // plan it from no history, converged tiles trace its tile). For what the SDK cannot see change: particles, UI,
   // a screen-space effect drawn into the G-buffer, a teleport the engine knows of. Not given = no pixel is reactive.
+  // Above 0.25 and at most 0.5 (a follow-up: a pixel restarted in one of the last frames) a pass with
+  // RaySchedule::resetRays traces them there and the scalar denoiser adds them to the kept history as
+  // DenoiseSettings::resetFrames frames; nothing else reads that level (HybridEffects writes it in its change masks).
   GBufferImage reactiveMask{};
 
   // Camera, column-major 4x4 (GLM layout) as used to rasterize the G-buffer, Vulkan clip space (depth 0..1,

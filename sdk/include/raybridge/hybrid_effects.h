@@ -89,6 +89,15 @@ inline constexpr uint32_t kMaxHybridOutputSize = 16384;
 // tests/motion_lag_test.cpp's teleport (docs/effects.md, "Reset rays"). ShadowEffectSettings::disableResetRays and
 // AoEffectSettings::disableResetRays turn it off.
 inline constexpr uint32_t kDefaultResetRaysFactor = 4;
+// HybridEffectsDesc::resetFollowUpFrames when left 0: after a change restarts a pixel's history, the effects with reset
+// rays trace them there for this many more frames (the change's boxes are sent again as follow-up boxes), and the
+// denoiser adds each such frame as resetRays / raysPerPixel frames. One frame of reset rays is still several times
+// the error of a long history where the signal is wide and soft (a penumbra at 2560x1440: docs/effects.md, "Reset
+// rays"); the follow-ups close that gap over the first frames without restarting anything. Three: measured on the
+// motion bench's teleport.
+inline constexpr uint32_t kDefaultResetFollowUpFrames = 3;
+// Largest HybridEffectsDesc::resetFollowUpFrames (the change tracker keeps this many frames of boxes).
+inline constexpr uint32_t kMaxResetFollowUpFrames = 8;
 
 struct ShadowEffectSettings {
   // 0 = the light decides: kDefaultSoftShadowRays for a light with a size, one ray (hard) for one without.
@@ -193,6 +202,13 @@ struct HybridEffectsDesc {
   TlasBuildMode tlasMode = TlasBuildMode::Adaptive;
   // false = change resets (see "Change resets" above). true = the denoisers follow changes by anti-lag alone.
   bool disableChangeResets = false;
+  // Frames after a change that its pixels still trace the reset rays, in the effects that have them (follow-ups;
+  // with change resets only). 0 = kDefaultResetFollowUpFrames; at most kMaxResetFollowUpFrames. Follow-up boxes take
+  // the room of the GPU's per-frame box list (256) that the frame's own changes leave; beyond it they are dropped
+  // (fewer extra rays, no missed restart).
+  uint32_t resetFollowUpFrames = 0;
+  // true = no follow-ups: only the frame of a change traces the reset rays.
+  bool disableResetFollowUp = false;
 };
 
 // `base` with the preset's effect set, ray counts, AO resolution and whether soft shadows skip converged tiles

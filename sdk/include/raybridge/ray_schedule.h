@@ -193,7 +193,8 @@ struct RaySchedule {
   // maxHistoryFrames of them, and stays several times their error for as many frames as it takes to catch up
   // (docs/effects.md, "Reset rays"). Tell the Denoiser: DenoiseSettings::resetFrames = resetRays / raysPerPixel, so
   // that its running mean weighs this frame's value by its rays. Costs resetRays - raysPerPixel extra rays in each
-  // changed pixel, nothing elsewhere. 0 (or at most raysPerPixel) = off. At most kMaxRaysPerPixel. Not with adaptive
+  // changed pixel, nothing elsewhere. Also traced where the mask is above 0.25 and at most 0.5 (a follow-up of a
+  // restart: GBufferDesc::reactiveMask). 0 (or at most raysPerPixel) = off. At most kMaxRaysPerPixel. Not with adaptive
   // rays (they already plan the most rays where a history restarts) nor halfResolution; soft shadows only.
   uint32_t resetRays = 0;
 };

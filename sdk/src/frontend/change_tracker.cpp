@@ -62,6 +62,11 @@ void ChangeTracker::addLightBox(const LightSource& source) {
 void ChangeTracker::update(std::span<const Instance> instances,
                            std::span<const AccelerationStructureService::MeshChange> meshes,
                            std::span<const LightSource> lights, std::span<const ChangedBox> engine) {
+  // The last frames' boxes, newest first: the follow-up boxes of toGpu().
+  if (primed_) {
+    recent_.insert(recent_.begin(), std::move(boxes_));
+    if (recent_.size() > kMaxResetFollowUpFrames) recent_.pop_back();
+  }
   boxes_.clear();
   if (primed_) {
     const size_t common = std::min(instances.size(), instances_.size());
@@ -106,29 +111,56 @@ void ChangeTracker::update(std::span<const Instance> instances,
   primed_ = true;
 }
 
-void ChangeTracker::toGpu(const double originOffset[3], std::vector<GpuChangeBox>& out) const {
+namespace {
+
+GpuChangeBox toGpuBox(const WorldChangeBox& w, const double originOffset[3], uint32_t effects) {
+  GpuChangeBox g{};
+  for (int i = 0; i < 3; ++i) {
+    // Rounded outwards so the float box holds the double one.
+    g.lo[i] = std::nextafter(float(w.lo[i] - originOffset[i]), -INFINITY);
+    g.hi[i] = std::nextafter(float(w.hi[i] - originOffset[i]), INFINITY);
+  }
+  g.effects = effects;
+  return g;
+}
+
+void mergeInto(GpuChangeBox& last, const GpuChangeBox& g) {
+  for (int i = 0; i < 3; ++i) last.lo[i] = std::min(last.lo[i], g.lo[i]), last.hi[i] = std::max(last.hi[i], g.hi[i]);
+  last.effects |= g.effects;
+}
+
+}  // namespace
+
+void ChangeTracker::toGpu(const double originOffset[3], const ChangeFollowUp& followUp,
+                          std::vector<GpuChangeBox>& out) const {
   out.clear();
   for (const WorldChangeBox& w : boxes_) {
-    GpuChangeBox g{};
-    for (int i = 0; i < 3; ++i) {
-      // Rounded outwards so the float box holds the double one.
-      g.lo[i] = std::nextafter(float(w.lo[i] - originOffset[i]), -INFINITY);
-      g.hi[i] = std::nextafter(float(w.hi[i] - originOffset[i]), INFINITY);
+    const GpuChangeBox g = toGpuBox(w, originOffset, w.effects);
+    if (out.size() < kMaxChangeBoxes) out.push_back(g);
+    else
+      mergeInto(out.back(), g);
+  }
+  // The follow-ups take the room this frame's boxes leave. Past it they merge into the last follow-up box, never
+  // into one of this frame's (which would restart its pixels); with no room at all they are dropped: fewer extra
+  // rays, no missed restart.
+  const size_t frames = std::min<size_t>(followUp.frames, recent_.size());
+  for (size_t f = 0; f < frames; ++f) {
+    for (const WorldChangeBox& w : recent_[f]) {
+      const uint32_t effects = w.effects & followUp.effects;
+      if (effects == 0u) continue;
+      const GpuChangeBox g = toGpuBox(w, originOffset, effects | RB_CHANGE_FOLLOW_UP);
+      if (out.size() < kMaxChangeBoxes) out.push_back(g);
+      else if (out.back().effects & RB_CHANGE_FOLLOW_UP)
+        mergeInto(out.back(), g);
     }
-    g.effects = w.effects;
-    if (out.size() < kMaxChangeBoxes) {
-      out.push_back(g);
-      continue;
-    }
-    GpuChangeBox& last = out.back();
-    for (int i = 0; i < 3; ++i) last.lo[i] = std::min(last.lo[i], g.lo[i]), last.hi[i] = std::max(last.hi[i], g.hi[i]);
-    last.effects |= g.effects;
   }
 }
 
 void ChangeTracker::forget() {
   instances_.clear();
   lights_.clear();
+  recent_.clear();
+  boxes_.clear();
   primed_ = false;
 }
 

@@ -48,6 +48,13 @@ struct GpuChangeBox {
 };
 static_assert(sizeof(GpuChangeBox) == 32);
 
+// Which of the last frames' boxes toGpu() sends again as follow-up boxes (RB_CHANGE_FOLLOW_UP): the boxes of the
+// `frames` frames before this one, for `effects` (RB_CHANGE_* bits: the effects that trace reset rays).
+struct ChangeFollowUp {
+  uint32_t frames = 0;  // at most kMaxResetFollowUpFrames
+  uint32_t effects = 0;
+};
+
 class ChangeTracker {
  public:
   // This frame's changes against the previous call's lists (none on the first call, or after forget()).
@@ -55,9 +62,10 @@ class ChangeTracker {
   void update(std::span<const Instance> instances, std::span<const AccelerationStructureService::MeshChange> meshes,
               std::span<const LightSource> lights, std::span<const ChangedBox> engine);
   const std::vector<WorldChangeBox>& boxes() const { return boxes_; }
-  // The boxes in the space of a TLAS built at `originOffset`, at most kMaxChangeBoxes.
-  void toGpu(const double originOffset[3], std::vector<GpuChangeBox>& out) const;
-  // The next update() compares against nothing (after a history reset: there is nothing to keep).
+  // This frame's boxes in the space of a TLAS built at `originOffset`, then those of `followUp`, at most
+  // kMaxChangeBoxes in all (this frame's come first).
+  void toGpu(const double originOffset[3], const ChangeFollowUp& followUp, std::vector<GpuChangeBox>& out) const;
+  // The next update() compares against nothing and has no follow-ups (after a history reset: nothing to keep).
   void forget();
 
  private:
@@ -73,6 +81,7 @@ class ChangeTracker {
   std::vector<LightSource> lights_;
   bool primed_ = false;
   std::vector<WorldChangeBox> boxes_;
+  std::vector<std::vector<WorldChangeBox>> recent_;  // the last frames' boxes_, newest first
 };
 
 }  // namespace rb

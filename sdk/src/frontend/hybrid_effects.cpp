@@ -10,6 +10,7 @@
 #include "change_tracker.h"
 #include "changed_box.h"
 #include "effect_schedule.h"
+#include "hybrid_effects_validation.h"
 #include "light_validation.h"
 #include "neutral_images.h"
 #include "pass_constants.h"
@@ -28,77 +29,6 @@ Error wrap(const char* what, const Error& e) {
   Error out = e;
   out.message = std::string("HybridEffects: ") + what + ": " + e.message;
   return out;
-}
-
-Status validateSize(uint32_t width, uint32_t height, const char* what) {
-  if ((width == 0) != (height == 0) || width > kMaxHybridOutputSize || height > kMaxHybridOutputSize) {
-    return invalid(std::string(what) + " " + std::to_string(width) + "x" + std::to_string(height) +
-                   " is not a size: give both (1.." + std::to_string(kMaxHybridOutputSize) +
-                   ") or neither (0x0 = follow the G-buffer)");
-  }
-  return {};
-}
-
-Status validate(const HybridEffectsDesc& d) {
-  if (d.effects & ~kAllEffects) return invalid("effects has unknown bits " + std::to_string(d.effects & ~kAllEffects));
-  if (Status st = validateSize(d.width, d.height, "width x height"); !st) return st;
-  const std::string maxRays = std::to_string(kMaxRaysPerPixel);
-  if (d.shadows.raysPerPixel > kMaxRaysPerPixel)
-    return invalid("shadows.raysPerPixel " + std::to_string(d.shadows.raysPerPixel) + " exceeds " + maxRays);
-  if (!(d.shadows.softAngularRadiusDegrees >= 0.0f &&
-        d.shadows.softAngularRadiusDegrees < kMaxLightAngularRadiusDegrees))
-    return invalid("shadows.softAngularRadiusDegrees " + std::to_string(d.shadows.softAngularRadiusDegrees) +
-                   " is outside [0, " + std::to_string(int(kMaxLightAngularRadiusDegrees)) + ")");
-  if (d.ao.raysPerPixel > kMaxRaysPerPixel)
-    return invalid("ao.raysPerPixel " + std::to_string(d.ao.raysPerPixel) + " exceeds " + maxRays);
-  if (!(d.ao.range >= 0.0f) || !std::isfinite(d.ao.range))
-    return invalid("ao.range " + std::to_string(d.ao.range) + " must be >= 0 and finite");
-  if (!(d.reflections.roughnessThreshold >= 0.0f && d.reflections.roughnessThreshold <= 1.0f))
-    return invalid("reflections.roughnessThreshold " + std::to_string(d.reflections.roughnessThreshold) +
-                   " is outside [0, 1]");
-  if (d.localLights.mode != ManyLightMode::Stochastic && d.localLights.mode != ManyLightMode::Exact)
-    return invalid("localLights.mode has an unknown value");
-  if (d.tlasMode > TlasBuildMode::UpdateIfPossible)
-    return invalid("tlasMode " + std::to_string(int(d.tlasMode)) +
-                   " is not a TlasBuildMode (Adaptive, Rebuild or UpdateIfPossible)");
-  if (d.localLights.raysPerPixel > 64 || d.localLights.candidates > 64)
-    return invalid("localLights.raysPerPixel " + std::to_string(d.localLights.raysPerPixel) + " and candidates " +
-                   std::to_string(d.localLights.candidates) + " must be at most 64");
-  if (d.reflections.raysPerPixel > 64)
-    return invalid("reflections.raysPerPixel " + std::to_string(d.reflections.raysPerPixel) + " exceeds 64");
-  // Each effect's schedule by the one validator, then against its denoiser (history is the effect's own).
-  struct Scheduled {
-    const RaySchedule& schedule;
-    uint32_t capabilities;
-    DenoiseSignal signal;
-    const char* field;
-    bool denoised;
-    const char* denoiserFix;
-  };
-  const bool stochasticLights = d.localLights.mode == ManyLightMode::Stochastic;
-  const Scheduled scheduled[] = {
-      {d.shadows.schedule, kShadowScheduleCapabilities, DenoiseSignal::Scalar, "shadows", !d.shadows.disableDenoiser,
-       "shadows.disableDenoiser = false"},
-      {d.ao.schedule, kAoScheduleCapabilities, DenoiseSignal::Scalar, "ao", !d.ao.disableDenoiser,
-       "ao.disableDenoiser = false"},
-      {d.reflections.schedule, kReflectionScheduleCapabilities, DenoiseSignal::Reflection, "reflections",
-       !d.reflections.disableDenoiser, "reflections.disableDenoiser = false"},
-      {d.localLights.schedule, kLocalLightScheduleCapabilities, DenoiseSignal::Rgb, "localLights",
-       !d.localLights.disableDenoiser && stochasticLights,
-       "localLights.mode = Stochastic and localLights.disableDenoiser = false (only that mode is denoised)"},
-  };
-  for (const Scheduled& e : scheduled) {
-    const std::string field = std::string("HybridEffects: HybridEffectsDesc::") + e.field + ".schedule";
-    if (Status st = validateRaySchedule(e.schedule, e.capabilities, e.signal, field, true); !st) return st;
-    const char* user = e.schedule.adaptive.enabled         ? "adaptive.enabled: adaptive rays plan from"
-                       : e.schedule.convergedTiles.enabled ? "convergedTiles.enabled: converged tiles are read from"
-                                                           : nullptr;
-    if (user && !e.denoised) {
-      return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
-                   field + "." + user + " the effect's denoiser's history: set " + e.denoiserFix + ", or disable it"};
-    }
-  }
-  return {};
 }
 
 // The frame's lighting as reflection hits see it: the pass lights hits by one directional light, the frame's; a
@@ -398,6 +328,29 @@ struct HybridEffects::Impl {
     return {};
   }
 
+  // Each effect's schedule and reset rays as its pass runs them (recordShadows, recordAo), also read by recordChanges:
+  // the effects with reset rays get follow-ups.
+  RaySchedule shadowSchedule(const ShadowPlan& plan) const {
+    RaySchedule s = effectSchedule(desc.shadows.schedule, shadowDenoiser.get(), plan.soft);
+    s.resetRays = plan.soft ? effectResetRays(s, desc.shadows.disableResetRays, plan.rays) : 0u;
+    return s;
+  }
+  uint32_t aoRays() const { return desc.ao.raysPerPixel ? desc.ao.raysPerPixel : kDefaultAoRays; }
+  RaySchedule aoSchedule() const {
+    RaySchedule s = effectSchedule(desc.ao.schedule, aoDenoiser.get());
+    s.resetRays = effectResetRays(s, desc.ao.disableResetRays, aoRays());
+    return s;
+  }
+  ChangeFollowUp changeFollowUp(const HybridFrame& f) const {
+    ChangeFollowUp out;
+    if (desc.disableResetFollowUp) return out;
+    out.frames = desc.resetFollowUpFrames ? desc.resetFollowUpFrames : kDefaultResetFollowUpFrames;
+    const ShadowPlan plan = planShadows(desc.shadows, f.light);
+    if (shadow && shadowSchedule(plan).resetRays > plan.rays) out.effects |= RB_CHANGE_SHADOWS;
+    if (ao && aoSchedule().resetRays > aoRays()) out.effects |= RB_CHANGE_AO;
+    return out;
+  }
+
   Status recordShadows(VkCommandBuffer cmd, const HybridFrame& f);
   Status recordAo(VkCommandBuffer cmd, const HybridFrame& f);
   Status recordReflections(VkCommandBuffer cmd, const HybridFrame& f);
@@ -416,7 +369,7 @@ Status HybridEffects::Impl::recordChanges(VkCommandBuffer cmd, const HybridFrame
   if (service && !instances.empty()) service->meshChanges(instances, meshChanges);
   const std::span<const LightSource> lights = localLights ? f.localLights : std::span<const LightSource>{};
   changes.update(instances, meshChanges, lights, f.changedBoxes);
-  changes.toGpu(tlas.originOffset, gpuChangeBoxes);
+  changes.toGpu(tlas.originOffset, changeFollowUp(f), gpuChangeBoxes);
   ChangeMaskInputs in;
   in.masks = effects;
   // The widest disk a soft shadow samples (planShadows may widen the frame's), so no changed ray is missed.
@@ -452,8 +405,7 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   s.raysPerPixel = plan.rays;
   s.materials = materials.get();  // alpha tests non-opaque geometry
   // Adaptive rays and converged tiles: only for soft shadows, whose denoiser runs after the pass this frame.
-  s.schedule = effectSchedule(desc.shadows.schedule, shadowDenoiser.get(), plan.soft);
-  s.schedule.resetRays = plan.soft ? effectResetRays(s.schedule, desc.shadows.disableResetRays, plan.rays) : 0u;
+  s.schedule = shadowSchedule(plan);
   const GBufferDesc g = changeMasks.gbufferFor(f.gbuffer, RB_CHANGE_SHADOWS);
   if (Status st = shadow->record(cmd, {.gbuffer = g, .tlas = tlas, .light = plan.light, .settings = s}); !st)
     return wrap("ShadowPass::record", st.error());
@@ -471,20 +423,16 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   s.raysPerPixel = desc.ao.raysPerPixel;
   s.range = desc.ao.range;
   s.estimator = desc.ao.estimator;
-  s.schedule = effectSchedule(desc.ao.schedule, aoDenoiser.get());
-  const uint32_t aoRays = s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays;
-  s.schedule.resetRays = effectResetRays(s.schedule, desc.ao.disableResetRays, aoRays);
+  s.schedule = aoSchedule();
   const GBufferDesc g = changeMasks.gbufferFor(f.gbuffer, RB_CHANGE_AO);
   if (Status st = ao->record(cmd, {.gbuffer = g, .tlas = tlas, .settings = s}); !st)
     return wrap("AoPass::record", st.error());
   const AoOutputs& o = ao->outputs();
   // Binary AO is a fraction of binary rays; distance-weighted AO is not, nor is adaptive AO (the count varies per
   // pixel), so their noise is estimated.
-  const uint32_t rays = s.estimator == AoEstimator::Binary && !desc.ao.schedule.adaptive.enabled
-                            ? (s.raysPerPixel ? s.raysPerPixel : kDefaultAoRays)
-                            : 0u;
+  const uint32_t rays = s.estimator == AoEstimator::Binary && !desc.ao.schedule.adaptive.enabled ? aoRays() : 0u;
   return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, g, o.aoView, rays, DenoiseSignal::Scalar,
-                 !desc.ao.disableShortHistoryFilter, denoiserResetFrames(s.schedule.resetRays, aoRays));
+                 !desc.ao.disableShortHistoryFilter, denoiserResetFrames(s.schedule.resetRays, aoRays()));
 }
 
 Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -514,7 +462,7 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
 
 Result<std::unique_ptr<HybridEffects>> HybridEffects::create(Context& context, AccelerationStructureService* service,
                                                              const HybridEffectsDesc& desc) {
-  if (Status s = validate(desc); !s) return s.error();
+  if (Status s = validateHybridEffectsDesc(desc); !s) return s.error();
   std::unique_ptr<HybridEffects> fx(new HybridEffects(std::make_unique<Impl>(context, service)));
   fx->impl_->desc = desc;
   if (Status s = fx->impl_->applyDesc(); !s) return s.error();
@@ -525,7 +473,7 @@ HybridEffects::HybridEffects(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 HybridEffects::~HybridEffects() = default;  // the passes retire their objects to the Context
 
 Status HybridEffects::setDesc(const HybridEffectsDesc& desc) {
-  if (Status s = validate(desc); !s) return s;
+  if (Status s = validateHybridEffectsDesc(desc); !s) return s;
   impl_->desc = desc;
   return impl_->applyDesc();
 }
