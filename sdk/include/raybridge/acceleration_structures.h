@@ -316,10 +316,15 @@ struct TlasInfo {
   VkDeviceSize shadingRecordsBytes = 0;
 };
 
+// AsServiceDesc::releasedCacheBytes when left 0: the released BLASes a streaming engine re-registers soon (a
+// level's props, a character's LODs) stay, and a level's worth of released geometry does not.
+inline constexpr VkDeviceSize kDefaultReleasedCacheBytes = 16ull << 20;
+
 struct AsServiceDesc {
-  // Scratch memory held for builds; 0 = 64 MiB. Queued builds are packed into batches whose scratch fits it;
-  // consecutive batches reuse it behind a barrier. A BLAS that alone needs more is built in a batch of its own
-  // with transient scratch released after the frame.
+  // Build scratch at most; 0 = 64 MiB. Queued builds are packed into batches whose scratch fits it; consecutive
+  // batches reuse it behind a barrier. A BLAS that alone needs more is built in a batch of its own with transient
+  // scratch released after the frame. The scratch held grows to what the batches need (doubling, up to this), and
+  // is freed when 64 recording calls in a row needed at most a quarter of it.
   VkDeviceSize scratchBudgetBytes = 0;
   // Triangles one recordPendingWork() call builds at most, to spread a large load over frames; 0 = unlimited.
   // At least one queued build is recorded per call. First builds of dynamic meshes count too (in the async modes
@@ -328,9 +333,18 @@ struct AsServiceDesc {
   // Device memory for BLAS storage; 0 = unlimited. When a registration would exceed it, BLASes of released
   // meshes are evicted, least recently used first; never one that a TLAS still in flight references.
   VkDeviceSize blasBudgetBytes = 0;
-  VkDeviceSize storageBlockBytes = 0;  // 0 = 32 MiB: size of the blocks BLAS storage is suballocated from
-  bool disableCompaction = false;      // false = compact static meshes (skipped where it saves < 2%)
-  bool disableTimestamps = false;      // false = time each build batch with timestamp queries
+  // The largest block BLAS storage is suballocated from; 0 = 32 MiB. The blocks grow with the content: the first
+  // is 256 KiB, each new one as large as those held together, up to this; a BLAS larger than it gets a block of its
+  // own size. An empty block is freed.
+  VkDeviceSize storageBlockBytes = 0;
+  // BLAS storage of meshes with no registration left that the service keeps, so that a later registration of equal
+  // geometry revives it without a build. Beyond it the least recently released are freed (once no frame in flight
+  // reads them), so the memory held comes back down when the content is released. 0 = kDefaultReleasedCacheBytes.
+  // blasBudgetBytes evicts them too, when a registration needs the room.
+  VkDeviceSize releasedCacheBytes = 0;
+  bool disableReleasedCache = false;  // true = free a BLAS once its last registration is released
+  bool disableCompaction = false;     // false = compact static meshes (skipped where it saves < 2%)
+  bool disableTimestamps = false;     // false = time each build batch with timestamp queries
 
   // A compute queue the engine hands over for the async dynamic modes; VK_NULL_HANDLE = none (the async modes
   // fall back to InFrame recording, see DynamicBuildMode). Used only inside submitDynamicWork(); the engine
@@ -372,21 +386,22 @@ struct BuildBatchTiming {
 };
 
 struct AsStats {
-  uint32_t meshHandles = 0;           // live handles (registered and not released)
-  uint32_t nonOpaqueMeshes = 0;       // live handles registered with MeshDesc::nonOpaque
-  uint32_t registrations = 0;         // registerMesh calls that succeeded
-  uint32_t dedupHits = 0;             // registrations that reused an existing BLAS
-  uint32_t blasCount = 0;             // BLASes that exist (built, building or queued; not Failed or Evicted)
-  uint32_t blasQueued = 0;            // waiting for a build
-  uint32_t blasFailed = 0;            // BLASes in MeshState::Failed (waiting for their retry; hold no storage)
-  uint32_t blasEvicted = 0;           // BLASes in MeshState::Evicted (registered, hold no storage nor budget)
-  uint32_t blasCompacted = 0;         // BLASes whose storage was replaced by a compacted copy
-  uint32_t compactionsSkipped = 0;    // compaction saved < 2% (lavapipe) so no copy was made
-  uint32_t evictions = 0;             // cached BLASes (no registration left) freed by the budget, least recent first
-  uint32_t meshEvictions = 0;         // BLASes freed by evictMesh() (cumulative)
-  VkDeviceSize evictedBlasBytes = 0;  // their sizes then (cumulative); no longer in blasBytes, and out of
-                                      // storageUsedBytes once the frames in flight are done
-  uint64_t triangles = 0;             // triangles over all BLASes
+  uint32_t meshHandles = 0;                    // live handles (registered and not released)
+  uint32_t nonOpaqueMeshes = 0;                // live handles registered with MeshDesc::nonOpaque
+  uint32_t registrations = 0;                  // registerMesh calls that succeeded
+  uint32_t dedupHits = 0;                      // registrations that reused an existing BLAS
+  uint32_t blasCount = 0;                      // BLASes that exist (built, building or queued; not Failed or Evicted)
+  uint32_t blasQueued = 0;                     // waiting for a build
+  uint32_t blasFailed = 0;                     // BLASes in MeshState::Failed (waiting for their retry; hold no storage)
+  uint32_t blasEvicted = 0;                    // BLASes in MeshState::Evicted (registered, hold no storage nor budget)
+  uint32_t blasCompacted = 0;                  // BLASes whose storage was replaced by a compacted copy
+  uint32_t compactionsSkipped = 0;             // compaction saved < 2% (lavapipe) so no copy was made
+  uint32_t evictions = 0;                      // cached BLASes (no registration left) freed by the budget or
+                                               // releasedCacheBytes, least recently released first
+  uint32_t meshEvictions = 0;                  // BLASes freed by evictMesh() (cumulative)
+  VkDeviceSize evictedBlasBytes = 0;           // their sizes then (cumulative); no longer in blasBytes, and out of
+                                               // storageUsedBytes once the frames in flight are done
+  uint64_t triangles = 0;                      // triangles over all BLASes
   VkDeviceSize blasBytesBeforeCompaction = 0;  // sum of built sizes of all BLASes
   VkDeviceSize blasBytes = 0;                  // sum of current sizes (after compaction where it happened;
                                                // every copy of a dynamic BLAS)
@@ -434,8 +449,8 @@ class AccelerationStructureService {
   Result<MeshHandle> registerMesh(const MeshDesc& desc);
   // Ends this registration; its buffers may be freed once the frames in flight are done (a queued build then
   // reads another live registration's buffers). When no registration of a BLAS is left, the BLAS stays
-  // cached (a later identical registration revives it) until the memory budget evicts it or the service is
-  // destroyed. Further use of the handle is an error.
+  // cached (a later identical registration revives it) until AsServiceDesc::releasedCacheBytes or the memory
+  // budget evicts it, or the service is destroyed. Further use of the handle is an error.
   Status releaseMesh(MeshHandle mesh);
   // A dynamic mesh's vertices changed (or, with update.desc, its buffers): refit or rebuild its BLAS, as the
   // policy decides, in the frame's dynamic work (submitDynamicWork() in the async modes, else the next

@@ -16,8 +16,8 @@ namespace {
 
 using Impl = AccelerationStructureService::Impl;
 
-// The scratch a batch's builds use: the persistent buffer when the batch fits the budget, else `transient`, made
-// for this batch.
+// The scratch a batch's builds use: the shared buffer (grown to the batch) when the batch fits the budget, else
+// `transient`, made for this batch.
 Result<VkDeviceAddress> acquireBatchScratch(Impl& s, VkDeviceSize scratchBytes, GpuBuffer& transient) {
   const VkDeviceSize align = s.scratchAlignment();
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
@@ -28,13 +28,7 @@ Result<VkDeviceAddress> acquireBatchScratch(Impl& s, VkDeviceSize scratchBytes, 
     transient = t.value();
     return alignUp(transient.address, align);
   }
-  if (!s.scratch.valid()) {
-    Result<GpuBuffer> t = createBuffer(s.ctx, s.desc.scratchBudgetBytes + align, usage, MemoryLocation::DeviceLocal,
-                                       MemoryCategory::Scratch, "BLAS build scratch");
-    if (!t) return t.error();
-    s.scratch = t.value();
-  }
-  return alignUp(s.scratch.address, align);
+  return s.sharedScratch(scratchBytes);
 }
 
 // Creates the storage and the acceleration structure of each mesh of the batch. One whose objects cannot be
@@ -220,6 +214,7 @@ Result<uint32_t> AccelerationStructureService::recordPendingWork(VkCommandBuffer
   s.handOnDeferredRetires();
   if (!cmd) return Error{ErrorCode::InvalidArgument, VK_SUCCESS, "recordPendingWork: cmd is VK_NULL_HANDLE"};
   s.resolveBatches();
+  s.trimReleasedCache();  // what releaseMesh could not free because a frame in flight read it
   if (!s.queryError) return std::exchange(s.queryError, Status()).error();
   bool recordedAny = false;
   if (Status st = s.recordCompactions(cmd, recordedAny); !st) return st.error();
@@ -255,6 +250,7 @@ Result<uint32_t> AccelerationStructureService::recordPendingWork(VkCommandBuffer
   }
   if (Status st = s.recordBuildBatch(cmd, batch, batchScratch, recordedAny, meshFailure); !st) return st.error();
   (void)recordedAny;
+  s.trimSharedScratch();
   if (!meshFailure) return meshFailure.error();
   uint32_t queued = static_cast<uint32_t>(s.queue.size());
   for (uint32_t i = 1; i < s.entries.size(); ++i) {

@@ -33,23 +33,41 @@ void AccelerationStructureService::Impl::destroyEntry(uint32_t index) {
   freeSlots.push_back(index);
 }
 
+uint32_t AccelerationStructureService::Impl::cachedVictim() const {
+  uint32_t victim = 0;
+  uint64_t oldest = UINT64_MAX;
+  for (uint32_t i = 1; i < entries.size(); ++i) {
+    const BlasEntry& e = entries[i];
+    if (e.state == BlasState::Free || e.refCount > 0) continue;
+    bool inLatestTlas = e.lastTlasSerial != 0 && e.lastTlasSerial == tlasSerial;
+    // Not c.frame: registerMesh may run while the recording thread is in Context::beginFrame.
+    bool inFlight = e.lastTlasSerial != 0 && !frameKnownDone(e.lastUsedFrame);
+    if (inLatestTlas || inFlight) continue;
+    if (e.releasedOrder < oldest) {
+      oldest = e.releasedOrder;
+      victim = i;
+    }
+  }
+  return victim;
+}
+
+void AccelerationStructureService::Impl::trimReleasedCache() {
+  VkDeviceSize cached = 0;
+  for (uint32_t i = 1; i < entries.size(); ++i)
+    if (entries[i].state != BlasState::Free && entries[i].refCount == 0) cached += entries[i].reserved;
+  while (cached > releasedCacheCap) {
+    const uint32_t victim = cachedVictim();
+    if (victim == 0) return;  // the rest is in flight: a later call frees it
+    cached -= entries[victim].reserved;
+    destroyEntry(victim);
+    ++counters.evictions;
+  }
+}
+
 Status AccelerationStructureService::Impl::makeRoom(VkDeviceSize bytes, const std::string& forWhat) {
   if (desc.blasBudgetBytes == 0) return {};
   while (reservedBytes + bytes > desc.blasBudgetBytes) {
-    uint32_t victim = 0;
-    uint64_t oldest = UINT64_MAX;
-    for (uint32_t i = 1; i < entries.size(); ++i) {
-      const BlasEntry& e = entries[i];
-      if (e.state == BlasState::Free || e.refCount > 0) continue;
-      bool inLatestTlas = e.lastTlasSerial != 0 && e.lastTlasSerial == tlasSerial;
-      // Not c.frame: registerMesh may run while the recording thread is in Context::beginFrame.
-      bool inFlight = e.lastTlasSerial != 0 && !frameKnownDone(e.lastUsedFrame);
-      if (inLatestTlas || inFlight) continue;
-      if (e.releasedOrder < oldest) {
-        oldest = e.releasedOrder;
-        victim = i;
-      }
-    }
+    const uint32_t victim = cachedVictim();
     if (victim == 0) {
       return Error{ErrorCode::OutOfBudget, VK_SUCCESS,
                    forWhat + " needs " + std::to_string(bytes) + " bytes of BLAS storage but the budget of " +
@@ -170,6 +188,7 @@ Status AccelerationStructureService::releaseMesh(MeshHandle mesh) {
     s.destroyEntry(index);
   } else {
     entry.releasedOrder = ++s.releaseCounter;
+    s.trimReleasedCache();
   }
   return {};
 }

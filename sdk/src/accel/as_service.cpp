@@ -36,6 +36,9 @@ AccelerationStructureService::Impl::Impl(Context& context, const AsServiceDesc& 
       storage(context, d.storageBlockBytes ? d.storageBlockBytes : kDefaultBlockBytes) {
   if (desc.scratchBudgetBytes == 0) desc.scratchBudgetBytes = kDefaultScratchBudget;
   if (desc.storageBlockBytes == 0) desc.storageBlockBytes = kDefaultBlockBytes;
+  releasedCacheCap = desc.disableReleasedCache      ? 0
+                     : desc.releasedCacheBytes != 0 ? desc.releasedCacheBytes
+                                                    : kDefaultReleasedCacheBytes;
   tlasSlots.resize(c.desc.framesInFlight);
   entries.emplace_back();  // index 0 is never used, so a zero handle is always the null handle
   registrations.emplace_back();
@@ -84,6 +87,45 @@ void AccelerationStructureService::Impl::handOnDeferredRetires() {
 
 VkDeviceSize AccelerationStructureService::Impl::scratchAlignment() const {
   return std::max<VkDeviceSize>(c.info.minAccelerationStructureScratchOffsetAlignment, 1);
+}
+
+Result<VkDeviceAddress> AccelerationStructureService::Impl::growScratch(GpuBuffer& buffer, VkDeviceSize need,
+                                                                        VkDeviceSize cap, const char* what) {
+  const VkDeviceSize align = scratchAlignment();
+  if (!buffer.valid() || buffer.size < need + align) {
+    VkDeviceSize bytes = need;
+    if (buffer.valid()) {
+      bytes = std::max(need, std::min(2 * (buffer.size - align), cap));
+      // Earlier builds of this command buffer, or of frames (or async submissions) in flight, may still use it.
+      GpuBuffer old = buffer;
+      Context* context = &ctx;
+      retireAfterAsync([context, old]() mutable { destroyBuffer(*context, old); });
+      buffer = GpuBuffer{};
+    }
+    Result<GpuBuffer> t = createBuffer(ctx, bytes + align,
+                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                                       MemoryLocation::DeviceLocal, MemoryCategory::Scratch, what);
+    if (!t) return t.error();
+    buffer = t.value();
+  }
+  return alignUp(buffer.address, align);
+}
+
+Result<VkDeviceAddress> AccelerationStructureService::Impl::sharedScratch(VkDeviceSize need) {
+  scratchNeedInWindow = std::max(scratchNeedInWindow, need);
+  return growScratch(scratch, need, desc.scratchBudgetBytes, "BLAS build scratch");
+}
+
+void AccelerationStructureService::Impl::trimSharedScratch() {
+  if (++scratchWindowCalls < kScratchWindowCalls) return;
+  if (scratch.valid() && scratchNeedInWindow * 4 <= scratch.size - scratchAlignment()) {
+    GpuBuffer old = scratch;
+    Context* context = &ctx;
+    retireAfterAsync([context, old]() mutable { destroyBuffer(*context, old); });
+    scratch = GpuBuffer{};
+  }
+  scratchWindowCalls = 0;
+  scratchNeedInWindow = 0;
 }
 
 VkDeviceSize AccelerationStructureService::Impl::storageNeed(const BlasEntry& e) const {

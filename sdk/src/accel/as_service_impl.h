@@ -161,6 +161,10 @@ struct TlasSlot {
   uint64_t writtenFrame = UINT64_MAX;  // frame whose instances the buffer holds
 };
 
+// Recording calls over which the main queue's build scratch is measured before it may be released (about a second
+// at 60 frames a second): builds come in bursts (a level's load, a streamed area), refits every frame.
+inline constexpr uint32_t kScratchWindowCalls = 64;
+
 struct AccelerationStructureService::Impl {
   Context& ctx;
   Context::Impl& c;
@@ -195,7 +199,11 @@ struct AccelerationStructureService::Impl {
   std::deque<uint32_t> queue;  // entry indices waiting for a build, in registration order
   // Failed entries waiting for their retry: the next recordPendingWork moves them to the back of `queue`.
   std::vector<uint32_t> failedBuilds;
-  GpuBuffer scratch;  // persistent build scratch (scratchBudgetBytes)
+  // Build scratch of the main queue, grown to what the builds need (up to scratchBudgetBytes) and released when the
+  // builds stop needing most of it (sharedScratch, trimSharedScratch).
+  GpuBuffer scratch;
+  VkDeviceSize scratchNeedInWindow = 0;  // the most scratch one recording call needed in the current window
+  uint32_t scratchWindowCalls = 0;       // recording calls in the current window
   std::vector<BuildBatch> inFlightBatches;
   std::vector<VkQueryPool> freeTimestampPools;
   std::vector<BuildBatchTiming> timings;
@@ -207,8 +215,9 @@ struct AccelerationStructureService::Impl {
   std::vector<float> tlasTransforms;   // scratch: the written instances' transforms, 12 floats each (Adaptive)
   uint64_t tlasMotionSerial = 0;       // the TLAS (tlasSerial) whose build last updated tlasMotion
   uint64_t releaseCounter = 0;
-  VkDeviceSize reservedBytes = 0;  // storage of all live BLASes (aligned), for the budget
-  AsStats counters;                // the cumulative counters (registrations, dedupHits, evictions, ...)
+  VkDeviceSize reservedBytes = 0;     // storage of all live BLASes (aligned), for the budget
+  VkDeviceSize releasedCacheCap = 0;  // AsServiceDesc::releasedCacheBytes resolved (0 with disableReleasedCache)
+  AsStats counters;                   // the cumulative counters (registrations, dedupHits, evictions, ...)
 
   // Dynamic meshes (dynamic_blas.cpp).
   RefitPolicy policy;          // defaults resolved
@@ -239,6 +248,11 @@ struct AccelerationStructureService::Impl {
   uint32_t liveRegistrations() const;
   void destroyEntry(uint32_t index);  // retires its AS and storage; frees the slot
   Status makeRoom(VkDeviceSize bytes, const std::string& forWhat);
+  // The least recently released cached BLAS (no registration left) that no TLAS in flight references; 0 = none.
+  uint32_t cachedVictim() const;
+  // Frees cached BLASes, least recently released first, while they hold more than releasedCacheCap (those in
+  // flight wait for a later call: releaseMesh and every recordPendingWork call it).
+  void trimReleasedCache();
   // Mesh states (as_mesh_state.cpp).
   std::string meshName(const BlasEntry& e) const;  // "mesh 'name'", or the handle of its source registration
   // Failed with `error` (the message as given), waiting in failedBuilds for the next recordPendingWork.
@@ -270,6 +284,14 @@ struct AccelerationStructureService::Impl {
   // Takes a 2-query timestamp pool from `pools`, creating one when it is empty.
   Result<VkQueryPool> takeTimestampPool(std::vector<VkQueryPool>& pools, const char* what);
   VkDeviceSize scratchAlignment() const;
+  // `buffer` (scratch, or the async queue's) holding at least `need` bytes, grown when it is smaller: to twice its
+  // size or `need`, whichever is more, at most `cap` (a larger need gets it exactly). Returns its aligned address.
+  Result<VkDeviceAddress> growScratch(GpuBuffer& buffer, VkDeviceSize need, VkDeviceSize cap, const char* what);
+  // The main queue's scratch for `need` bytes (growScratch up to the budget), counted in the shrink window.
+  Result<VkDeviceAddress> sharedScratch(VkDeviceSize need);
+  // Ends one recording call for the shrink window: every kScratchWindowCalls calls, the scratch is released
+  // when the window's largest need was at most a quarter of it (the next need creates it again at its size).
+  void trimSharedScratch();
   VkDeviceSize storageNeed(const BlasEntry& e) const;  // aligned storage of all its copies
 
   // Dynamic meshes (dynamic_blas.cpp).

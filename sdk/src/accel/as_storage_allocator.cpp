@@ -28,7 +28,9 @@ Result<StorageAllocation> AsStorageAllocator::allocate(VkDeviceSize size) {
       return a;
     }
   }
-  VkDeviceSize bytes = std::max(blockBytes_, need);
+  // A new block doubles what is held (from kMinBlockBytes, up to maxBlockBytes_), and holds `need` whatever it is.
+  const VkDeviceSize grown = std::clamp(blockBytes(), std::min(kMinBlockBytes, maxBlockBytes_), maxBlockBytes_);
+  const VkDeviceSize bytes = std::max(grown, need);
   Result<GpuBuffer> buffer = createBuffer(
       ctx_, bytes, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
       MemoryLocation::DeviceLocal, MemoryCategory::BlasStorage, "BLAS storage block", sharedWith_);

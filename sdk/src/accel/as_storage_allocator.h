@@ -1,5 +1,8 @@
 // Packs acceleration-structure storage into large device buffers at the required 256-byte alignment instead
-// of one buffer (and one VkDeviceMemory) per BLAS.
+// of one buffer (and one VkDeviceMemory) per BLAS. The blocks grow with the content: the first is
+// kMinBlockBytes, each new one as large as those held together (so the blocks' count grows with the log of the
+// content), at most the block size given (AsServiceDesc::storageBlockBytes); a BLAS larger than that gets a block
+// of its own size. An empty block is released at once, so the memory held comes back down with the content.
 #pragma once
 
 #include <vector>
@@ -18,11 +21,14 @@ struct StorageAllocation {
 class AsStorageAllocator {
  public:
   static constexpr VkDeviceSize kAlignment = 256;  // VkAccelerationStructureCreateInfoKHR::offset rule
+  // The first block's size: a scene of a few thousand triangles reserves about this much.
+  static constexpr VkDeviceSize kMinBlockBytes = 256ull << 10;
 
-  // `sharedWith`: the queue families whose queues build or read these BLASes when there are two (the blocks are
-  // then VK_SHARING_MODE_CONCURRENT over them); empty = the main queue only.
-  AsStorageAllocator(Context& ctx, VkDeviceSize blockBytes, std::vector<uint32_t> sharedWith = {})
-      : ctx_(ctx), blockBytes_(blockBytes), sharedWith_(std::move(sharedWith)) {}
+  // `maxBlockBytes`: the largest block grown to. `sharedWith`: the queue families whose queues build or read these
+  // BLASes when there are two (the blocks are then VK_SHARING_MODE_CONCURRENT over them); empty = the main queue
+  // only.
+  AsStorageAllocator(Context& ctx, VkDeviceSize maxBlockBytes, std::vector<uint32_t> sharedWith = {})
+      : ctx_(ctx), maxBlockBytes_(maxBlockBytes), sharedWith_(std::move(sharedWith)) {}
   ~AsStorageAllocator();
 
   Result<StorageAllocation> allocate(VkDeviceSize size);
@@ -44,7 +50,7 @@ class AsStorageAllocator {
     VkDeviceSize used = 0;
   };
   Context& ctx_;
-  VkDeviceSize blockBytes_;
+  VkDeviceSize maxBlockBytes_;
   std::vector<uint32_t> sharedWith_;
   std::vector<Block> blocks_;  // a destroyed block keeps its slot (invalid buffer) so indices stay stable
 };

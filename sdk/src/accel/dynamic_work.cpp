@@ -252,22 +252,12 @@ Result<std::vector<ScratchBatch>> placeDynamicScratch(Impl& s, DynamicBuildInfos
   }
   VkDeviceAddress sharedBase = 0;
   if (largestShared > 0) {
-    // The async queue has scratch of its own (exclusive to its family), grown to what its batches need.
-    GpuBuffer& buffer = onAsyncQueue ? s.asyncScratch : s.scratch;
-    if (!buffer.valid() || buffer.size < largestShared + align) {
-      if (buffer.valid()) {
-        GpuBuffer old = buffer;
-        Context* context = &s.ctx;
-        s.retireAfterAsync([context, old]() mutable { destroyBuffer(*context, old); });
-        buffer = GpuBuffer{};
-      }
-      Result<GpuBuffer> t = createBuffer(s.ctx, (onAsyncQueue ? largestShared : budget) + align, scratchUsage,
-                                         MemoryLocation::DeviceLocal, MemoryCategory::Scratch,
-                                         onAsyncQueue ? "async BLAS build scratch" : "BLAS build scratch");
-      if (!t) return t.error();
-      buffer = t.value();
-    }
-    sharedBase = alignUp(buffer.address, align);
+    // The async queue has scratch of its own (exclusive to its family); both grow to what their batches need.
+    Result<VkDeviceAddress> base = onAsyncQueue ? s.growScratch(s.asyncScratch, largestShared, budget,
+                                                                "async BLAS build scratch")
+                                                : s.sharedScratch(largestShared);
+    if (!base) return base.error();
+    sharedBase = base.value();
   }
   for (size_t k = 0, begin = 0; k < batches.size(); begin = batches[k++].end) {
     VkDeviceAddress address = batches[k].transientBase ? batches[k].transientBase : sharedBase;
