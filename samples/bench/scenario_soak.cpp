@@ -18,10 +18,11 @@
 //     instances, shading records, rebuild, fast trace): every frame slot's TLAS buffers are in one configuration, a
 //     compaction decided before S has happened, and what was retired has been released;
 //   - the device is idle and Context::releaseAfterIdle() has run.
-// Besides that cache, S holds the pools that grow to a high-water mark (storage blocks, build scratch, per-slot TLAS
-// buffers sized for the largest instance list and every build flag, readbacks of the refit measure): the prime
-// drives each to the most the run can ask for (every mesh at its largest, the most instances, every TLAS option in
-// every frame slot) before the warm-up ends.
+// Besides that cache, S holds the pools that grow to a high-water mark (per-slot TLAS buffers sized for the largest
+// instance list and every build flag, readbacks of the refit measure): the prime drives each to the most the run can
+// ask for (every mesh at its largest, the most instances, every TLAS option in every frame slot) before the warm-up
+// ends. The storage blocks hold what is in use (an empty block is freed) and the build scratch is released by the
+// frames without builds that end S's sequence (rb::kScratchWindowCalls).
 // So memoryGrowthBytes = total bytes at the end's S minus those at the warm-up's S is 0 unless the SDK leaked, and
 // so is the growth of the BLAS storage in use (AsStats::storageUsedBytes), which sees a leaked BLAS that a storage
 // block's size hides. After the end's S the service and the effects are destroyed: the Context must then hold what
@@ -797,8 +798,9 @@ MemorySample SoakRun::quiesce() {
   for (uint32_t f = 0; f < settle; ++f) frame();  // compaction (GPU) decided, copied and the originals released
   while (!live_.empty()) release(0);
   placing_ = true;
-  // Retired objects released, every frame slot's TLAS buffers back in the one configuration above.
-  for (uint32_t f = 0; f < settle; ++f) frame();
+  // Retired objects released, every frame slot's TLAS buffers back in the one configuration above, and the build
+  // scratch let go (released at the end of a window of recording calls that built nothing).
+  for (uint32_t f = 0; f < std::max(settle, 2 * rb::kScratchWindowCalls); ++f) frame();
   ring_->waitAll();
   check(env_.device().waitIdle(), "vkDeviceWaitIdle (quiesce)");
   env_.ctx().releaseAfterIdle();

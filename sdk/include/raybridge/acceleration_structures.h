@@ -320,11 +320,17 @@ struct TlasInfo {
 // level's props, a character's LODs) stay, and a level's worth of released geometry does not.
 inline constexpr VkDeviceSize kDefaultReleasedCacheBytes = 16ull << 20;
 
+// Recording calls (recordPendingWork) over which the build scratch held is measured: at the end of each such
+// window it is released if no call of the window needed more than a quarter of it (the next build creates it again
+// at its need). About a second at 60 frames a second: builds come in bursts (a level's load, a streamed area),
+// refits every frame. So 2 x kScratchWindowCalls calls without builds leave no scratch held.
+inline constexpr uint32_t kScratchWindowCalls = 64;
+
 struct AsServiceDesc {
   // Build scratch at most; 0 = 64 MiB. Queued builds are packed into batches whose scratch fits it; consecutive
   // batches reuse it behind a barrier. A BLAS that alone needs more is built in a batch of its own with transient
   // scratch released after the frame. The scratch held grows to what the batches need (doubling, up to this), and
-  // is freed when 64 recording calls in a row needed at most a quarter of it.
+  // is freed when a window of kScratchWindowCalls recording calls needed at most a quarter of it.
   VkDeviceSize scratchBudgetBytes = 0;
   // Triangles one recordPendingWork() call builds at most, to spread a large load over frames; 0 = unlimited.
   // At least one queued build is recorded per call. First builds of dynamic meshes count too (in the async modes

@@ -161,10 +161,6 @@ struct TlasSlot {
   uint64_t writtenFrame = UINT64_MAX;  // frame whose instances the buffer holds
 };
 
-// Recording calls over which the main queue's build scratch is measured before it may be released (about a second
-// at 60 frames a second): builds come in bursts (a level's load, a streamed area), refits every frame.
-inline constexpr uint32_t kScratchWindowCalls = 64;
-
 struct AccelerationStructureService::Impl {
   Context& ctx;
   Context::Impl& c;
