@@ -128,8 +128,9 @@ int main(int argc, char** argv) {
                                                      {rb::kEffectReflections, runReflectionSweep}};
   nlohmann::json motionResult;
   if (motion) {
-    auto m = runMotionScenario(
-        driver, motionScene, makeMotionPlan(o.quick, width, height, o.effects, o.images, switchesOf(o), o.motionRays));
+    MotionPlan motionPlan = makeMotionPlan(o.quick, width, height, o.effects, o.images, switchesOf(o), o.motionRays);
+    motionPlan.cases = o.motionCases;
+    auto m = runMotionScenario(driver, motionScene, motionPlan);
     if (!m) return fail(m.error);
     motionResult = std::move(m.value);
   }

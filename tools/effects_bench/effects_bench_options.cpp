@@ -71,6 +71,10 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_option("--motion-rays", o.motionRays, "motion: rays per pixel of the denoised sequences (default 1 4 16)")
       ->type_name("N ...")
       ->check(rbCli::wholeNumber(1, 64));
+  app.add_option("--motion-cases", o.motionCases,
+                 "motion: the cases to run (default all: still pan turn walkers teleport lamp_jump door)")
+      ->type_name("NAME ...")
+      ->check(rbCli::oneOf(std::vector<std::string>(std::begin(kMotionCases), std::end(kMotionCases))));
   app.add_flag("--no-anti-lag", o.noAntiLag, "motion: denoisers without anti-lag (DenoiseSettings::disableAntiLag)");
   app.add_flag("--no-short-history-filter", o.noShortHistoryFilter,
                "motion: AO's denoiser without the short-history filter\n"

@@ -10,6 +10,9 @@
 
 namespace rbEffects {
 
+// The motion scenario's cases, in the order they run (motion_sweep.cpp makes them).
+inline constexpr const char* kMotionCases[] = {"still", "pan", "turn", "walkers", "teleport", "lamp_jump", "door"};
+
 struct Options {
   std::string scenario = "speed-vs-error";
   rb::EffectSet effects = rb::kThesisEffects;  // motion: every effect unless --effects says otherwise
@@ -22,10 +25,11 @@ struct Options {
   uint32_t resetRaysFactor = 0;       // motion: RaySchedule::resetRays = this x the rays; 0 = the SDK's default
   // motion: HybridEffectsDesc::resetFollowUpFrames (0 = disableResetFollowUp); not given = the SDK's default
   std::optional<uint32_t> resetFollowUp;
-  bool noChangeResets = false;       // motion: HybridEffectsDesc::disableChangeResets
-  bool convergedTiles = false;       // motion: RaySchedule::convergedTiles on for every effect
-  std::vector<uint32_t> motionRays;  // motion: rays per pixel of the denoised sequences; empty = 1, 4, 16
-  std::string scenes;                // motion: character models; empty = ../shared/scenes beside the source tree
+  bool noChangeResets = false;           // motion: HybridEffectsDesc::disableChangeResets
+  bool convergedTiles = false;           // motion: RaySchedule::convergedTiles on for every effect
+  std::vector<uint32_t> motionRays;      // motion: rays per pixel of the denoised sequences; empty = 1, 4, 16
+  std::vector<std::string> motionCases;  // motion: the cases to run (rbEffects::kMotionCases); empty = all
+  std::string scenes;                    // motion: character models; empty = ../shared/scenes beside the source tree
   // Empty: 1920x1080 on a GPU, 320x180 on a CPU device (lavapipe); --quick: 160x90.
   std::optional<uint32_t> width, height;
   std::string out;     // JSON file; empty = none

@@ -392,6 +392,8 @@ se::Result<nlohmann::json> Runner::run() {
   nlohmann::json out;
   out["cases"] = nlohmann::json::array();
   for (const Case& c : cases) {
+    if (!plan_.cases.empty() && std::find(plan_.cases.begin(), plan_.cases.end(), c.name) == plan_.cases.end())
+      continue;
     const auto start = std::chrono::steady_clock::now();
     if (se::Status st = setDesc(plan_.referenceRaysPerFrame, true); !st) return R::failure(st.error);
     progress("motion: %s: references, %u frames of %u rays per measured frame", c.name.c_str(), plan_.referenceFrames,

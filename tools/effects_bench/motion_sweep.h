@@ -46,7 +46,8 @@ struct MotionPlan {
   double fps = 30.0;
   MotionSwitches switches;
   rb::EffectSet effects = 0;
-  std::string imagesDir;  // "" = no PNGs
+  std::string imagesDir;           // "" = no PNGs
+  std::vector<std::string> cases;  // the cases to run (kMotionCases); empty = all
 };
 
 // The published plan (GPU: 16 warm-up and 10 measured frames, references of 4 x 64 rays, 1, 4 and 16 rays) or, with
