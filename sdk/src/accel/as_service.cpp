@@ -93,15 +93,9 @@ Result<VkDeviceAddress> AccelerationStructureService::Impl::growScratch(GpuBuffe
                                                                         VkDeviceSize cap, const char* what) {
   const VkDeviceSize align = scratchAlignment();
   if (!buffer.valid() || buffer.size < need + align) {
-    VkDeviceSize bytes = need;
-    if (buffer.valid()) {
-      bytes = std::max(need, std::min(2 * (buffer.size - align), cap));
-      // Earlier builds of this command buffer, or of frames (or async submissions) in flight, may still use it.
-      GpuBuffer old = buffer;
-      Context* context = &ctx;
-      retireAfterAsync([context, old]() mutable { destroyBuffer(*context, old); });
-      buffer = GpuBuffer{};
-    }
+    const VkDeviceSize bytes = buffer.valid() ? std::max(need, std::min(2 * (buffer.size - align), cap)) : need;
+    // Earlier builds of this command buffer, or of frames (or async submissions) in flight, may still use it.
+    retireBufferAfterAsync(buffer);
     Result<GpuBuffer> t = createBuffer(ctx, bytes + align,
                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
                                        MemoryLocation::DeviceLocal, MemoryCategory::Scratch, what);
@@ -118,12 +112,7 @@ Result<VkDeviceAddress> AccelerationStructureService::Impl::sharedScratch(VkDevi
 
 void AccelerationStructureService::Impl::trimSharedScratch() {
   if (++scratchWindowCalls < kScratchWindowCalls) return;
-  if (scratch.valid() && scratchNeedInWindow * 4 <= scratch.size - scratchAlignment()) {
-    GpuBuffer old = scratch;
-    Context* context = &ctx;
-    retireAfterAsync([context, old]() mutable { destroyBuffer(*context, old); });
-    scratch = GpuBuffer{};
-  }
+  if (scratch.valid() && scratchNeedInWindow * 4 <= scratch.size - scratchAlignment()) retireBufferAfterAsync(scratch);
   scratchWindowCalls = 0;
   scratchNeedInWindow = 0;
 }

@@ -301,6 +301,8 @@ struct AccelerationStructureService::Impl {
   void retireCopies(std::vector<BlasCopy>& copies);
   // Retires through the Context once the async timeline shows the GPU past every submission so far.
   void retireAfterAsync(std::function<void()> release);
+  // Hands `buffer` to retireAfterAsync (destroyed once nothing in flight can use it) and leaves it empty.
+  void retireBufferAfterAsync(GpuBuffer& buffer);
   void releaseAsyncRetired();
   void resolveDynamicSubmissions();
   // Plans, records and commits one frame's dynamic work into `cmd` (the engine's command buffer in the

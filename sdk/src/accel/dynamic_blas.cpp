@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "as_service_impl.h"
@@ -110,6 +111,13 @@ void AccelerationStructureService::Impl::retireAfterAsync(std::function<void()> 
   } else {
     retire(std::move(release));
   }
+}
+
+void AccelerationStructureService::Impl::retireBufferAfterAsync(GpuBuffer& buffer) {
+  if (!buffer.valid()) return;
+  GpuBuffer old = std::exchange(buffer, GpuBuffer{});
+  Context* context = &ctx;
+  retireAfterAsync([context, old]() mutable { destroyBuffer(*context, old); });
 }
 
 void AccelerationStructureService::Impl::releaseAsyncRetired() {
@@ -314,11 +322,7 @@ Status AccelerationStructureService::submitDynamicWork(const AsyncBuildWait& rea
   sub.frame = s.c.frame;
   sub.timelineValue = value.value();
   s.dynamicSubmissions.push_back(std::move(sub));
-  for (GpuBuffer& b : transientScratch) {
-    GpuBuffer copy = b;
-    Context* context = &s.ctx;
-    s.retireAfterAsync([context, copy]() mutable { destroyBuffer(*context, copy); });
-  }
+  for (GpuBuffer& b : transientScratch) s.retireBufferAfterAsync(b);
   s.lastVertexReadValue = value.value();
   s.lastDynamicWriteFrame = s.c.frame;
   return {};
