@@ -11,6 +11,9 @@
 //   - shadows: where the ray from P to the shadow light crosses a box (the object's old and new shadow), the box
 //     widened by the light's spread (soft shadows' rays leave P in a cone);
 //   - AO: where P lies within the AO range of a box (the contact shadow the object leaves and brings).
+//   - follow-up level (below) for the box's effects: where the segment from P to the camera crosses a box of where
+//     geometry was (RB_CHANGE_REVEALS): P may be newly visible, without a history to reproject (the motion bench's
+//     teleport: half the changed pixels of the shadows were such, starting from one frame of the usual rays).
 // Local-light boxes (RB_CHANGE_LOCAL_LIGHTS only) are a light's range: where it can light, it lit differently.
 // The engine's reactive mask is set in every mask. Each mask is 1 (changed) or 0, or RB_REACTIVE_FOLLOW_UP_VALUE
 // where only a follow-up box (RB_CHANGE_FOLLOW_UP: a change of one of the last frames) changes the pixel: there the
@@ -54,11 +57,20 @@ shared uint candidates[RB_CHANGE_MAX_BOXES];
 
 // Which of `effects` box b changes at the surface points within `extent` of `c` (per axis), `margin` being the
 // largest of their reconstruction margins: a pixel's own test is extent 0, a tile's is its points' bounding box (the
-// box grown by it: a test from c then stands for every point, so the tile's result holds every pixel's).
-uint changedEffects(ChangeBox b, uint effects, vec3 c, vec3 extent, float margin) {
+// box grown by it: a test from c then stands for every point, so the tile's result holds every pixel's). `revealed`:
+// the effects for which those points may be newly visible through the box (RB_CHANGE_REVEALS; follow-up level). The
+// segments from the tile's points to the camera lie within `extent` of the one from c, as a point light's do.
+uint changedEffects(ChangeBox b, uint effects, vec3 c, vec3 extent, float margin, out uint revealed) {
   vec3 lo = b.lo - extent, hi = b.hi + extent;
   float d2 = distance2(c, lo, hi);
+  revealed = 0u;
   if (d2 <= margin * margin) return effects;  // on the object itself
+  if ((b.effects & RB_CHANGE_REVEALS) != 0u) {
+    vec3 toCamera = pc.gbuffer.cameraToTlas - c;
+    float cameraDistance = length(toCamera);
+    if (cameraDistance > 0.0 && rbSegmentHitsBox(c, toCamera / cameraDistance, cameraDistance, lo - margin, hi + margin))
+      revealed = effects;
+  }
   uint changed = 0u;
   if ((effects & RB_CHANGE_AO) != 0u && d2 <= (pc.aoRange + margin) * (pc.aoRange + margin)) changed |= RB_CHANGE_AO;
   if ((effects & RB_CHANGE_SHADOWS) != 0u) {
@@ -110,9 +122,11 @@ void main() {
     const vec3 c = 0.5 * (tLo + tHi), extent = 0.5 * (tHi - tLo);
     const float tileMargin = 1e-3 * (length(c - pc.gbuffer.cameraToTlas) + length(extent)) + 1e-4;
     ChangeBoxes boxes = ChangeBoxes(pc.boxes);
-    for (uint i = local; i < pc.boxCount; i += 64u)
-      if (changedEffects(boxes.b[i], boxes.b[i].effects & pc.masks, c, extent, tileMargin) != 0u)
+    for (uint i = local; i < pc.boxCount; i += 64u) {
+      uint revealed;
+      if ((changedEffects(boxes.b[i], boxes.b[i].effects & pc.masks, c, extent, tileMargin, revealed) | revealed) != 0u)
         candidates[atomicAdd(candidateCount, 1u)] = i;
+    }
   }
   barrier();
 
@@ -126,9 +140,11 @@ void main() {
       const bool isFollowUp = (b.effects & RB_CHANGE_FOLLOW_UP) != 0u;
       uint effects = b.effects & pc.masks & ~changed & (isFollowUp ? ~followUp : ~0u);
       if (effects == 0u) continue;
-      const uint hit = changedEffects(b, effects, p, vec3(0.0), margin);
+      uint revealed;
+      const uint hit = changedEffects(b, effects, p, vec3(0.0), margin, revealed);
       if (isFollowUp) followUp |= hit;
       else changed |= hit;
+      followUp |= revealed;
     }
   }
   if (!inImage) return;

@@ -44,9 +44,11 @@ void main() {
   float dist = length(rel);
   imageStore(distanceOut, ip, vec4(dist));
   float accumulated = value;
-  // A pixel whose history the reactive mask restarts traced RaySchedule::resetRays rays (reset_rays.glsl): its value
-  // counts as that many frames of the usual rays, so the frames after it weigh in by their rays.
-  float frames = rbDnReactive(pixel, gReactive) ? min(pc.resetFrames, float(pc.maxHistoryFrames)) : 1.0;
+  // A pixel whose history the reactive mask restarts, or follows up (rbDnFollowUp), traced RaySchedule::resetRays rays
+  // (reset_rays.glsl): its value counts as that many frames of the usual rays, so the frames after it weigh in by
+  // their rays; so where it finds no history (a follow-up pixel newly visible, RB_CHANGE_REVEALS).
+  const bool resetRays = rbDnReactive(pixel, gReactive) || (!kept && rbDnFollowUp(pixel, gReactive));
+  float frames = resetRays ? min(pc.resetFrames, float(pc.maxHistoryFrames)) : 1.0;
   ivec2 pp;
   vec2 h;
   if (rbDnFindHistoryBilinear(pixel, rel, gMotion, gReactive, distanceIn, historyIn, h, pp)) {

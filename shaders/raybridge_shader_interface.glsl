@@ -100,6 +100,11 @@
 // ChangeBox::effects flag: a box of one of the last frames' changes (HybridEffectsDesc::resetFollowUpFrames). Its
 // pixels get RB_REACTIVE_FOLLOW_UP_VALUE, not 1, unless a box of this frame changes them.
 #define RB_CHANGE_FOLLOW_UP 16u
+// ChangeBox::effects flag: where geometry was before the change (a moved, deformed or vanished instance's old box, or
+// the engine's box). A surface seen through it (the segment to the camera crosses it) may be newly visible, with no
+// history to reproject: its pixels get RB_REACTIVE_FOLLOW_UP_VALUE, so the effects with reset rays trace them there
+// and their denoisers weigh them (a disoccluded pixel otherwise starts from one frame of the usual rays).
+#define RB_CHANGE_REVEALS 32u
 // Boxes a frame's list holds at most (rb::kMaxChangeBoxes, change_tracker.h).
 #define RB_CHANGE_MAX_BOXES 256
 // The depth-aware upsample of half-resolution AO and reflections (upsample_depth_aware.glsl).

@@ -94,6 +94,12 @@ bool inShadowFootprint(const std::vector<Box>& boxes, const glm::dvec3& p, const
   return false;
 }
 
+// Seen through box b: the segment from p to the camera crosses it, grown by `grow` (negative: shrunk).
+bool seenThrough(const Box& b, double grow, const glm::dvec3& p) {
+  const glm::dvec3 toEye = view().eye - p;
+  return rayHits(b, grow, p, glm::normalize(toEye)) && distanceTo(b, view().eye) > 0.0;
+}
+
 bool inAoFootprint(const std::vector<Box>& boxes, const glm::dvec3& p, double range) {
   for (const Box& b : boxes)
     if (distanceTo(b, p) <= range) return true;
@@ -205,6 +211,26 @@ TEST_CASE("a moved instance resets history only inside its old and new footprint
   }
   std::printf("change masks: shadows %u, AO %u of %u surface pixels; missed %u / %u, stray %u / %u\n", shadowSet, aoSet,
               surface, shadowMissed, aoMissed, shadowStray, aoStray);
+  // Where the box was reveals what it hid (RB_CHANGE_REVEALS): the pixels seen through its old box and not changed
+  // are marked at the follow-up level (reset rays, history kept), all of a narrower footprint, none outside a wider.
+  const float followUp = std::round(RB_REACTIVE_FOLLOW_UP_VALUE * 255.0) / 255.0f;
+  uint32_t revealed = 0, revealMissed = 0, revealStray = 0;
+  for (size_t i = 0; i < size_t(kW) * kH; ++i) {
+    if (!after.cpu.hit[i]) continue;
+    const glm::dvec3 p = after.cpu.position[i];
+    const double pad = 1e-3 * glm::length(p - view().eye);
+    for (const std::vector<float>* mask : {&on.shadowMask, &on.aoMask}) {
+      const float m = (*mask)[i];
+      revealed += m == followUp;
+      revealMissed += m <= 0.5f && m != followUp && seenThrough(boxes[0], -0.01, p);
+      revealStray += m == followUp && !seenThrough(boxes[0], 3.0 * pad + 0.01, p);
+      CHECK((m == 0.0f || m == followUp || m == 1.0f));
+    }
+  }
+  std::printf("revealed: %u follow-up marks, missed %u, stray %u\n", revealed, revealMissed, revealStray);
+  CHECK(revealed > 20);
+  CHECK(revealMissed == 0);
+  CHECK(revealStray == 0);
   CHECK(shadowSet > 50);  // the box and both of its shadows are in view
   CHECK(aoSet > 50);
   CHECK(shadowSet < surface / 2);  // and most of the image is not
@@ -216,27 +242,35 @@ TEST_CASE("a moved instance resets history only inside its old and new footprint
 
   // The history: a masked pixel starts afresh, at kDefaultResetRaysFactor frames (HybridEffects traced that many
   // times the rays there: RaySchedule::resetRays); an unmasked one keeps its history unless disoccluded (the surface
-  // there is another one than last frame's: the box's old place, its new place).
+  // there is another one than last frame's: the box's old place, its new place), and adds that many frames where
+  // marked at the follow-up level. A disoccluded follow-up pixel starts from the reset rays' frames, not one.
   const float restartFrames = float(rb::kDefaultResetRaysFactor);
   auto check = [&](const std::vector<float>& mask, const std::vector<float>& frames, const char* what) {
-    uint32_t reset = 0, kept = 0, strayResets = 0, maskedKept = 0;
+    uint32_t reset = 0, kept = 0, strayResets = 0, maskedKept = 0, revealedNew = 0, revealedNewWrong = 0;
     for (size_t i = 0; i < size_t(kW) * kH; ++i) {
       if (!after.cpu.hit[i]) continue;
       const bool disoccluded = !before.cpu.hit[i] || before.cpu.instance[i] != after.cpu.instance[i] ||
                                glm::length(before.cpu.position[i] - after.cpu.position[i]) > 1e-3;
+      const bool follow = mask[i] == followUp;
       if (mask[i] > 0.5f) {
         maskedKept += frames[i] != restartFrames;
         ++reset;
       } else if (!disoccluded) {
-        strayResets += frames[i] != float(kStillFrames + 1);
+        strayResets += frames[i] != float(kStillFrames) + (follow ? restartFrames : 1.0f);
         ++kept;
+      } else if (follow) {
+        revealedNew += 1;
+        revealedNewWrong += frames[i] != restartFrames;
       }
     }
-    std::printf("%s history: %u masked pixels restarted (%u did not), %u kept (%u did not)\n", what, reset, maskedKept,
-                kept, strayResets);
+    std::printf("%s history: %u masked pixels restarted (%u did not), %u kept (%u did not), %u revealed afresh "
+                "(%u not at the reset rays' frames)\n",
+                what, reset, maskedKept, kept, strayResets, revealedNew, revealedNewWrong);
     CHECK(maskedKept == 0);
     CHECK(strayResets == 0);
     CHECK(kept > reset);
+    CHECK(revealedNew > 0);
+    CHECK(revealedNewWrong == 0);
   };
   check(on.shadowMask, on.shadowFrames, "shadow");
   check(on.aoMask, on.aoFrames, "AO");
@@ -244,13 +278,12 @@ TEST_CASE("a moved instance resets history only inside its old and new footprint
   // The frame after (kDefaultResetFollowUpFrames > 0, nothing moves): the same pixels are marked at the follow-up
   // level and nothing else; they traced the reset rays again and add that many frames to the history they kept.
   static_assert(rb::kDefaultResetFollowUpFrames > 0);
-  const float followUp = std::round(RB_REACTIVE_FOLLOW_UP_VALUE * 255.0) / 255.0f;
   auto checkFollowUp = [&](const std::vector<float>& mask, const std::vector<float>& frames,
                            const std::vector<float>& followMask, const std::vector<float>& followFrames,
                            const char* what) {
     uint32_t marked = 0, wrongMark = 0, wrongFrames = 0;
     for (size_t i = 0; i < size_t(kW) * kH; ++i) {
-      const bool changed = mask[i] > 0.5f;
+      const bool changed = mask[i] > 0.5f || mask[i] == followUp;  // restarted, or revealed
       marked += changed;
       wrongMark += followMask[i] != (changed ? followUp : 0.0f);
       if (after.cpu.hit[i]) wrongFrames += followFrames[i] != frames[i] + (changed ? restartFrames : 1.0f);

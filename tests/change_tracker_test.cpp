@@ -52,6 +52,8 @@ TEST_CASE("the change tracker reports moved, appeared and vanished instances by 
   CHECK(t.boxes()[0].lo[0] == 9.0);   // where it was
   CHECK(t.boxes()[1].lo[0] == 11.0);  // where it is
   CHECK(t.boxes()[1].hi[0] == 13.0);
+  // Where it was reveals what it hid (RB_CHANGE_REVEALS); where it is does not.
+  CHECK(t.boxes()[0].effects == (rb::kChangeAllEffects | RB_CHANGE_REVEALS));
   CHECK(t.boxes()[1].effects == rb::kChangeAllEffects);
 
   a.push_back(at(20.0f));  // appears
@@ -59,12 +61,14 @@ TEST_CASE("the change tracker reports moved, appeared and vanished instances by 
   t.update(a, m, {}, {});
   REQUIRE(t.boxes().size() == 1);
   CHECK(t.boxes()[0].lo[0] == 19.0);
+  CHECK(t.boxes()[0].effects == rb::kChangeAllEffects);  // appeared: it hid nothing before
 
   a.resize(1), m.resize(1);  // instances 1 and 2 vanish
   t.update(a, m, {}, {});
   REQUIRE(t.boxes().size() == 2);
   CHECK(t.boxes()[0].lo[0] == 11.0);
   CHECK(t.boxes()[1].lo[0] == 19.0);
+  for (const rb::WorldChangeBox& b : t.boxes()) CHECK(b.effects == (rb::kChangeAllEffects | RB_CHANGE_REVEALS));
 
   // A rotated transform's box holds the rotated box: 45 degrees about y widens x and z by sqrt(2).
   std::vector<rb::Instance> r = {at(0.0f)};
@@ -130,7 +134,7 @@ TEST_CASE("the change tracker reports changed local lights by their range, for l
   const rb::ChangedBox engine{{1.0, 2.0, 3.0}, {4.0, 5.0, 6.0}};
   t.update({}, {}, lights, std::span<const rb::ChangedBox>(&engine, 1));
   REQUIRE(t.boxes().size() == 1);
-  CHECK(t.boxes()[0].effects == rb::kChangeAllEffects);
+  CHECK(t.boxes()[0].effects == (rb::kChangeAllEffects | RB_CHANGE_REVEALS));  // it may be where something was
 
   // More boxes than the GPU list holds merge into its last one, which then holds them all.
   std::vector<rb::ChangedBox> many(rb::kMaxChangeBoxes + 10);
@@ -156,7 +160,8 @@ TEST_CASE("the change tracker sends the last frames' boxes again as follow-ups, 
   t.update(instances, std::span<const MeshChange>(&box, 1), {}, {});
   t.toGpu(origin, followUp, gpu);
   REQUIRE(gpu.size() == 2);  // nothing before it to follow up
-  for (const rb::GpuChangeBox& g : gpu) CHECK(g.effects == rb::kChangeAllEffects);
+  CHECK(gpu[0].effects == (rb::kChangeAllEffects | RB_CHANGE_REVEALS));
+  CHECK(gpu[1].effects == rb::kChangeAllEffects);
 
   // The two frames after it: no change of their own, the move's boxes again, for the effects with reset rays only.
   for (int frame = 1; frame <= 2; ++frame) {
@@ -164,7 +169,8 @@ TEST_CASE("the change tracker sends the last frames' boxes again as follow-ups, 
     t.toGpu(origin, followUp, gpu);
     INFO("frame " << frame << " after the move");
     REQUIRE(gpu.size() == 2);
-    CHECK(gpu[0].effects == (RB_CHANGE_SHADOWS | RB_CHANGE_AO | RB_CHANGE_FOLLOW_UP));
+    CHECK(gpu[0].effects == (RB_CHANGE_SHADOWS | RB_CHANGE_AO | RB_CHANGE_REVEALS | RB_CHANGE_FOLLOW_UP));
+    CHECK(gpu[1].effects == (RB_CHANGE_SHADOWS | RB_CHANGE_AO | RB_CHANGE_FOLLOW_UP));
     CHECK(gpu[0].lo[0] == std::nextafter(-1.0f, -INFINITY));  // the old box
     CHECK(gpu[1].lo[0] == std::nextafter(4.0f, -INFINITY));   // the new box
   }
@@ -179,11 +185,12 @@ TEST_CASE("the change tracker sends the last frames' boxes again as follow-ups, 
   t.update(instances, std::span<const MeshChange>(&box, 1), {}, {});
   t.toGpu(origin, followUp, gpu);
   REQUIRE(gpu.size() == 4);
-  CHECK(gpu[0].effects == rb::kChangeAllEffects);
+  CHECK(gpu[0].effects == (rb::kChangeAllEffects | RB_CHANGE_REVEALS));
   CHECK(gpu[1].effects == rb::kChangeAllEffects);
-  CHECK(gpu[2].effects == (RB_CHANGE_SHADOWS | RB_CHANGE_AO | RB_CHANGE_FOLLOW_UP));
-  t.toGpu(origin, {}, gpu);  // no follow-up asked for
-  CHECK(gpu.size() == 2);
+  CHECK(gpu[2].effects == (RB_CHANGE_SHADOWS | RB_CHANGE_AO | RB_CHANGE_REVEALS | RB_CHANGE_FOLLOW_UP));
+  t.toGpu(origin, {}, gpu);  // no follow-up asked for: no revealed pixels either
+  REQUIRE(gpu.size() == 2);
+  CHECK(gpu[0].effects == rb::kChangeAllEffects);
 
   // A local light's box concerns local lights alone, which have no reset rays: no follow-up.
   std::vector<rb::LightSource> lights{pointLight(0.0, 2.0f)};
@@ -201,8 +208,8 @@ TEST_CASE("the change tracker sends the last frames' boxes again as follow-ups, 
   t.update(instances, std::span<const MeshChange>(&box, 1), lights, many);
   t.toGpu(origin, followUp, gpu);
   REQUIRE(gpu.size() == rb::kMaxChangeBoxes);
-  CHECK(gpu[rb::kMaxChangeBoxes - 2].effects == rb::kChangeAllEffects);
-  CHECK(gpu.back().effects == ((rb::kChangeAllEffects & followUp.effects) | RB_CHANGE_FOLLOW_UP));
+  CHECK(gpu[rb::kMaxChangeBoxes - 2].effects == (rb::kChangeAllEffects | RB_CHANGE_REVEALS));
+  CHECK(gpu.back().effects == ((rb::kChangeAllEffects & followUp.effects) | RB_CHANGE_REVEALS | RB_CHANGE_FOLLOW_UP));
   CHECK(gpu.back().hi[0] >= float(many.size() - 1));  // the rest of the last frame's merged into that follow-up
   many.push_back(many.back());
   t.update(instances, std::span<const MeshChange>(&box, 1), lights, many);

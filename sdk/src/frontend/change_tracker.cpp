@@ -24,12 +24,12 @@ bool sameLight(const LightSource& a, const LightSource& b) {
 
 }  // namespace
 
-void ChangeTracker::addInstanceBox(const float t[12], const MeshBounds& bounds) {
+void ChangeTracker::addInstanceBox(const float t[12], const MeshBounds& bounds, bool reveals) {
   if (!bounds.given()) return;
   // The box of the transformed box (Arvo): per world axis, the translation plus each object axis's contribution at
   // whichever end of the box makes it smallest and largest.
   WorldChangeBox box;
-  box.effects = kChangeAllEffects;
+  box.effects = kChangeAllEffects | (reveals ? RB_CHANGE_REVEALS : 0u);
   for (int r = 0; r < 3; ++r) {
     double lo = t[r * 4 + 3], hi = t[r * 4 + 3];
     for (int c = 0; c < 3; ++c) {
@@ -81,12 +81,12 @@ void ChangeTracker::update(std::span<const Instance> instances,
             sameBounds(was.change.bounds, change.bounds)) {
           continue;
         }
-        addInstanceBox(was.transform, was.change.bounds);
+        addInstanceBox(was.transform, was.change.bounds, /*reveals=*/true);
       }
-      addInstanceBox(now.transform, change.bounds);  // moved, deformed or appeared: where it is now
+      addInstanceBox(now.transform, change.bounds, /*reveals=*/false);  // moved, deformed or appeared: where it is now
     }
     for (size_t i = common; i < instances_.size(); ++i)  // vanished: where it was
-      addInstanceBox(instances_[i].transform, instances_[i].change.bounds);
+      addInstanceBox(instances_[i].transform, instances_[i].change.bounds, /*reveals=*/true);
     const size_t commonLights = std::min(lights.size(), lights_.size());
     for (size_t i = 0; i < lights.size(); ++i) {
       if (i < commonLights && sameLight(lights[i], lights_[i])) continue;
@@ -97,7 +97,7 @@ void ChangeTracker::update(std::span<const Instance> instances,
   }
   for (const ChangedBox& e : engine) {
     WorldChangeBox box;
-    box.effects = kChangeAllEffects;
+    box.effects = kChangeAllEffects | RB_CHANGE_REVEALS;  // the engine's box may be where something was
     for (int i = 0; i < 3; ++i) box.lo[i] = e.min[i], box.hi[i] = e.max[i];
     boxes_.push_back(box);
   }
@@ -134,8 +134,10 @@ void mergeInto(GpuChangeBox& last, const GpuChangeBox& g) {
 void ChangeTracker::toGpu(const double originOffset[3], const ChangeFollowUp& followUp,
                           std::vector<GpuChangeBox>& out) const {
   out.clear();
+  // Revealed pixels are marked at the follow-up level: without follow-ups, none.
+  const uint32_t keep = followUp.frames > 0 && followUp.effects != 0u ? ~0u : ~RB_CHANGE_REVEALS;
   for (const WorldChangeBox& w : boxes_) {
-    const GpuChangeBox g = toGpuBox(w, originOffset, w.effects);
+    const GpuChangeBox g = toGpuBox(w, originOffset, w.effects & keep);
     if (out.size() < kMaxChangeBoxes) out.push_back(g);
     else
       mergeInto(out.back(), g);
@@ -148,7 +150,7 @@ void ChangeTracker::toGpu(const double originOffset[3], const ChangeFollowUp& fo
     for (const WorldChangeBox& w : recent_[f]) {
       const uint32_t effects = w.effects & followUp.effects;
       if (effects == 0u) continue;
-      const GpuChangeBox g = toGpuBox(w, originOffset, effects | RB_CHANGE_FOLLOW_UP);
+      const GpuChangeBox g = toGpuBox(w, originOffset, effects | (w.effects & RB_CHANGE_REVEALS) | RB_CHANGE_FOLLOW_UP);
       if (out.size() < kMaxChangeBoxes) out.push_back(g);
       else if (out.back().effects & RB_CHANGE_FOLLOW_UP)
         mergeInto(out.back(), g);

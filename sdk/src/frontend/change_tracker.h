@@ -63,7 +63,8 @@ class ChangeTracker {
               std::span<const LightSource> lights, std::span<const ChangedBox> engine);
   const std::vector<WorldChangeBox>& boxes() const { return boxes_; }
   // This frame's boxes in the space of a TLAS built at `originOffset`, then those of `followUp`, at most
-  // kMaxChangeBoxes in all (this frame's come first).
+  // kMaxChangeBoxes in all (this frame's come first). Without follow-ups (no frames or no effects) no box carries
+  // RB_CHANGE_REVEALS: revealed pixels are follow-up marks.
   void toGpu(const double originOffset[3], const ChangeFollowUp& followUp, std::vector<GpuChangeBox>& out) const;
   // The next update() compares against nothing and has no follow-ups (after a history reset: nothing to keep).
   void forget();
@@ -74,7 +75,8 @@ class ChangeTracker {
     float transform[12];
     AccelerationStructureService::MeshChange change;
   };
-  void addInstanceBox(const float transform[12], const MeshBounds& bounds);
+  // `reveals`: the box is where the instance was (RB_CHANGE_REVEALS: what it hid may be visible now).
+  void addInstanceBox(const float transform[12], const MeshBounds& bounds, bool reveals);
   void addLightBox(const LightSource& light);
 
   std::vector<SeenInstance> instances_;
