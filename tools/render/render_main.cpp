@@ -727,6 +727,24 @@ void addRaybridgeStats(const RenderRun& run, nlohmann::json& stats) {
   for (size_t c = 0; c < size_t(rb::MemoryCategory::Count); ++c)
     memory[rb::toString(rb::MemoryCategory(c))] = mem.bytes[c];
   memory["total"] = mem.total();
+  // HybridEffects' own, by effect and category (EffectMemoryStats), with bytes per pixel of the pass images.
+  const rb::EffectMemoryStats byEffect = run.adapter->effects().memoryByEffect();
+  const double pixels = double(o.width) * double(o.height);
+  nlohmann::json effects = nlohmann::json::object();
+  for (const auto& [name, m] :
+       {std::pair{"shadows", &byEffect.shadows}, std::pair{"ao", &byEffect.ao},
+        std::pair{"reflections", &byEffect.reflections}, std::pair{"local_lights", &byEffect.localLights},
+        std::pair{"shared", &byEffect.shared}}) {
+    nlohmann::json e;
+    for (rb::MemoryCategory c :
+         {rb::MemoryCategory::ShaderTables, rb::MemoryCategory::PassImages, rb::MemoryCategory::PassBuffers})
+      e[rb::toString(c)] = m->of(c);
+    e["total"] = m->total();
+    e["pass_image_bytes_per_pixel"] = double(m->of(rb::MemoryCategory::PassImages)) / pixels;
+    effects[name] = e;
+  }
+  memory["by_effect"] = effects;
+  memory["pass_image_bytes_per_pixel"] = double(byEffect.total().of(rb::MemoryCategory::PassImages)) / pixels;
   nlohmann::json passes = nlohmann::json::object();
   const uint64_t rays = addPassStats(run, passes);
   std::printf(" BLAS build %.2f ms; memory %.1f MiB\n", buildMs, mem.total() / 1048576.0);

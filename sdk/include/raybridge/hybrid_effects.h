@@ -205,9 +205,12 @@ struct HybridEffectsDesc {
   // Frames after a change that its pixels still trace the reset rays, in the effects that have them (follow-ups;
   // with change resets only). 0 = kDefaultResetFollowUpFrames; at most kMaxResetFollowUpFrames. Follow-up boxes take
   // the room of the GPU's per-frame box list (256) that the frame's own changes leave; beyond it they are dropped
-  // (fewer extra rays, no missed restart).
+  // (fewer extra rays, no missed restart). The pixels seen through where a moved, deformed or vanished instance was (or
+  // through an engine box) are follow-up pixels too, on the change's frame and its follow-ups: they may be newly
+  // visible, with no history to reproject, and would otherwise start from one frame of the usual rays (the motion
+  // bench's teleport: half the shadows' changed pixels; docs/effects.md, "Revealed pixels").
   uint32_t resetFollowUpFrames = 0;
-  // true = no follow-ups: only the frame of a change traces the reset rays.
+  // true = no follow-ups: only the frame of a change traces the reset rays, and only where it restarts a history.
   bool disableResetFollowUp = false;
 };
 
@@ -270,6 +273,23 @@ struct HybridOutputs {
   EffectImage localLights, localLightsRaw;
 };
 
+// HybridEffects' device memory by effect (HybridEffects::memoryByEffect), in the Context's pass categories
+// (ShaderTables, PassImages, PassBuffers; the others are 0): each effect's pass, its denoiser and its ray schedule's
+// images and buffers (local lights: their light list too). `shared`: what serves several effects (the change masks,
+// the material table, the neutral images named for effects that are off). The total equals memoryStats() when no other
+// HybridEffects or engine-made pass shares the Context. `allocations`: the live allocations of each.
+struct EffectMemoryStats {
+  MemoryStats shadows, ao, reflections, localLights, shared;
+  MemoryStats total() const {
+    MemoryStats sum;
+    for (const MemoryStats* m : {&shadows, &ao, &reflections, &localLights, &shared}) {
+      for (size_t c = 0; c < static_cast<size_t>(MemoryCategory::Count); ++c) sum.bytes[c] += m->bytes[c];
+      sum.allocations += m->allocations;
+    }
+    return sum;
+  }
+};
+
 // Per-pass measurements of the latest recordings whose frames have finished (zero for what does not exist).
 struct HybridStats {
   PassStats shadow, shadowDenoise, ao, aoDenoise, reflection, localLights, localLightsDenoise, reflectionDenoise;
@@ -329,6 +349,8 @@ class HybridEffects {
   // categories are 0): this object's passes and denoisers, plus any pass the engine created itself on the same
   // Context. `allocations` counts the whole Context's.
   MemoryStats memoryStats() const;
+  // The same categories of this object's own memory by effect (EffectMemoryStats).
+  EffectMemoryStats memoryByEffect() const;
 
   // The passes, for tools that want more than outputs() (nullptr where the effect is off).
   const ShadowPass* shadowPass() const;

@@ -23,6 +23,15 @@ struct Context::Impl {
   uint64_t idleThrough = 0;
   bool idleSeen = false;
   MemoryStats memory{};
+  // Memory attribution (HybridEffects::memoryByEffect): what is allocated while memoryOwner is set (MemoryOwnerScope)
+  // counts to that owner too, until it is freed. Ids come from newMemoryOwner(), 0 is nobody's; an id lives as long
+  // as the Context (a MemoryStats each: a few per HybridEffects).
+  uint32_t memoryOwner = 0;
+  std::vector<MemoryStats> ownerMemory;  // [id - 1]
+  uint32_t newMemoryOwner() {
+    ownerMemory.emplace_back();
+    return uint32_t(ownerMemory.size());
+  }
 
   struct PendingRelease {
     uint64_t frame;  // frame in which it was retired
@@ -71,6 +80,20 @@ struct Context::Impl {
     uint64_t frame;
   };
   std::vector<KeptMarks> keptMarkSignals;
+};
+
+// Attributes what is allocated during its lifetime to `owner` (Context::Impl::memoryOwner); restores the previous
+// owner after, so that scopes nest (an effect's scope inside HybridEffects' own).
+class MemoryOwnerScope {
+ public:
+  MemoryOwnerScope(Context::Impl& c, uint32_t owner) : c_(c), previous_(c.memoryOwner) { c.memoryOwner = owner; }
+  ~MemoryOwnerScope() { c_.memoryOwner = previous_; }
+  MemoryOwnerScope(const MemoryOwnerScope&) = delete;
+  MemoryOwnerScope& operator=(const MemoryOwnerScope&) = delete;
+
+ private:
+  Context::Impl& c_;
+  uint32_t previous_;
 };
 
 }  // namespace rb

@@ -8,15 +8,21 @@ namespace rb {
 
 namespace {
 
-void account(Context::Impl& c, MemoryCategory category, VkDeviceSize bytes, bool add) {
-  VkDeviceSize& slot = c.memory.bytes[static_cast<size_t>(category)];
+void account(MemoryStats& m, MemoryCategory category, VkDeviceSize bytes, bool add) {
+  VkDeviceSize& slot = m.bytes[static_cast<size_t>(category)];
   if (add) {
     slot += bytes;
-    ++c.memory.allocations;
+    ++m.allocations;
   } else {
     slot -= bytes;
-    --c.memory.allocations;
+    --m.allocations;
   }
+}
+
+// The Context's totals and, when it has one, the owner's (Context::Impl::ownerMemory).
+void account(Context::Impl& c, MemoryCategory category, uint32_t owner, VkDeviceSize bytes, bool add) {
+  account(c.memory, category, bytes, add);
+  if (owner != 0 && owner <= c.ownerMemory.size()) account(c.ownerMemory[owner - 1], category, bytes, add);
 }
 
 Result<VkDeviceMemory> allocate(Context::Impl& c, const VkMemoryRequirements& req, MemoryLocation location,
@@ -88,7 +94,8 @@ Result<GpuBuffer> createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFla
     addr.buffer = out.buffer;
     out.address = c.vk.vkGetBufferDeviceAddress(c.desc.device, &addr);
   }
-  account(c, category, out.allocatedBytes, true);
+  out.owner = c.memoryOwner;
+  account(c, category, out.owner, out.allocatedBytes, true);
   return out;
 }
 
@@ -97,7 +104,7 @@ void destroyBuffer(Context& ctx, GpuBuffer& buffer) {
   Context::Impl& c = internal::contextImpl(ctx);
   c.vk.vkDestroyBuffer(c.desc.device, buffer.buffer, c.allocator());
   c.vk.vkFreeMemory(c.desc.device, buffer.memory, c.allocator());
-  account(c, buffer.category, buffer.allocatedBytes, false);
+  account(c, buffer.category, buffer.owner, buffer.allocatedBytes, false);
   buffer = GpuBuffer{};
 }
 
@@ -155,7 +162,8 @@ Result<GpuImage> createStorageImage(Context& ctx, uint32_t width, uint32_t heigh
     c.vk.vkFreeMemory(c.desc.device, out.memory, c.allocator());
     return vulkanError(r, std::string("vkCreateImageView for ") + what);
   }
-  account(c, category, out.allocatedBytes, true);
+  out.owner = c.memoryOwner;
+  account(c, category, out.owner, out.allocatedBytes, true);
   return out;
 }
 
@@ -165,7 +173,7 @@ void destroyImage(Context& ctx, GpuImage& image) {
   c.vk.vkDestroyImageView(c.desc.device, image.view, c.allocator());
   c.vk.vkDestroyImage(c.desc.device, image.image, c.allocator());
   c.vk.vkFreeMemory(c.desc.device, image.memory, c.allocator());
-  account(c, image.category, image.allocatedBytes, false);
+  account(c, image.category, image.owner, image.allocatedBytes, false);
   image = GpuImage{};
 }
 

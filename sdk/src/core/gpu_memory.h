@@ -24,6 +24,7 @@ struct GpuBuffer {
   VkDeviceSize allocatedBytes = 0;
   void* mapped = nullptr;
   MemoryCategory category = MemoryCategory::PassBuffers;
+  uint32_t owner = 0;  // Context::Impl::memoryOwner when created
   bool valid() const { return buffer != VK_NULL_HANDLE; }
 };
 
@@ -35,6 +36,7 @@ struct GpuImage {
   uint32_t width = 0, height = 0;
   VkDeviceSize allocatedBytes = 0;
   MemoryCategory category = MemoryCategory::PassImages;
+  uint32_t owner = 0;  // Context::Impl::memoryOwner when created
   bool valid() const { return image != VK_NULL_HANDLE; }
 };
 

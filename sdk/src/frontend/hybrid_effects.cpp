@@ -9,6 +9,7 @@
 #include "change_masks.h"
 #include "change_tracker.h"
 #include "changed_box.h"
+#include "context_impl.h"
 #include "effect_schedule.h"
 #include "hybrid_effects_validation.h"
 #include "light_validation.h"
@@ -111,6 +112,11 @@ struct HybridEffects::Impl {
   Context& ctx;
   AccelerationStructureService* service = nullptr;
   HybridEffectsDesc desc;
+  // memoryByEffect(): the Context's memory owners of each effect and of what they share. Every entry point holds the
+  // shared one (MemoryOwnerScope), and the work of one effect its own.
+  enum Owner : uint8_t { kOwnShadows, kOwnAo, kOwnReflections, kOwnLocalLights, kOwnShared, kOwnerCount };
+  uint32_t owners[kOwnerCount] = {};
+  MemoryOwnerScope own(Owner o) { return MemoryOwnerScope(internal::contextImpl(ctx), owners[o]); }
   std::unique_ptr<ShadowPass> shadow;
   std::unique_ptr<Denoiser> shadowDenoiser;
   std::unique_ptr<AoPass> ao;
@@ -155,7 +161,9 @@ struct HybridEffects::Impl {
   std::vector<AccelerationStructureService::MeshChange> meshChanges;
   std::vector<GpuChangeBox> gpuChangeBoxes;
 
-  Impl(Context& c, AccelerationStructureService* s) : ctx(c), service(s) {}
+  Impl(Context& c, AccelerationStructureService* s) : ctx(c), service(s) {
+    for (uint32_t& id : owners) id = internal::contextImpl(ctx).newMemoryOwner();
+  }
   ~Impl() {
     neutral.retire(ctx);
     changeMasks.retire(ctx);
@@ -182,16 +190,20 @@ struct HybridEffects::Impl {
     const uint32_t w = desc.width, h = desc.height;
     if (w == 0) return {};
     if (shadow && shadowsSoftByDesc(desc.shadows)) {
+      const MemoryOwnerScope scope = own(kOwnShadows);
       if (Status st = ensureDenoiser(shadowDenoiser, true, DenoiseSignal::Scalar, "Denoiser (shadows)"); !st) return st;
     }
     if (ao && !desc.ao.disableDenoiser) {
+      const MemoryOwnerScope scope = own(kOwnAo);
       if (Status st = ensureDenoiser(aoDenoiser, true, DenoiseSignal::Scalar, "Denoiser (AO)"); !st) return st;
     }
     if (localLightsDenoised()) {
+      const MemoryOwnerScope scope = own(kOwnLocalLights);
       if (Status st = ensureDenoiser(localLightDenoiser, true, DenoiseSignal::Rgb, "Denoiser (local lights)"); !st)
         return st;
     }
     if (reflection && !desc.reflections.disableDenoiser) {
+      const MemoryOwnerScope scope = own(kOwnReflections);
       if (Status st = ensureDenoiser(reflectionDenoiser, true, DenoiseSignal::Reflection, "Denoiser (reflections)");
           !st)
         return st;
@@ -199,18 +211,20 @@ struct HybridEffects::Impl {
     if (const uint32_t masks = changeMaskEffects(); masks != 0u) {
       if (Status st = changeMasks.prepare(ctx, masks, w, h); !st) return wrap("change masks", st.error());
     }
-    auto prepare = [&](auto* object, const char* what) -> Status {
+    auto prepare = [&](auto* object, Owner owner, const char* what) -> Status {
       if (!object) return {};
+      const MemoryOwnerScope scope = own(owner);
       if (Status st = object->prepare(w, h); !st) return wrap(what, st.error());
       return {};
     };
     for (Status st :
-         {prepare(shadow.get(), "ShadowPass::prepare"), prepare(ao.get(), "AoPass::prepare"),
-          prepare(localLights.get(), "ManyLightPass::prepare"), prepare(reflection.get(), "ReflectionPass::prepare"),
-          prepare(shadowDenoiser.get(), "Denoiser::prepare (shadows)"),
-          prepare(aoDenoiser.get(), "Denoiser::prepare (AO)"),
-          prepare(localLightDenoiser.get(), "Denoiser::prepare (local lights)"),
-          prepare(reflectionDenoiser.get(), "Denoiser::prepare (reflections)")}) {
+         {prepare(shadow.get(), kOwnShadows, "ShadowPass::prepare"), prepare(ao.get(), kOwnAo, "AoPass::prepare"),
+          prepare(localLights.get(), kOwnLocalLights, "ManyLightPass::prepare"),
+          prepare(reflection.get(), kOwnReflections, "ReflectionPass::prepare"),
+          prepare(shadowDenoiser.get(), kOwnShadows, "Denoiser::prepare (shadows)"),
+          prepare(aoDenoiser.get(), kOwnAo, "Denoiser::prepare (AO)"),
+          prepare(localLightDenoiser.get(), kOwnLocalLights, "Denoiser::prepare (local lights)"),
+          prepare(reflectionDenoiser.get(), kOwnReflections, "Denoiser::prepare (reflections)")}) {
       if (!st) return st;
     }
     return {};
@@ -276,20 +290,29 @@ struct HybridEffects::Impl {
   // Passes follow the effect set; denoisers are decided per frame (hard shadows need none).
   Status applyDesc() {
     const EffectSet e = desc.effects;
-    if (Status s = ensure(shadow, e & kEffectShadows, "ShadowPass::create", [&] { return ShadowPass::create(ctx); });
+    const MemoryOwnerScope scope = own(kOwnShared);
+    auto owned = [&](Owner o, auto create) {
+      return [this, o, create] {
+        const MemoryOwnerScope effectScope = own(o);
+        return create();
+      };
+    };
+    if (Status s = ensure(shadow, e & kEffectShadows, "ShadowPass::create",
+                          owned(kOwnShadows, [&] { return ShadowPass::create(ctx); }));
         !s)
       return s;
-    if (Status s = ensure(ao, e & kEffectAo, "AoPass::create", [&] { return AoPass::create(ctx); }); !s) return s;
+    if (Status s = ensure(ao, e & kEffectAo, "AoPass::create", owned(kOwnAo, [&] { return AoPass::create(ctx); })); !s)
+      return s;
     if (Status s = ensure(reflection, e & kEffectReflections, "ReflectionPass::create",
-                          [&] { return ReflectionPass::create(ctx); });
+                          owned(kOwnReflections, [&] { return ReflectionPass::create(ctx); }));
         !s)
       return s;
     if (Status s = ensure(localLights, e & kEffectLocalLights, "ManyLightPass::create",
-                          [&] { return ManyLightPass::create(ctx); });
+                          owned(kOwnLocalLights, [&] { return ManyLightPass::create(ctx); }));
         !s)
       return s;
     if (Status s = ensure(lightList, e & kEffectLocalLights, "LightList::create",
-                          [&] { return LightList::create(ctx); });
+                          owned(kOwnLocalLights, [&] { return LightList::create(ctx); }));
         !s)
       return s;
     if (!shadow || desc.shadows.disableDenoiser) shadowDenoiser.reset();
@@ -383,6 +406,7 @@ Status HybridEffects::Impl::recordChanges(VkCommandBuffer cmd, const HybridFrame
 }
 
 Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridFrame& f) {
+  const MemoryOwnerScope scope = own(kOwnLocalLights);
   ManyLightSettings s;
   s.mode = desc.localLights.mode;
   s.raysPerPixel = desc.localLights.raysPerPixel;
@@ -400,6 +424,7 @@ Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridF
 }
 
 Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame& f) {
+  const MemoryOwnerScope scope = own(kOwnShadows);
   const ShadowPlan plan = planShadows(desc.shadows, f.light);
   ShadowSettings s;
   s.raysPerPixel = plan.rays;
@@ -418,6 +443,7 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
 }
 
 Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) {
+  const MemoryOwnerScope scope = own(kOwnAo);
   AoSettings s;
   s.materials = materials.get();
   s.raysPerPixel = desc.ao.raysPerPixel;
@@ -436,6 +462,7 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
 }
 
 Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
+  const MemoryOwnerScope scope = own(kOwnReflections);
   ReflectionSettings s;
   s.materials = materials.get();
   s.roughnessThreshold = desc.reflections.roughnessThreshold;
@@ -494,6 +521,7 @@ const HybridEffectsDesc& HybridEffects::desc() const { return impl_->desc; }
 
 Status HybridEffects::setMaterials(std::span<const Material> materials, std::span<const VkImageView> textures) {
   Impl& a = *impl_;
+  const MemoryOwnerScope scope = a.own(Impl::kOwnShared);
   if (a.materials) {
     if (Status st = a.materials->setMaterials(materials, textures); !st)
       return wrap("MaterialTable::setMaterials", st.error());
@@ -507,6 +535,7 @@ Status HybridEffects::setMaterials(std::span<const Material> materials, std::spa
 Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
   Impl& a = *impl_;
   if (!cmd) return invalid("record: cmd is VK_NULL_HANDLE");
+  const MemoryOwnerScope scope = a.own(Impl::kOwnShared);
   if (a.desc.effects == 0) {
     a.neutral.recordInit(a.ctx, cmd);
     return {};  // nothing enabled: no TLAS, no rays
@@ -555,6 +584,8 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
       return invalid(
           "record: the frame brings no TLAS (HybridFrame::tlas) and no AccelerationStructureService was given "
           "to create() to build one over HybridFrame::instances");
+    // The acceleration structures are the service's, nobody's in memoryByEffect().
+    const MemoryOwnerScope serviceScope(internal::contextImpl(a.ctx), 0);
     if (auto pending = a.service->recordPendingWork(cmd); !pending) return wrap("recordPendingWork", pending.error());
     TlasBuildOptions options;
     options.mode = a.desc.tlasMode;
@@ -627,6 +658,13 @@ MemoryStats HybridEffects::memoryStats() const {
     passes.bytes[size_t(c)] = all.of(c);
   passes.allocations = all.allocations;
   return passes;
+}
+
+EffectMemoryStats HybridEffects::memoryByEffect() const {
+  const Context::Impl& c = internal::contextImpl(impl_->ctx);
+  auto of = [&](Impl::Owner o) { return c.ownerMemory[impl_->owners[o] - 1]; };
+  return {of(Impl::kOwnShadows), of(Impl::kOwnAo), of(Impl::kOwnReflections), of(Impl::kOwnLocalLights),
+          of(Impl::kOwnShared)};
 }
 
 const ShadowPass* HybridEffects::shadowPass() const { return impl_->shadow.get(); }
