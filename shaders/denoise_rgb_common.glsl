@@ -26,6 +26,11 @@ bool rbDnRgbKeptMark(float a) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && a 
 // Its history is stale: it starts afresh, as a disoccluded pixel does.
 bool rbDnRgbStaleMark(float a) { return (pc.flags & RB_DN_KEPT_MARKS) != 0u && a > 1.5; }
 
+// The surface history (RG16F): .x the view distance, .y the standard deviation of one frame's colour, kept as a
+// deviation, not a variance, because a variance of HDR values overflows a half float; read back as the variance.
+float rbDnRgbSurfaceVariance(vec4 surface) { return surface.y * surface.y; }
+vec4 rbDnRgbSurfaceTexel(float dist, float variance) { return vec4(dist, sqrt(max(variance, 0.0)), 0.0, 0.0); }
+
 // Where the surface at `pixel` (camera-relative position `rel`) was in the latest history, read over the bilinear
 // footprint of the texels that hold the same surface (rbDnBilinearSameSurface). Returns whether any did: then `h` is
 // the history (rgb mean, a frames) and `v` the variance of one frame's colour there; none where the engine's reactive
@@ -46,7 +51,7 @@ bool rbDnRgbFindHistory(uvec2 pixel, vec3 rel, sampler2D motion, sampler2D react
     if (w[k] <= 0.0) continue;
     ivec2 q = base + ivec2(k & 1, k >> 1);
     h += w[k] * texelFetch(historyIn, q, 0);
-    v += w[k] * texelFetch(surfaceIn, q, 0).y;
+    v += w[k] * rbDnRgbSurfaceVariance(texelFetch(surfaceIn, q, 0));
   }
   if (weights <= 1e-3) return false;
   h /= weights;
@@ -97,7 +102,7 @@ float rbDnRgbHistoryTrust(ivec2 ip, ivec2 pp, sampler2D depthImage, sampler2D si
         h1 += h.rgb;
         hn += 1.0;
         hInverseFrames += 1.0 / h.a;
-        pooled += texelFetch(surfaceIn, hq, 0).y;
+        pooled += rbDnRgbSurfaceVariance(texelFetch(surfaceIn, hq, 0));
       }
     }
   }

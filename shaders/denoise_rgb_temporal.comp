@@ -21,7 +21,7 @@ layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SIGNAL) uniform sampler2D sign
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_HISTORY_IN) uniform sampler2D historyIn;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SURFACE_IN) uniform sampler2D surfaceIn;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_HISTORY_OUT, rgba16f) uniform writeonly image2D historyOut;
-layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SURFACE_OUT, rg32f) uniform writeonly image2D surfaceOut;
+layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_SURFACE_OUT, rg16f) uniform writeonly image2D surfaceOut;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_VALUE_OUT, rgba16f) uniform writeonly image2D valueOut;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_GUIDE_OUT, rg32ui) uniform writeonly uimage2D guideOut;
 layout(set = 0, binding = RB_RGB_TEMPORAL_BINDING_NORMAL) uniform sampler2D gNormal;
@@ -115,7 +115,7 @@ void main() {
     }
   }
   imageStore(historyOut, ip, vec4(accumulated, frames));
-  imageStore(surfaceOut, ip, vec4(dist, variance, 0.0, 0.0));
+  imageStore(surfaceOut, ip, rbDnRgbSurfaceTexel(dist, variance));
   // Too few frames for the recurrence to know the noise: the neighbourhood's.
   float frameVariance = frames < kRbDnMinTemporalVarianceFrames ? spatialVariance(ip, dist) : variance;
   float deviation = sqrt(frameVariance / frames);

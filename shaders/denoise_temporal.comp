@@ -17,7 +17,7 @@ layout(set = 0, binding = RB_TEMPORAL_BINDING_SIGNAL) uniform sampler2D signalIn
 layout(set = 0, binding = RB_TEMPORAL_BINDING_HISTORY_IN) uniform sampler2D historyIn;   // x: value, y: frames
 layout(set = 0, binding = RB_TEMPORAL_BINDING_DISTANCE_IN) uniform sampler2D distanceIn; // last frame's distance
 layout(set = 0, binding = RB_TEMPORAL_BINDING_HISTORY_OUT, rg16f) uniform writeonly image2D historyOut;
-layout(set = 0, binding = RB_TEMPORAL_BINDING_DISTANCE_OUT, r32f) uniform writeonly image2D distanceOut;
+layout(set = 0, binding = RB_TEMPORAL_BINDING_DISTANCE_OUT, r16f) uniform writeonly image2D distanceOut;
 layout(set = 0, binding = RB_TEMPORAL_BINDING_VALUE_OUT, rg16f) uniform writeonly image2D valueOut;
 layout(set = 0, binding = RB_TEMPORAL_BINDING_FINAL_OUT, r16f) uniform writeonly image2D finalOut;
 

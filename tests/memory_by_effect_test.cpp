@@ -12,14 +12,14 @@ using namespace rbtest;
 namespace {
 
 // docs/integration.md, "Memory by effect": bytes of pass images per pixel of the G-buffer, `high` with local lights.
-// Shadows: visibility R16F (2) + the scalar denoiser (history 2 x RG16F, view distance 2 x R32F, temporal RG16F,
-// a-trous ping RG16F, output R16F: 26). AO: the same, plus its half-resolution samples R16F at a quarter of the
-// pixels. Reflections and local lights: radiance RGBA16F (8) + the RGB denoiser (history, surface, a-trous ping-pong:
-// 2 x 8 each, guide RG32UI 8: 56). Shared: one R8 change mask per denoised effect.
-constexpr uint64_t kShadowBytesPerPixel = 28;
-constexpr uint64_t kAoBytesPerPixel = 28;
+// Shadows: visibility R16F (2) + the scalar denoiser (history 2 x RG16F, view distance 2 x R16F, temporal RG16F,
+// a-trous ping RG16F, output R16F: 22). AO: the same, plus its half-resolution samples R16F at a quarter of the
+// pixels. Reflections and local lights: radiance RGBA16F (8) + the RGB denoiser (history 2 x RGBA16F, surface
+// 2 x RG16F, a-trous ping-pong 2 x RGBA16F, guide RG32UI: 48). Shared: one R8 change mask per denoised effect.
+constexpr uint64_t kShadowBytesPerPixel = 24;
+constexpr uint64_t kAoBytesPerPixel = 24;
 constexpr uint64_t kAoHalfResolutionBytesPerSample = 2;
-constexpr uint64_t kRgbEffectBytesPerPixel = 64;
+constexpr uint64_t kRgbEffectBytesPerPixel = 56;
 constexpr uint64_t kChangeMaskBytesPerPixel = 1;
 
 std::vector<rb::LightSource> twoLamps() {

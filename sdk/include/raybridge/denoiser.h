@@ -18,15 +18,15 @@
 // value by at most as much as its noise explains (one standard deviation, falling off beyond, and less where the
 // previous steps changed the neighbourhood by more than its noise: a pattern finer than the filter), and not at all
 // where the noise is under DenoiseSettings::convergedNoise: converged or many-ray signals pass bit for bit. One
-// temporal and spatialIterations a-trous dispatches (3 dispatches by default); 26 bytes of images per pixel (30 with
-// three or more steps; 91 MiB at 2560x1440).
+// temporal and spatialIterations a-trous dispatches (3 dispatches by default); 22 bytes of images per pixel (26 with
+// three or more steps; 77 MiB at 2560x1440).
 //
 // RGB and reflection signals (SVGF-style, Schied et al. 2017): the temporal pass reprojects bilinearly and keeps,
 // beside the mean colour, the running variance of one frame's colour (from the 3x3 windows around the pixel while the
 // history is shorter than 4 frames); the a-trous steps (3x3 taps, 5 by default) stop at colour differences larger
 // than the remaining noise of the mean, so a converged or noise-free signal passes nearly unchanged, and filter
 // in the signal's own domain (no albedo demodulation: ManyLightPass's irradiance has none). One temporal and
-// DenoiseSettings::spatialIterations a-trous dispatches; 56 bytes of images per pixel (197 MiB at 2560x1440).
+// DenoiseSettings::spatialIterations a-trous dispatches; 48 bytes of images per pixel (169 MiB at 2560x1440).
 //
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipelines, history and
 // output images and measurement objects are handed to the Context's deferred release (see context.h) and
@@ -147,8 +147,8 @@ struct DenoiseHistory {
   // Scalar: RG16F (mean, frames accumulated). Rgb and Reflection: RGBA16F (mean colour, frames accumulated).
   VkImageView mean = VK_NULL_HANDLE;
   VkImage meanImage = VK_NULL_HANDLE;  // the image of `mean`, for a copy or a debug view's readback
-  // Scalar: R32F (view distance of each pixel's surface). Rgb and Reflection: RG32F (view distance, variance of one
-  // frame's colour).
+  // Scalar: R16F (view distance of each pixel's surface). Rgb and Reflection: RG16F (view distance, standard deviation
+  // of one frame's colour).
   VkImageView distance = VK_NULL_HANDLE;
   // Scalar only: RG16F, the latest temporal result (value, variance of its noise). VK_NULL_HANDLE otherwise.
   VkImageView noise = VK_NULL_HANDLE;

@@ -62,7 +62,7 @@ struct Denoiser::Impl {
   ComputePipeline temporal, atrous;
   ComputePipeline atrousFinal;  // Scalar: the last a-trous step (writes the output)
   VkSampler sampler = VK_NULL_HANDLE;
-  // Scalar: 0,1: history ping-pong (RG16F: mean, frames); 2,3: view distance ping-pong (R32F); 4: this frame's
+  // Scalar: 0,1: history ping-pong (RG16F: mean, frames); 2,3: view distance ping-pong (R16F); 4: this frame's
   // temporal result (RG16F: value, noise variance); 5 and 7: the a-trous ping-pong (RG16F, 7 only for three steps
   // or more); 6: the output (R16F). Rgb: see recordRgb.
   PassImages images;
@@ -92,18 +92,21 @@ namespace {
 
 // The images of either path. Their set never depends on the settings, so the output (Scalar: image 6, Rgb: image
 // 5) stays the same image from prepare() or the first record() until the size changes. Scalar: see Impl::images;
-// Rgb: see recordRgb.
+// Rgb: see recordRgb. The view distances are half floats: the reprojection's same-surface test allows 2% and a half
+// float holds a distance to 0.05% (to 65,504 m from the camera; farther reads as another surface: no history), and
+// the RGB path keeps a standard deviation there, not a variance (whose HDR values overflow a half float; issue 30: 8
+// and 16 bytes per pixel less).
 std::vector<PassImages::Spec> imageSpecs(DenoiseSignal signal) {
   if (signal == DenoiseSignal::Scalar) {
     return {{VK_FORMAT_R16G16_SFLOAT, "denoiser history A"}, {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},
-            {VK_FORMAT_R32_SFLOAT, "denoiser distance A"},   {VK_FORMAT_R32_SFLOAT, "denoiser distance B"},
+            {VK_FORMAT_R16_SFLOAT, "denoiser distance A"},   {VK_FORMAT_R16_SFLOAT, "denoiser distance B"},
             {VK_FORMAT_R16G16_SFLOAT, "denoiser temporal"},  {VK_FORMAT_R16G16_SFLOAT, "denoiser spatial A"},
             {VK_FORMAT_R16_SFLOAT, "denoiser output"}};
   }
   return {{VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history A"},
           {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history B"},
-          {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB surface A"},
-          {VK_FORMAT_R32G32_SFLOAT, "denoiser RGB surface B"},
+          {VK_FORMAT_R16G16_SFLOAT, "denoiser RGB surface A"},
+          {VK_FORMAT_R16G16_SFLOAT, "denoiser RGB surface B"},
           {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial A"},
           {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial B"},
           {VK_FORMAT_R32G32_UINT, "denoiser RGB guide"}};
@@ -234,10 +237,10 @@ namespace {
 Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
                  const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags) {
   Context& ctx = s.ctx;
-  // 0,1: colour history ping-pong (rgb mean, a frames); 2,3: surface ping-pong (view distance, variance of one
-  // frame's colour: RG32F, a variance of HDR values overflows half floats); 4,5: the temporal result and the
-  // a-trous ping-pong (rgb, a: the colour's standard deviation; a = 1 in the output); 6: the guide (distance and
-  // normal, see denoise_rgb_common.glsl).
+  // 0,1: colour history ping-pong (rgb mean, a frames); 2,3: surface ping-pong (view distance, standard deviation
+  // of one frame's colour: RG16F, the deviation because a variance of HDR values overflows half floats); 4,5: the
+  // temporal result and the a-trous ping-pong (rgb, a: the colour's standard deviation; a = 1 in the output); 6: the
+  // guide (distance and normal, see denoise_rgb_common.glsl).
   if (Status st = ensureImages(s, g.width, g.height); !st) return st;
   const PassImages& im = s.images;
   const DeviceFunctions& vk = internal::deviceFunctions(ctx);
