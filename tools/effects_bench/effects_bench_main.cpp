@@ -35,8 +35,8 @@ nlohmann::json vec(const glm::vec3& v) { return {v.x, v.y, v.z}; }
 // self-checks still have a "fewest" and a "most" row, in well under a minute with validation on lavapipe.
 // The mechanisms the motion scenario's command line turns off or on.
 MotionSwitches switchesOf(const Options& o) {
-  return {o.noAntiLag,   o.noChangeResets,  o.convergedTiles,    o.noShortHistoryFilter,
-          o.noResetRays, o.resetRaysFactor, o.reflectionChanges, o.resetFollowUp};
+  return {o.noAntiLag,   o.noChangeResets,  o.convergedTiles,      o.noShortHistoryFilter,
+          o.noResetRays, o.resetRaysFactor, o.noReflectionChanges, o.resetFollowUp};
 }
 
 SweepPlan makePlan(const Options& o, bool cpu, uint32_t width, uint32_t height) {

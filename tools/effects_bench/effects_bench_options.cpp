@@ -82,9 +82,9 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_flag("--no-reset-rays", o.noResetRays,
                "motion: soft shadows and AO trace their own rays where a change restarts the history\n"
                "(Shadow/AoEffectSettings::disableResetRays)");
-  app.add_flag("--reflection-changes", o.reflectionChanges,
-               "motion: reflections restart where a ray hits a changed light's reach\n"
-               "(ReflectionEffectSettings::relitResets)");
+  app.add_flag("--no-reflection-changes", o.noReflectionChanges,
+               "motion: reflections do not restart where a ray hits a changed light's reach\n"
+               "(ReflectionEffectSettings::disableRelitResets)");
   app.add_option("--reset-rays-factor", o.resetRaysFactor,
                  "motion: soft shadows and AO trace F x their rays where a change restarts the history\n"
                  "(RaySchedule::resetRays; default: rb::kDefaultResetRaysFactor)")

@@ -21,7 +21,7 @@ struct Options {
   bool noAntiLag = false;             // motion: DenoiseSettings::disableAntiLag
   bool noShortHistoryFilter = false;  // motion: AoEffectSettings::disableShortHistoryFilter
   bool noResetRays = false;           // motion: Shadow/AoEffectSettings::disableResetRays
-  bool reflectionChanges = false;     // motion: ReflectionEffectSettings::relitResets
+  bool noReflectionChanges = false;   // motion: ReflectionEffectSettings::disableRelitResets
   uint32_t resetRaysFactor = 0;       // motion: RaySchedule::resetRays = this x the rays; 0 = the SDK's default
   // motion: HybridEffectsDesc::resetFollowUpFrames (0 = disableResetFollowUp); not given = the SDK's default
   std::optional<uint32_t> resetFollowUp;

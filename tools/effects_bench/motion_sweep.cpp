@@ -45,6 +45,13 @@ const MotionEffect kEffects[] = {
 constexpr float kChangeThreshold = 0.2f;
 // Lag: the changed pixels' error is back when it is within this factor of the still sequence's.
 constexpr double kLagFactor = 1.5;
+// An RMSE below this is no error: the rounding of the half-float outputs. Where the still sequence's error is 0 (the
+// local lights traced exactly at 4 and more rays), the moved one is back once it is below this too; until 2026-12-06
+// a still error of 0 gave a ratio of 0, read as "lag 0" however wrong the moved frames were.
+constexpr double kErrorFloor = 1e-4;
+
+// The moved sequence's error over the still one's, each at least kErrorFloor.
+double errorRatio(double moved, double still) { return std::max(moved, kErrorFloor) / std::max(still, kErrorFloor); }
 
 enum class Kind { Still, Camera, Event, Steady };
 
@@ -185,7 +192,7 @@ se::Status Runner::setDesc(uint32_t rays, bool reference) {
   d.ao.disableShortHistoryFilter = plan_.switches.disableShortHistoryFilter;
   d.ao.disableResetRays = plan_.switches.disableResetRays;
   d.shadows.disableResetRays = plan_.switches.disableResetRays;
-  d.reflections.relitResets = plan_.switches.reflectionChanges;
+  d.reflections.disableRelitResets = plan_.switches.noReflectionChanges;
   if (plan_.switches.resetRaysFactor && !reference) {
     d.shadows.schedule.resetRays = plan_.switches.resetRaysFactor * rays;
     d.ao.schedule.resetRays = plan_.switches.resetRaysFactor * rays;
@@ -338,7 +345,7 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
     for (uint32_t k = ev; k < m; ++k) {
       moved.push_back(rmseOver(frames[k].effects.at(e.name), refs[k].effects.at(e.name), ch));
       still.push_back(rmseOver(control[k].effects.at(e.name), refs[k].effects.at(e.name), ch));
-      ratio.push_back(still.back() > 0.0 ? moved.back() / still.back() : 0.0);
+      ratio.push_back(errorRatio(moved.back(), still.back()));
       if (lag.is_null() && ratio.back() <= kLagFactor) lag = k - ev;
     }
     j["event"] = {{"changed_pixels", count(ch)},
@@ -356,7 +363,7 @@ nlohmann::json Runner::score(const Case& c, const MotionEffect& e, const std::ve
     j["steady"] = {{"pixels", count(pixels)},
                    {"rmse_moving", moving},
                    {"rmse_at_rest", rest},
-                   {"ratio", rest > 0.0 ? nlohmann::json(moving / rest) : nlohmann::json(nullptr)}};
+                   {"ratio", errorRatio(moving, rest)}};
   }
   return j;
 }
@@ -518,7 +525,7 @@ se::Result<nlohmann::json> runMotionScenario(FrameDriver& driver, const MotionSc
                {"converged_tiles", plan.switches.convergedTiles},
                {"short_history_filter", !plan.switches.disableShortHistoryFilter},
                {"reset_rays", !plan.switches.disableResetRays},
-               {"reflection_relit_resets", plan.switches.reflectionChanges},
+               {"reflection_relit_resets", !plan.switches.noReflectionChanges},
                {"reset_rays_factor", plan.switches.disableResetRays  ? 0u
                                      : plan.switches.resetRaysFactor ? plan.switches.resetRaysFactor
                                                                      : rb::kDefaultResetRaysFactor},

@@ -27,9 +27,9 @@ struct MotionSwitches {
   bool convergedTiles = false;       // --converged-tiles: every effect skips its converged tiles (not the reference)
   // --no-short-history-filter: AoEffectSettings::disableShortHistoryFilter
   bool disableShortHistoryFilter = false;
-  bool disableResetRays = false;   // --no-reset-rays: Shadow/AoEffectSettings::disableResetRays
-  uint32_t resetRaysFactor = 0;    // --reset-rays-factor F: RaySchedule::resetRays = F x the rays; 0 = the default
-  bool reflectionChanges = false;  // --reflection-changes: ReflectionEffectSettings::relitResets
+  bool disableResetRays = false;     // --no-reset-rays: Shadow/AoEffectSettings::disableResetRays
+  uint32_t resetRaysFactor = 0;      // --reset-rays-factor F: RaySchedule::resetRays = F x the rays; 0 = the default
+  bool noReflectionChanges = false;  // --no-reflection-changes: ReflectionEffectSettings::disableRelitResets
   // --reset-follow-up N: HybridEffectsDesc::resetFollowUpFrames (0 = disableResetFollowUp); not given = the default
   std::optional<uint32_t> resetFollowUp;
 };

@@ -394,9 +394,9 @@ void addScheduleOptions(CLI::App& app, RenderOptions& o) {
   app.add_flag("--no-reset-rays", o.noResetRays,
                "soft shadows and AO: trace their own rays per pixel where a change restarts the\n"
                "history too (Shadow/AoEffectSettings::disableResetRays; to measure what reset rays buy)");
-  app.add_flag("--reflection-changes", o.reflectionChanges,
-               "reflections: restart the history where a reflection ray hits the reach of a local\n"
-               "light that changed (ReflectionEffectSettings::relitResets)");
+  app.add_flag("--no-reflection-changes", o.noReflectionChanges,
+               "reflections: do not restart the history where a reflection ray hits the reach of a\n"
+               "local light that changed (ReflectionEffectSettings::disableRelitResets)");
   app.add_option("--reset-rays", o.resetRays,
                  "soft shadows and AO: rays per pixel where a change restarts the history\n"
                  "(RaySchedule::resetRays; default: rb::kDefaultResetRaysFactor x their rays)")
@@ -590,7 +590,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
     h.resetFollowUpFrames = *o.resetFollowUp;
     h.disableResetFollowUp = *o.resetFollowUp == 0u;
   }
-  h.reflections.relitResets = o.reflectionChanges;
+  h.reflections.disableRelitResets = o.noReflectionChanges;
   h.ao.schedule.adaptive.enabled = o.adaptiveAoMs.has_value();
   h.ao.schedule.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
   h.ao.schedule.adaptive.granularity = o.adaptiveGranularity;
@@ -654,8 +654,8 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
   if (o.resetRays && o.noResetRays) return "--reset-rays and --no-reset-rays: give one of them";
   if (o.resetFollowUp && o.noResetRays)
     return "--reset-follow-up: follow-ups trace the reset rays, which --no-reset-rays turns off; give one of them";
-  if (o.reflectionChanges && (!o.denoise || o.mode != Mode::Hybrid))
-    return "--reflection-changes: only --mode hybrid's denoised reflections have a history to restart";
+  if (o.noReflectionChanges && (!o.denoise || o.mode != Mode::Hybrid))
+    return "--no-reflection-changes: only --mode hybrid's denoised reflections have a history to restart";
   if (o.noResetRays && !o.denoise)
     return "--no-reset-rays: reset rays restart a denoiser's history, which --no-denoise turns off; give one of them";
   if (o.noResetRays && o.mode != Mode::Hybrid)

@@ -66,8 +66,8 @@ struct RenderOptions {
   bool noShortHistoryFilter = false;
   // --no-reset-rays: HybridEffectsDesc::shadows and ao.disableResetRays (to measure what reset rays buy).
   bool noResetRays = false;
-  // --reflection-changes: HybridEffectsDesc::reflections.relitResets.
-  bool reflectionChanges = false;
+  // --no-reflection-changes: HybridEffectsDesc::reflections.disableRelitResets.
+  bool noReflectionChanges = false;
   // --reset-rays N: HybridEffectsDesc::shadows and ao.schedule.resetRays (0 = the SDK's default).
   uint32_t resetRays = 0;
   // --reset-follow-up N: HybridEffectsDesc::resetFollowUpFrames (0 = disableResetFollowUp); not given = the default.

@@ -155,15 +155,14 @@ struct ReflectionEffectSettings {
   // output then holds kept-history marks there, a = -1, the denoised one is complete; needs the effect's
   // denoiser). schedule.history is set to the effect's denoiser (a value given is ignored).
   RaySchedule schedule{};
-  // true = the reflection rays test the reach of every local light that changed this frame
+  // Light resets (on by default): the reflection rays test the reach of every local light that changed this frame
   // (ReflectionSettings::relitBoxes) and the denoiser restarts the pixels whose reflection hit lies in one: a lamp that
-  // moved or switched, seen in a mirror, which anti-lag can miss. With change resets on and the denoiser, at full
-  // resolution; moved objects are left to anti-lag (src/frontend/effect_schedule.h says why). false (default) =
-  // reflections follow every change by anti-lag alone. Off by default because it is not yet a clear gain: on the
-  // motion bench's lamp jump (lavapipe, 160x90, docs/effects.md "Motion") it lowered the mean reflection error at 4
-  // and 16 rays (0.0215 -> 0.0164, 0.0214 -> 0.0181) but lengthened the lag at 1 ray (2 -> 6 frames) and tripled the
-  // flicker; it has not been measured on a GPU.
-  bool relitResets = false;
+  // moved or switched, seen in a mirror, which anti-lag alone follows over many frames. With change resets on and the
+  // denoiser, at full resolution; moved objects are left to anti-lag (src/frontend/effect_schedule.h says why). On the
+  // motion bench's lamp jump at 2560x1440 (H100, 2026-12-06, docs/effects.md "Motion") the reflections' lag went from
+  // more than 6 frames to 2 at 1, 4 and 16 rays and their mean error down by a fifth; their flicker rose to 0.5-0.7x
+  // the reference's (0.2x without). true = reflections follow every change by anti-lag alone.
+  bool disableRelitResets = false;
 };
 
 struct LocalLightEffectSettings {

@@ -93,8 +93,8 @@ struct ReflectionSettings {
   // reads; full resolution only). Zero = every pixel traces its rays.
   RaySchedule schedule{};
   // Where the world changed since the last frame, in world space (HybridEffects hands over the reach of every local
-  // light that changed as relitBoxes with ReflectionEffectSettings::relitResets). A reflection shows a change the
-  // pixel's own surface does not: the lamp that moved, seen in a mirror. So the rays test them: a pixel whose
+  // light that changed as relitBoxes unless ReflectionEffectSettings::disableRelitResets). A reflection shows a change
+  // the pixel's own surface does not: the lamp that moved, seen in a mirror. So the rays test them: a pixel whose
   // reflection ray crosses a box of changedBoxes (an object moved into or out of its path), or whose hit's sun ray
   // does (a moved object's shadow seen in the mirror), or whose hit lies in a box of relitBoxes (the reach of a light
   // that moved, switched or changed), writes a = 2: its history is stale, and the Denoiser filtering the output

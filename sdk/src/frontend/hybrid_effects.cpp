@@ -472,7 +472,8 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.lighting = reflectionLighting(f);
   // The light changes a reflection shows, where the change resets run (the denoiser then drops those pixels'
   // history; effect_schedule.h says why lights only).
-  if (reflectionDenoiser && desc.reflections.relitResets && (changeMaskEffects() & RB_CHANGE_REFLECTIONS) != 0u) {
+  if (reflectionDenoiser && !desc.reflections.disableRelitResets &&
+      (changeMaskEffects() & RB_CHANGE_REFLECTIONS) != 0u) {
     reflectionRelitBoxes(changes.boxes(), reflectionRelit);
     s.relitBoxes = reflectionRelit;
   }
