@@ -12,15 +12,17 @@ using namespace rbtest;
 namespace {
 
 // docs/integration.md, "Memory by effect": bytes of pass images per pixel of the G-buffer, `high` with local lights.
-// Shadows: visibility R16F (2) + the scalar denoiser (history 2 x RG16F, view distance 2 x R16F, temporal RG16F,
-// a-trous ping RG16F, output R16F: 22). AO: the same, plus its half-resolution samples R16F at a quarter of the
-// pixels. Reflections and local lights: radiance RGBA16F (8) + the RGB denoiser (history 2 x RGBA16F, surface
-// 2 x RG16F, a-trous ping-pong 2 x RGBA16F, guide RG32UI: 48). Shared: one R8 change mask per denoised effect.
-constexpr uint64_t kShadowBytesPerPixel = 24;
-constexpr uint64_t kAoBytesPerPixel = 24;
+// Shadows: visibility R16F (2) + the scalar denoiser's own images (history 2 x RG16F, view distance 2 x R16F,
+// temporal RG16F, output R16F: 18). AO: the same, plus its half-resolution samples R16F at a quarter of the pixels.
+// Reflections and local lights: radiance RGBA16F (8) + the RGB denoiser's own (history 2 x RGBA16F, surface 2 x RG16F,
+// output RGBA16F: 32). Shared: one R8 change mask per denoised effect, and the denoisers' one DenoiserScratch (scalar
+// a-trous ping RG16F, RGB a-trous ping RGBA16F, RGB guide RG32UI: 20).
+constexpr uint64_t kShadowBytesPerPixel = 20;
+constexpr uint64_t kAoBytesPerPixel = 20;
 constexpr uint64_t kAoHalfResolutionBytesPerSample = 2;
-constexpr uint64_t kRgbEffectBytesPerPixel = 56;
+constexpr uint64_t kRgbEffectBytesPerPixel = 40;
 constexpr uint64_t kChangeMaskBytesPerPixel = 1;
+constexpr uint64_t kDenoiserScratchBytesPerPixel = 20;
 
 std::vector<rb::LightSource> twoLamps() {
   std::vector<rb::LightSource> lights(2);
@@ -111,7 +113,7 @@ TEST_CASE("memory by effect follows the documented formula at two resolutions", 
     CHECK(images(e.ao) == kAoBytesPerPixel * pixels + kAoHalfResolutionBytesPerSample * (w / 2) * (h / 2));
     CHECK(images(e.reflections) == kRgbEffectBytesPerPixel * pixels);
     CHECK(images(e.localLights) == kRgbEffectBytesPerPixel * pixels);
-    CHECK(images(e.shared) == 4 * kChangeMaskBytesPerPixel * pixels);
+    CHECK(images(e.shared) == (4 * kChangeMaskBytesPerPixel + kDenoiserScratchBytesPerPixel) * pixels);
     // The sum is the Context's pass memory: nothing of HybridEffects is left unattributed.
     for (rb::MemoryCategory c :
          {rb::MemoryCategory::ShaderTables, rb::MemoryCategory::PassImages, rb::MemoryCategory::PassBuffers})

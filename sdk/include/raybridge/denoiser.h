@@ -18,15 +18,16 @@
 // value by at most as much as its noise explains (one standard deviation, falling off beyond, and less where the
 // previous steps changed the neighbourhood by more than its noise: a pattern finer than the filter), and not at all
 // where the noise is under DenoiseSettings::convergedNoise: converged or many-ray signals pass bit for bit. One
-// temporal and spatialIterations a-trous dispatches (3 dispatches by default); 22 bytes of images per pixel (26 with
-// three or more steps; 77 MiB at 2560x1440).
+// temporal and spatialIterations a-trous dispatches (3 dispatches by default); 18 bytes of images per pixel of its own
+// (63 MiB at 2560x1440) and 4 transient ones (8 with three or more steps) in a DenoiserScratch, its own or shared.
 //
 // RGB and reflection signals (SVGF-style, Schied et al. 2017): the temporal pass reprojects bilinearly and keeps,
 // beside the mean colour, the running variance of one frame's colour (from the 3x3 windows around the pixel while the
 // history is shorter than 4 frames); the a-trous steps (3x3 taps, 5 by default) stop at colour differences larger
 // than the remaining noise of the mean, so a converged or noise-free signal passes nearly unchanged, and filter
 // in the signal's own domain (no albedo demodulation: ManyLightPass's irradiance has none). One temporal and
-// DenoiseSettings::spatialIterations a-trous dispatches; 48 bytes of images per pixel (169 MiB at 2560x1440).
+// DenoiseSettings::spatialIterations a-trous dispatches; 32 bytes of images per pixel of its own (113 MiB at 2560x1440)
+// and 16 transient ones in a DenoiserScratch, its own or shared.
 //
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipelines, history and
 // output images and measurement objects are handed to the Context's deferred release (see context.h) and
@@ -118,6 +119,29 @@ struct DenoiseSettings {
   uint32_t resetFrames = 0;
 };
 
+// The transient images of denoisers that share them: the a-trous ping-pong images and the RGB guide, which each
+// record() writes before it reads them and which nothing reads after it (issue 30: 16 bytes per pixel of each RGB
+// denoiser, 4 of each scalar one). Denoisers recorded one after another into command buffers that run in submission
+// order on one queue may share one: each record() orders its first write after the previous one's reads. HybridEffects
+// shares one among its denoisers. Holds one image per kind at the size last asked for (a record() at another size
+// replaces it: share one among denoisers of one size). Created empty; its images count to the Context's PassImages.
+// Lifetime: as a Denoiser's (deferred release), and it must outlive the denoisers' records that name it.
+// Thread safety: externally synchronised, together with every Denoiser that records with it.
+class DenoiserScratch {
+ public:
+  static Result<std::unique_ptr<DenoiserScratch>> create(Context& context);
+  ~DenoiserScratch();
+  DenoiserScratch(const DenoiserScratch&) = delete;
+  DenoiserScratch& operator=(const DenoiserScratch&) = delete;
+
+  struct Impl;  // opaque
+
+ private:
+  friend struct internal::ContextAccess;
+  explicit DenoiserScratch(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
 // What one record() filters. The G-buffer and signal have no defaults: a zero-initialised frame is refused by name.
 struct DenoiseFrame {
   GBufferDesc gbuffer{};  // the one the signal was traced from
@@ -129,6 +153,8 @@ struct DenoiseFrame {
   //        (GBufferDesc::roughnessInNormalW or roughnessMetalness), that of the reflection rays.
   VkImageView signal = VK_NULL_HANDLE;
   DenoiseSettings settings{};
+  // Transient images shared with other denoisers (DenoiserScratch); nullptr = the denoiser's own.
+  DenoiserScratch* scratch = nullptr;
 };
 
 // Owned by the denoiser, left in SHADER_READ_ONLY_OPTIMAL after record().

@@ -275,8 +275,9 @@ struct HybridOutputs {
 // HybridEffects' device memory by effect (HybridEffects::memoryByEffect), in the Context's pass categories
 // (ShaderTables, PassImages, PassBuffers; the others are 0): each effect's pass, its denoiser and its ray schedule's
 // images and buffers (local lights: their light list too). `shared`: what serves several effects (the change masks,
-// the material table, the neutral images named for effects that are off). The total equals memoryStats() when no other
-// HybridEffects or engine-made pass shares the Context. `allocations`: the live allocations of each.
+// the material table, the neutral images named for effects that are off, the denoisers' one DenoiserScratch). The total
+// equals memoryStats() when no other HybridEffects or engine-made pass shares the Context. `allocations`: the live
+// allocations of each.
 struct EffectMemoryStats {
   MemoryStats shadows, ao, reflections, localLights, shared;
   MemoryStats total() const {

@@ -13,6 +13,11 @@ namespace internal {
 struct ContextAccess {
   static Context::Impl& impl(Context& ctx) { return *ctx.impl_; }
   static const Context::Impl& impl(const Context& ctx) { return *ctx.impl_; }
+  // The Impl of another public SDK type that befriends ContextAccess (DenoiserScratch).
+  template <typename T>
+  static typename T::Impl& implOf(T& object) {
+    return *object.impl_;
+  }
 };
 
 inline Context::Impl& contextImpl(Context& ctx) { return ContextAccess::impl(ctx); }

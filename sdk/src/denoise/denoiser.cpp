@@ -8,6 +8,7 @@
 #include "context_impl.h"
 #include "denoise_rgb_interface.glsl"
 #include "denoiser_history.h"
+#include "denoiser_scratch.h"
 #include "gbuffer_sampler.h"
 #include "image_barriers.h"
 #include "initial_extent.h"
@@ -62,11 +63,13 @@ struct Denoiser::Impl {
   ComputePipeline temporal, atrous;
   ComputePipeline atrousFinal;  // Scalar: the last a-trous step (writes the output)
   VkSampler sampler = VK_NULL_HANDLE;
-  // Scalar: 0,1: history ping-pong (RG16F: mean, frames); 2,3: view distance ping-pong (R16F); 4: this frame's
-  // temporal result (RG16F: value, noise variance); 5 and 7: the a-trous ping-pong (RG16F, 7 only for three steps
-  // or more); 6: the output (R16F). Rgb: see recordRgb.
+  // The images a record() leaves for later readers (the next frame, the engine, the ray schedule), numbered as the
+  // record paths number them (recordScalar, recordRgb), the transient ones (DenoiserScratch) left out. Scalar: 0,1:
+  // history ping-pong (RG16F: mean, frames); 2,3: view distance ping-pong (R16F); 4: this frame's temporal result
+  // (RG16F: value, noise variance); then the output (R16F, image 6). Rgb: 0-3 as recordRgb, then the output (5).
   PassImages images;
-  PassImages extraSpatial;  // Scalar: the second a-trous image (7), only for three steps or more
+  // The transient images when the frame brings no shared DenoiserScratch (created on first use).
+  std::unique_ptr<DenoiserScratch> ownScratch;
   PassMetrics metrics;
   DenoiseOutputs outputs;
   uint32_t parity = 0;  // which of each ping-pong pair this frame writes
@@ -83,15 +86,16 @@ struct Denoiser::Impl {
     atrousFinal.retire(ctx);
     internal::contextImpl(ctx).retireHandle(sampler, &DeviceFunctions::vkDestroySampler);
     images.retire(ctx);
-    extraSpatial.retire(ctx);
+    ownScratch.reset();  // retires its images
     metrics.retire(ctx);
   }
 };
 
 namespace {
 
-// The images of either path. Their set never depends on the settings, so the output (Scalar: image 6, Rgb: image
-// 5) stays the same image from prepare() or the first record() until the size changes. Scalar: see Impl::images;
+// The persistent images of either path (Impl::images). Their set never depends on the settings, so the output
+// (Scalar: image 6, Rgb: image 5; persistent images 5 and 4) stays the same image from prepare() or the first
+// record() until the size changes. The transient ones come from a DenoiserScratch. Scalar: see Impl::images;
 // Rgb: see recordRgb. The view distances are half floats: the reprojection's same-surface test allows 2% and a half
 // float holds a distance to 0.05% (to 65,504 m from the camera; farther reads as another surface: no history), and
 // the RGB path keeps a standard deviation there, not a variance (whose HDR values overflow a half float; issue 30: 8
@@ -100,16 +104,13 @@ std::vector<PassImages::Spec> imageSpecs(DenoiseSignal signal) {
   if (signal == DenoiseSignal::Scalar) {
     return {{VK_FORMAT_R16G16_SFLOAT, "denoiser history A"}, {VK_FORMAT_R16G16_SFLOAT, "denoiser history B"},
             {VK_FORMAT_R16_SFLOAT, "denoiser distance A"},   {VK_FORMAT_R16_SFLOAT, "denoiser distance B"},
-            {VK_FORMAT_R16G16_SFLOAT, "denoiser temporal"},  {VK_FORMAT_R16G16_SFLOAT, "denoiser spatial A"},
-            {VK_FORMAT_R16_SFLOAT, "denoiser output"}};
+            {VK_FORMAT_R16G16_SFLOAT, "denoiser temporal"},  {VK_FORMAT_R16_SFLOAT, "denoiser output"}};
   }
   return {{VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history A"},
           {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB history B"},
           {VK_FORMAT_R16G16_SFLOAT, "denoiser RGB surface A"},
           {VK_FORMAT_R16G16_SFLOAT, "denoiser RGB surface B"},
-          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial A"},
-          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial B"},
-          {VK_FORMAT_R32G32_UINT, "denoiser RGB guide"}};
+          {VK_FORMAT_R16G16B16A16_SFLOAT, "denoiser RGB spatial B"}};
 }
 
 // DenoiseSettings::maxHistoryFrames with its default; one frame without temporal filtering.
@@ -120,6 +121,33 @@ uint32_t historyFrames(const DenoiseSettings& s) {
 
 constexpr uint32_t kScalarOutputImage = 6;
 constexpr uint32_t kRgbOutputImage = 5;
+// The output's place among the persistent images (Impl::images).
+constexpr uint32_t kScalarOutputPersistent = 5;
+constexpr uint32_t kRgbOutputPersistent = 4;
+
+// A record path's images by number: the persistent ones (Impl::images) and the transient ones of the scratch, in the
+// numbering of the comments of recordScalar and recordRgb.
+struct ImageSlots {
+  const GpuImage* slot[8] = {};
+  uint32_t count = 0;
+  const GpuImage& operator[](size_t i) const { return *slot[i]; }
+  size_t size() const { return count; }
+};
+
+// The scratch a record uses: the frame's shared one, else the denoiser's own (created on first use; retired once a
+// shared one is given, so no byte is held twice).
+Result<DenoiserScratch::Impl*> scratchFor(Denoiser::Impl& s, DenoiserScratch* shared) {
+  if (shared) {
+    s.ownScratch.reset();
+    return &internal::scratchImpl(*shared);
+  }
+  if (!s.ownScratch) {
+    auto made = DenoiserScratch::create(s.ctx);
+    if (!made) return made.error();
+    s.ownScratch = std::move(made.value());
+  }
+  return &internal::scratchImpl(*s.ownScratch);
+}
 
 // Creates the images at width x height unless they exist at that size, and names the output in s.outputs. New
 // images (a new size, or a set an earlier failure left incomplete) hold no history.
@@ -129,7 +157,7 @@ Status ensureImages(Denoiser::Impl& s, uint32_t width, uint32_t height) {
   if (recreated) s.imagesWritten = false;  // even when ensure() fails: it replaces what there was
   if (Status st = s.images.ensure(s.ctx, width, height, specs); !st) return st;
   if (recreated) s.historyValid = false;
-  const GpuImage& out = s.images[s.signal == DenoiseSignal::Scalar ? kScalarOutputImage : kRgbOutputImage];
+  const GpuImage& out = s.images[s.signal == DenoiseSignal::Scalar ? kScalarOutputPersistent : kRgbOutputPersistent];
   s.outputs.denoised = out.image;
   s.outputs.denoisedView = out.view;
   s.outputs.width = width;
@@ -235,14 +263,26 @@ namespace {
 // a-trous weights need (with disableTemporal it ignores the history). The a-trous steps then ping-pong between
 // the two spatial images, the temporal result being the first of them; the last dispatch writes a = 1.
 Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
-                 const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags) {
+                 const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags, DenoiserScratch* shared) {
   Context& ctx = s.ctx;
   // 0,1: colour history ping-pong (rgb mean, a frames); 2,3: surface ping-pong (view distance, standard deviation
   // of one frame's colour: RG16F, the deviation because a variance of HDR values overflows half floats); 4,5: the
   // temporal result and the a-trous ping-pong (rgb, a: the colour's standard deviation; a = 1 in the output); 6: the
   // guide (distance and normal, see denoise_rgb_common.glsl).
   if (Status st = ensureImages(s, g.width, g.height); !st) return st;
-  const PassImages& im = s.images;
+  Result<DenoiserScratch::Impl*> scratch = scratchFor(s, shared);
+  if (!scratch) return scratch.error();
+  Result<const GpuImage*> ping = scratch.value()->image(DenoiserScratch::Impl::kRgbPing, g.width, g.height);
+  if (!ping) return ping.error();
+  Result<const GpuImage*> guide = scratch.value()->image(DenoiserScratch::Impl::kRgbGuide, g.width, g.height);
+  if (!guide) return guide.error();
+  // 4 and 6 are the scratch's (transient: written here before they are read, read by nothing after).
+  ImageSlots im;
+  for (uint32_t i = 0; i < 4; ++i) im.slot[i] = &s.images[i];
+  im.slot[4] = ping.value();
+  im.slot[5] = &s.images[kRgbOutputPersistent];
+  im.slot[6] = guide.value();
+  im.count = 7;
   const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   const uint32_t cur = s.parity, prev = 1 - s.parity;
 
@@ -333,34 +373,36 @@ Status recordRgb(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, V
   return {};
 }
 
-// The scalar path's images by number: the fixed set, then the optional second a-trous image as number 7.
-struct ScalarImages {
-  const PassImages& fixed;
-  const PassImages& extra;
-  const GpuImage& operator[](size_t i) const { return i < fixed.size() ? fixed[i] : extra[i - fixed.size()]; }
-  size_t size() const { return fixed.size() + extra.size(); }
-};
 
 // The scalar path (DenoiseSignal::Scalar). The temporal pass always runs: it measures the noise the a-trous
 // weights and the final shift need (with disableTemporal it ignores the history). Its result (value, variance)
 // stays in image 4 for the final step; the steps before it ping-pong between images 5 and 7 (7 exists only for
 // three steps or more); the final step writes the R16 output, image 6.
 Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g, VkImageView signal,
-                    const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags) {
+                    const DenoiseSettings& settings, DenoiseConstants pc, uint32_t flags, DenoiserScratch* shared) {
   Context& ctx = s.ctx;
   const uint32_t iterations = settings.disableSpatial ? 0u
                                                       : (settings.spatialIterations ? settings.spatialIterations
                                                                                     : kDefaultScalarIterations);
   if (Status st = ensureImages(s, g.width, g.height); !st) return st;
+  Result<DenoiserScratch::Impl*> scratch = scratchFor(s, shared);
+  if (!scratch) return scratch.error();
+  // Images 0-6, then 7 (the second a-trous image) where there are three steps or more; 5 and 7 are the scratch's.
+  ImageSlots im;
+  for (uint32_t i = 0; i < 5; ++i) im.slot[i] = &s.images[i];
+  Result<const GpuImage*> ping = scratch.value()->image(DenoiserScratch::Impl::kScalarPing, g.width, g.height);
+  if (!ping) return ping.error();
+  im.slot[5] = ping.value();
+  im.slot[6] = &s.images[kScalarOutputPersistent];
+  im.count = 7;
   if (iterations >= 3) {
-    if (Status st = s.extraSpatial.ensure(ctx, g.width, g.height, {{VK_FORMAT_R16G16_SFLOAT, "denoiser spatial B"}});
-        !st)
-      return st;
-  } else {
-    s.extraSpatial.retire(ctx);  // no byte that no step reads
+    Result<const GpuImage*> pong = scratch.value()->image(DenoiserScratch::Impl::kScalarPong, g.width, g.height);
+    if (!pong) return pong.error();
+    im.slot[7] = pong.value();
+    im.count = 8;
+  } else if (!shared) {
+    scratch.value()->release(DenoiserScratch::Impl::kScalarPong);  // its own: no byte that no step reads
   }
-  // Images 0-6, then 7 (the second a-trous image) where there are three steps or more.
-  ScalarImages im{s.images, s.extraSpatial};
   const DeviceFunctions& vk = internal::deviceFunctions(ctx);
   const uint32_t cur = s.parity, prev = 1 - s.parity;
 
@@ -524,7 +566,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const DenoiseFrame& frame) {
   if (!settings.disableAntiLag) flags |= RB_DN_ANTI_LAG;
   if (settings.shortHistoryFilter) flags |= RB_DN_SHORT_HISTORY;
   if (s.signal != DenoiseSignal::Scalar) {
-    Status st = recordRgb(s, cmd, g, signal, settings, pc, flags);
+    Status st = recordRgb(s, cmd, g, signal, settings, pc, flags, frame.scratch);
     if (st) {
       std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
       std::memcpy(s.previousCamera, camera, sizeof camera);
@@ -532,7 +574,7 @@ Status Denoiser::record(VkCommandBuffer cmd, const DenoiseFrame& frame) {
     return st;
   }
 
-  Status st = recordScalar(s, cmd, g, signal, settings, pc, flags);
+  Status st = recordScalar(s, cmd, g, signal, settings, pc, flags, frame.scratch);
   if (st) {
     std::memcpy(s.previousViewProjection, viewProjection, sizeof viewProjection);
     std::memcpy(s.previousCamera, camera, sizeof camera);

@@ -127,6 +127,10 @@ struct HybridEffects::Impl {
   std::unique_ptr<LightList> lightList;
   std::unique_ptr<Denoiser> localLightDenoiser;
   std::unique_ptr<Denoiser> reflectionDenoiser;
+  // The denoisers' transient images, one set for all of them (recorded one after another into one command buffer):
+  // made for the first denoiser at the frame's size, under the shared memory owner; gone with the last denoiser.
+  std::unique_ptr<DenoiserScratch> denoiserScratch;
+  uint32_t frameWidth = 0, frameHeight = 0;  // the latest record()'s G-buffer
   // The engine's materials, shared by every pass: reflection hits shade with them, and shadow, AO and
   // reflection rays alpha-test non-opaque geometry with them. The table (GPU memory) exists only while a pass
   // does; the engine's last setMaterials is kept here to fill it when one is created.
@@ -297,28 +301,24 @@ struct HybridEffects::Impl {
         return create();
       };
     };
-    if (Status s = ensure(shadow, e & kEffectShadows, "ShadowPass::create",
-                          owned(kOwnShadows, [&] { return ShadowPass::create(ctx); }));
-        !s)
-      return s;
-    if (Status s = ensure(ao, e & kEffectAo, "AoPass::create", owned(kOwnAo, [&] { return AoPass::create(ctx); })); !s)
-      return s;
-    if (Status s = ensure(reflection, e & kEffectReflections, "ReflectionPass::create",
-                          owned(kOwnReflections, [&] { return ReflectionPass::create(ctx); }));
-        !s)
-      return s;
-    if (Status s = ensure(localLights, e & kEffectLocalLights, "ManyLightPass::create",
-                          owned(kOwnLocalLights, [&] { return ManyLightPass::create(ctx); }));
-        !s)
-      return s;
-    if (Status s = ensure(lightList, e & kEffectLocalLights, "LightList::create",
-                          owned(kOwnLocalLights, [&] { return LightList::create(ctx); }));
-        !s)
-      return s;
+    Status made = ensure(shadow, e & kEffectShadows, "ShadowPass::create",
+                         owned(kOwnShadows, [&] { return ShadowPass::create(ctx); }));
+    if (made) made = ensure(ao, e & kEffectAo, "AoPass::create", owned(kOwnAo, [&] { return AoPass::create(ctx); }));
+    if (made)
+      made = ensure(reflection, e & kEffectReflections, "ReflectionPass::create",
+                    owned(kOwnReflections, [&] { return ReflectionPass::create(ctx); }));
+    if (made)
+      made = ensure(localLights, e & kEffectLocalLights, "ManyLightPass::create",
+                    owned(kOwnLocalLights, [&] { return ManyLightPass::create(ctx); }));
+    if (made)
+      made = ensure(lightList, e & kEffectLocalLights, "LightList::create",
+                    owned(kOwnLocalLights, [&] { return LightList::create(ctx); }));
+    if (!made) return made;
     if (!shadow || desc.shadows.disableDenoiser) shadowDenoiser.reset();
     if (!ao || desc.ao.disableDenoiser) aoDenoiser.reset();
     if (!localLightsDenoised()) localLightDenoiser.reset();
     if (!reflection || desc.reflections.disableDenoiser) reflectionDenoiser.reset();
+    dropScratchWithoutDenoisers();
     if (changeMaskEffects() == 0u) {  // the change masks follow the denoisers (prepareOutputs sizes new ones)
       changeMasks.retire(ctx);
       changes.forget();
@@ -326,6 +326,11 @@ struct HybridEffects::Impl {
     if (Status st = syncMaterialTable(); !st) return st;
     if (Status st = prepareOutputs(); !st) return st;
     return refreshOutputs();
+  }
+
+  // No byte that nothing reads: the shared transient images go with the last denoiser.
+  void dropScratchWithoutDenoisers() {
+    if (!shadowDenoiser && !aoDenoiser && !localLightDenoiser && !reflectionDenoiser) denoiserScratch.reset();
   }
 
   // Stochastic local lights are noisy; the exact mode has no noise to remove.
@@ -342,11 +347,23 @@ struct HybridEffects::Impl {
                  uint32_t resetFrames = 0) {
     if (Status st = ensureDenoiser(slot, wanted, kind, what); !st) return st;
     if (!slot) return {};
+    // A denoiser at another size than the frame's (a reflection G-buffer of its own) keeps its own transient images,
+    // so that the shared ones are not re-created every frame.
+    DenoiserScratch* scratch = nullptr;
+    if (gbuffer.width == frameWidth && gbuffer.height == frameHeight) {
+      if (!denoiserScratch) {
+        const MemoryOwnerScope sharedScope = own(kOwnShared);
+        auto made = DenoiserScratch::create(ctx);
+        if (!made) return wrap("DenoiserScratch::create", made.error());
+        denoiserScratch = std::move(made.value());
+      }
+      scratch = denoiserScratch.get();
+    }
     DenoiseSettings d = desc.denoiser;
     d.raysPerPixel = kind == DenoiseSignal::Scalar ? rays : 0u;
     d.shortHistoryFilter = d.shortHistoryFilter || shortHistoryFilter;
     d.resetFrames = std::min(resetFrames, d.maxHistoryFrames ? d.maxHistoryFrames : kDefaultMaxHistoryFrames);
-    if (Status st = slot->record(cmd, {.gbuffer = gbuffer, .signal = signal, .settings = d}); !st)
+    if (Status st = slot->record(cmd, {.gbuffer = gbuffer, .signal = signal, .settings = d, .scratch = scratch}); !st)
       return wrap(what, st.error());
     return {};
   }
@@ -578,6 +595,8 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
     }
   }
   a.neutral.recordInit(a.ctx, cmd);
+  a.frameWidth = g.width;
+  a.frameHeight = g.height;
   if (frame.tlas && frame.tlas->tlas) {
     a.tlas = *frame.tlas;
   } else {
@@ -607,6 +626,7 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
   if (st && a.ao) st = a.recordAo(cmd, frame);
   if (st && a.localLights) st = a.recordLocalLights(cmd, frame);
   if (st && a.reflection) st = a.recordReflections(cmd, frame);
+  a.dropScratchWithoutDenoisers();  // hard shadows drop theirs frame by frame
   // A first frame of a size-following description, or the shadow effect between soft and hard, may have changed
   // the images; an error leaves the existing ones named.
   Status refreshed = a.refreshOutputs();
