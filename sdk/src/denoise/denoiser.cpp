@@ -393,7 +393,7 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
   Result<const GpuImage*> ping = scratch.value()->image(DenoiserScratch::Impl::kScalarPing, g.width, g.height);
   if (!ping) return ping.error();
   im.slot[5] = ping.value();
-  im.slot[6] = &s.images[kScalarOutputPersistent];
+  im.slot[kScalarOutputImage] = &s.images[kScalarOutputPersistent];
   im.count = 7;
   if (iterations >= 3) {
     Result<const GpuImage*> pong = scratch.value()->image(DenoiserScratch::Impl::kScalarPong, g.width, g.height);
@@ -452,7 +452,7 @@ Status recordScalar(Denoiser::Impl& s, VkCommandBuffer cmd, const GBufferDesc& g
   uint32_t input = 4;
   for (uint32_t i = 0; i < iterations; ++i) {
     const bool final = i + 1 == iterations;
-    const uint32_t out = final ? 6u : (i % 2 == 0 ? 5u : 7u);
+    const uint32_t out = final ? kScalarOutputImage : (i % 2 == 0 ? 5u : 7u);
     if (!writable[out]) {
       // Reusing the spatial image read one step earlier.
       batch.add(im[out], ro, gen, read, write);
