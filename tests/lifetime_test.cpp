@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "context_impl.h"
 #include "synthetic_gbuffer.h"
 
 using namespace rbtest;
@@ -234,6 +235,11 @@ TEST_CASE("effects front ends created and destroyed every frame, cycling all pre
     peak = std::max(peak, passBytes(fx.ctx().memoryStats()) - passBytes(start));
   }
   REQUIRE(peak > 0);
+  // memoryByEffect's owner ids are given out again once what they counted is freed: 5 per front end alive or with
+  // memory still in flight, not 5 per front end ever created.
+  const size_t owners = rb::internal::contextImpl(fx.ctx()).ownerMemory.size();
+  INFO(owners << " memory owner ids after " << frames << " front ends");
+  CHECK(owners <= 5 * (framesInFlight + 2));
 
   REQUIRE(fx.device().waitIdle().ok());
   fx.ctx().releaseAfterIdle();

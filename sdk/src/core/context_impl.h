@@ -24,13 +24,24 @@ struct Context::Impl {
   bool idleSeen = false;
   MemoryStats memory{};
   // Memory attribution (HybridEffects::memoryByEffect): what is allocated while memoryOwner is set (MemoryOwnerScope)
-  // counts to that owner too, until it is freed. Ids come from newMemoryOwner(), 0 is nobody's; an id lives as long
-  // as the Context (a MemoryStats each: a few per HybridEffects).
+  // counts to that owner too, until it is freed. Ids come from newMemoryOwner(), 0 is nobody's. A released id is given
+  // out again once everything counted to it is freed (what its owner retired may outlive it by frames in flight), so
+  // an engine that creates and destroys front ends every frame holds a bounded number of them.
   uint32_t memoryOwner = 0;
   std::vector<MemoryStats> ownerMemory;  // [id - 1]
+  std::vector<uint32_t> releasedOwners;
   uint32_t newMemoryOwner() {
+    for (auto it = releasedOwners.begin(); it != releasedOwners.end(); ++it) {
+      const uint32_t id = *it;
+      if (ownerMemory[id - 1].allocations != 0) continue;
+      releasedOwners.erase(it);
+      return id;
+    }
     ownerMemory.emplace_back();
     return uint32_t(ownerMemory.size());
+  }
+  void releaseMemoryOwner(uint32_t id) {
+    if (id != 0) releasedOwners.push_back(id);
   }
 
   struct PendingRelease {

@@ -113,7 +113,8 @@ struct HybridEffects::Impl {
   AccelerationStructureService* service = nullptr;
   HybridEffectsDesc desc;
   // memoryByEffect(): the Context's memory owners of each effect and of what they share. Every entry point holds the
-  // shared one (MemoryOwnerScope), and the work of one effect its own.
+  // shared one (MemoryOwnerScope), and the work of one effect its own. Released by ~Impl: the Context gives them out
+  // again once what the members retire is freed.
   enum Owner : uint8_t { kOwnShadows, kOwnAo, kOwnReflections, kOwnLocalLights, kOwnShared, kOwnerCount };
   uint32_t owners[kOwnerCount] = {};
   MemoryOwnerScope own(Owner o) { return MemoryOwnerScope(internal::contextImpl(ctx), owners[o]); }
@@ -171,6 +172,7 @@ struct HybridEffects::Impl {
   ~Impl() {
     neutral.retire(ctx);
     changeMasks.retire(ctx);
+    for (uint32_t id : owners) internal::contextImpl(ctx).releaseMemoryOwner(id);
   }
 
   // The masks to write: one per effect whose denoiser exists (the readers of a history).
@@ -347,16 +349,14 @@ struct HybridEffects::Impl {
                  uint32_t resetFrames = 0) {
     if (Status st = ensureDenoiser(slot, wanted, kind, what); !st) return st;
     if (!slot) return {};
-    // A denoiser at another size than the frame's (a reflection G-buffer of its own) keeps its own transient images,
-    // so that the shared ones are not re-created every frame.
+    // One at another size (a reflection G-buffer of its own) keeps its own scratch: the shared one is not resized.
     DenoiserScratch* scratch = nullptr;
     if (gbuffer.width == frameWidth && gbuffer.height == frameHeight) {
-      if (!denoiserScratch) {
-        const MemoryOwnerScope sharedScope = own(kOwnShared);
-        auto made = DenoiserScratch::create(ctx);
-        if (!made) return wrap("DenoiserScratch::create", made.error());
-        denoiserScratch = std::move(made.value());
-      }
+      const MemoryOwnerScope sharedScope = own(kOwnShared);
+      if (Status st = ensure(denoiserScratch, true, "DenoiserScratch::create",
+                             [&] { return DenoiserScratch::create(ctx); });
+          !st)
+        return st;
       scratch = denoiserScratch.get();
     }
     DenoiseSettings d = desc.denoiser;
