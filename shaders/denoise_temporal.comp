@@ -47,8 +47,8 @@ void main() {
   // A pixel whose history the reactive mask restarts, or follows up (rbDnFollowUp), traced RaySchedule::resetRays rays
   // (reset_rays.glsl): its value counts as that many frames of the usual rays, so the frames after it weigh in by
   // their rays; so where it finds no history (a follow-up pixel newly visible, RB_CHANGE_REVEALS).
-  const bool resetRays = rbDnReactive(pixel, gReactive) || (!kept && rbDnFollowUp(pixel, gReactive));
-  float frames = resetRays ? min(pc.resetFrames, float(pc.maxHistoryFrames)) : 1.0;
+  const bool followUp = !kept && rbDnFollowUp(pixel, gReactive);
+  float frames = rbDnReactive(pixel, gReactive) || followUp ? min(pc.resetFrames, float(pc.maxHistoryFrames)) : 1.0;
   ivec2 pp;
   vec2 h;
   if (rbDnFindHistoryBilinear(pixel, rel, gMotion, gReactive, distanceIn, historyIn, h, pp)) {
@@ -56,7 +56,7 @@ void main() {
     if (!kept && (pc.flags & RB_DN_ANTI_LAG) != 0u)
       h.y = floor(h.y * rbDnHistoryTrust(signalIn, gDepth, ip, historyIn, pp));
     // A follow-up pixel traced the reset rays again: its value adds that many frames (the same weighing by rays).
-    const float added = kept ? 0.0 : rbDnFollowUp(pixel, gReactive) ? max(pc.resetFrames, 1.0) : 1.0;
+    const float added = kept ? 0.0 : followUp ? max(pc.resetFrames, 1.0) : 1.0;
     frames = min(kept ? max(h.y, 1.0) : h.y + added, float(pc.maxHistoryFrames));
     accumulated = kept ? h.x : mix(h.x, value, min(added / frames, 1.0));
   }

@@ -12,13 +12,11 @@ using namespace rbtest;
 
 namespace {
 
+// The motion tests' camera, slid sideways by `shift`.
 SyntheticView viewAt(double shift) {
-  SyntheticView v;
-  v.eye = {-6.0 + shift, 3.5, 7.0};
-  v.target = {0.0 + shift, 0.8, 0.0};
-  v.fovYDegrees = 45.0;
-  v.width = 96;
-  v.height = 72;
+  SyntheticView v = motionTestView(96, 72);
+  v.eye.x += shift;
+  v.target.x += shift;
   return v;
 }
 
