@@ -190,15 +190,19 @@ if want render; then
   RENDER="$RT/bin/${RB_RENDER_BIN:-raybridge-render}"
   RDIR="$(mktemp -d)"
   # RB_RENDER_VARIANTS="name|args;name|args" replaces the variants below (e.g. an A/B of one switch, alternated);
-  # RB_RENDER_SIZE="W H" the size (default 1920 1080); RB_RENDER_FRAMES the frames of each (default 12).
+  # RB_RENDER_SIZE="W H" the size (default 1920 1080); RB_RENDER_FRAMES the frames of each (default 12);
+  # RB_RENDER_LIMIT the seconds each may take (default 60). In a variant's args @RDIR@ is the folder the variants
+  # write to (--compare-with @RDIR@/NAME scores against an earlier variant) and @SCENES@ the carried models.
   VARIANTS=("raster|--mode raster" "hybrid|--mode hybrid" "raster_ultra|--mode raster --preset ultra"
             "hybrid_ultra|--mode hybrid --preset ultra" "hybrid_low|--mode hybrid --preset low")
   [ -n "${RB_RENDER_VARIANTS:-}" ] && IFS=';' read -r -a VARIANTS <<<"$RB_RENDER_VARIANTS"
   read -r RW RH <<<"${RB_RENDER_SIZE:-1920 1080}"
   for variant in "${VARIANTS[@]}"; do
     name="${variant%%|*}"
-    read -r -a vargs <<<"${variant#*|}"
-    RAYBRIDGE_VALIDATION=0 step "render $name" 60 "$OUT/render_gpu.log" \
+    vline="${variant#*|}"
+    vline="${vline//@RDIR@/$RDIR}"
+    read -r -a vargs <<<"${vline//@SCENES@/$SCENES}"
+    RAYBRIDGE_VALIDATION=0 step "render $name" "${RB_RENDER_LIMIT:-60}" "$OUT/render_gpu.log" \
       "$RENDER" --width "$RW" --height "$RH" --frames "${RB_RENDER_FRAMES:-12}" --dump "${vargs[@]}" \
       --out "$RDIR/$name"
   done

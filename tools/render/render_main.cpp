@@ -21,6 +21,7 @@
 
 #include "animated_scene.h"
 #include "camera_path.h"
+#include "dump_compare.h"
 #include "frame_capture.h"
 #include "frame_series.h"
 #include "perf_scene.h"
@@ -479,6 +480,7 @@ void collectTimings(RenderRun& run) {
   const rb::HybridStats es = run.adapter->effects().stats();
   for (const auto& [name, p] : namedPassStats(es))
     if (p->frame) run.series.add(std::string(name) + "_gpu_ms", p->frame, p->gpuMs);
+  if (es.hook.frame) run.series.add("record_gpu_ms", es.hook.frame, es.hook.gpuMs);  // what --budget holds
 }
 
 // Frame k of N: its animation time and, with --camera-path, its camera. Frame k shows time - (N-1-k)/fps (every
@@ -749,8 +751,24 @@ void addRaybridgeStats(const RenderRun& run, nlohmann::json& stats) {
   const uint64_t rays = addPassStats(run, passes);
   std::printf(" BLAS build %.2f ms; memory %.1f MiB\n", buildMs, mem.total() / 1048576.0);
   stats["rays_traced"] = rays;
+  // The frame budget (--budget; FrameBudgetStats) as the last frame planned it, and HybridEffects::record()'s own time.
+  const rb::HybridStats es = run.adapter->effects().stats();
+  const rb::FrameBudgetStats& b = es.budget;
+  nlohmann::json budget = {
+      {"budget_ms", b.budgetMs},
+      {"fixed_ms", b.fixedMs},
+      {"floor_ms", b.floorMs},
+      {"below_floor", b.belowFloor},
+      {"given_ms",
+       {{"shadows", b.shadowsMs}, {"ao", b.aoMs}, {"reflections", b.reflectionsMs}, {"local_lights", b.localLightsMs}}},
+      {"reflection_level", b.reflectionLevel},
+      {"local_light_level", b.localLightLevel},
+      {"measurements", b.measurements},
+      {"level_steps", b.levelSteps}};
   stats["raybridge"] = {
       {"passes", passes},
+      {"record_gpu_ms", es.hook.gpuMs},
+      {"budget", budget},
       {"acceleration_structures",
        {{"blas_build_gpu_ms", buildMs},
         {"build_batches", as.batches.size()},
@@ -875,7 +893,16 @@ std::string writeDump(RenderRun& run, const nlohmann::json& stats) {
     if (auto it = f.images.find(name); it != f.images.end()) w.lights(name, toExr(f, it->second, 4));
   dumpEngineImages(run, f, w);
   if (!w.error().empty()) return w.error();
-  if (se::Status s = se::writeFile((out / "stats.json").string(), stats.dump(2) + "\n"); !s) return s.error;
+  nlohmann::json written = stats;
+  if (!run.o.compareWith.empty()) {
+    std::string error;
+    written["compare_with"] = compareDumps(run.o.compareWith, out, error);
+    if (!error.empty()) return error;
+    for (const auto& [name, e] : written["compare_with"]["images"].items())
+      std::printf("%s against %s: RMSE %.5f (%.2f%% of its RMS)\n", name.c_str(), run.o.compareWith.c_str(),
+                  e["rmse"].get<double>(), 100.0 * e["relative_rmse"].get<double>());
+  }
+  if (se::Status s = se::writeFile((out / "stats.json").string(), written.dump(2) + "\n"); !s) return s.error;
   w.written().push_back("stats.json");
   std::printf("wrote");
   for (size_t i = 0; i < w.written().size(); ++i) std::printf("%s %s", i ? "," : "", w.written()[i].c_str());

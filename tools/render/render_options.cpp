@@ -343,6 +343,11 @@ void addFrameOptions(CLI::App& app, RenderOptions& o) {
   app.add_option("--out", o.out, "output folder (default out): final.png, final.exr")
       ->type_name("DIR")
       ->check(rbCli::nonEmpty("folder name"));
+  app.add_option("--compare-with", o.compareWith,
+                 "with --dump: each effect image (shadow, ao, reflection, lights) against the one\n"
+                 "an earlier --dump of the same size and camera wrote to DIR: RMSE into stats.json")
+      ->type_name("DIR")
+      ->check(CLI::ExistingDirectory);
   app.add_flag("--dump", o.dump,
                "also depth.exr (distance from the eye, 0 = sky), normal.exr (world normal used\n"
                "by the passes), shadow.exr (sun visibility the lighting used; plus shadow_raw.exr\n"
@@ -434,6 +439,12 @@ void addScheduleOptions(CLI::App& app, RenderOptions& o) {
          "(sides 1, 2, 4 or 8), e.g. ao,tile=8x4")
       ->type_name("LIST")
       ->check(CLI::Validator([](std::string& v) { return parseAdaptive(v, nullptr); }, ""));
+  app.add_option("--budget", o.budgetMs,
+                 "a GPU time in ms for everything Raybridge records in a frame, which the SDK holds by\n"
+                 "dividing it between the effects (HybridEffectsDesc::budgetMs): adaptive rays for\n"
+                 "soft shadows and AO, reflections at full or half resolution, local-light rays")
+      ->type_name("MS")
+      ->check(rbCli::floatNumber(rbCli::above(0.0), rbCli::atMost(double(rb::kMaxFrameBudgetMs)), " ms"));
 }
 
 // The performance scene and where the shared models are, the dynamic BLAS builds, the device and validation.
@@ -591,6 +602,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
     h.disableResetFollowUp = *o.resetFollowUp == 0u;
   }
   h.reflections.disableRelitResets = o.noReflectionChanges;
+  h.budgetMs = o.budgetMs.value_or(0.0f);
   h.ao.schedule.adaptive.enabled = o.adaptiveAoMs.has_value();
   h.ao.schedule.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
   h.ao.schedule.adaptive.granularity = o.adaptiveGranularity;
@@ -688,6 +700,11 @@ std::string parseRenderOptions(int argc, char** argv, RenderOptions& o) {
     return "--adaptive: adaptive rays plan from the denoiser's history; drop --no-denoise";
   if ((o.adaptiveShadowsMs || o.adaptiveAoMs) && o.mode != Mode::Hybrid)
     return "--adaptive: only --mode hybrid traces the shadow and AO passes it adapts";
+  if (!o.compareWith.empty() && !o.dump) return "--compare-with: it compares the images --dump writes; add --dump";
+  if (o.budgetMs && (o.adaptiveShadowsMs || o.adaptiveAoMs))
+    return "--budget: the frame budget sets the adaptive rays' time targets itself; drop --adaptive";
+  if (o.budgetMs && o.mode != Mode::Hybrid)
+    return "--budget: only --mode hybrid records the SDK's effects it divides the budget between";
   if (uint64_t(o.width) * o.height > uint64_t(8192) * 8192)
     return "--width/--height: " + std::to_string(o.width) + "x" + std::to_string(o.height) + " exceeds 67 megapixels";
   return {};

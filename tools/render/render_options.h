@@ -87,6 +87,9 @@ struct RenderOptions {
   // --adaptive's granularity keywords, for both effects: "pixel", "tile" or "tile=WxH" (AdaptiveRaySettings::
   // granularity, tileWidth, tileHeight; 0 = the SDK's default tile). Default: per tile.
   rb::AdaptiveRayGranularity adaptiveGranularity = rb::AdaptiveRayGranularity::Tile;
+  // --budget MS: HybridEffectsDesc::budgetMs, the SDK's frame budget (it sets the adaptive targets: not with
+  // --adaptive). Unset = none.
+  std::optional<float> budgetMs;
   uint32_t adaptiveTileWidth = 0, adaptiveTileHeight = 0;
   // Raster mode's shadow map: --shadow-map-size (0 = none, else 1024..8192) and --pcf (taps per axis, 1..9);
   // else the preset's raster counterpart.
@@ -95,6 +98,8 @@ struct RenderOptions {
   Mode mode = Mode::Hybrid;
   std::string out = "out";
   bool dump = false;
+  // --compare-with DIR: with --dump, each effect image against DIR's (dump_compare.h), into stats.json.
+  std::string compareWith;
   bool geometricNormals = false;
   uint32_t frames = 3;  // enough for the SDK's deferred statistics (resolved kFramesInFlight frames later)
   // Animation: the last frame shows the scene at `time` seconds; with `fps`, frame k of `frames` is at

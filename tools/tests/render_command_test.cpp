@@ -1,7 +1,9 @@
-// raybridge-render as a subprocess: bad input, half-resolution and reordered reflections, a dumped hybrid render
+// raybridge-render as a subprocess: bad input, half-resolution and reordered reflections, the frame budget and
+// --compare-with, a dumped hybrid render
 // with every effect (files, statistics, AO contact darkening), every preset in both modes, raster mode's
 // counterparts. The validation layer is on; any error fails.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -9,6 +11,7 @@
 #include <string>
 
 #include <ImfRgbaFile.h>
+#include <catch2/catch_approx.hpp>
 #include <catch2/catch_test_macros.hpp>
 #include <nlohmann/json.hpp>
 
@@ -103,6 +106,15 @@ TEST_CASE("raybridge-render rejects bad input with a message naming the problem"
       {"--adaptive ao,tile=3x4", "--adaptive: '3x4' in 'tile=3x4' is not a tile WxH with sides 1, 2, 4 or 8"},
       {"--adaptive ao,pixel=8x4", "--adaptive: '8x4' in 'pixel=8x4' is not allowed (pixel takes no size)"},
       {"--adaptive pixel", "--adaptive: 'pixel' names no effect with adaptive rays (shadows, ao)"},
+      {"--budget 0", "--budget: 0 is outside (0, 1000] ms"},
+      {"--budget -2", "--budget: -2 is outside (0, 1000] ms"},
+      {"--budget nan", "--budget: 'nan' is not finite; give a finite number"},
+      {"--budget inf", "--budget: 'inf' is not finite; give a finite number"},
+      {"--budget 5000", "--budget: 5000 is outside (0, 1000] ms"},
+      {"--budget fast", "--budget: 'fast' is not a number"},
+      {"--budget 4 --adaptive ao", "--budget: the frame budget sets the adaptive rays' time targets itself"},
+      {"--budget 4 --mode raster", "--budget: only --mode hybrid records the SDK's effects"},
+      {"--compare-with .", "--compare-with: it compares the images --dump writes; add --dump"},
       {"--converged-tiles 0", "--converged-tiles: 0 is outside 1..65535"},
       {"--converged-tiles 8 --no-denoise", "--converged-tiles: converged tiles are read from the shadow denoiser's"},
       {"--converged-tiles 8 --no-converged-tiles", "--converged-tiles and --no-converged-tiles: give one of them"},
@@ -232,6 +244,38 @@ TEST_CASE("raybridge-render --no-short-history-filter changes the denoised AO of
   for (size_t i = 0; i < on.size(); ++i) differ += on[i] != off[i];
   INFO(differ << " of " << on.size() << " denoised AO pixels differ");
   CHECK(differ > on.size() / 20);
+}
+
+TEST_CASE("raybridge-render --budget writes the frame budget's split; --compare-with scores a dump against another",
+          "[render][budget]") {
+  const fs::path none = tempDir("budget_none"), tight = tempDir("budget_tight"), same = tempDir("budget_same");
+  const std::string common = "--width 96 --height 64 --frames 8 --preset high --dump ";
+  RunResult r = runRender(common + "--out " + none.string());
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  r = runRender(common + "--budget 0.01 --compare-with " + none.string() + " --out " + tight.string());
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  const nlohmann::json s = rbRenderTest::readJson(tight / "stats.json");
+  const nlohmann::json& b = s["raybridge"]["budget"];
+  CHECK(b["budget_ms"].get<double>() == Catch::Approx(0.01));
+  CHECK(b["below_floor"].get<bool>());  // no frame records in 10 microseconds
+  CHECK(b["reflection_level"].get<int>() == 1);
+  CHECK(b["measurements"].get<int>() >= 3);
+  CHECK(s["raybridge"]["record_gpu_ms"].get<double>() > 0.0);
+  // Every effect image differs from the unbudgeted one (fewer rays), by a finite error.
+  for (const char* name : {"shadow", "ao", "reflection"}) {
+    INFO(name);
+    const double e = s["compare_with"]["images"][name]["rmse"].get<double>();
+    CHECK(e > 0.0);
+    CHECK(std::isfinite(e));
+  }
+  // The same run compared with itself: zero.
+  r = runRender(common + "--compare-with " + none.string() + " --out " + same.string());
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  const nlohmann::json again = rbRenderTest::readJson(same / "stats.json");
+  for (const char* name : {"shadow", "ao", "reflection"}) CHECK(again["compare_with"]["images"][name]["rmse"] == 0.0);
 }
 
 TEST_CASE("raybridge-render --reorder: stats.json says whether reflections reordered", "[render][reorder]") {

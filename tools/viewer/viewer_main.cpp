@@ -366,6 +366,7 @@ struct Session {
     m.frameMs = frameMs;
     m.engine = engine.lastTimings();
     m.effectStats = fx.stats();
+    m.budgetMs = fx.desc().budgetMs;
     m.as = rt.accelerationStructures().stats();
     m.memory = rt.context().memoryStats();
     const rbViewer::PanelRequests req = rbViewer::drawPanel(m);
@@ -376,6 +377,11 @@ struct Session {
     if (req.toggleSoftShadows) toggleSoftShadows();
     if (req.toggleDenoise) toggleDenoise();
     if (req.inspect) inspect = *req.inspect, printState();
+    if (req.budgetMs) {
+      rb::HybridEffectsDesc d = fx.desc();
+      d.budgetMs = *req.budgetMs;
+      setDesc(d);
+    }
     engineTerms();
   }
 

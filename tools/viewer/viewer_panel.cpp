@@ -12,6 +12,19 @@ namespace {
 double mib(VkDeviceSize bytes) { return double(bytes) / (1024.0 * 1024.0); }
 
 // One row of the GPU table: name, ms, and rays/s where the pass traces.
+// The frame budget (HybridEffectsDesc::budgetMs): a slider (0 = off) and how the SDK divides it (FrameBudgetStats).
+void budgetControls(const PanelModel& m, PanelRequests& r) {
+  if (!ImGui::CollapsingHeader("Frame budget", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  float ms = m.budgetMs;
+  if (ImGui::SliderFloat("budget ms (0 = off)", &ms, 0.0f, 16.0f, "%.1f") && ms != m.budgetMs) r.budgetMs = ms;
+  const rb::FrameBudgetStats& b = m.effectStats.budget;
+  if (b.budgetMs <= 0.0f) return;
+  ImGui::Text("record() %.2f ms of %.1f; fixed %.2f, floor %.2f%s", m.effectStats.hook.gpuMs, b.budgetMs, b.fixedMs,
+              b.floorMs, b.belowFloor ? "  (under the floor: everything at its cheapest)" : "");
+  ImGui::Text("given: shadows %.2f  AO %.2f  reflections %.2f (%s)  local lights %.2f (rays / %u)", b.shadowsMs, b.aoMs,
+              b.reflectionsMs, b.reflectionLevel ? "half res" : "full res", b.localLightsMs, 1u << b.localLightLevel);
+}
+
 void passRow(const char* name, double ms, const rb::PassStats* rays = nullptr) {
   ImGui::TableNextRow();
   ImGui::TableNextColumn();
@@ -135,6 +148,8 @@ PanelRequests drawPanel(const PanelModel& m) {
       ImGui::EndTable();
     }
   }
+
+  budgetControls(m, r);
 
   // --- Acceleration structures ---
   if (ImGui::CollapsingHeader("Acceleration structures", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -27,7 +27,8 @@ struct PanelModel {
   float sunAzimuthDegrees = 0.0f, sunElevationDegrees = 0.0f;
   double frameMs = 0.0;               // CPU time between frames, smoothed
   sample_engine::PassTimings engine;  // the engine's passes (hookMs holds everything Raybridge recorded)
-  rb::HybridStats effectStats;        // Raybridge's passes
+  rb::HybridStats effectStats;        // Raybridge's passes, and the frame budget's split (effectStats.budget)
+  float budgetMs = 0.0f;              // HybridEffectsDesc::budgetMs now (0 = off)
   rb::AsStats as;
   rb::MemoryStats memory;  // the rb::Context's, every category
 };
@@ -40,6 +41,7 @@ struct PanelRequests {
   bool toggleDenoise = false;
   bool toggleSoftShadows = false;
   std::optional<Inspect> inspect;
+  std::optional<float> budgetMs;  // HybridEffectsDesc::budgetMs (0 = off)
 };
 
 // Draws the window (between ImGuiOverlay::beginFrame and endFrame).

@@ -99,6 +99,30 @@ inline constexpr uint32_t kDefaultResetFollowUpFrames = 3;
 // Largest HybridEffectsDesc::resetFollowUpFrames (the change tracker keeps this many frames of boxes).
 inline constexpr uint32_t kMaxResetFollowUpFrames = 8;
 
+// ---- Frame budget (HybridEffectsDesc::budgetMs) ----
+//
+// record() times itself (HybridStats::hook) and each pass; from finished frames the front end estimates the fixed cost
+// (the TLAS, the change masks, the denoisers, hard shadows) and divides what is left of the budget:
+//  - denoised soft shadows and denoised AO trace adaptive rays under a time target each (ray_schedule.h): what is
+//    left goes to them in proportion to the error a millisecond buys each (kBudgetShadowErrorWeight,
+//    kBudgetAoErrorWeight), an effect whose rays reach their maximum leaving the rest to the other. Their
+//    schedule.adaptive settings are taken as given but for enabled, timeBudgetMs and initialRaysPerPixel, which the
+//    budget sets (their reset rays give way to the plan);
+//  - reflections step between as described (level 0) and half resolution (level 1, without converged tiles), and
+//    stochastic local lights between their rays per pixel and one (level k = raysPerPixel / 2^k): a step at a time, a
+//    step up only where the measured (or predicted) cost leaves the adaptive effects twice the share they need.
+// Every effect starts at its cheapest and climbs as the measurements show room: the budget holds from the first
+// frames. The division is src/schedule/frame_budget.h's, tested with injected timings. A budget under the floor
+// (fixed cost plus every effect at its cheapest) runs everything at its cheapest: HybridStats::budget reports
+// belowFloor and floorMs. Held on the H100 at 2560x1440 (docs/performance.md, "Frame budget").
+inline constexpr float kMaxFrameBudgetMs = 1000.0f;
+// The error weights of the split: a Monte Carlo error falls as a / sqrt(ms), and the split that minimises the summed
+// squared error gives each effect time in proportion to a. Measured by raybridge-effects-bench --scenario adaptive
+// (docs/performance.md, "Adaptive rays": per-tile adaptive rays at equal time, H200, 2560x1440): soft shadows RMSE
+// 0.00630 at 1.42 ms, AO 0.01456 at 1.33 ms; a = RMSE x sqrt(ms).
+inline constexpr double kBudgetShadowErrorWeight = 0.0075;
+inline constexpr double kBudgetAoErrorWeight = 0.0168;
+
 struct ShadowEffectSettings {
   // 0 = the light decides: kDefaultSoftShadowRays for a light with a size, one ray (hard) for one without.
   // 1 = hard shadows whatever the light's size (the presets' "1 ray"), unless softAngularRadiusDegrees is set:
@@ -211,6 +235,11 @@ struct HybridEffectsDesc {
   uint32_t resetFollowUpFrames = 0;
   // true = no follow-ups: only the frame of a change traces the reset rays, and only where it restarts a history.
   bool disableResetFollowUp = false;
+  // The frame budget: GPU milliseconds for the whole record() (the TLAS, the change masks, every pass and denoiser),
+  // which the front end holds by dividing what the fixed costs leave between the effects, from its own timestamps of
+  // finished frames ("Frame budget" above). 0 = off: every effect runs as described. At most kMaxFrameBudgetMs; needs
+  // GPU timestamps on the Context's queue family (create()/setDesc() name the problem otherwise).
+  float budgetMs = 0.0f;
 };
 
 // `base` with the preset's effect set, ray counts, AO resolution and whether soft shadows skip converged tiles
@@ -290,12 +319,30 @@ struct EffectMemoryStats {
   }
 };
 
+// The frame budget as the latest record() planned it (HybridEffectsDesc::budgetMs; all zero when off).
+struct FrameBudgetStats {
+  float budgetMs = 0.0f;
+  double fixedMs = 0.0;  // estimated: what no effect's setting moves (the TLAS, change masks, denoisers, hard shadows)
+  double floorMs = 0.0;  // estimated least frame: the fixed cost and every effect at its cheapest
+  bool belowFloor = false;  // budgetMs < floorMs: every effect runs at its cheapest and the frame takes floorMs
+  // Per effect: the time it was given (an adaptive effect's time target; a levelled one's measured cost at its level).
+  double shadowsMs = 0.0, aoMs = 0.0, reflectionsMs = 0.0, localLightsMs = 0.0;
+  uint32_t reflectionLevel = 0;  // 0 = as described, 1 = half resolution
+  uint32_t localLightLevel = 0;  // rays per pixel = the described ones / 2^level
+  uint64_t measurements = 0;     // finished frames taken in
+  uint64_t levelSteps = 0;       // level changes so far
+};
+
 // Per-pass measurements of the latest recordings whose frames have finished (zero for what does not exist).
 struct HybridStats {
   PassStats shadow, shadowDenoise, ao, aoDenoise, reflection, localLights, localLightsDenoise, reflectionDenoise;
   // The change masks ("Change resets"): recorded only on frames with a known change, so this is the latest such
   // frame's (PassStats::frame says which); not in totalGpuMs(), which is this frame's.
   PassStats changeMasks;
+  // The whole record() (the TLAS and pending acceleration-structure work included): what HybridEffectsDesc::budgetMs
+  // holds. Its frame may be later than the passes'. rays = 0.
+  PassStats hook;
+  FrameBudgetStats budget;
   double totalGpuMs() const {
     return shadow.gpuMs + shadowDenoise.gpuMs + ao.gpuMs + aoDenoise.gpuMs + reflection.gpuMs + localLights.gpuMs +
            localLightsDenoise.gpuMs + reflectionDenoise.gpuMs;

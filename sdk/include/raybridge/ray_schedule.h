@@ -115,6 +115,10 @@ struct AdaptiveRaySettings {
   // kMaxAdaptiveRaysPerFrame (as is any larger value). Per tile, at least one ray in every pixel of one tile (the
   // claim takes whole tiles: less would trace nothing).
   uint64_t maxRaysPerFrame = 0;
+  // With a time target: where the budget starts, in rays per pixel of the image. 0 = raysPerPixel (the uniform
+  // pass's rays). Low values start cheap and climb to the target (at most 2x a measurement): what a frame budget
+  // (HybridEffectsDesc::budgetMs) asks for, so that the first frames do not run over it.
+  float initialRaysPerPixel = 0.0f;
   uint32_t minRaysPerPixel = 0;  // 0 = kDefaultAdaptiveMinRays
   uint32_t maxRaysPerPixel = 0;  // 0 = kDefaultAdaptiveMaxRaysFactor x raysPerPixel; at most kMaxAdaptiveRays
   AdaptiveRayGranularity granularity = AdaptiveRayGranularity::Tile;  // default: per tile (see the header comment)

@@ -10,6 +10,7 @@
 #include "change_tracker.h"
 #include "changed_box.h"
 #include "context_impl.h"
+#include "effect_budget.h"
 #include "effect_schedule.h"
 #include "hybrid_effects_validation.h"
 #include "light_validation.h"
@@ -165,6 +166,7 @@ struct HybridEffects::Impl {
   std::vector<ChangedBox> reflectionRelit;
   std::vector<AccelerationStructureService::MeshChange> meshChanges;
   std::vector<GpuChangeBox> gpuChangeBoxes;
+  EffectBudget budget;  // HybridEffectsDesc::budgetMs, and the hook's timestamps (HybridStats::hook)
 
   Impl(Context& c, AccelerationStructureService* s) : ctx(c), service(s) {
     for (uint32_t& id : owners) id = internal::contextImpl(ctx).newMemoryOwner();
@@ -172,6 +174,7 @@ struct HybridEffects::Impl {
   ~Impl() {
     neutral.retire(ctx);
     changeMasks.retire(ctx);
+    budget.retire(ctx);
     for (uint32_t id : owners) internal::contextImpl(ctx).releaseMemoryOwner(id);
   }
 
@@ -371,13 +374,17 @@ struct HybridEffects::Impl {
   // Each effect's schedule and reset rays as its pass runs them (recordShadows, recordAo), also read by recordChanges:
   // the effects with reset rays get follow-ups.
   RaySchedule shadowSchedule(const ShadowPlan& plan) const {
-    RaySchedule s = effectSchedule(desc.shadows.schedule, shadowDenoiser.get(), plan.soft);
+    RaySchedule wanted = desc.shadows.schedule;
+    budget.applyShadows(wanted);
+    RaySchedule s = effectSchedule(wanted, shadowDenoiser.get(), plan.soft);
     s.resetRays = plan.soft ? effectResetRays(s, desc.shadows.disableResetRays, plan.rays) : 0u;
     return s;
   }
   uint32_t aoRays() const { return desc.ao.raysPerPixel ? desc.ao.raysPerPixel : kDefaultAoRays; }
   RaySchedule aoSchedule() const {
-    RaySchedule s = effectSchedule(desc.ao.schedule, aoDenoiser.get());
+    RaySchedule wanted = desc.ao.schedule;
+    budget.applyAo(wanted);
+    RaySchedule s = effectSchedule(wanted, aoDenoiser.get());
     s.resetRays = effectResetRays(s, desc.ao.disableResetRays, aoRays());
     return s;
   }
@@ -426,7 +433,8 @@ Status HybridEffects::Impl::recordLocalLights(VkCommandBuffer cmd, const HybridF
   const MemoryOwnerScope scope = own(kOwnLocalLights);
   ManyLightSettings s;
   s.mode = desc.localLights.mode;
-  s.raysPerPixel = desc.localLights.raysPerPixel;
+  s.raysPerPixel = budget.localLightRays(desc.localLights.raysPerPixel ? desc.localLights.raysPerPixel
+                                                                       : kDefaultLightRays);
   s.candidates = desc.localLights.candidates;
   s.materials = materials.get();
   s.schedule = effectSchedule(desc.localLights.schedule, localLightDenoiser.get());
@@ -455,8 +463,8 @@ Status HybridEffects::Impl::recordShadows(VkCommandBuffer cmd, const HybridFrame
   // The visibility is a fraction of plan.rays binary rays; with adaptive rays the count varies per pixel, so the
   // denoiser measures the noise instead.
   return denoise(shadowDenoiser, plan.soft && !desc.shadows.disableDenoiser, "Denoiser (shadows)", cmd, g,
-                 o.visibilityView, desc.shadows.schedule.adaptive.enabled ? 0u : plan.rays, DenoiseSignal::Scalar,
-                 false, denoiserResetFrames(s.schedule.resetRays, plan.rays));
+                 o.visibilityView, s.schedule.adaptive.enabled ? 0u : plan.rays, DenoiseSignal::Scalar, false,
+                 denoiserResetFrames(s.schedule.resetRays, plan.rays));
 }
 
 Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) {
@@ -473,7 +481,7 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
   const AoOutputs& o = ao->outputs();
   // Binary AO is a fraction of binary rays; distance-weighted AO is not, nor is adaptive AO (the count varies per
   // pixel), so their noise is estimated.
-  const uint32_t rays = s.estimator == AoEstimator::Binary && !desc.ao.schedule.adaptive.enabled ? aoRays() : 0u;
+  const uint32_t rays = s.estimator == AoEstimator::Binary && !s.schedule.adaptive.enabled ? aoRays() : 0u;
   return denoise(aoDenoiser, !desc.ao.disableDenoiser, "Denoiser (AO)", cmd, g, o.aoView, rays, DenoiseSignal::Scalar,
                  !desc.ao.disableShortHistoryFilter, denoiserResetFrames(s.schedule.resetRays, aoRays()));
 }
@@ -485,7 +493,9 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.roughnessThreshold = desc.reflections.roughnessThreshold;
   s.raysPerPixel = desc.reflections.raysPerPixel;
   s.invocationReorder = desc.reflections.invocationReorder;
-  s.schedule = effectSchedule(desc.reflections.schedule, reflectionDenoiser.get());
+  RaySchedule wanted = desc.reflections.schedule;
+  budget.applyReflections(wanted);
+  s.schedule = effectSchedule(wanted, reflectionDenoiser.get());
   s.lighting = reflectionLighting(f);
   // The light changes a reflection shows, where the change resets run (the denoiser then drops those pixels'
   // history; effect_schedule.h says why lights only).
@@ -509,6 +519,7 @@ Result<std::unique_ptr<HybridEffects>> HybridEffects::create(Context& context, A
                                                              const HybridEffectsDesc& desc) {
   if (Status s = validateHybridEffectsDesc(desc); !s) return s.error();
   std::unique_ptr<HybridEffects> fx(new HybridEffects(std::make_unique<Impl>(context, service)));
+  if (Status s = fx->impl_->budget.configure(context, desc); !s) return s.error();
   fx->impl_->desc = desc;
   if (Status s = fx->impl_->applyDesc(); !s) return s.error();
   return fx;
@@ -519,6 +530,7 @@ HybridEffects::~HybridEffects() = default;  // the passes retire their objects t
 
 Status HybridEffects::setDesc(const HybridEffectsDesc& desc) {
   if (Status s = validateHybridEffectsDesc(desc); !s) return s;
+  if (Status s = impl_->budget.configure(impl_->ctx, desc); !s) return s;
   impl_->desc = desc;
   return impl_->applyDesc();
 }
@@ -559,42 +571,15 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
     return {};  // nothing enabled: no TLAS, no rays
   }
   const GBufferDesc& g = frame.gbuffer;
-  if (a.desc.width && (g.width != a.desc.width || g.height != a.desc.height)) {
-    return invalid("record: HybridFrame::gbuffer is " + std::to_string(g.width) + "x" + std::to_string(g.height) +
-                   " but the outputs are " + std::to_string(a.desc.width) + "x" + std::to_string(a.desc.height) +
-                   ": call resize(" + std::to_string(g.width) + ", " + std::to_string(g.height) +
-                   ") when the G-buffer changes size");
-  }
-  // The hand-over (gbuffer.h) before anything is recorded: a bad layout, usage or aspect names its field.
-  if (Status st = validateGBufferImages(g, "HybridEffects: record: HybridFrame::gbuffer"); !st) return st;
-  if (frame.reflectionGBuffer) {
-    if (Status st = validateGBufferImages(*frame.reflectionGBuffer, "HybridEffects: record: reflectionGBuffer"); !st)
-      return st;
-  }
-  // The light shadows and lights reflection hits: checked as every effect checks a light.
-  if (a.shadow || a.reflection) {
-    if (Status st = validateLight(frame.light, "HybridEffects: record: HybridFrame::light: "); !st) return st;
-  }
+  if (Status st = validateHybridFrame(a.desc, frame, a.shadow || a.reflection); !st) return st;
   // Sun, sky and ambient of reflection hits: by the one resolver the pass uses, before anything is recorded.
   if (a.reflection) {
     Result<ResolvedLighting> lit = resolveSceneLighting(reflectionLighting(frame),
                                                         "HybridEffects: record: HybridFrame::lighting");
     if (!lit) return lit.error();
   }
-  if (frame.changedBoxes.size() > kMaxEngineChangedBoxes) {
-    return invalid("record: HybridFrame::changedBoxes holds " + std::to_string(frame.changedBoxes.size()) +
-                   " boxes, more than kMaxEngineChangedBoxes (" + std::to_string(kMaxEngineChangedBoxes) +
-                   "); merge nearby ones, or reset the history (resetHistory) for a change that large");
-  }
-  for (size_t i = 0; i < frame.changedBoxes.size(); ++i) {
-    const ChangedBox& b = frame.changedBoxes[i];
-    if (const int k = invalidChangedBoxAxis(b); k >= 0) {
-      return invalid("record: HybridFrame::changedBoxes[" + std::to_string(i) + "] has min " +
-                     std::to_string(b.min[k]) + " and max " + std::to_string(b.max[k]) + " on axis " +
-                     std::to_string(k) + "; give finite world-space corners with min <= max");
-    }
-  }
   a.neutral.recordInit(a.ctx, cmd);
+  if (Status st = a.budget.begin(a.ctx, cmd, stats()); !st) return wrap("frame budget", st.error());
   a.frameWidth = g.width;
   a.frameHeight = g.height;
   if (frame.tlas && frame.tlas->tlas) {
@@ -631,6 +616,7 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
   // the images; an error leaves the existing ones named.
   Status refreshed = a.refreshOutputs();
   a.neutral.recordInit(a.ctx, cmd);
+  a.budget.end(a.ctx, cmd);
   if (!st) return st;
   return refreshed;
 }
@@ -669,7 +655,9 @@ HybridStats HybridEffects::stats() const {
           statsOf(a.localLights),
           statsOf(a.localLightDenoiser),
           statsOf(a.reflectionDenoiser),
-          a.changeMasks.stats(a.ctx)};
+          a.changeMasks.stats(a.ctx),
+          a.budget.hook(a.ctx),
+          a.budget.stats()};
 }
 
 MemoryStats HybridEffects::memoryStats() const {

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <string>
 
+#include "changed_box.h"
+#include "light_validation.h"
+#include "pass_constants.h"
 #include "ray_schedule_stage.h"
 
 namespace rb {
@@ -52,6 +55,9 @@ Status validateHybridEffectsDesc(const HybridEffectsDesc& d) {
                    std::to_string(d.localLights.candidates) + " must be at most 64");
   if (d.reflections.raysPerPixel > 64)
     return invalid("reflections.raysPerPixel " + std::to_string(d.reflections.raysPerPixel) + " exceeds 64");
+  if (!(d.budgetMs >= 0.0f && d.budgetMs <= kMaxFrameBudgetMs))
+    return invalid("budgetMs " + std::to_string(d.budgetMs) + " is not a frame budget: give GPU milliseconds in (0, " +
+                   std::to_string(int(kMaxFrameBudgetMs)) + "], or 0 for none");
   if (d.resetFollowUpFrames > kMaxResetFollowUpFrames)
     return invalid("resetFollowUpFrames " + std::to_string(d.resetFollowUpFrames) +
                    " exceeds kMaxResetFollowUpFrames (" + std::to_string(kMaxResetFollowUpFrames) +
@@ -86,6 +92,39 @@ Status validateHybridEffectsDesc(const HybridEffectsDesc& d) {
     if (user && !e.denoised) {
       return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
                    field + "." + user + " the effect's denoiser's history: set " + e.denoiserFix + ", or disable it"};
+    }
+  }
+  return {};
+}
+
+Status validateHybridFrame(const HybridEffectsDesc& d, const HybridFrame& frame, bool lit) {
+  if (d.width && (frame.gbuffer.width != d.width || frame.gbuffer.height != d.height)) {
+    return invalid("record: HybridFrame::gbuffer is " + std::to_string(frame.gbuffer.width) + "x" +
+                   std::to_string(frame.gbuffer.height) + " but the outputs are " + std::to_string(d.width) + "x" +
+                   std::to_string(d.height) + ": call resize(" + std::to_string(frame.gbuffer.width) + ", " +
+                   std::to_string(frame.gbuffer.height) + ") when the G-buffer changes size");
+  }
+  // The hand-over (gbuffer.h) before anything is recorded: a bad layout, usage or aspect names its field.
+  if (Status st = validateGBufferImages(frame.gbuffer, "HybridEffects: record: HybridFrame::gbuffer"); !st) return st;
+  if (frame.reflectionGBuffer) {
+    if (Status st = validateGBufferImages(*frame.reflectionGBuffer, "HybridEffects: record: reflectionGBuffer"); !st)
+      return st;
+  }
+  // The light shadows and lights reflection hits: checked as every effect checks a light.
+  if (lit) {
+    if (Status st = validateLight(frame.light, "HybridEffects: record: HybridFrame::light: "); !st) return st;
+  }
+  if (frame.changedBoxes.size() > kMaxEngineChangedBoxes) {
+    return invalid("record: HybridFrame::changedBoxes holds " + std::to_string(frame.changedBoxes.size()) +
+                   " boxes, more than kMaxEngineChangedBoxes (" + std::to_string(kMaxEngineChangedBoxes) +
+                   "); merge nearby ones, or reset the history (resetHistory) for a change that large");
+  }
+  for (size_t i = 0; i < frame.changedBoxes.size(); ++i) {
+    const ChangedBox& b = frame.changedBoxes[i];
+    if (const int k = invalidChangedBoxAxis(b); k >= 0) {
+      return invalid("record: HybridFrame::changedBoxes[" + std::to_string(i) + "] has min " +
+                     std::to_string(b.min[k]) + " and max " + std::to_string(b.max[k]) + " on axis " +
+                     std::to_string(k) + "; give finite world-space corners with min <= max");
     }
   }
   return {};

@@ -127,10 +127,11 @@ Result<bool> AdaptiveRayPlanner::record(Context& ctx, VkCommandBuffer cmd, const
   // The claim takes whole tiles: a cap under one tile's rays would trace nothing, frame after frame.
   if (tiles) cap = std::max(cap, double(pc.tileSize[0]) * pc.tileSize[1]);
   if (s.timeBudgetMs > 0.0f) {
-    // Start from the uniform rays over the whole image; never below one ray per 64 pixels, so a measurement
-    // (which needs rays) always comes back, nor per tile below one ray in every pixel of a tile: the claim takes
-    // whole tiles, and a budget under one tile's rays would trace nothing.
-    const double initial = double(std::max(raysPerPixel, 1u)) * pixels;
+    // Start from the uniform rays (or initialRaysPerPixel) over the whole image; never below one ray per 64 pixels, so
+    // a measurement (which needs rays) always comes back, nor per tile below one ray in every pixel of a tile: the
+    // claim takes whole tiles, and a budget under one tile's rays would trace nothing.
+    const double initial =
+        (s.initialRaysPerPixel > 0.0f ? double(s.initialRaysPerPixel) : double(std::max(raysPerPixel, 1u))) * pixels;
     const double tilePixels = tiles ? double(pc.tileSize[0]) * pc.tileSize[1] : 1.0;
     const uint64_t r = controller_.next(ctx.frameIndex(), latest, s.timeBudgetMs, initial,
                                         std::max(1.0, std::min(std::max(pixels / 64.0, tilePixels), cap)),

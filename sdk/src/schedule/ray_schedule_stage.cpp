@@ -22,6 +22,10 @@ Status validateAdaptive(const AdaptiveRaySettings& s, const std::string& field) 
   if (!(s.timeBudgetMs >= 0.0f) || !std::isfinite(s.timeBudgetMs)) {
     return invalid("timeBudgetMs " + std::to_string(s.timeBudgetMs) + " must be a finite number >= 0 (0 = no target)");
   }
+  if (!(s.initialRaysPerPixel >= 0.0f) || s.initialRaysPerPixel > float(kMaxAdaptiveRays)) {
+    return invalid("initialRaysPerPixel " + std::to_string(s.initialRaysPerPixel) + " must be a number from 0 to " +
+                   std::to_string(kMaxAdaptiveRays) + " (0 = raysPerPixel)");
+  }
   if (s.maxRaysPerPixel > kMaxAdaptiveRays) {
     return invalid("maxRaysPerPixel " + std::to_string(s.maxRaysPerPixel) + " exceeds " +
                    std::to_string(kMaxAdaptiveRays));

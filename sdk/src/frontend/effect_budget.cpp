@@ -1,0 +1,133 @@
+#include "effect_budget.h"
+
+#include <raybridge/many_light_pass.h>
+
+#include <bit>
+#include <string>
+
+namespace rb {
+
+namespace {
+
+// Where an adaptive effect's rays start under a budget (AdaptiveRaySettings::initialRaysPerPixel): at the planner's
+// least (one ray per 64 pixels, or one tile), so that the first frames stay under the budget; they climb at most
+// 2x a measurement to the target.
+constexpr float kBudgetStartRaysPerPixel = 1.0f / 64.0f;
+// The predicted cost of full-resolution reflections over half-resolution ones, until both are measured: four times
+// the rays, less the upsample (2.8x on the perf scene, 1.4x on the demo: docs/performance.md, "Half resolution").
+constexpr double kReflectionHalfResolutionStep = 3.0;
+
+bool sameKnobs(const std::array<BudgetKnob, kBudgetEffects>& a, const std::array<BudgetKnob, kBudgetEffects>& b) {
+  for (uint32_t e = 0; e < kBudgetEffects; ++e) {
+    if (a[e].enabled != b[e].enabled || a[e].adaptive != b[e].adaptive || a[e].levels != b[e].levels) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Status EffectBudget::configure(Context& ctx, const HybridEffectsDesc& desc) {
+  if (desc.budgetMs > 0.0f && !ctx.deviceInfo().timestampsSupported) {
+    return Error{ErrorCode::InvalidArgument, VK_SUCCESS,
+                 "HybridEffectsDesc::budgetMs " + std::to_string(desc.budgetMs) +
+                     " needs GPU timestamps, which the Context's queue family does not have (timestampValidBits " +
+                     std::to_string(ctx.deviceInfo().timestampValidBits) +
+                     "): set budgetMs = 0 and choose each effect's rays (or a preset) instead"};
+  }
+  // Denoised shadows and AO take a time target (hard shadows ignore it: their one ray is exact, a fixed cost).
+  const bool shadows = desc.effects & kEffectShadows, ao = desc.effects & kEffectAo;
+  std::array<BudgetKnob, kBudgetEffects> k{};
+  k[kBudgetShadows] = {shadows, shadows && !desc.shadows.disableDenoiser, 1, kBudgetShadowErrorWeight, 2.0};
+  k[kBudgetAo] = {ao, ao && !desc.ao.disableDenoiser, 1, kBudgetAoErrorWeight, 2.0};
+  k[kBudgetReflections] = {(desc.effects & kEffectReflections) != 0, false,
+                           desc.reflections.schedule.halfResolution ? 1u : 2u, 1.0, kReflectionHalfResolutionStep};
+  // Stochastic local lights: their rays halved down to one (1 + log2 levels); the exact mode has nothing to move.
+  const uint32_t lightRays = desc.localLights.raysPerPixel ? desc.localLights.raysPerPixel : kDefaultLightRays;
+  const uint32_t lightLevels = desc.localLights.mode == ManyLightMode::Stochastic ? uint32_t(std::bit_width(lightRays))
+                                                                                  : 1u;
+  k[kBudgetLocalLights] = {(desc.effects & kEffectLocalLights) != 0, false, std::min(lightLevels, kBudgetMaxLevels),
+                           1.0, 2.0};
+  const bool wanted = desc.budgetMs > 0.0f;
+  const bool restart = wanted && (!active_ || budgetMs_ != desc.budgetMs || !sameKnobs(k, knobs_));
+  active_ = wanted;
+  budgetMs_ = wanted ? desc.budgetMs : 0.0f;
+  knobs_ = k;
+  if (restart) {
+    controller_.configure(budgetMs_, knobs_);
+    plan_ = controller_.latest();
+  }
+  if (!active_) plan_ = {};
+  return {};
+}
+
+void EffectBudget::retire(Context& ctx) {
+  if (hookReady_) hook_.retire(ctx);
+  hookReady_ = false;
+}
+
+Status EffectBudget::begin(Context& ctx, VkCommandBuffer cmd, const HybridStats& passes) {
+  if (!hookReady_) {
+    if (Status st = hook_.init(ctx, "HybridEffects::record", false); !st) return st;
+    hookReady_ = true;
+  }
+  if (Status st = hook_.beginRecording(ctx, cmd); !st) return st;
+  if (active_) {
+    const PassStats h = hook_.latest(ctx);
+    const PassStats* of[kBudgetEffects] = {&passes.shadow, &passes.ao, &passes.reflection, &passes.localLights};
+    BudgetMeasurement m;
+    m.frame = h.frame;
+    m.hookMs = h.gpuMs;
+    bool sameFrame = h.frame != 0;
+    for (uint32_t e = 0; e < kBudgetEffects; ++e) {
+      if (!knobs_[e].enabled) continue;
+      sameFrame = sameFrame && of[e]->frame == h.frame;  // a pass created since has no measurement of that frame
+      m.passMs[e] = of[e]->gpuMs;
+    }
+    if (sameFrame) controller_.measure(m);
+    plan_ = controller_.plan(ctx.frameIndex());
+  }
+  hook_.writeStart(ctx, cmd);
+  return {};
+}
+
+void EffectBudget::end(Context& ctx, VkCommandBuffer cmd) {
+  if (hookReady_) hook_.writeEnd(ctx, cmd);
+}
+
+void EffectBudget::applyAdaptive(RaySchedule& s, BudgetEffect e) const {
+  if (!active_ || !knobs_[e].adaptive) return;
+  s.adaptive.enabled = true;
+  s.adaptive.timeBudgetMs = float(plan_.targetMs[e]);
+  s.adaptive.initialRaysPerPixel = kBudgetStartRaysPerPixel;
+}
+
+void EffectBudget::applyReflections(RaySchedule& s) const {
+  if (!active_ || plan_.level[kBudgetReflections] == 0) return;
+  s.halfResolution = true;
+  s.convergedTiles.enabled = false;  // a full-resolution stage
+}
+
+uint32_t EffectBudget::localLightRays(uint32_t described) const {
+  if (!active_) return described;
+  return std::max(1u, described >> plan_.level[kBudgetLocalLights]);
+}
+
+FrameBudgetStats EffectBudget::stats() const {
+  FrameBudgetStats s;
+  if (!active_) return s;
+  s.budgetMs = budgetMs_;
+  s.fixedMs = plan_.fixedMs;
+  s.floorMs = plan_.floorMs;
+  s.belowFloor = plan_.belowFloor;
+  s.shadowsMs = plan_.targetMs[kBudgetShadows];
+  s.aoMs = plan_.targetMs[kBudgetAo];
+  s.reflectionsMs = plan_.targetMs[kBudgetReflections];
+  s.localLightsMs = plan_.targetMs[kBudgetLocalLights];
+  s.reflectionLevel = plan_.level[kBudgetReflections];
+  s.localLightLevel = plan_.level[kBudgetLocalLights];
+  s.measurements = plan_.measurements;
+  s.levelSteps = plan_.levelSteps;
+  return s;
+}
+
+}  // namespace rb
