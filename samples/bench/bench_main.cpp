@@ -54,9 +54,9 @@ int run(const BenchOptions& options) {
                              : "");
   std::fflush(stdout);
 
-  // "all" is every scenario but the soak, which runs only when named.
+  // "all" is every scenario but the soak and the memory sweep, which run only when named.
   auto wanted = [&](const std::string& name) {
-    return options.scenario == name || (options.scenario == "all" && name != "soak");
+    return options.scenario == name || (options.scenario == "all" && name != "soak" && name != "memory");
   };
   std::vector<GltfModel> models;
   std::vector<std::string> messages;
@@ -103,6 +103,7 @@ int run(const BenchOptions& options) {
       {"alpha", [&] { return runAlphaScenario(env); }},
       {"lights", [&] { return runLightsScenario(env); }},
       {"soak", [&] { return runSoakScenario(env); }},
+      {"memory", [&] { return runMemoryScenario(env); }},
   };
   // A failing scenario is reported and the others still run (a GPU session is too costly to lose whole).
   std::vector<std::string> failures;

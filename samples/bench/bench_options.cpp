@@ -9,7 +9,7 @@ const std::vector<std::string>& scenarioNames() {
   static const std::vector<std::string> names = {"build",      "duplication", "fastbuild-vs-fasttrace",
                                                  "compaction", "tlas",        "tlas-motion",
                                                  "trace",      "gigarays",    "alpha",
-                                                 "lights",     "soak"};
+                                                 "lights",     "soak",        "memory"};
   return names;
 }
 
@@ -21,7 +21,7 @@ void addOptions(CLI::App& app, BenchOptions& o) {
   std::vector<std::string> scenarios = scenarioNames();
   scenarios.push_back("all");
   app.add_option("--scenario", o.scenario,
-                 "scenario to run: " + rbCli::joinNames(scenarios) + " (default all: every one but soak)")
+                 "scenario to run: " + rbCli::joinNames(scenarios) + " (default all: every one but soak and memory)")
       ->type_name("NAME")
       ->check(rbCli::oneOf(scenarios));
   app.add_option("--out", o.outPath, "JSON report (default: none)")->type_name("FILE.json");

@@ -13,7 +13,7 @@ inline constexpr uint32_t kQuickSoakFrames = 2000;
 inline constexpr uint64_t kDefaultSoakSeed = 20261202;
 
 struct BenchOptions {
-  std::string scenario = "all";  // one of scenarioNames() or "all" (every one but "soak")
+  std::string scenario = "all";  // one of scenarioNames() or "all" (every one but "soak" and "memory")
   std::string outPath;           // empty = no JSON file
   bool quick = false;            // smallest sizes and fewest repeats (smoke test, under ~2 minutes on lavapipe)
   bool full = false;             // the GPU sizes even on a CPU device (1M triangles, ...)
@@ -28,8 +28,9 @@ struct BenchOptions {
   bool help = false;
 };
 
-// The scenarios, in the order they run. "all" runs every one but "soak", which runs only when named (it takes
-// minutes and measures no speed).
+// The scenarios, in the order they run. "all" runs every one but "soak" and "memory", which run only when named
+// (they measure no speed; the soak takes minutes, the memory sweep a minute on lavapipe with --quick when the driver
+// compiles its pipelines afresh).
 const std::vector<std::string>& scenarioNames();
 // The help CLI11 generates for these options.
 std::string usage();

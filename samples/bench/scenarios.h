@@ -36,5 +36,10 @@ nlohmann::json runLightsScenario(BenchEnv& env);
 // (seeded); the SDK's memory and handles at the start, after the warm-up and at the end, which must show no growth,
 // no live handle after release and no validation error. Its result lists what failed under "failures".
 nlohmann::json runSoakScenario(BenchEnv& env);
+// The device memory of HybridEffects for every preset (with local lights) at four resolutions: by effect and category,
+// and pass images per pixel (docs/integration.md, "Memory sweep"). Its result lists what failed under "failures": the
+// effects' sum against the pass memory, pass images per pixel against the pixel count, what a destroyed HybridEffects
+// leaves behind.
+nlohmann::json runMemoryScenario(BenchEnv& env);
 
 }  // namespace rbbench
