@@ -24,6 +24,7 @@
 #include "dump_compare.h"
 #include "frame_capture.h"
 #include "frame_series.h"
+#include "glossy_scene.h"
 #include "perf_scene.h"
 #include "raybridge_sample_engine_adapter.h"
 #include "render_options.h"
@@ -108,6 +109,7 @@ se::Result<se::Scene> loadScene(const RenderOptions& o, std::vector<se::Animatio
                    info.missing.c_str());
     return perf;
   }
+  if (o.glossyScene) return R::success(makeGlossyScene());
   if (o.characters) {
     const std::string& dir = modelsDir;
     // In front of the demo's objects, facing its camera's view (the benchmark centres them on the scene).
@@ -567,6 +569,7 @@ void addSceneStats(const RenderRun& run, nlohmann::json& stats) {
   stats["gbuffer_normals"] = o.geometricNormals ? "geometric" : "shading";
   stats["scene"] = o.characters      ? "procedural demo scene with " + std::to_string(o.characters) + " characters"
                    : o.perfScene     ? "performance scene"
+                   : o.glossyScene   ? "glossy scene"
                    : o.scene.empty() ? "procedural demo scene"
                                      : o.scene;
   stats["device"] = {{"name", engine.deviceInfo().name}};

@@ -115,6 +115,8 @@ struct RenderOptions {
   uint32_t perfGroundSegments = 0;  // --perf-ground N; 0 = kPerfGroundSegments (perf_scene.h)
   uint32_t perfCopies = 0;          // --perf-copies K: K times the models' copies; 0 = 1; with --perf-ground-only none
   bool perfGroundOnly = false;      // --perf-ground-only
+  // --glossy-scene: the glossy scene of glossy_scene.h (procedural, issue 30) instead of the demo scene.
+  bool glossyScene = false;
   std::string modelsFrom;  // --models-from DIR (or --characters-from); empty = ../shared/scenes beside the source tree
   rb::DynamicBuildMode dynamicMode = rb::DynamicBuildMode::InFrame;  // --dynamic-builds
   std::string device;
