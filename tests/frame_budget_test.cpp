@@ -187,6 +187,17 @@ TEST_CASE("frame budget: under the floor everything runs at its cheapest and the
   CHECK(percentile(hooks(r, 50, r.size()), 0.5) <= 1.1 * p.floorMs);
 }
 
+TEST_CASE("frame budget: a first frame that builds the scene does not hold the plan down", "[budget]") {
+  FrameBudgetController c;
+  c.configure(4.0, ultraKnobs());
+  auto load = [](uint32_t f, SimScene&) { return f == 1 ? 40.0 : 1.0; };  // the BLAS builds of the load: 64 ms
+  const std::vector<FrameRecord> r = simulate(c, SimScene{}, 40, 0.0, load);
+  // By the tenth frame the fixed estimate is the frame's own (1.6 ms), not the load's, and the adaptive effects
+  // have their share.
+  CHECK(r[9].plan.fixedMs == Catch::Approx(1.6).epsilon(0.02));
+  CHECK(r[9].plan.targetMs[kBudgetAo] > 0.3);
+}
+
 TEST_CASE("frame budget: an effect at its ray cap leaves its share to the others", "[budget]") {
   FrameBudgetController c;
   c.configure(6.0, ultraKnobs());

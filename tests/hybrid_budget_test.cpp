@@ -17,7 +17,8 @@ struct BudgetRun {
   rb::HybridStats firstStats;  // after the third frame
 };
 
-// `high` with four local-light rays and eight lamps at 64x48 for `frames` frames under `budgetMs` (0 = none).
+// `high` with four glossy reflection rays, four local-light rays and eight lamps at 64x48 for `frames` frames under
+// `budgetMs` (0 = none).
 BudgetRun run(GpuFixture& fx, float budgetMs, int frames) {
   TestScene scene = makeConformanceScene();
   EmbreeScene embree;
@@ -29,6 +30,7 @@ BudgetRun run(GpuFixture& fx, float budgetMs, int frames) {
   rb::HybridEffectsDesc desc = rb::withPreset({}, rb::Preset::High);
   desc.effects |= rb::kEffectLocalLights;
   desc.localLights.raysPerPixel = 4;
+  desc.reflections.raysPerPixel = 4;
   desc.budgetMs = budgetMs;
   auto created = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
   RB_REQUIRE_OK(created);
@@ -99,7 +101,7 @@ TEST_CASE("a frame budget under the floor runs every effect at its cheapest and 
   CHECK(b.belowFloor);
   CHECK(b.floorMs > b.fixedMs);
   CHECK(b.fixedMs > 0.0);
-  CHECK(b.reflectionLevel == 1);  // half resolution
+  CHECK(b.reflectionLevel == 3);  // one ray (4 / 2 / 1), then half resolution
   CHECK(b.localLightLevel == 2);  // 4 rays / 4
   // The adaptive effects trace far fewer rays than the description's uniform ones; reflections at half resolution a
   // quarter; local lights one ray where they traced four.
@@ -113,15 +115,15 @@ TEST_CASE("a frame budget with room climbs back to the description's levels", "[
   GpuFixture fx;
   if (!fx.ctx().deviceInfo().timestampsSupported) SKIP("the device has no timestamps: a frame budget needs them");
   const BudgetRun none = run(fx, 0.0f, 12);
-  const BudgetRun roomy = run(fx, 1000.0f, 36);
+  const BudgetRun roomy = run(fx, 1000.0f, 48);
   // Every effect starts at its cheapest (the first frames hold any budget)...
-  CHECK(roomy.firstStats.budget.reflectionLevel == 1);
+  CHECK(roomy.firstStats.budget.reflectionLevel == 3);
   CHECK(roomy.firstStats.budget.localLightLevel == 2);
-  // ...and three steps later, one per kBudgetSettleFrames, runs as described.
+  // ...and five steps later (reflections 3 -> 0, local lights 2 -> 0), one per kBudgetSettleFrames, runs as described.
   const rb::FrameBudgetStats& b = roomy.stats.budget;
   CHECK(b.reflectionLevel == 0);
   CHECK(b.localLightLevel == 0);
-  CHECK(b.levelSteps == 3);
+  CHECK(b.levelSteps == 5);
   CHECK_FALSE(b.belowFloor);
   // The adaptive effects share what is left, far more than the uniform rays take: they trace more than those (up to
   // AdaptiveRaySettings::maxRaysPerPixel, 4x the uniform ones, where the denoiser's history asks).

@@ -197,6 +197,11 @@ if want render; then
             "hybrid_ultra|--mode hybrid --preset ultra" "hybrid_low|--mode hybrid --preset low")
   [ -n "${RB_RENDER_VARIANTS:-}" ] && IFS=';' read -r -a VARIANTS <<<"$RB_RENDER_VARIANTS"
   read -r RW RH <<<"${RB_RENDER_SIZE:-1920 1080}"
+  # RB_RENDER_PROBE=1: the raw-rate probe first (stress and primary rates, ~1M triangles), into render_gpu.log.
+  if [ "${RB_RENDER_PROBE:-0}" = 1 ] && [ -x "$RT/probe/probe" ]; then
+    RAYBRIDGE_VALIDATION=0 step "probe k10" 60 "$OUT/render_gpu.log" "$RT/probe/probe" --width "$RW" --height "$RH" \
+      --rays 64 --k 10 --ground-tiles 64 --reps 7
+  fi
   for variant in "${VARIANTS[@]}"; do
     name="${variant%%|*}"
     vline="${variant#*|}"

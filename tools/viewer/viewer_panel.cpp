@@ -21,8 +21,8 @@ void budgetControls(const PanelModel& m, PanelRequests& r) {
   if (b.budgetMs <= 0.0f) return;
   ImGui::Text("record() %.2f ms of %.1f; fixed %.2f, floor %.2f%s", m.effectStats.hook.gpuMs, b.budgetMs, b.fixedMs,
               b.floorMs, b.belowFloor ? "  (under the floor: everything at its cheapest)" : "");
-  ImGui::Text("given: shadows %.2f  AO %.2f  reflections %.2f (%s)  local lights %.2f (rays / %u)", b.shadowsMs, b.aoMs,
-              b.reflectionsMs, b.reflectionLevel ? "half res" : "full res", b.localLightsMs, 1u << b.localLightLevel);
+  ImGui::Text("given: shadows %.2f  AO %.2f  reflections %.2f (level %u)  local lights %.2f (rays / %u)", b.shadowsMs,
+              b.aoMs, b.reflectionsMs, b.reflectionLevel, b.localLightsMs, 1u << b.localLightLevel);
 }
 
 void passRow(const char* name, double ms, const rb::PassStats* rays = nullptr) {

@@ -108,9 +108,10 @@ inline constexpr uint32_t kMaxResetFollowUpFrames = 8;
 //    kBudgetAoErrorWeight), an effect whose rays reach their maximum leaving the rest to the other. Their
 //    schedule.adaptive settings are taken as given but for enabled, timeBudgetMs and initialRaysPerPixel, which the
 //    budget sets (their reset rays give way to the plan);
-//  - reflections step between as described (level 0) and half resolution (level 1, without converged tiles), and
-//    stochastic local lights between their rays per pixel and one (level k = raysPerPixel / 2^k): a step at a time, a
-//    step up only where the measured (or predicted) cost leaves the adaptive effects twice the share they need.
+//  - reflections step from as described (level 0) through their glossy rays halved down to one, then (unless they are
+//    at half resolution already) one ray at half resolution, without converged tiles; stochastic local lights from
+//    their rays per pixel down to one (level k = raysPerPixel / 2^k): a step at a time, a step up only where the
+//    measured (or predicted) cost leaves the adaptive effects twice the share they need.
 // Every effect starts at its cheapest and climbs as the measurements show room: the budget holds from the first
 // frames. The division is src/schedule/frame_budget.h's, tested with injected timings. A budget under the floor
 // (fixed cost plus every effect at its cheapest) runs everything at its cheapest: HybridStats::budget reports
@@ -327,7 +328,8 @@ struct FrameBudgetStats {
   bool belowFloor = false;  // budgetMs < floorMs: every effect runs at its cheapest and the frame takes floorMs
   // Per effect: the time it was given (an adaptive effect's time target; a levelled one's measured cost at its level).
   double shadowsMs = 0.0, aoMs = 0.0, reflectionsMs = 0.0, localLightsMs = 0.0;
-  uint32_t reflectionLevel = 0;  // 0 = as described, 1 = half resolution
+  // 0 = as described; level k < log2(rays) + 1: the glossy rays / 2^k; the next (the last): one ray, half resolution.
+  uint32_t reflectionLevel = 0;
   uint32_t localLightLevel = 0;  // rays per pixel = the described ones / 2^level
   uint64_t measurements = 0;     // finished frames taken in
   uint64_t levelSteps = 0;       // level changes so far

@@ -1,7 +1,9 @@
 #include "effect_budget.h"
 
 #include <raybridge/many_light_pass.h>
+#include <raybridge/reflection_pass.h>
 
+#include <algorithm>
 #include <bit>
 #include <string>
 
@@ -13,9 +15,17 @@ namespace {
 // least (one ray per 64 pixels, or one tile), so that the first frames stay under the budget; they climb at most
 // 2x a measurement to the target.
 constexpr float kBudgetStartRaysPerPixel = 1.0f / 64.0f;
-// The predicted cost of full-resolution reflections over half-resolution ones, until both are measured: four times
-// the rays, less the upsample (2.8x on the perf scene, 1.4x on the demo: docs/performance.md, "Half resolution").
-constexpr double kReflectionHalfResolutionStep = 3.0;
+// The predicted cost of a reflection level over the next cheaper one, until both are measured: twice the rays (and,
+// for the last step, four times the pixels at one ray: 2.8x on the perf scene, docs/performance.md "Half
+// resolution"), so three, on the safe side: a step up that is predicted too cheap overruns once, then waits.
+constexpr double kReflectionStepCost = 3.0;
+
+// Reflection levels: the described glossy rays halved down to one (log2 + 1 levels), then, unless the description
+// traces at half resolution already, one ray at half resolution.
+uint32_t reflectionRays(const HybridEffectsDesc& d) {
+  return d.reflections.raysPerPixel ? d.reflections.raysPerPixel : kDefaultReflectionRays;
+}
+uint32_t reflectionRayLevels(const HybridEffectsDesc& d) { return uint32_t(std::bit_width(reflectionRays(d))); }
 
 bool sameKnobs(const std::array<BudgetKnob, kBudgetEffects>& a, const std::array<BudgetKnob, kBudgetEffects>& b) {
   for (uint32_t e = 0; e < kBudgetEffects; ++e) {
@@ -39,8 +49,9 @@ Status EffectBudget::configure(Context& ctx, const HybridEffectsDesc& desc) {
   std::array<BudgetKnob, kBudgetEffects> k{};
   k[kBudgetShadows] = {shadows, shadows && !desc.shadows.disableDenoiser, 1, kBudgetShadowErrorWeight, 2.0};
   k[kBudgetAo] = {ao, ao && !desc.ao.disableDenoiser, 1, kBudgetAoErrorWeight, 2.0};
+  const uint32_t reflectionLevels = reflectionRayLevels(desc) + (desc.reflections.schedule.halfResolution ? 0u : 1u);
   k[kBudgetReflections] = {(desc.effects & kEffectReflections) != 0, false,
-                           desc.reflections.schedule.halfResolution ? 1u : 2u, 1.0, kReflectionHalfResolutionStep};
+                           std::min(reflectionLevels, kBudgetMaxLevels), 1.0, kReflectionStepCost};
   // Stochastic local lights: their rays halved down to one (1 + log2 levels); the exact mode has nothing to move.
   const uint32_t lightRays = desc.localLights.raysPerPixel ? desc.localLights.raysPerPixel : kDefaultLightRays;
   const uint32_t lightLevels = desc.localLights.mode == ManyLightMode::Stochastic ? uint32_t(std::bit_width(lightRays))
@@ -101,8 +112,15 @@ void EffectBudget::applyAdaptive(RaySchedule& s, BudgetEffect e) const {
   s.adaptive.initialRaysPerPixel = kBudgetStartRaysPerPixel;
 }
 
-void EffectBudget::applyReflections(RaySchedule& s) const {
-  if (!active_ || plan_.level[kBudgetReflections] == 0) return;
+void EffectBudget::applyReflections(RaySchedule& s, uint32_t& raysPerPixel) const {
+  const uint32_t level = plan_.level[kBudgetReflections];
+  if (!active_ || level == 0) return;
+  const uint32_t rays = raysPerPixel ? raysPerPixel : kDefaultReflectionRays;
+  if (level < uint32_t(std::bit_width(rays))) {
+    raysPerPixel = rays >> level;
+    return;
+  }
+  raysPerPixel = 1;
   s.halfResolution = true;
   s.convergedTiles.enabled = false;  // a full-resolution stage
 }

@@ -29,7 +29,8 @@ class EffectBudget {
   // The plan on each effect's settings (nothing without a budget).
   void applyShadows(RaySchedule& s) const { applyAdaptive(s, kBudgetShadows); }
   void applyAo(RaySchedule& s) const { applyAdaptive(s, kBudgetAo); }
-  void applyReflections(RaySchedule& s) const;
+  // Reflections' glossy rays (0 = the default) and schedule at the planned level.
+  void applyReflections(RaySchedule& s, uint32_t& raysPerPixel) const;
   uint32_t localLightRays(uint32_t described) const;
 
   PassStats hook(Context& ctx) { return hookReady_ ? hook_.latest(ctx) : PassStats{}; }

@@ -494,7 +494,7 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
   s.raysPerPixel = desc.reflections.raysPerPixel;
   s.invocationReorder = desc.reflections.invocationReorder;
   RaySchedule wanted = desc.reflections.schedule;
-  budget.applyReflections(wanted);
+  budget.applyReflections(wanted, s.raysPerPixel);
   s.schedule = effectSchedule(wanted, reflectionDenoiser.get());
   s.lighting = reflectionLighting(f);
   // The light changes a reflection shows, where the change resets run (the denoiser then drops those pixels'

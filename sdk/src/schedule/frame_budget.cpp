@@ -82,7 +82,12 @@ void FrameBudgetController::measure(const BudgetMeasurement& m) {
   double passes = 0.0;
   for (uint32_t e = 0; e < kBudgetEffects; ++e) passes += knobs_[e].enabled ? m.passMs[e] : 0.0;
   double fixed = std::max(fixed_, 0.0);  // the first sample sets it (smooth() from "not measured")
-  smooth(fixed, m.hookMs - passes);
+  if (plan_.measurements <= kBudgetStartMeasurements && fixed > 0.0) {
+    // The first frames also build the scene's BLASes (a load, not a frame's cost): their least is the estimate.
+    fixed = std::min(fixed, std::max(m.hookMs - passes, 1e-6));
+  } else {
+    smooth(fixed, m.hookMs - passes);
+  }
   fixed_ = fixed;
   for (uint32_t e = 0; e < kBudgetEffects; ++e) {
     const BudgetKnob& k = knobs_[e];

@@ -52,6 +52,10 @@ inline constexpr double kBudgetSmoothing = 0.3;
 inline constexpr double kBudgetAdaptiveShare = 0.15;
 // The least time target of an adaptive effect (its pass then traces its minimum rays).
 inline constexpr double kBudgetMinTargetMs = 0.02;
+// The first measurements, over which the fixed cost is their least rather than smoothed: the first frames build the
+// scene's BLASes (recordPendingWork inside record()), a load many times a frame's cost that smoothing would carry for
+// twenty frames.
+inline constexpr uint64_t kBudgetStartMeasurements = 4;
 // Frames between two level steps: the frames in flight plus two measurements at the new level.
 inline constexpr uint64_t kBudgetSettleFrames = 6;
 // A step up undone within this many frames was a failed try: the next waits twice as long.
