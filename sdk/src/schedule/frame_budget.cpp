@@ -50,8 +50,12 @@ double FrameBudgetController::levelCost(uint32_t e, uint32_t level) const {
   return 0.0;
 }
 
+double FrameBudgetController::headroom() const {
+  return std::clamp(3.0 * change_, kBudgetMinHeadroom, kBudgetMaxHeadroom);
+}
+
 double FrameBudgetController::leftMs() const {
-  double left = budget_ * kBudgetHeadroom - std::max(fixed_, 0.0);
+  double left = budget_ * (1.0 - headroom()) - std::max(fixed_, 0.0);
   for (uint32_t e = 0; e < kBudgetEffects; ++e) {
     if (knobs_[e].enabled && !knobs_[e].adaptive) left -= levelCost(e, plan_.level[e]);
   }
@@ -79,6 +83,13 @@ void FrameBudgetController::measure(const BudgetMeasurement& m) {
   }
   lastMeasured_ = m.frame;
   ++plan_.measurements;
+  // The frame-to-frame change over the budget, smoothed over about 20 frames; one change counts as at most a quarter
+  // of the budget, so that a single spike (or the load's first frames) does not widen the headroom for long.
+  if (lastHook_ >= 0.0 && plan_.measurements > kBudgetStartMeasurements) {
+    const double change = std::min(std::abs(m.hookMs - lastHook_) / budget_, 0.25);
+    change_ += 0.05 * (change - change_);
+  }
+  lastHook_ = m.hookMs;
   double passes = 0.0;
   for (uint32_t e = 0; e < kBudgetEffects; ++e) passes += knobs_[e].enabled ? m.passMs[e] : 0.0;
   double fixed = std::max(fixed_, 0.0);  // the first sample sets it (smooth() from "not measured")

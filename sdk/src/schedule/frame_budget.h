@@ -12,7 +12,7 @@
 // Each measurement (a finished frame): fixed = hook - the adjustable passes, and each levelled pass's cost at the level
 // that frame ran, are smoothed (kBudgetSmoothing; a sample is clipped to 0.5x-1.5x the estimate, so one spike moves
 // the estimate by at most 15%, and a lasting step is followed by up to 15% a frame). Each plan:
-//  1. left = budget * kBudgetHeadroom - fixed - the levelled passes at their levels;
+//  1. left = budget * (1 - headroom) - fixed - the levelled passes at their levels (headroom: kBudgetMinHeadroom);
 //  2. levels, at most one step per kBudgetSettleFrames and only after two measurements at the current levels: a step
 //     down (the one that saves most) while `left` is under what the adaptive effects need at least
 //     (kBudgetAdaptiveShare of the budget); a step up (the cheapest, by its measured or predicted cost) only when
@@ -43,8 +43,11 @@ enum BudgetEffect : uint32_t { kBudgetShadows, kBudgetAo, kBudgetReflections, kB
 
 // The longest level ladder.
 inline constexpr uint32_t kBudgetMaxLevels = 8;
-// The share of the budget the plan aims at: the rest absorbs the frame-to-frame noise (p99 <= 1.1x budget).
-inline constexpr double kBudgetHeadroom = 0.93;
+// The share of the budget kept free (p99 <= 1.1x budget): at least kBudgetMinHeadroom, and three times the mean
+// frame-to-frame change of the hook (over the budget, smoothed; for a normal change about 2.4 standard deviations),
+// which the plan, two frames late, cannot follow (a camera path's content changing, noise), up to kBudgetMaxHeadroom.
+inline constexpr double kBudgetMinHeadroom = 0.05;
+inline constexpr double kBudgetMaxHeadroom = 0.2;
 // Weight of a new sample in the smoothed costs.
 inline constexpr double kBudgetSmoothing = 0.3;
 // What the adaptive effects together need at least, as a share of the budget, before a levelled effect keeps or
@@ -108,6 +111,7 @@ class FrameBudgetController {
 
  private:
   double levelCost(uint32_t e, uint32_t level) const;
+  double headroom() const;
   double leftMs() const;
   double adaptiveNeedMs() const;
   void stepLevels(uint64_t frame);
@@ -117,6 +121,8 @@ class FrameBudgetController {
   std::array<BudgetKnob, kBudgetEffects> knobs_{};
   BudgetPlan plan_;
   double fixed_ = -1.0;                                                      // < 0: not measured
+  double lastHook_ = -1.0;                                                   // the latest measured hook (< 0: none)
+  double change_ = 0.0;                                                      // smoothed |hook - previous hook| / budget
   std::array<std::array<double, kBudgetMaxLevels>, kBudgetEffects> cost_{};  // per level; 0 = not measured
   std::array<double, kBudgetEffects> use_{};                                 // adaptive passes' smoothed time
   std::array<double, kBudgetEffects> least_{};                               // adaptive passes' least time seen
