@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "synthetic_gbuffer.h"
+#include "effects_rig.h"
 
 using namespace rbtest;
 
@@ -20,47 +20,23 @@ struct BudgetRun {
 // `high` with four glossy reflection rays, four local-light rays and eight lamps at 64x48 for `frames` frames under
 // `budgetMs` (0 = none).
 BudgetRun run(GpuFixture& fx, float budgetMs, int frames) {
-  TestScene scene = makeConformanceScene();
-  EmbreeScene embree;
-  addToEmbree(embree, scene);
-  const CpuGBuffer cpu = traceGBuffer(embree, motionTestView(64, 48));
-  auto service = rb::AccelerationStructureService::create(fx.ctx());
-  RB_REQUIRE_OK(service);
-  BuiltScene built = buildScene(fx, *service.value(), scene);
+  EffectsRig rig(fx, 64, 48);
   rb::HybridEffectsDesc desc = rb::withPreset({}, rb::Preset::High);
   desc.effects |= rb::kEffectLocalLights;
   desc.localLights.raysPerPixel = 4;
   desc.reflections.raysPerPixel = 4;
   desc.budgetMs = budgetMs;
-  auto created = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
+  auto created = rb::HybridEffects::create(fx.ctx(), &rig.service(), desc);
   RB_REQUIRE_OK(created);
-  rb::HybridEffects& effects = *created.value();
   // Eight lamps: more than the rays, so the four rays are stochastic (with fewer lights than rays every light gets
   // its own ray, whatever the count).
-  std::vector<rb::LightSource> lights(8);
-  for (size_t i = 0; i < lights.size(); ++i) {
-    lights[i].light.type = rb::LightType::Point;
-    lights[i].light.position[0] = -1.5 + 0.5 * double(i);
-    lights[i].light.position[1] = 1.5;
-    lights[i].light.range = 6.0f;
-    lights[i].intensity = 4.0f;
-  }
-  GpuGBuffer gbuffer(fx, cpu);
+  const std::vector<rb::LightSource> lights = lampRow(8);
   BudgetRun out;
   for (int i = 0; i < frames; ++i) {
-    fx.runFrame([&](VkCommandBuffer cmd) {
-      rb::HybridFrame f;
-      f.gbuffer = gbuffer.desc();
-      f.instances = built.instances;
-      f.localLights = lights;
-      f.light.angularRadiusDegrees = 1.0f;
-      RB_REQUIRE_OK(effects.record(cmd, f));
-    });
-    if (i == 2) out.firstStats = effects.stats();
+    rig.record(*created.value(), lights);
+    if (i == 2) out.firstStats = created.value()->stats();
   }
-  out.stats = effects.stats();
-  created.value().reset();
-  destroyScene(fx, built);
+  out.stats = created.value()->stats();
   return out;
 }
 

@@ -5,7 +5,7 @@
 
 #include <cstdio>
 
-#include "synthetic_gbuffer.h"
+#include "effects_rig.h"
 
 using namespace rbtest;
 
@@ -24,18 +24,6 @@ constexpr uint64_t kRgbEffectBytesPerPixel = 40;
 constexpr uint64_t kChangeMaskBytesPerPixel = 1;
 constexpr uint64_t kDenoiserScratchBytesPerPixel = 20;
 
-std::vector<rb::LightSource> twoLamps() {
-  std::vector<rb::LightSource> lights(2);
-  for (size_t i = 0; i < lights.size(); ++i) {
-    lights[i].light.type = rb::LightType::Point;
-    lights[i].light.position[0] = i == 0 ? -1.0 : 1.5;
-    lights[i].light.position[1] = 1.5;
-    lights[i].light.range = 6.0f;
-    lights[i].intensity = 4.0f;
-  }
-  return lights;
-}
-
 struct Measured {
   rb::EffectMemoryStats byEffect;
   rb::MemoryStats context;
@@ -43,30 +31,14 @@ struct Measured {
 
 // `high` with local lights at width x height: three frames, then the memory.
 Measured measure(GpuFixture& fx, uint32_t width, uint32_t height) {
-  TestScene scene = makeConformanceScene();
-  EmbreeScene embree;
-  addToEmbree(embree, scene);
-  const CpuGBuffer cpu = traceGBuffer(embree, motionTestView(width, height));
-  auto service = rb::AccelerationStructureService::create(fx.ctx());
-  RB_REQUIRE_OK(service);
-  BuiltScene built = buildScene(fx, *service.value(), scene);
+  EffectsRig rig(fx, width, height);
   rb::HybridEffectsDesc desc = rb::withPreset({}, rb::Preset::High);
   desc.effects |= rb::kEffectLocalLights;
-  auto created = rb::HybridEffects::create(fx.ctx(), service.value().get(), desc);
+  auto created = rb::HybridEffects::create(fx.ctx(), &rig.service(), desc);
   RB_REQUIRE_OK(created);
   rb::HybridEffects& effects = *created.value();
-  const std::vector<rb::LightSource> lights = twoLamps();
-  GpuGBuffer gbuffer(fx, cpu);
-  auto frame = [&] {
-    fx.runFrame([&](VkCommandBuffer cmd) {
-      rb::HybridFrame f;
-      f.gbuffer = gbuffer.desc();
-      f.instances = built.instances;
-      f.localLights = lights;
-      f.light.angularRadiusDegrees = 1.0f;
-      RB_REQUIRE_OK(effects.record(cmd, f));
-    });
-  };
+  const std::vector<rb::LightSource> lights = lampRow(2);
+  auto frame = [&] { rig.record(effects, lights); };
   for (int i = 0; i < 3; ++i) frame();
   Measured m{effects.memoryByEffect(), fx.ctx().memoryStats()};
   CHECK(m.byEffect.total().of(rb::MemoryCategory::PassImages) ==
@@ -89,8 +61,6 @@ Measured measure(GpuFixture& fx, uint32_t width, uint32_t height) {
                               kChangeMaskBytesPerPixel * width * height;
   CHECK(after.shared.of(rb::MemoryCategory::PassImages) >= sharedLeft);
   CHECK(after.shared.of(rb::MemoryCategory::PassImages) <= sharedLeft + 4096);
-  created.value().reset();
-  destroyScene(fx, built);
   return m;
 }
 

@@ -79,20 +79,7 @@ SoakGBuffer makeBandGBuffer(BenchEnv& env, uint32_t width, uint32_t height, uint
       g.normal[4 * i + 3] = kRoughness[(x / 8) % 3];
     }
   }
-  SoakGBuffer s;
-  s.depth = uploadSampledImage(env, VK_FORMAT_D32_SFLOAT, VK_IMAGE_ASPECT_DEPTH_BIT, width, height, g.depth.data(),
-                               g.depth.size() * sizeof(float), "the memory G-buffer depth");
-  s.normal = uploadSampledImage(env, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_ASPECT_COLOR_BIT, width, height,
-                                g.normal.data(), g.normal.size() * sizeof(float), "the memory G-buffer normal");
-  s.desc.width = width;
-  s.desc.height = height;
-  s.desc.depth = {s.depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-  s.desc.normal = {s.normal.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-  s.desc.roughnessInNormalW = true;
-  std::memcpy(s.desc.view, g.view, sizeof s.desc.view);
-  std::memcpy(s.desc.projection, g.projection, sizeof s.desc.projection);
-  for (int i = 0; i < 3; ++i) s.desc.cameraPosition[i] = view.eye[i];
-  return s;
+  return uploadGroundGBuffer(env, view, g, "the memory G-buffer");
 }
 
 class MemorySweep {

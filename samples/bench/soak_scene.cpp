@@ -54,6 +54,25 @@ SoakSizes pickSoakSizes(const BenchOptions& o, bool isCpu) {
   return s;
 }
 
+SoakGBuffer uploadGroundGBuffer(BenchEnv& env, const FoliageView& view, const AnalyticGBuffer& g,
+                                const std::string& what) {
+  SoakGBuffer s;
+  const uint32_t w = view.width, h = view.height;
+  s.depth = uploadSampledImage(env, VK_FORMAT_D32_SFLOAT, VK_IMAGE_ASPECT_DEPTH_BIT, w, h, g.depth.data(),
+                               g.depth.size() * sizeof(float), (what + " depth").c_str());
+  s.normal = uploadSampledImage(env, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_ASPECT_COLOR_BIT, w, h, g.normal.data(),
+                                g.normal.size() * sizeof(float), (what + " normal").c_str());
+  s.desc.width = w;
+  s.desc.height = h;
+  s.desc.depth = {s.depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  s.desc.normal = {s.normal.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  s.desc.roughnessInNormalW = true;
+  std::memcpy(s.desc.view, g.view, sizeof s.desc.view);
+  std::memcpy(s.desc.projection, g.projection, sizeof s.desc.projection);
+  for (int i = 0; i < 3; ++i) s.desc.cameraPosition[i] = view.eye[i];
+  return s;
+}
+
 SoakScene::SoakScene(BenchEnv& env, const SoakSizes& sizes) : env_(env) {
   rb::HeadlessDevice& dev = env.device();
 
@@ -129,20 +148,7 @@ SoakScene::SoakScene(BenchEnv& env, const SoakSizes& sizes) : env_(env) {
     for (uint32_t y = 0; y < h; ++y) {
       for (uint32_t x = 0; x < w; ++x) g.normal[(size_t(y) * w + x) * 4 + 3] = groundRoughness(x, y);
     }
-    SoakGBuffer s;
-    s.depth = uploadSampledImage(env, VK_FORMAT_D32_SFLOAT, VK_IMAGE_ASPECT_DEPTH_BIT, w, h, g.depth.data(),
-                                 g.depth.size() * sizeof(float), "a soak G-buffer depth");
-    s.normal = uploadSampledImage(env, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_ASPECT_COLOR_BIT, w, h, g.normal.data(),
-                                  g.normal.size() * sizeof(float), "a soak G-buffer normal");
-    s.desc.width = w;
-    s.desc.height = h;
-    s.desc.depth = {s.depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    s.desc.normal = {s.normal.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    s.desc.roughnessInNormalW = true;
-    std::memcpy(s.desc.view, g.view, sizeof s.desc.view);
-    std::memcpy(s.desc.projection, g.projection, sizeof s.desc.projection);
-    for (int i = 0; i < 3; ++i) s.desc.cameraPosition[i] = view_.eye[i];
-    gbuffers_.push_back(s);
+    gbuffers_.push_back(uploadGroundGBuffer(env, view_, g, "a soak G-buffer"));
     if (gbuffers_.size() == 1) {
       // Objects float up to 1.2 above the ground the camera sees, shifted towards the sun so their shadows land
       // on it.

@@ -62,6 +62,11 @@ struct SoakGBuffer {
   rb::GBufferDesc desc;
 };
 
+// `g` (made by makeGroundGBuffer(view), roughness in the normal's w) uploaded as a G-buffer the passes read; `what`
+// names its images.
+SoakGBuffer uploadGroundGBuffer(BenchEnv& env, const FoliageView& view, const AnalyticGBuffer& g,
+                                const std::string& what);
+
 // Targets of deformation: dynamicSlots cloth slots, then crowdKeys crowd meshes.
 struct DeformRequest {
   uint32_t target = 0;
