@@ -63,11 +63,7 @@ Status EffectBudget::configure(Context& ctx, const HybridEffectsDesc& desc) {
   active_ = wanted;
   budgetMs_ = wanted ? desc.budgetMs : 0.0f;
   knobs_ = k;
-  if (restart) {
-    controller_.configure(budgetMs_, knobs_);
-    plan_ = controller_.latest();
-  }
-  if (!active_) plan_ = {};
+  if (restart) controller_.configure(budgetMs_, knobs_);
   return {};
 }
 
@@ -76,29 +72,31 @@ void EffectBudget::retire(Context& ctx) {
   hookReady_ = false;
 }
 
-Status EffectBudget::begin(Context& ctx, VkCommandBuffer cmd, const HybridStats& passes) {
+Status EffectBudget::begin(Context& ctx, VkCommandBuffer cmd) {
   if (!hookReady_) {
     if (Status st = hook_.init(ctx, "HybridEffects::record", false); !st) return st;
     hookReady_ = true;
   }
   if (Status st = hook_.beginRecording(ctx, cmd); !st) return st;
-  if (active_) {
-    const PassStats h = hook_.latest(ctx);
-    const PassStats* of[kBudgetEffects] = {&passes.shadow, &passes.ao, &passes.reflection, &passes.localLights};
-    BudgetMeasurement m;
-    m.frame = h.frame;
-    m.hookMs = h.gpuMs;
-    bool sameFrame = h.frame != 0;
-    for (uint32_t e = 0; e < kBudgetEffects; ++e) {
-      if (!knobs_[e].enabled) continue;
-      sameFrame = sameFrame && of[e]->frame == h.frame;  // a pass created since has no measurement of that frame
-      m.passMs[e] = of[e]->gpuMs;
-    }
-    if (sameFrame) controller_.measure(m);
-    plan_ = controller_.plan(ctx.frameIndex());
-  }
   hook_.writeStart(ctx, cmd);
   return {};
+}
+
+void EffectBudget::plan(Context& ctx, const HybridStats& passes) {
+  if (!active_) return;
+  const PassStats h = hook(ctx);
+  const PassStats* of[kBudgetEffects] = {&passes.shadow, &passes.ao, &passes.reflection, &passes.localLights};
+  BudgetMeasurement m;
+  m.frame = h.frame;
+  m.hookMs = h.gpuMs;
+  bool sameFrame = h.frame != 0;
+  for (uint32_t e = 0; e < kBudgetEffects; ++e) {
+    if (!knobs_[e].enabled) continue;
+    sameFrame = sameFrame && of[e]->frame == h.frame;  // a pass created since has no measurement of that frame
+    m.passMs[e] = of[e]->gpuMs;
+  }
+  if (sameFrame) controller_.measure(m);
+  controller_.plan(ctx.frameIndex());
 }
 
 void EffectBudget::end(Context& ctx, VkCommandBuffer cmd) {
@@ -108,13 +106,13 @@ void EffectBudget::end(Context& ctx, VkCommandBuffer cmd) {
 void EffectBudget::applyAdaptive(RaySchedule& s, BudgetEffect e) const {
   if (!active_ || !knobs_[e].adaptive) return;
   s.adaptive.enabled = true;
-  s.adaptive.timeBudgetMs = float(plan_.targetMs[e]);
+  s.adaptive.timeBudgetMs = float(latest().targetMs[e]);
   s.adaptive.initialRaysPerPixel = kBudgetStartRaysPerPixel;
 }
 
 void EffectBudget::applyReflections(RaySchedule& s, uint32_t& raysPerPixel) const {
-  const uint32_t level = plan_.level[kBudgetReflections];
-  if (!active_ || level == 0) return;
+  if (!active_ || latest().level[kBudgetReflections] == 0) return;
+  const uint32_t level = latest().level[kBudgetReflections];
   const uint32_t rays = raysPerPixel ? raysPerPixel : kDefaultReflectionRays;
   if (level < uint32_t(std::bit_width(rays))) {
     raysPerPixel = rays >> level;
@@ -127,24 +125,25 @@ void EffectBudget::applyReflections(RaySchedule& s, uint32_t& raysPerPixel) cons
 
 uint32_t EffectBudget::localLightRays(uint32_t described) const {
   if (!active_) return described;
-  return std::max(1u, described >> plan_.level[kBudgetLocalLights]);
+  return std::max(1u, described >> latest().level[kBudgetLocalLights]);
 }
 
 FrameBudgetStats EffectBudget::stats() const {
   FrameBudgetStats s;
   if (!active_) return s;
+  const BudgetPlan& p = latest();
   s.budgetMs = budgetMs_;
-  s.fixedMs = plan_.fixedMs;
-  s.floorMs = plan_.floorMs;
-  s.belowFloor = plan_.belowFloor;
-  s.shadowsMs = plan_.targetMs[kBudgetShadows];
-  s.aoMs = plan_.targetMs[kBudgetAo];
-  s.reflectionsMs = plan_.targetMs[kBudgetReflections];
-  s.localLightsMs = plan_.targetMs[kBudgetLocalLights];
-  s.reflectionLevel = plan_.level[kBudgetReflections];
-  s.localLightLevel = plan_.level[kBudgetLocalLights];
-  s.measurements = plan_.measurements;
-  s.levelSteps = plan_.levelSteps;
+  s.fixedMs = p.fixedMs;
+  s.floorMs = p.floorMs;
+  s.belowFloor = p.belowFloor;
+  s.shadowsMs = p.targetMs[kBudgetShadows];
+  s.aoMs = p.targetMs[kBudgetAo];
+  s.reflectionsMs = p.targetMs[kBudgetReflections];
+  s.localLightsMs = p.targetMs[kBudgetLocalLights];
+  s.reflectionLevel = p.level[kBudgetReflections];
+  s.localLightLevel = p.level[kBudgetLocalLights];
+  s.measurements = p.measurements;
+  s.levelSteps = p.levelSteps;
   return s;
 }
 

@@ -19,13 +19,14 @@ class EffectBudget {
   Status configure(Context& ctx, const HybridEffectsDesc& desc);
   void retire(Context& ctx);
 
-  // At the start of record(), outside a render pass: takes the latest finished frame in (`passes`: the passes'
-  // latest stats; used when they and the hook measured the same frame), plans this frame and writes the hook's
-  // start timestamp.
-  Status begin(Context& ctx, VkCommandBuffer cmd, const HybridStats& passes);
+  // At the start of record(), outside a render pass: the hook's start timestamp (with or without a budget).
+  Status begin(Context& ctx, VkCommandBuffer cmd);
   void end(Context& ctx, VkCommandBuffer cmd);  // the hook's end timestamp
 
   bool active() const { return active_; }
+  // With a budget, once per record(): takes the latest finished frame in (`passes`: the passes' latest stats; used
+  // when they and the hook measured the same frame) and plans this frame.
+  void plan(Context& ctx, const HybridStats& passes);
   // The plan on each effect's settings (nothing without a budget).
   void applyShadows(RaySchedule& s) const { applyAdaptive(s, kBudgetShadows); }
   void applyAo(RaySchedule& s) const { applyAdaptive(s, kBudgetAo); }
@@ -38,6 +39,7 @@ class EffectBudget {
 
  private:
   void applyAdaptive(RaySchedule& s, BudgetEffect e) const;
+  const BudgetPlan& latest() const { return controller_.latest(); }  // meaningful while active_
 
   PassMetrics hook_;
   bool hookReady_ = false;
@@ -45,7 +47,6 @@ class EffectBudget {
   float budgetMs_ = 0.0f;
   std::array<BudgetKnob, kBudgetEffects> knobs_{};
   FrameBudgetController controller_;
-  BudgetPlan plan_;
 };
 
 }  // namespace rb

@@ -579,7 +579,8 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
     if (!lit) return lit.error();
   }
   a.neutral.recordInit(a.ctx, cmd);
-  if (Status st = a.budget.begin(a.ctx, cmd, stats()); !st) return wrap("frame budget", st.error());
+  if (Status st = a.budget.begin(a.ctx, cmd); !st) return wrap("frame budget", st.error());
+  if (a.budget.active()) a.budget.plan(a.ctx, stats());  // the passes' stats only where a budget reads them
   a.frameWidth = g.width;
   a.frameHeight = g.height;
   if (frame.tlas && frame.tlas->tlas) {
