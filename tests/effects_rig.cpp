@@ -22,14 +22,20 @@ EffectsRig::~EffectsRig() {
 }
 
 void EffectsRig::record(rb::HybridEffects& effects, std::span<const rb::LightSource> lights) {
+  RB_REQUIRE_OK(recordEdited(effects, [&](rb::HybridFrame& f) { f.localLights = lights; }));
+}
+
+rb::Status EffectsRig::recordEdited(rb::HybridEffects& effects, const std::function<void(rb::HybridFrame&)>& edit) {
+  rb::Status st;
   fx_.runFrame([&](VkCommandBuffer cmd) {
     rb::HybridFrame f;
     f.gbuffer = gbuffer_->desc();
     f.instances = built_.instances;
-    f.localLights = lights;
     f.light.angularRadiusDegrees = 1.0f;
-    RB_REQUIRE_OK(effects.record(cmd, f));
+    edit(f);
+    st = effects.record(cmd, f);
   });
+  return st;
 }
 
 std::vector<rb::LightSource> lampRow(size_t count) {

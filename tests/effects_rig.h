@@ -5,6 +5,7 @@
 
 #include <raybridge/raybridge.h>
 
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -23,6 +24,8 @@ class EffectsRig {
   rb::AccelerationStructureService& service() { return *service_; }
   // One frame of `effects`: the rig's G-buffer and instances, the sun 1 degree wide, `lights` as local lights.
   void record(rb::HybridEffects& effects, std::span<const rb::LightSource> lights = {});
+  // One frame whose description `edit` changes first (for the error paths): record()'s status, unchecked.
+  rb::Status recordEdited(rb::HybridEffects& effects, const std::function<void(rb::HybridFrame&)>& edit);
 
  private:
   GpuFixture& fx_;

@@ -107,3 +107,31 @@ TEST_CASE("a frame budget with room climbs back to the description's levels", "[
   CHECK(roomy.stats.ao.rays > none.stats.ao.rays);
   CHECK(b.shadowsMs > roomy.stats.shadow.gpuMs);
 }
+
+TEST_CASE("a record() that fails after the hook's start timestamp still times the frame", "[budget][hybrid]") {
+  GpuFixture fx;
+  if (!fx.ctx().deviceInfo().timestampsSupported) SKIP("the device has no timestamps to time record() with");
+  EffectsRig rig(fx, 32, 24);
+  auto created = rb::HybridEffects::create(fx.ctx(), &rig.service(), rb::withPreset({}, rb::Preset::SoftShadows));
+  RB_REQUIRE_OK(created);
+  rb::HybridEffects& effects = *created.value();
+  rig.record(effects);
+  rig.record(effects);
+  // An instance without a mesh: the frame passes record()'s own checks, and the TLAS build inside it fails, after
+  // the hook's start timestamp was written.
+  const uint64_t failedFrame = fx.ctx().frameIndex();
+  const rb::Instance noMesh;
+  const rb::Status failed = rig.recordEdited(effects, [&](rb::HybridFrame& f) { f.instances = std::span(&noMesh, 1); });
+  REQUIRE_FALSE(failed.ok());
+  INFO(failed.error().message);
+  CHECK(failed.error().message.find("recordTlasBuild") != std::string::npos);
+  // The failed frame has its end timestamp too: it is measured (read back as the next frame starts), not left "not
+  // ready" (gpuMs 0) for ever.
+  rig.record(effects);
+  CHECK(effects.stats().hook.frame == failedFrame);
+  CHECK(effects.stats().hook.gpuMs > 0.0);
+  // And the frames after it are timed as before.
+  rig.record(effects);
+  CHECK(effects.stats().hook.frame == failedFrame + 1);
+  CHECK(effects.stats().hook.gpuMs > 0.0);
+}

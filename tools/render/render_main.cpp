@@ -234,14 +234,15 @@ std::vector<std::pair<const char*, const rb::PassStats*>> namedPassStats(const r
   return out;
 }
 
-se::ImageRGBA32F toExr(const CapturedFrame& f, const std::vector<float>& values, int channels) {
+// `keepAlpha`: A is the image's fourth channel (4 channels only), else 1.
+se::ImageRGBA32F toExr(const CapturedFrame& f, const std::vector<float>& values, int channels, bool keepAlpha = false) {
   se::ImageRGBA32F img;
   img.width = f.width;
   img.height = f.height;
   img.pixels.resize(size_t(f.width) * f.height * 4);
   for (size_t i = 0; i < size_t(f.width) * f.height; ++i) {
     for (int c = 0; c < 3; ++c) img.pixels[i * 4 + c] = values[i * channels + (channels == 1 ? 0 : c)];
-    img.pixels[i * 4 + 3] = 1.0f;
+    img.pixels[i * 4 + 3] = keepAlpha && channels == 4 ? values[i * 4 + 3] : 1.0f;
   }
   return img;
 }
@@ -886,7 +887,8 @@ std::string writeDump(RenderRun& run, const nlohmann::json& stats) {
   // The hook's viewProj is camera-relative: the eye is at the origin of the positions it reconstructs.
   // Ray-traced: the primary rays' own distances (the same convention); the engine drew no G-buffer normals.
   w.exr("depth.exr", toExr(f, run.rayTraced ? f.images.at("distance") : distances(f, run.capturedViewProj), 1));
-  if (!run.rayTraced) w.exr("normal.exr", toExr(f, f.normal, 4));
+  // A: the G-buffer normal image's own (the roughness, with shading normals), which reflections read.
+  if (!run.rayTraced) w.exr("normal.exr", toExr(f, f.normal, 4, true));
   // Hybrid: Raybridge's images as captured in the hook (raw only where a denoiser ran).
   for (const auto& [name, channels] : {std::pair{"shadow", 1}, std::pair{"shadow_raw", 1}, std::pair{"ao", 1},
                                        std::pair{"ao_raw", 1}, std::pair{"reflection", 4}})

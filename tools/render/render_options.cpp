@@ -445,6 +445,9 @@ void addScheduleOptions(CLI::App& app, RenderOptions& o) {
                  "soft shadows and AO, reflections at full or half resolution, local-light rays")
       ->type_name("MS")
       ->check(rbCli::floatNumber(rbCli::above(0.0), rbCli::atMost(double(rb::kMaxFrameBudgetMs)), " ms"));
+  app.add_flag("--no-aliasing", o.noAliasing,
+               "each denoiser keeps its own transient images instead of sharing one set\n"
+               "(HybridEffectsDesc::disableTransientAliasing): more memory, the same images");
 }
 
 // The performance scene and where the shared models are, the dynamic BLAS builds, the device and validation.
@@ -607,6 +610,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
   }
   h.reflections.disableRelitResets = o.noReflectionChanges;
   h.budgetMs = o.budgetMs.value_or(0.0f);
+  h.disableTransientAliasing = o.noAliasing;
   h.ao.schedule.adaptive.enabled = o.adaptiveAoMs.has_value();
   h.ao.schedule.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
   h.ao.schedule.adaptive.granularity = o.adaptiveGranularity;

@@ -13,6 +13,7 @@
 // two runs differ (half_res_test and adaptive_rays_test check that combination by its statistics instead).
 #include <raybridge/presets.h>
 
+#include <catch2/catch_approx.hpp>
 #include <catch2/catch_test_macros.hpp>
 
 #include <cstdint>
@@ -61,15 +62,18 @@ constexpr ScheduleRun kScheduleRuns[] = {
 };
 
 // The hashes of one render's dumped images, by file name (stats.json, with its timings, and final.png left out).
-nlohmann::json renderHashes(const std::string& name, const std::string& arguments, std::string& driver) {
+// `stats`, when given, receives the render's stats.json.
+nlohmann::json renderHashes(const std::string& name, const std::string& arguments, std::string& driver,
+                            nlohmann::json* stats = nullptr) {
   const fs::path out = fs::temp_directory_path() / ("raybridge_preset_hash_" + name);
   fs::remove_all(out);
   const int status = runRender("--width " + std::to_string(kWidth) + " --height " + std::to_string(kHeight) + " " +
                                arguments + " --dump --out \"" + out.string() + "\" > /dev/null");
   REQUIRE(status == 0);
-  const nlohmann::json stats = readJson(out / "stats.json");
-  REQUIRE_FALSE(stats.is_discarded());
-  driver = stats["device"]["name"].get<std::string>() + " / " + stats["device"]["driver_info"].get<std::string>();
+  const nlohmann::json read = readJson(out / "stats.json");
+  REQUIRE_FALSE(read.is_discarded());
+  driver = read["device"]["name"].get<std::string>() + " / " + read["device"]["driver_info"].get<std::string>();
+  if (stats) *stats = read;
   nlohmann::json hashes = nlohmann::json::object();
   for (const fs::directory_entry& e : fs::directory_iterator(out)) {
     // final.png is final.exr through the engine's display pass, a fragment shader whose 8-bit rounding follows the
@@ -121,4 +125,32 @@ TEST_CASE("every preset renders the images recorded at the named commit, bit for
     CHECK(now["presets"][preset].size() == images.size());  // no image appeared or vanished
   }
   CHECK(now["presets"].size() == recorded["presets"].size());
+}
+
+// Transient aliasing (HybridEffectsDesc::disableTransientAliasing) changes no image: every preset's images over four
+// frames, with the denoisers sharing one DenoiserScratch and with each keeping its own, are the same bytes. Unlike the
+// recorded hashes this holds on any driver. The switch must really switch: the unaliased run holds each scratch
+// image once per denoiser of its kind.
+TEST_CASE("every preset's images are bit-identical with transient aliasing on and off", "[render][presets][aliasing]") {
+  std::string driver;
+  for (uint32_t i = 0; i < rb::kPresetCount; ++i) {
+    const std::string preset = rb::toString(rb::Preset(i));
+    INFO("preset " << preset);
+    nlohmann::json statsOn, statsOff;
+    const nlohmann::json on = renderHashes(preset + "-aliased", "--preset " + preset + " --frames 4", driver, &statsOn);
+    const nlohmann::json off = renderHashes(preset + "-unaliased", "--preset " + preset + " --frames 4 --no-aliasing",
+                                            driver, &statsOff);
+    REQUIRE(on.size() > 2);  // the dump wrote its images
+    CHECK(on == off);
+    // The scratch holds one set of images per kind of denoiser (scalar: shadows, AO; RGB: reflections, local
+    // lights): sharing saves memory where two of one kind run.
+    const nlohmann::json& passes = statsOn["raybridge"]["passes"];
+    const bool twoScalar = passes.contains("shadow_denoise") && passes.contains("ao_denoise");
+    const bool twoRgb = passes.contains("reflection_denoise") && passes.contains("local_lights_denoise");
+    const double bppOn = statsOn["raybridge"]["memory_bytes"]["pass_image_bytes_per_pixel"].get<double>();
+    const double bppOff = statsOff["raybridge"]["memory_bytes"]["pass_image_bytes_per_pixel"].get<double>();
+    INFO("pass images per pixel: aliased " << bppOn << ", unaliased " << bppOff);
+    // Per pixel of the 96x64 dump: the scalar scratch RG16F (4 B), the RGB one RGBA16F + RG32UI (16 B).
+    CHECK(bppOff - bppOn == Catch::Approx((twoScalar ? 4.0 : 0.0) + (twoRgb ? 16.0 : 0.0)).margin(0.01));
+  }
 }

@@ -48,18 +48,22 @@ inline nlohmann::json readJson(const std::filesystem::path& path) {
   return nlohmann::json::parse(in, nullptr, false);
 }
 
-inline std::vector<float> readExrRed(const std::filesystem::path& path, int& width, int& height) {
+inline std::vector<float> readExrChannel(const std::filesystem::path& path, const char* channel, int& width,
+                                         int& height) {
   Imf::InputFile file(path.string().c_str());
   Imath::Box2i dw = file.header().dataWindow();
   width = dw.max.x - dw.min.x + 1;
   height = dw.max.y - dw.min.y + 1;
-  std::vector<float> red(size_t(width) * height);
+  std::vector<float> values(size_t(width) * height);
   Imf::FrameBuffer fb;
-  fb.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(red.data() - dw.min.x - dw.min.y * width),
-                            sizeof(float), sizeof(float) * width));
+  fb.insert(channel, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(values.data() - dw.min.x - dw.min.y * width),
+                                sizeof(float), sizeof(float) * width));
   file.setFrameBuffer(fb);
   file.readPixels(dw.min.y, dw.max.y);
-  return red;
+  return values;
+}
+inline std::vector<float> readExrRed(const std::filesystem::path& path, int& width, int& height) {
+  return readExrChannel(path, "R", width, height);
 }
 
 // R, G and B of an EXR image, interleaved, rows from the top.

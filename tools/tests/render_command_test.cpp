@@ -441,22 +441,17 @@ TEST_CASE("raybridge-render --mode raster uses the engine's shadow map, SSAO and
 TEST_CASE("raybridge-render --glossy-scene: 1M+ triangles, 70% of the pixels reflecting at roughness 0.2-0.5",
           "[render][glossy]") {
   // Issue 30's glossy scene as far as a small render can check it, from its own camera (the first keyframe of
-  // scripts/gpu/glossy_path.json): its size, and the share of pixels the reflection pass traces at roughness
-  // 0.2-0.5. normal.exr does not keep the roughness (its A is 1), so the raw reflection image tells: a pixel over
-  // the threshold is written 0, one under it the light its rays brought back. Reflecting under 0.5 and not under 0.2
-  // is the glossy range; a reflecting pixel whose rays all brought back black would count as not glossy, so the
-  // share is a lower bound.
-  auto render = [](const std::string& name, const char* threshold) {
-    const fs::path dir = tempDir(name);
-    const RunResult r = runRender(std::string("--glossy-scene --preset reflections --no-denoise --width 96 --height 64 "
-                                              "--frames 3 --dump --reflection-roughness ") +
-                                  threshold + " --out " + dir.string());
-    INFO(r.output);
-    REQUIRE(r.exitCode == 0);
-    return dir;
-  };
-  const fs::path glossyAndMirror = render("glossy_05", "0.5"), mirror = render("glossy_02", "0.2");
-  const nlohmann::json stats = rbRenderTest::readJson(glossyAndMirror / "stats.json");
+  // scripts/gpu/glossy_path.json): its size, and the share of pixels that reflect at roughness 0.2-0.5. normal.exr's
+  // A is the roughness the reflection pass reads; the raw reflection image tells which pixels traced (a pixel over
+  // --reflection-roughness is written 0, one under it the light its rays brought back). A reflecting pixel whose
+  // rays all brought back black would count as not reflecting, so the share is a lower bound.
+  const fs::path dir = tempDir("glossy");
+  const RunResult r = runRender("--glossy-scene --preset reflections --no-denoise --width 96 --height 64 --frames 3 "
+                                "--dump --reflection-roughness 0.5 --out " +
+                                dir.string());
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  const nlohmann::json stats = rbRenderTest::readJson(dir / "stats.json");
   REQUIRE_FALSE(stats.is_discarded());
   CHECK(stats["scene"] == "glossy scene");
   CHECK(stats["triangles"].get<uint64_t>() >= 1000000u);  // summed over instances: what the TLAS holds
@@ -466,23 +461,25 @@ TEST_CASE("raybridge-render --glossy-scene: 1M+ triangles, 70% of the pixels ref
   CHECK(stats["raybridge"]["passes"]["reflection"]["rays"].get<uint64_t>() > 0u);
   CHECK(stats["validation"]["errors"] == 0);
   int w = 0, h = 0;
-  const std::vector<float> upTo05 = rbRenderTest::readExrRgb(glossyAndMirror / "reflection.exr", w, h);
-  const std::vector<float> upTo02 = rbRenderTest::readExrRgb(mirror / "reflection.exr", w, h);
-  const std::vector<float> normal = rbRenderTest::readExrRgb(glossyAndMirror / "normal.exr", w, h);
+  const std::vector<float> reflection = rbRenderTest::readExrRgb(dir / "reflection.exr", w, h);
+  const std::vector<float> normal = rbRenderTest::readExrRgb(dir / "normal.exr", w, h);
+  const std::vector<float> roughness = rbRenderTest::readExrChannel(dir / "normal.exr", "A", w, h);
   REQUIRE((w == 96 && h == 64));
-  REQUIRE((upTo05.size() == normal.size() && upTo02.size() == normal.size()));
-  auto lit = [](const std::vector<float>& rgb, size_t i) {
-    return rgb[3 * i] + rgb[3 * i + 1] + rgb[3 * i + 2] > 0.0f;
-  };
-  size_t surface = 0, glossy = 0, underGlossy = 0;
+  REQUIRE((reflection.size() == normal.size() && roughness.size() * 3 == normal.size()));
+  size_t surface = 0, glossy = 0, mirror = 0, reflectingOverThreshold = 0;
   for (size_t i = 0; i < size_t(w) * h; ++i) {
     surface += normal[3 * i] != 0.0f || normal[3 * i + 1] != 0.0f || normal[3 * i + 2] != 0.0f;  // the sky is 0
-    glossy += lit(upTo05, i) && !lit(upTo02, i);
-    underGlossy += lit(upTo02, i);
+    const bool lit = reflection[3 * i] + reflection[3 * i + 1] + reflection[3 * i + 2] > 0.0f;
+    const float a = roughness[i];
+    glossy += lit && a >= 0.2f && a <= 0.5f;
+    mirror += lit && a < 0.2f;
+    reflectingOverThreshold += lit && a > 0.5f;  // the pass skips those: none may reflect
   }
-  INFO(glossy << " glossy and " << underGlossy << " mirror pixels of " << surface << " surface pixels, " << w * h
+  INFO(glossy << " glossy and " << mirror << " mirror pixels of " << surface << " surface pixels, " << w * h
               << " in all");
   CHECK(double(glossy) >= 0.7 * double(surface));
   CHECK(double(glossy) >= 0.7 * double(w) * double(h));  // the path keeps the sky out of view
-  CHECK(underGlossy > 0u);                               // a mirror for contrast
+  CHECK(mirror > 0u);                                    // a mirror for contrast
+  CHECK(reflectingOverThreshold == 0u);
+  fs::remove_all(dir);
 }

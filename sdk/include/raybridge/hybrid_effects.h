@@ -241,6 +241,12 @@ struct HybridEffectsDesc {
   // finished frames ("Frame budget" above). 0 = off: every effect runs as described. At most kMaxFrameBudgetMs; needs
   // GPU timestamps on the Context's queue family (create()/setDesc() name the problem otherwise).
   float budgetMs = 0.0f;
+  // false = the denoisers share one set of transient images (DenoiserScratch: written and read within one denoiser's
+  // record, so denoisers recorded one after another alias them; "Memory by effect" in docs/integration.md). true =
+  // each denoiser keeps its own: 20 B/px more in `high`, the same images bit for bit
+  // (tools/tests/preset_hash_test.cpp checks every preset both ways). For ruling aliasing out when an image looks
+  // wrong, and for tools that record one denoiser's work elsewhere.
+  bool disableTransientAliasing = false;
 };
 
 // `base` with the preset's effect set, ray counts, AO resolution and whether soft shadows skip converged tiles

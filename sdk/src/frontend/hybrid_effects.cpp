@@ -184,6 +184,7 @@ struct HybridEffects::Impl {
     return (shadowDenoiser ? RB_CHANGE_SHADOWS : 0u) | (aoDenoiser ? RB_CHANGE_AO : 0u) |
            (localLightDenoiser ? RB_CHANGE_LOCAL_LIGHTS : 0u) | (reflectionDenoiser ? RB_CHANGE_REFLECTIONS : 0u);
   }
+  Status recordTlas(VkCommandBuffer cmd, const HybridFrame& frame);
   Status recordChanges(VkCommandBuffer cmd, const HybridFrame& f, bool trackInstances);
 
   // The denoiser of one signal: created when wanted (with the outputs, so its output is named from create() on,
@@ -335,7 +336,8 @@ struct HybridEffects::Impl {
 
   // No byte that nothing reads: the shared transient images go with the last denoiser.
   void dropScratchWithoutDenoisers() {
-    if (!shadowDenoiser && !aoDenoiser && !localLightDenoiser && !reflectionDenoiser) denoiserScratch.reset();
+    if (desc.disableTransientAliasing || (!shadowDenoiser && !aoDenoiser && !localLightDenoiser && !reflectionDenoiser))
+      denoiserScratch.reset();
   }
 
   // Stochastic local lights are noisy; the exact mode has no noise to remove.
@@ -354,7 +356,7 @@ struct HybridEffects::Impl {
     if (!slot) return {};
     // One at another size (a reflection G-buffer of its own) keeps its own scratch: the shared one is not resized.
     DenoiserScratch* scratch = nullptr;
-    if (gbuffer.width == frameWidth && gbuffer.height == frameHeight) {
+    if (!desc.disableTransientAliasing && gbuffer.width == frameWidth && gbuffer.height == frameHeight) {
       const MemoryOwnerScope sharedScope = own(kOwnShared);
       if (Status st = ensure(denoiserScratch, true, "DenoiserScratch::create",
                              [&] { return DenoiserScratch::create(ctx); });
@@ -426,6 +428,35 @@ Status HybridEffects::Impl::recordChanges(VkCommandBuffer cmd, const HybridFrame
   in.aoRange = desc.ao.range > 0.0f ? desc.ao.range : kDefaultAoRange;
   Result<bool> recorded = changeMasks.record(ctx, cmd, f.gbuffer, tlas, gpuChangeBoxes, in);
   if (!recorded) return wrap("change masks", recorded.error());
+  return {};
+}
+
+// The frame's TLAS: the engine's, or the service's pending work and a TLAS over the frame's instances.
+Status HybridEffects::Impl::recordTlas(VkCommandBuffer cmd, const HybridFrame& frame) {
+  if (frame.tlas && frame.tlas->tlas) {
+    tlas = *frame.tlas;
+  } else {
+    if (!service)
+      return invalid(
+          "record: the frame brings no TLAS (HybridFrame::tlas) and no AccelerationStructureService was given "
+          "to create() to build one over HybridFrame::instances");
+    // The acceleration structures are the service's, nobody's in memoryByEffect().
+    const MemoryOwnerScope serviceScope(internal::contextImpl(ctx), 0);
+    if (auto pending = service->recordPendingWork(cmd); !pending) return wrap("recordPendingWork", pending.error());
+    TlasBuildOptions options;
+    options.mode = desc.tlasMode;
+    if (!desc.worldSpaceTlas) {
+      // Camera-relative: precision holds far from the origin (gbuffer.h). The passes read the offset back from
+      // TlasInfo, so a G-buffer without cameraPosition (all zero) simply gets a world-space TLAS.
+      for (int i = 0; i < 3; ++i) options.originOffset[i] = frame.gbuffer.cameraPosition[i];
+    }
+    // Vertex data + material per instance: for reflection hits, and for the any-hit alpha tests of non-opaque
+    // geometry in every ray; an all-opaque scene without reflections allocates none.
+    options.writeShadingRecords = reflection != nullptr || service->nonOpaqueMeshCount() > 0;
+    auto built = service->recordTlasBuild(cmd, frame.instances, options);
+    if (!built) return wrap("recordTlasBuild", built.error());
+    tlas = built.value();
+  }
   return {};
 }
 
@@ -583,31 +614,10 @@ Status HybridEffects::record(VkCommandBuffer cmd, const HybridFrame& frame) {
   if (a.budget.active()) a.budget.plan(a.ctx, stats());  // the passes' stats only where a budget reads them
   a.frameWidth = g.width;
   a.frameHeight = g.height;
-  if (frame.tlas && frame.tlas->tlas) {
-    a.tlas = *frame.tlas;
-  } else {
-    if (!a.service)
-      return invalid(
-          "record: the frame brings no TLAS (HybridFrame::tlas) and no AccelerationStructureService was given "
-          "to create() to build one over HybridFrame::instances");
-    // The acceleration structures are the service's, nobody's in memoryByEffect().
-    const MemoryOwnerScope serviceScope(internal::contextImpl(a.ctx), 0);
-    if (auto pending = a.service->recordPendingWork(cmd); !pending) return wrap("recordPendingWork", pending.error());
-    TlasBuildOptions options;
-    options.mode = a.desc.tlasMode;
-    if (!a.desc.worldSpaceTlas) {
-      // Camera-relative: precision holds far from the origin (gbuffer.h). The passes read the offset back from
-      // TlasInfo, so a G-buffer without cameraPosition (all zero) simply gets a world-space TLAS.
-      for (int i = 0; i < 3; ++i) options.originOffset[i] = frame.gbuffer.cameraPosition[i];
-    }
-    // Vertex data + material per instance: for reflection hits, and for the any-hit alpha tests of non-opaque
-    // geometry in every ray; an all-opaque scene without reflections allocates none.
-    options.writeShadingRecords = a.reflection != nullptr || a.service->nonOpaqueMeshCount() > 0;
-    auto tlas = a.service->recordTlasBuild(cmd, frame.instances, options);
-    if (!tlas) return wrap("recordTlasBuild", tlas.error());
-    a.tlas = tlas.value();
-  }
-  Status st = a.recordChanges(cmd, frame, !(frame.tlas && frame.tlas->tlas));
+  // Every failure from here on still records the hook's end timestamp below: a start without an end would leave
+  // the frame's timing unfinished.
+  Status st = a.recordTlas(cmd, frame);
+  if (st) st = a.recordChanges(cmd, frame, !(frame.tlas && frame.tlas->tlas));
   if (st && a.shadow) st = a.recordShadows(cmd, frame);
   if (st && a.ao) st = a.recordAo(cmd, frame);
   if (st && a.localLights) st = a.recordLocalLights(cmd, frame);
