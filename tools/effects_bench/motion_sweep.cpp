@@ -16,6 +16,7 @@
 
 #include "image_error.h"
 #include "motion_metrics.h"
+#include "reset_follow_up.h"
 #include "sweep_common.h"
 
 namespace rbEffects {
@@ -198,10 +199,7 @@ se::Status Runner::setDesc(uint32_t rays, bool reference) {
     d.ao.schedule.resetRays = plan_.switches.resetRaysFactor * rays;
   }
   d.disableChangeResets = plan_.switches.disableChangeResets;
-  if (plan_.switches.resetFollowUp) {
-    d.resetFollowUpFrames = *plan_.switches.resetFollowUp;
-    d.disableResetFollowUp = *plan_.switches.resetFollowUp == 0u;
-  }
+  rbTools::applyResetFollowUp(d, plan_.switches.resetFollowUp);
   if (plan_.switches.convergedTiles && !reference) {
     d.shadows.schedule.convergedTiles.enabled = true;
     d.ao.schedule.convergedTiles.enabled = true;

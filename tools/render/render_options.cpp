@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli_support.h"
+#include "reset_follow_up.h"
 
 namespace rbRender {
 
@@ -604,10 +605,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.ao.disableShortHistoryFilter = o.noShortHistoryFilter;
   h.ao.disableResetRays = o.noResetRays;
   h.shadows.disableResetRays = o.noResetRays;
-  if (o.resetFollowUp) {
-    h.resetFollowUpFrames = *o.resetFollowUp;
-    h.disableResetFollowUp = *o.resetFollowUp == 0u;
-  }
+  rbTools::applyResetFollowUp(h, o.resetFollowUp);
   h.reflections.disableRelitResets = o.noReflectionChanges;
   h.budgetMs = o.budgetMs.value_or(0.0f);
   h.disableTransientAliasing = o.noAliasing;
