@@ -6,7 +6,9 @@
 // instance's shading record, fetched by device address.
 //
 // The including shader declares first: `tlas` (accelerationStructureEXT), `lights` (GpuLight[], light_list.glsl)
-// and the shadow rays' payload `shadowHit` (float, location 1; occlusion.rmiss is miss shader 1).
+// and the shadow rays' payload `shadowHit` (float, location 1; occlusion.rmiss is miss shader 1). With
+// RB_HIT_SUN_FROM_SCREEN defined it also declares `bool rbSunFromScreen(vec3 hit, vec3 ng, out float visibility)`
+// (ng: the hit's geometric normal, facing the ray): true = the sun's visibility of the hit is known without a ray.
 #ifndef RAYBRIDGE_HIT_SHADING_GLSL
 #define RAYBRIDGE_HIT_SHADING_GLSL
 
@@ -72,10 +74,16 @@ vec3 rbShadeHit(HitLighting l, vec2 barycentrics, inout uint shadowRays) {
   uint flags = gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT;
   if (!l.alphaTest) flags |= gl_RayFlagsOpaqueEXT;
   if (nDotL > 0.0 && dot(ng, toSun) > 0.0 && any(greaterThan(l.sunRadiance, vec3(0.0)))) {
-    shadowHit = -1.0;
-    traceRayEXT(tlas, flags, 0xFF, 0, 0, 1, origin, 0.0, toSun, 1e30, 1);
-    sunVisible = shadowHit == 0.0 ? 1.0 : 0.0;
-    ++shadowRays;
+#ifdef RB_HIT_SUN_FROM_SCREEN
+    // Where this frame's shadows already hold the hit's sun visibility (the including shader decides), no ray.
+    if (!rbSunFromScreen(hit, ng, sunVisible))
+#endif
+    {
+      shadowHit = -1.0;
+      traceRayEXT(tlas, flags, 0xFF, 0, 0, 1, origin, 0.0, toSun, 1e30, 1);
+      sunVisible = shadowHit == 0.0 ? 1.0 : 0.0;
+      ++shadowRays;
+    }
   }
   // Local lights: irradiance E from one resampled light (see the top), shadowed.
   vec3 localIrradiance = vec3(0.0);

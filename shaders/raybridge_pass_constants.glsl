@@ -62,7 +62,10 @@ struct ReflectionConstants {
   uint halfResolution;       // 216: 1 = one sample per 2x2 block into the half-resolution image (half_resolution.glsl)
   uint changedBoxCount;      // 220: boxes at changedBoxes (ReflectionSettings::changedBoxes + relitBoxes); 0 = none
   uvec2 changedBoxes;        // 224: their device address (RbReflectionChangedBox[], reflection_changes.glsl)
-  uvec2 pad1;                // 232
+  // 232: pixels at least this rough read their hits' sun visibility from RB_REFLECTION_BINDING_SUN_VISIBILITY where
+  // the hit is on screen (reflect.rchit); above 1 = none (no image given)
+  float sunCacheRoughness;
+  uint pad1;                 // 236
 };
 
 // The depth-aware upsample of half-resolution AO and reflections (upsample_depth_aware.glsl). 176 bytes.

@@ -34,6 +34,11 @@
 #define RB_REFLECTION_BINDING_ROUGHNESS_METALNESS 5  // the normal image again when roughness is in normal.w
 #define RB_REFLECTION_BINDING_RADIANCE 6
 #define RB_REFLECTION_BINDING_LIGHTS 10  // the ManyLightPass's light list (GpuLight[]), read by the hits
+// ReflectionFrame::sunVisibility, read by the hits (the depth image again without one: then never read).
+#define RB_REFLECTION_BINDING_SUN_VISIBILITY 9
+// Its surface test (rb::kReflectionSunCacheDistanceTolerance, kReflectionSunCacheMinNormalCos in reflection_pass.h).
+#define RB_REFLECTION_SUN_CACHE_DISTANCE_TOLERANCE 0.01
+#define RB_REFLECTION_SUN_CACHE_MIN_NORMAL_COS 0.9
 // ReflectionSettings::schedule.convergedTiles: the tile state (rgb_converged.glsl), at the shadow pass's binding.
 #define RB_REFLECTION_BINDING_TILE_STATE RB_SHADOW_BINDING_TILE_STATE
 // Adaptive rays (the AO and shadow passes' adaptive ray generation modules): the plan of adaptive_rays.glsl.

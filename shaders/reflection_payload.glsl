@@ -10,6 +10,9 @@ struct ReflectionPayload {
   // Distance to the hit, written by the closest-hit shader; the ray generation shader sets it below 0 before
   // tracing, so a ray that escaped keeps that (ReflectionSettings::changedBoxes tests the ray's path).
   float hitT;
+  // Set by the ray generation shader: 1 = the ray's pixel is rough enough that its hit may read the sun's visibility
+  // from the screen (ReflectionSettings::sunVisibilityMinRoughness), 0 = the hit traces its sun ray.
+  uint sunFromScreen;
 };
 
 #endif

@@ -96,6 +96,8 @@ void main() {
   float alpha = max(roughness * roughness, 1e-4);
   bool mirror = roughness < 0.02;
   uint count = mirror ? 1u : max(pc.raysPerPixel, 1u);  // every mirror ray would go the same way
+  // A mirror shows a shadow's edge sharply: its hits trace (a soft or denoised screen value is not what it would see).
+  const uint sunFromScreen = !mirror && roughness >= pc.sunCacheRoughness ? 1u : 0u;
   uint seed = rbPcg(pixel.x + pc.gbuffer.size.x * pixel.y + rbPcg(pc.gbuffer.frameIndex ^ 0x85ebca6bu));
   vec3 t, b;
   rbBasis(n, t, b);
@@ -122,6 +124,7 @@ void main() {
     payload.radiance = vec3(0.0);
     payload.shadowRays = 0u;
     payload.hitT = -1.0;
+    payload.sunFromScreen = sunFromScreen;
     uint flags = (pc.gbuffer.flags & RB_GB_ALPHA_TEST) != 0u ? gl_RayFlagsNoneEXT : gl_RayFlagsOpaqueEXT;
 #ifdef RB_REFLECTION_REORDER
     // The same ray, traced into a hit object (any-hit shaders run here); the threads are then regrouped so

@@ -4,11 +4,12 @@
 
 namespace rbtest {
 
-EffectsRig::EffectsRig(GpuFixture& fx, uint32_t width, uint32_t height) : fx_(fx) {
+EffectsRig::EffectsRig(GpuFixture& fx, uint32_t width, uint32_t height, float roughness) : fx_(fx) {
   const TestScene scene = makeConformanceScene();
   EmbreeScene embree;
   addToEmbree(embree, scene);
-  const CpuGBuffer cpu = traceGBuffer(embree, motionTestView(width, height));
+  const std::vector<float> perInstance(scene.instances.size(), roughness);
+  const CpuGBuffer cpu = traceGBuffer(embree, motionTestView(width, height), perInstance);
   auto service = rb::AccelerationStructureService::create(fx.ctx());
   RB_REQUIRE_OK(service);
   service_ = std::move(service.value());

@@ -16,7 +16,8 @@ namespace rbtest {
 
 class EffectsRig {
  public:
-  EffectsRig(GpuFixture& fx, uint32_t width, uint32_t height);
+  // `roughness`: every surface's, in the G-buffer's normal image (0: mirrors).
+  EffectsRig(GpuFixture& fx, uint32_t width, uint32_t height, float roughness = 0.0f);
   ~EffectsRig();
   EffectsRig(const EffectsRig&) = delete;
   EffectsRig& operator=(const EffectsRig&) = delete;

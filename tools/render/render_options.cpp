@@ -449,6 +449,9 @@ void addScheduleOptions(CLI::App& app, RenderOptions& o) {
   app.add_flag("--no-aliasing", o.noAliasing,
                "each denoiser keeps its own transient images instead of sharing one set\n"
                "(HybridEffectsDesc::disableTransientAliasing): more memory, the same images");
+  app.add_flag("--no-sun-cache", o.noSunCache,
+               "every reflection hit traces its sun shadow ray, none reads the shadow effect's image\n"
+               "(ReflectionEffectSettings::disableSunFromScreen)");
 }
 
 // The performance scene and where the shared models are, the dynamic BLAS builds, the device and validation.
@@ -609,6 +612,7 @@ ResolvedEffects resolve(const RenderOptions& o) {
   h.reflections.disableRelitResets = o.noReflectionChanges;
   h.budgetMs = o.budgetMs.value_or(0.0f);
   h.disableTransientAliasing = o.noAliasing;
+  h.reflections.disableSunFromScreen = o.noSunCache;
   h.ao.schedule.adaptive.enabled = o.adaptiveAoMs.has_value();
   h.ao.schedule.adaptive.timeBudgetMs = o.adaptiveAoMs.value_or(0.0f);
   h.ao.schedule.adaptive.granularity = o.adaptiveGranularity;

@@ -92,6 +92,8 @@ struct RenderOptions {
   std::optional<float> budgetMs;
   // --no-aliasing: HybridEffectsDesc::disableTransientAliasing (each denoiser keeps its own transient images).
   bool noAliasing = false;
+  // --no-sun-cache: ReflectionEffectSettings::disableSunFromScreen (every reflection hit traces its sun ray).
+  bool noSunCache = false;
   uint32_t adaptiveTileWidth = 0, adaptiveTileHeight = 0;
   // Raster mode's shadow map: --shadow-map-size (0 = none, else 1024..8192) and --pcf (taps per axis, 1..9);
   // else the preset's raster counterpart.

@@ -188,6 +188,11 @@ struct ReflectionEffectSettings {
   // more than 6 frames to 2 at 1, 4 and 16 rays and their mean error down by a fifth; their flicker rose to 0.5-0.7x
   // the reference's (0.2x without). true = reflections follow every change by anti-lag alone.
   bool disableRelitResets = false;
+  // false (default) = hits of rough lobes read their sun visibility from this frame's shadow effect where they are
+  // the surface on screen (ReflectionFrame::sunVisibility; reflection_pass.h, "Sun visibility from the screen"),
+  // when the shadow effect is on for the directional sun and the reflection G-buffer has the frame's depth buffer.
+  // true = every hit traces its sun shadow ray.
+  bool disableSunFromScreen = false;
 };
 
 struct LocalLightEffectSettings {

@@ -44,6 +44,19 @@
 // converged, and the reflection rays saved (not counting the shadow rays their hits would have traced). The tile
 // state takes 4 bytes per tile (MemoryCategory::PassBuffers), held only while the setting is on.
 //
+// Sun visibility from the screen (ReflectionFrame::sunVisibility, ReflectionSettings::sunVisibilityMinRoughness): the
+// sun's visibility of every surface on screen exists already where shadows were traced this frame for the same sun
+// (the ShadowPass's visibility, or its denoised image). A hit of a ray from a pixel at least that rough reads it there
+// instead of tracing its sun shadow ray, where the hit projects into the G-buffer and the G-buffer's surface at that
+// pixel is the hit's own: the hit lies within kReflectionSunCacheDistanceTolerance of its view distance from that
+// surface's tangent plane, the normals agree within kReflectionSunCacheMinNormalCos, and the hit is on the side the
+// camera sees. Hits off screen, hidden from the camera or on another surface trace as usual, and so do mirror-like
+// pixels (roughness under 0.02: their reflection shows a shadow's edge sharply, and a soft or denoised one is not
+// what they would trace). stats().rays counts the rays traced, so the shadow rays read from the screen are the
+// difference to a run without it; the image's value is used as it is (a soft shadow's penumbra, the denoiser's
+// history), where the traced ray is hard. See docs/performance.md ("Reflections: sun visibility from the shadow
+// image") for what it saves and what it changes.
+//
 // Lifetime: destroying it is safe while frames that recorded it are in flight: its pipeline, output image,
 // material table, texture set and measurement objects are handed to the Context's deferred release (see
 // context.h) and freed once those frames are done. Destroy it before its Context.
@@ -68,6 +81,14 @@ namespace rb {
 inline constexpr float kDefaultReflectionRoughnessThreshold = 0.3f;
 inline constexpr uint32_t kDefaultReflectionRays = 1;
 inline constexpr uint32_t kDefaultReflectionLightCandidates = 4;  // local lights weighed per hit
+// Pixels at least this rough read their hits' sun visibility from ReflectionFrame::sunVisibility (where given): their
+// lobe blurs a shadow's edge more than the screen image's softness differs from a traced ray's (docs/performance.md).
+inline constexpr float kDefaultReflectionSunCacheRoughness = 0.2f;
+// The screen's surface is the hit's own when the hit lies within this fraction of its view distance from the
+// surface's tangent plane at the pixel it projects to, and their normals' cosine is at least the second: tight
+// enough that a contact (an object resting on a floor) or a crease reads the other surface rarely.
+inline constexpr float kReflectionSunCacheDistanceTolerance = 0.01f;
+inline constexpr float kReflectionSunCacheMinNormalCos = 0.9f;
 
 // A zero-initialised ReflectionSettings is valid: every zero field means the default constant above.
 struct ReflectionSettings {
@@ -102,6 +123,11 @@ struct ReflectionSettings {
   // half resolution (the upsample writes coverage, a = 1). Empty (default) = no test.
   std::span<const ChangedBox> changedBoxes{};
   std::span<const ChangedBox> relitBoxes{};
+  // Sun visibility from the screen (see the top): pixels at least this rough read their hits' sun visibility from
+  // ReflectionFrame::sunVisibility instead of tracing the shadow ray, where the hit is on screen and the same surface;
+  // mirror-like pixels (under 0.02) always trace. 0 = kDefaultReflectionSunCacheRoughness; at most 1. Without
+  // ReflectionFrame::sunVisibility every hit traces.
+  float sunVisibilityMinRoughness = 0.0f;
 };
 
 // Largest ReflectionSettings::changedBoxes plus relitBoxes: the GPU tests every box for every ray (HybridEffects merges
@@ -120,6 +146,14 @@ struct ReflectionFrame {
   GBufferDesc gbuffer{};  // the engine's G-buffer (with roughness), its images in their declared layouts
   TlasInfo tlas{};        // from recordTlasBuild() earlier in submission order
   ReflectionSettings settings{};
+  // Optional: the sun's visibility of the G-buffer's pixels this frame (.r, 1 = lit, 0 = shadowed, read clamped to
+  // [0, 1]), traced for the sun of settings.lighting, e.g. ShadowOutputs::visibility or a Denoiser's output of it (not
+  // a raw image with kept-history marks: pass the denoised one there). HybridEffects gives it when its shadow effect
+  // is on and the reflection G-buffer has the frame's depth buffer. Any float or unorm colour format, the G-buffer's
+  // size (width and height, when stated, are checked), in a sampled-read layout (as GBufferImage), written before
+  // record() and made visible to ray tracing shaders. Hits read it per settings.sunVisibilityMinRoughness (see the
+  // top). VK_NULL_HANDLE (default) = every hit traces its sun ray.
+  GBufferImage sunVisibility{};
 };
 
 // Owned by the pass, left in SHADER_READ_ONLY_OPTIMAL after record().

@@ -519,9 +519,7 @@ Status HybridEffects::Impl::recordAo(VkCommandBuffer cmd, const HybridFrame& f) 
 
 Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridFrame& f) {
   const MemoryOwnerScope scope = own(kOwnReflections);
-  ReflectionSettings s;
-  s.materials = materials.get();
-  s.roughnessThreshold = desc.reflections.roughnessThreshold;
+  ReflectionSettings s{.roughnessThreshold = desc.reflections.roughnessThreshold, .materials = materials.get()};
   s.raysPerPixel = desc.reflections.raysPerPixel;
   s.invocationReorder = desc.reflections.invocationReorder;
   RaySchedule wanted = desc.reflections.schedule;
@@ -536,14 +534,17 @@ Status HybridEffects::Impl::recordReflections(VkCommandBuffer cmd, const HybridF
     s.relitBoxes = reflectionRelit;
   }
   if (lightList && !f.localLights.empty()) s.lights = lightList.get();  // recorded earlier this frame
-  const GBufferDesc g = changeMasks.gbufferFor(f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer,
-                                               RB_CHANGE_REFLECTIONS);
-  if (Status st = reflection->record(cmd, {.gbuffer = g, .tlas = tlas, .settings = s}); !st)
-    return wrap("ReflectionPass::record", st.error());
-  const ReflectionOutputs& o = reflection->outputs();
+  const GBufferDesc& source = f.reflectionGBuffer ? *f.reflectionGBuffer : f.gbuffer;
+  const GBufferDesc g = changeMasks.gbufferFor(source, RB_CHANGE_REFLECTIONS);
+  ReflectionFrame in{.gbuffer = g, .tlas = tlas, .settings = s};
+  // This frame's sun visibility of the same pixels (one depth buffer; denoised where soft): rough lobes' hits read it.
+  if (shadow && !desc.reflections.disableSunFromScreen && source.depth.view == f.gbuffer.depth.view &&
+      f.light.type == LightType::Directional)
+    in.sunVisibility.view = shadowDenoiser ? shadowDenoiser->outputs().denoisedView : shadow->outputs().visibilityView;
+  if (Status st = reflection->record(cmd, in); !st) return wrap("ReflectionPass::record", st.error());
   // Guided by the roughness of the G-buffer the rays were traced from.
   return denoise(reflectionDenoiser, !desc.reflections.disableDenoiser, "Denoiser (reflections)", cmd, g,
-                 o.radianceView, 0, DenoiseSignal::Reflection);
+                 reflection->outputs().radianceView, 0, DenoiseSignal::Reflection);
 }
 
 Result<std::unique_ptr<HybridEffects>> HybridEffects::create(Context& context, AccelerationStructureService* service,

@@ -100,7 +100,8 @@ struct ReflectionConstants {
   uint32_t halfResolution;       // 1 = one sample per 2x2 block into the half-resolution image
   uint32_t changedBoxCount;      // ReflectionSettings::changedBoxes + relitBoxes at changedBoxes; 0 = none
   VkDeviceAddress changedBoxes;  // ReflectionChangedBox[] in a host-visible ring (reflection_pass.cpp)
-  uint32_t pad1[2];
+  float sunCacheRoughness;       // pixels at least this rough read the sun from the screen; > 1 = none
+  uint32_t pad1;
 };
 static_assert(sizeof(ReflectionConstants) == 240);
 RB_ASSERT_OFFSET(ReflectionConstants, gbuffer, 0);
@@ -115,6 +116,7 @@ RB_ASSERT_OFFSET(ReflectionConstants, lightCandidates, 212);
 RB_ASSERT_OFFSET(ReflectionConstants, halfResolution, 216);
 RB_ASSERT_OFFSET(ReflectionConstants, changedBoxCount, 220);
 RB_ASSERT_OFFSET(ReflectionConstants, changedBoxes, 224);
+RB_ASSERT_OFFSET(ReflectionConstants, sunCacheRoughness, 232);
 
 struct UpsampleConstants {
   GBufferConstants gbuffer;  // the traced pass's: full-resolution size, the frame that chose the samples

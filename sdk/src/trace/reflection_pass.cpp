@@ -21,6 +21,11 @@ namespace rb {
 namespace {
 const VkShaderStageFlags kRaygen = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
 const VkShaderStageFlags kHit = VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR;
+// ReflectionConstants::sunCacheRoughness without ReflectionFrame::sunVisibility: rougher than any pixel.
+constexpr float kNoSunCache = 2.0f;
+static_assert(kReflectionSunCacheDistanceTolerance == float(RB_REFLECTION_SUN_CACHE_DISTANCE_TOLERANCE) &&
+                  kReflectionSunCacheMinNormalCos == float(RB_REFLECTION_SUN_CACHE_MIN_NORMAL_COS),
+              "reflect.rchit tests the surface with the values reflection_pass.h documents");
 
 // The pipelines of the pass: reflect.rgen, and its variants (ScheduleVariant bits) with shader execution
 // reordering and skipping the converged tiles (which adds the tile state's binding).
@@ -39,10 +44,15 @@ RayTracingPipelineDesc reflectionPipelineDesc(uint32_t variant) {
   p.bindings = PassCore::commonBindings();
   p.bindings[RB_BINDING_TLAS].stageFlags |= kHit;          // shadow rays from hits
   p.bindings[RB_BINDING_RAY_COUNTERS].stageFlags |= kHit;  // and their count
+  // Hits that read the sun's visibility from the screen find their pixel's surface (reflect.rchit).
+  p.bindings[RB_BINDING_DEPTH].stageFlags |= kHit;
+  p.bindings[RB_BINDING_GEOMETRIC_NORMAL].stageFlags |= kHit;
   p.bindings.push_back(
       {RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, kRaygen, nullptr});
   p.bindings.push_back({RB_REFLECTION_BINDING_RADIANCE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kRaygen, nullptr});
   p.bindings.push_back({RB_REFLECTION_BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kHit, nullptr});
+  p.bindings.push_back(
+      {RB_REFLECTION_BINDING_SUN_VISIBILITY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, kHit, nullptr});
   if (tiles) {
     p.bindings.push_back({RB_REFLECTION_BINDING_TILE_STATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kRaygen, nullptr});
   }
@@ -153,6 +163,31 @@ Status writeChangedBoxes(ReflectionPass::Impl& s, const ReflectionSettings& sett
   return {};
 }
 
+// ReflectionFrame::sunVisibility against its contract (reflection_pass.h); "" when it holds or is not given.
+std::string sunVisibilityProblem(const GBufferImage& image, const GBufferDesc& g) {
+  if (!image.view) return {};
+  const std::string name = "ReflectionFrame::sunVisibility";
+  switch (image.layout) {
+    case VK_IMAGE_LAYOUT_UNDEFINED:
+    case VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL:
+    case VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL:
+    case VK_IMAGE_LAYOUT_GENERAL: break;
+    default:
+      return name + ".layout " + std::to_string(int(image.layout)) +
+             " does not allow sampled reads: transition it to SHADER_READ_ONLY_OPTIMAL before record() and state that";
+  }
+  if (image.usage != 0 && !(image.usage & VK_IMAGE_USAGE_SAMPLED_BIT))
+    return name + ".usage lacks VK_IMAGE_USAGE_SAMPLED_BIT: the hits read it through a sampler";
+  if (image.aspectMask != 0 && image.aspectMask != VK_IMAGE_ASPECT_COLOR_BIT)
+    return name + ".aspectMask is not VK_IMAGE_ASPECT_COLOR_BIT: pass a colour view";
+  if ((image.width != 0 || image.height != 0) && (image.width != g.width || image.height != g.height)) {
+    return name + " is " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", not the G-buffer's " +
+           std::to_string(g.width) + "x" + std::to_string(g.height) +
+           ": a hit reads the pixel it projects to, so the image must cover the G-buffer pixel for pixel";
+  }
+  return {};
+}
+
 void nameOutputs(ReflectionPass::Impl& s) {
   s.outputs.radiance = s.core.images[0].image;
   s.outputs.radianceView = s.core.images[0].view;
@@ -230,6 +265,13 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const ReflectionFrame& input)
     return invalid("ReflectionSettings::roughnessThreshold " + std::to_string(threshold) + " is outside (0, 1]");
   }
   if (settings.raysPerPixel > 64) return invalid("ReflectionSettings::raysPerPixel exceeds 64");
+  const float sunCacheRoughness = settings.sunVisibilityMinRoughness == 0.0f ? kDefaultReflectionSunCacheRoughness
+                                                                             : settings.sunVisibilityMinRoughness;
+  if (!(sunCacheRoughness > 0.0f && sunCacheRoughness <= 1.0f)) {
+    return invalid("ReflectionSettings::sunVisibilityMinRoughness " + std::to_string(sunCacheRoughness) +
+                   " is outside (0, 1]");
+  }
+  if (std::string problem = sunVisibilityProblem(input.sunVisibility, g); !problem.empty()) return invalid(problem);
   Result<ResolvedLighting> lighting = resolveSceneLighting(settings.lighting,
                                                            "ReflectionPass: ReflectionSettings::lighting");
   if (!lighting) return lighting.error();
@@ -239,6 +281,7 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const ReflectionFrame& input)
   pc.roughnessThreshold = threshold;
   pc.raysPerPixel = settings.raysPerPixel ? settings.raysPerPixel : kDefaultReflectionRays;
   pc.halfResolution = settings.schedule.halfResolution ? 1u : 0u;
+  pc.sunCacheRoughness = input.sunVisibility.view ? sunCacheRoughness : kNoSunCache;
 
   LightListInfo lights;
   if (settings.lights) {
@@ -264,6 +307,9 @@ Status ReflectionPass::record(VkCommandBuffer cmd, const ReflectionFrame& input)
   w.sampledImage(RB_REFLECTION_BINDING_ROUGHNESS_METALNESS, rm.view, s.core.sampler, readLayout(rm));
   // The local lights' list when given, else any valid buffer (never read: lightCount is 0).
   w.storageBuffer(RB_REFLECTION_BINDING_LIGHTS, pc.lightCount ? lights.buffer : table->info().materials);
+  // The sun's visibility when given, else the depth image (never read: no pixel reaches kNoSunCache).
+  const GBufferImage& sun = input.sunVisibility.view ? input.sunVisibility : g.depth;
+  w.sampledImage(RB_REFLECTION_BINDING_SUN_VISIBILITY, sun.view, s.core.sampler, readLayout(sun));
   ScheduleFrame frame{g, settings.schedule, w, &pc, &pc.gbuffer, pc.raysPerPixel, {}, threshold, variant};
   if (Result<bool> traced = s.schedule.trace(s.ctx, s.core, cmd, frame); !traced) return traced.error();
   // Stale marks (a = 2) where a ray met a change: the Denoiser filtering this view reads them (RB_DN_KEPT_MARKS).
