@@ -71,17 +71,6 @@ void cameraPosition(const GBufferDesc& g, double out[3]) {
   for (int i = 0; i < 3; ++i) out[i] = inv[12 + i];
 }
 
-namespace {
-
-bool isCombinedDepthStencil(VkFormat f) {
-  return f == VK_FORMAT_D32_SFLOAT_S8_UINT || f == VK_FORMAT_D24_UNORM_S8_UINT || f == VK_FORMAT_D16_UNORM_S8_UINT;
-}
-
-// What a G-buffer field holds, which decides the formats it may have.
-enum class ImageRole : uint8_t { Depth, Color, Motion, Reactive };
-
-// One G-buffer image against the hand-over contract of gbuffer.h ("Images"): a sampled-read layout, and where
-// the engine states them, SAMPLED usage and a single aspect. Returns "" when it holds, else the message.
 std::string checkImage(const GBufferImage& image, const std::string& name, bool depth) {
   switch (image.layout) {
     case VK_IMAGE_LAYOUT_UNDEFINED:
@@ -114,6 +103,16 @@ std::string checkImage(const GBufferImage& image, const std::string& name, bool 
   }
   return {};
 }
+
+namespace {
+
+bool isCombinedDepthStencil(VkFormat f) {
+  return f == VK_FORMAT_D32_SFLOAT_S8_UINT || f == VK_FORMAT_D24_UNORM_S8_UINT || f == VK_FORMAT_D16_UNORM_S8_UINT;
+}
+
+// What a G-buffer field holds, which decides the formats it may have.
+enum class ImageRole : uint8_t { Depth, Color, Motion, Reactive };
+
 
 // Why a stated motion-vector format cannot hold motion in pixels, or "" when it can: a signed float of two or
 // more 16- or 32-bit channels.

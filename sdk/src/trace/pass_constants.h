@@ -316,6 +316,11 @@ Status validateGBufferImages(const GBufferDesc& gbuffer, const char* passName);
 Status fillGBufferConstants(const GBufferDesc& gbuffer, const TlasInfo& tlas, uint64_t frame, const char* passName,
                             GBufferConstants& out);
 
+// One image handed over like a G-buffer image (gbuffer.h, "Images"; validateGBufferImages checks each with it): a
+// sampled-read layout, and where the engine states them, SAMPLED usage and the depth or colour aspect alone. `name`
+// starts the message. Returns "" when it holds, else the message.
+std::string checkImage(const GBufferImage& image, const std::string& name, bool depth);
+
 // The world-space camera position: GBufferDesc::cameraPosition, or the translation of inverse(view).
 void cameraPosition(const GBufferDesc& gbuffer, double out[3]);
 

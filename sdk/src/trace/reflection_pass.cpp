@@ -11,6 +11,7 @@
 #include "initial_extent.h"
 #include "light_list_buffer.h"
 #include "material_table_impl.h"
+#include "pass_constants.h"
 #include "pass_core.h"
 #include "ray_schedule_stage.h"
 #include "raybridge_shaders.h"
@@ -163,23 +164,12 @@ Status writeChangedBoxes(ReflectionPass::Impl& s, const ReflectionSettings& sett
   return {};
 }
 
-// ReflectionFrame::sunVisibility against its contract (reflection_pass.h); "" when it holds or is not given.
+// ReflectionFrame::sunVisibility against its contract (reflection_pass.h): a G-buffer image's, at the G-buffer's
+// size; "" when it holds or is not given.
 std::string sunVisibilityProblem(const GBufferImage& image, const GBufferDesc& g) {
   if (!image.view) return {};
   const std::string name = "ReflectionFrame::sunVisibility";
-  switch (image.layout) {
-    case VK_IMAGE_LAYOUT_UNDEFINED:
-    case VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL:
-    case VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL:
-    case VK_IMAGE_LAYOUT_GENERAL: break;
-    default:
-      return name + ".layout " + std::to_string(int(image.layout)) +
-             " does not allow sampled reads: transition it to SHADER_READ_ONLY_OPTIMAL before record() and state that";
-  }
-  if (image.usage != 0 && !(image.usage & VK_IMAGE_USAGE_SAMPLED_BIT))
-    return name + ".usage lacks VK_IMAGE_USAGE_SAMPLED_BIT: the hits read it through a sampler";
-  if (image.aspectMask != 0 && image.aspectMask != VK_IMAGE_ASPECT_COLOR_BIT)
-    return name + ".aspectMask is not VK_IMAGE_ASPECT_COLOR_BIT: pass a colour view";
+  if (std::string problem = checkImage(image, name, false); !problem.empty()) return problem;
   if ((image.width != 0 || image.height != 0) && (image.width != g.width || image.height != g.height)) {
     return name + " is " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", not the G-buffer's " +
            std::to_string(g.width) + "x" + std::to_string(g.height) +
