@@ -4,9 +4,9 @@
 # or in the programs they start), any validation error and any failed test makes the script exit non-zero.
 #   scripts/sanitize.sh [asan|tsan|all]     (default all)
 #   asan: AddressSanitizer + UndefinedBehaviorSanitizer + LeakSanitizer, in ./build-asan: every test program
-#         that ctest runs (raybridge_tests but its 8K case, sample_engine_tests, pose_reference_tests, minimal_integration_test,
-#         the adapter's and the tools' tests, which start the sanitized raybridge-render) and the three benchmark
-#         smoke runs.
+#         that ctest runs (raybridge_tests but its 8K case, sample_engine_tests, pose_reference_tests,
+#         minimal_integration_test, the adapter's and the tools' tests, which start the sanitized raybridge-render)
+#         and the three benchmark smoke runs.
 #   tsan: ThreadSanitizer, in ./build-tsan: the calls documented as callable from several threads
 #         (raybridge_tests "[threads]": registerMesh/releaseMesh on streaming threads, validation messages).
 # What runs and why, the timings and the suppressions: docs/reliability.md, "Sanitizers".
@@ -109,9 +109,9 @@ if [ "$what" = asan ] || [ "$what" = all ]; then
     # The Vulkan loader unloads the driver and the layers before the leak check at exit: see keep_loaded.c.
     export LD_PRELOAD="$root/build-asan/keep_loaded.so"
     b=build-asan
-    # Two processes on the two cores, balanced by their times on the CI machine (about 490 s each): the
-    # allocation-failure injection (about 450 s under ASan) and two short tools in the background, the rest of
-    # raybridge_tests and the other programs here. The 8K case ([large], 210 s under ASan) is left to ctest: it runs
+    # Two processes on the two cores, split by their times on the CI machine: the allocation-failure injection and
+    # two short tools in the background (about 280 s on 2026-12-07), the rest of raybridge_tests and the other
+    # programs here (about 390 s). The 8K case ([large], 210 s under ASan) is left to ctest: it runs
     # the host code the small sizes run, at a size that only costs time here.
     (
       run "raybridge_tests [inject]" $b/tests/raybridge_tests "[inject]"
